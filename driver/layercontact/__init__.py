@@ -1,0 +1,32 @@
+"""layercontact: sliding contact of rough rigid surfaces on thin elastic layers with
+Coulomb friction, by the Green's function (Fourier multiplier) method.
+
+Sign convention P (see README): ``x`` is the sliding direction of the indenter, ``z``
+points into the layer, ``p > 0`` is compressive, ``w = u_z > 0`` is indentation and the
+friction traction on the layer is ``tau = +mu_c p``.
+"""
+
+from .api import (
+    LayercontactError,
+    LineResult,
+    layer_multipliers,
+    layer_multipliers_lapack,
+    read_result,
+    run,
+    solve_line,
+)
+from .profiles import load_profile, self_affine_profile, sinusoid_profile
+
+__all__ = [
+    "LayercontactError",
+    "LineResult",
+    "layer_multipliers",
+    "layer_multipliers_lapack",
+    "load_profile",
+    "read_result",
+    "run",
+    "self_affine_profile",
+    "sinusoid_profile",
+    "solve_line",
+]
+__version__ = "0.1.0"

@@ -1,0 +1,47 @@
+"""Command line: ``python -m layercontact run FILE.nml [--png PICTURE]``.
+
+Runs the scene like the ``layercontact`` executable (same library routine, same HDF5
+file, same summary and exit codes) and draws the seed's Fig. 2(a) view next to the
+result file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .api import LayercontactError, _check
+from . import _core
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m layercontact", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    run_p = sub.add_parser("run", help="run a namelist scene, write HDF5 and a PNG")
+    run_p.add_argument("nml", help="namelist input file")
+    run_p.add_argument("--png", help="picture to draw (default: the result file with .png)")
+    run_p.add_argument("--no-png", action="store_true", help="do not draw a picture")
+    args = parser.parse_args(argv)
+
+    out, converged, stat, errmsg = _core.py_run(args.nml, 1)
+    try:
+        _check(stat, errmsg)
+    except LayercontactError as err:
+        print(f"layercontact: error: {err}", file=sys.stderr)
+        return err.code
+    h5 = Path(out.decode().strip() if isinstance(out, bytes) else str(out).strip())
+    if not args.no_png:
+        from .plot import plot_result
+
+        png = Path(args.png) if args.png else h5.with_suffix(".png")
+        plot_result(h5, png)
+        print(f"  {'picture':<32}{png}")
+    if not converged:
+        print("layercontact: warning: the solver did not reach its tolerance", file=sys.stderr)
+        return 3
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

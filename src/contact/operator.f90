@@ -1,0 +1,151 @@
+!> The compliance operator of a scene: w = G_eff * p as a Fourier multiplier.
+!>
+!> Convention P (DESIGN.md §1): for a mode k of p(x) = sum_k p^(k) exp(i k x),
+!>    w^(k) = 2/(E*|k|) [ (1-A) - i sgn(k) mu_c c ] p^(k),
+!> with 1-A and c from seed Eqs. (7)-(9) (lc_greens_layer), tau = mu_c p. The k = 0
+!> mode of a finite layer is h/M (M = E(1-nu)/((1+nu)(1-2nu)), zero for nu = 0.5); for
+!> a half-space it is set to zero (the penetration is then measured from the mean
+!> displacement).
+!>
+!> Only what the scene needs is built: a real multiplier when there is no coupling
+!> (mu_c = 0, or a half-space with nu = 0.5), a complex one otherwise. The coupled
+!> operator is split as G = M + (G - M) with the real, even, positive "metric"
+!> M(k) = |G_eff(k)|: the symmetric solver works with M, the outer iteration with G - M.
+!> With this metric the linearised outer map has eigenvalues exp(i arg G_eff(k)) on the
+!> right half of the unit circle however strong the coupling (DESIGN.md suggests the real
+!> part Re G_eff instead, whose map has eigenvalues 1 - i Im G/Re G, up to ~300 in
+!> modulus for thin incompressible layers).
+module lc_contact_operator
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use lc_kinds, only: wp
+   use lc_errors, only: error_type
+   use lc_fft_plans, only: fft_plan
+   use lc_greens_layer, only: layer_coefficients, halfspace_coupling
+   implicit none (type, external)
+   private
+   public :: compliance_operator, build_operator
+
+   real(wp), parameter :: pi = acos(-1.0_wp)
+
+   !> Fourier multipliers of one scene and the FFT plans to apply them.
+   type :: compliance_operator
+      integer :: n = 0
+      integer :: nk = 0
+      real(wp) :: period = 1.0_wp
+      real(wp) :: friction = 0.0_wp
+      logical :: coupled = .false.          !< complex multiplier (not symmetric)
+      real(wp), allocatable :: metric(:)    !< M(k) = |G_eff(k)|, k = 0..n/2 (L/S)
+      complex(wp), allocatable :: full(:)   !< G_eff(k), only when coupled
+      type(fft_plan) :: fft
+   contains
+      procedure :: apply_metric
+      procedure :: apply_full
+      procedure :: apply_difference
+      procedure :: wavenumber
+   end type compliance_operator
+
+contains
+
+   !> Build the operator of a line contact: n points on a period, layer thickness
+   !> (+Inf = half-space), Young's modulus, Poisson ratio, Coulomb coefficient.
+   subroutine build_operator(op, n, period, thickness, young, poisson, friction, threads, error)
+      type(compliance_operator), intent(out) :: op
+      integer, intent(in) :: n, threads
+      real(wp), intent(in) :: period, thickness, young, poisson, friction
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: estar, k, x, one_minus_a, one_minus_b, c, scale
+      complex(wp) :: g
+      integer :: m
+      logical :: halfspace
+
+      call op%fft%init(n, threads, error)
+      if (allocated(error)) return
+      op%n = n
+      op%nk = n/2 + 1
+      op%period = period
+      op%friction = friction
+      halfspace = .not. ieee_is_finite(thickness)
+      estar = young/(1.0_wp - poisson**2)
+      ! A half-space of an incompressible material has c = 0: friction changes nothing.
+      op%coupled = friction > 0.0_wp .and. .not. (halfspace .and. poisson == 0.5_wp)
+
+      allocate (op%metric(op%nk))
+      if (op%coupled) allocate (op%full(op%nk))
+      if (halfspace) then
+         op%metric(1) = 0.0_wp
+      else
+         ! h/M, written so that nu = 0.5 gives exactly zero
+         op%metric(1) = thickness*(1.0_wp + poisson)*(1.0_wp - 2.0_wp*poisson)/(young*(1.0_wp - poisson))
+      end if
+      if (op%coupled) op%full(1) = op%metric(1)
+
+      do m = 1, op%nk - 1
+         k = op%wavenumber(m)
+         scale = 2.0_wp/(estar*k)
+         if (halfspace) then
+            one_minus_a = 1.0_wp
+            c = halfspace_coupling(poisson)
+         else
+            x = k*thickness
+            call layer_coefficients(x, poisson, one_minus_a, one_minus_b, c)
+         end if
+         ! sgn(k) = +1 on the half spectrum; the Nyquist mode is its own mirror image
+         ! (sgn averages to 0), so its multiplier must be real.
+         if (2*m == n) c = 0.0_wp
+         g = scale*cmplx(one_minus_a, -friction*c, kind=wp)
+         op%metric(m + 1) = abs(g)
+         if (op%coupled) op%full(m + 1) = g
+      end do
+   end subroutine build_operator
+
+   !> Wavenumber k = 2 pi m / period of mode index m (0..n/2).
+   pure real(wp) function wavenumber(self, m)
+      class(compliance_operator), intent(in) :: self
+      integer, intent(in) :: m
+      wavenumber = 2.0_wp*pi*m/self%period
+   end function wavenumber
+
+   !> w = M p with the real symmetric metric.
+   subroutine apply_metric(self, p, w)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), intent(in) :: p(:)
+      real(wp), intent(out) :: w(:)
+      self%fft%real_buffer = p
+      call self%fft%forward()
+      self%fft%spectrum = self%fft%spectrum*self%metric
+      call self%fft%backward()
+      w = self%fft%real_buffer
+   end subroutine apply_metric
+
+   !> w = G_eff p with the full (possibly complex) multiplier.
+   subroutine apply_full(self, p, w)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), intent(in) :: p(:)
+      real(wp), intent(out) :: w(:)
+      if (.not. self%coupled) then
+         call self%apply_metric(p, w)
+         return
+      end if
+      self%fft%real_buffer = p
+      call self%fft%forward()
+      self%fft%spectrum = self%fft%spectrum*self%full
+      call self%fft%backward()
+      w = self%fft%real_buffer
+   end subroutine apply_full
+
+   !> w = (G_eff - M) p, the part the outer iteration of a coupled problem carries.
+   subroutine apply_difference(self, p, w)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), intent(in) :: p(:)
+      real(wp), intent(out) :: w(:)
+      if (.not. self%coupled) then
+         w = 0.0_wp
+         return
+      end if
+      self%fft%real_buffer = p
+      call self%fft%forward()
+      self%fft%spectrum = self%fft%spectrum*(self%full - self%metric)
+      call self%fft%backward()
+      w = self%fft%real_buffer
+   end subroutine apply_difference
+end module lc_contact_operator

@@ -1,0 +1,136 @@
+!> Solve one line-contact scene for a given Coulomb coefficient: build the operator the
+!> scene needs, pick the solver, fill a contact_result.
+!>
+!> Geometry (seed Eq. 10, convention P): the indenter surface sits at r(x) - Lambda + Delta
+!> with Lambda = max r, so the highest asperity touches at Delta = 0; the gap is
+!> g = w - (r - Lambda + Delta) >= 0. Load control gives p_m (or the seed's normalised
+!> p_m/(E* Lambda0/lambda), Lambda0 = max r - mean r) and finds Delta; displacement
+!> control gives Delta and finds p_m.
+module lc_contact_solve
+   use lc_kinds, only: wp, i8
+   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_scene, only: scene_type, is_halfspace, not_set
+   use lc_result, only: contact_result
+   use lc_contact_operator, only: compliance_operator, build_operator
+   use lc_contact_solver_cg, only: constrained_cg, cg_outcome
+   use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
+   use lc_observables_friction, only: interlocking_friction
+   implicit none (type, external)
+   private
+   public :: solve_line_contact, scene_mean_pressure
+
+contains
+
+   !> p_m of a load-controlled scene on profile `height` (S).
+   pure real(wp) function scene_mean_pressure(scene, height) result(pm)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:)
+      real(wp) :: estar, lambda0
+      if (scene%mean_pressure /= not_set) then
+         pm = scene%mean_pressure
+      else
+         estar = scene%young/(1.0_wp - scene%poisson**2)
+         lambda0 = maxval(height) - sum(height)/size(height)
+         pm = scene%normalised_pressure*estar*lambda0/scene%period
+      end if
+   end function scene_mean_pressure
+
+   !> Solve the scene on profile `height` with Coulomb coefficient `friction` (the
+   !> scene's, or 0 for the frictionless companion).
+   subroutine solve_line_contact(scene, height, friction, result, error)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:)
+      real(wp), intent(in) :: friction
+      type(contact_result), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(compliance_operator) :: op
+      type(cg_outcome) :: cg
+      type(anderson_outcome) :: outer
+      real(wp), allocatable :: p(:), w(:), gap(:), history(:)
+      real(wp) :: pm, s, g_ref, lambda_max
+      integer(i8) :: start, finish, rate
+      logical :: load_control
+      integer :: n
+
+      call system_clock(start, rate)
+      n = scene%n
+      if (size(height) /= n) then
+         call fatal_error(error, 'solve: the profile has ' // itoa(size(height)) // ' heights, &scene n = ' &
+            & // itoa(n), code_input)
+         return
+      end if
+      load_control = trim(scene%control) == 'load'
+      if (.not. load_control .and. (is_halfspace(scene) .or. scene%poisson == 0.5_wp)) then
+         call fatal_error(error, "&loading: control = 'displacement' needs a finite layer with poisson < 0.5: " // &
+            & 'the uniform mode of a half-space or of an incompressible bonded layer has no compliance, ' // &
+            & "so the penetration does not fix the load; use control = 'load'", code_input)
+         return
+      end if
+      call build_operator(op, n, scene%period, scene%thickness, scene%young, scene%poisson, friction, &
+         & scene%solver%threads, error)
+      if (allocated(error)) return
+      if (op%coupled .and. trim(scene%solver%method) == 'cg') then
+         call fatal_error(error, "&solver: method = 'cg' cannot solve this scene: friction couples the normal " // &
+            & "and tangential fields and the operator is not symmetric; allowed: 'auto' or 'anderson'", code_input)
+         return
+      end if
+
+      lambda_max = maxval(height)
+      g_ref = maxval(height) - minval(height)
+      if (g_ref <= 0.0_wp) g_ref = scene%period   ! flat punch: any length scale will do
+      allocate (p(n), w(n), gap(n), history(scene%solver%max_iter))
+      history = 0.0_wp
+      if (load_control) then
+         pm = scene_mean_pressure(scene, height)
+         p = pm
+         s = 0.0_wp
+      else
+         pm = 0.0_wp
+         p = 0.0_wp
+         s = scene%penetration - lambda_max
+      end if
+
+      if (op%coupled) then
+         call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+            & scene%solver%memory, p, w, gap, outer, history, error)
+         if (allocated(error)) return
+         result%converged = outer%converged
+         result%iterations = outer%cg_iterations
+         result%outer_iterations = outer%outer_iterations
+         result%fft_pairs = outer%fft_pairs
+         result%residual = outer%residual
+         result%residual_history = history(1:outer%outer_iterations)
+      else
+         call constrained_cg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+            & p, w, gap, cg, history)
+         result%converged = cg%converged
+         result%iterations = cg%iterations
+         result%outer_iterations = 1
+         result%fft_pairs = cg%fft_pairs
+         result%residual = cg%residual
+         result%residual_history = history(1:cg%iterations)
+      end if
+
+      result%friction = friction
+      result%pressure = p
+      result%gap = gap
+      result%displacement_z = w
+      result%mean_pressure = sum(p)/n
+      result%penetration = s + lambda_max
+      result%contact_fraction = real(count(p > 0.0_wp), wp)/n
+      if (result%mean_pressure > 0.0_wp) then
+         call interlocking_friction(op, p, height, scene%thickness, scene%young, scene%poisson, &
+            & result%delta_mu, result%delta_mu_spectral, result%delta_mu_energy)
+      end if
+      call system_clock(finish)
+      result%wall_time = real(finish - start, wp)/real(rate, wp)
+   end subroutine solve_line_contact
+
+   pure function itoa(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buffer
+      write (buffer, '(i0)') i
+      s = trim(buffer)
+   end function itoa
+end module lc_contact_solve

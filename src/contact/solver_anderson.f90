@@ -1,0 +1,156 @@
+!> Coupled (non-symmetric) contact problem G_eff = M + N, N = G_eff - M (lc_contact_operator):
+!>    find p >= 0, gap = G_eff p - r - s >= 0, p gap = 0 (+ load or displacement control).
+!>
+!> Outer fixed point x -> T(x): T(x) solves the symmetric problem with metric M and target
+!> b = r - N x (constrained CG, warm-started); its fixed point solves the coupled problem.
+!> The outer iteration is accelerated with Anderson mixing (Walker & Ni, SIAM J. Numer.
+!> Anal. 49 (2011) 1715), which for the linearised map behaves like GMRES: with
+!> M = |G_eff| the map's eigenvalues lie on the right half of the unit circle, so the rate
+!> does not degrade with the strength of the coupling.
+!>
+!> Convergence is judged on the complementarity residual of the full coupled problem at
+!> T's output (which is always feasible: p >= 0 and the load is exact).
+module lc_contact_solver_anderson
+   use lc_kinds, only: wp
+   use lc_errors, only: error_type, fatal_error, code_internal
+   use lc_contact_operator, only: compliance_operator
+   use lc_contact_solver_cg, only: constrained_cg, cg_outcome, complementarity_residual
+   implicit none (type, external)
+   private
+   public :: anderson_coupled, anderson_outcome
+
+   !> What one coupled solve did.
+   type :: anderson_outcome
+      logical :: converged = .false.
+      integer :: outer_iterations = 0
+      integer :: cg_iterations = 0
+      integer :: fft_pairs = 0
+      real(wp) :: residual = huge(1.0_wp)
+   end type anderson_outcome
+
+   interface
+      subroutine dgelsd(m, n, nrhs, a, lda, b, ldb, s, rcond, rank, work, lwork, iwork, info)
+         import :: wp
+         integer, intent(in) :: m, n, nrhs, lda, ldb, lwork
+         real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+         real(wp), intent(out) :: s(*), work(*)
+         real(wp), intent(in) :: rcond
+         integer, intent(out) :: rank, iwork(*), info
+      end subroutine dgelsd
+   end interface
+
+contains
+
+   !> Solve the coupled problem. p: starting guess in, solution out; w = G_eff p;
+   !> gap and s as in lc_contact_solver_cg. history(k) = residual after outer iteration k.
+   subroutine anderson_coupled(op, r, load_control, mean_pressure, s, g_ref, tol, max_iter, memory, &
+         & p, w, gap, outcome, history, error)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: r(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure, g_ref, tol
+      real(wp), intent(inout) :: s
+      integer, intent(in) :: max_iter   !< budget of inner CG iterations
+      integer, intent(in) :: memory
+      real(wp), intent(inout) :: p(:)
+      real(wp), intent(out) :: w(:), gap(:)
+      type(anderson_outcome), intent(out) :: outcome
+      real(wp), intent(inout) :: history(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: x(:), f(:), x_old(:), f_old(:), tx(:), dx(:, :), df(:, :), b(:), nw(:)
+      real(wp), allocatable :: gamma(:)
+      type(cg_outcome) :: inner
+      real(wp) :: inner_tol, p_ref, s_full, s_inner
+      integer :: n, k, columns, newest, j
+
+      n = size(p)
+      allocate (x(n), f(n), x_old(n), f_old(n), tx(n), b(n), nw(n), dx(n, memory), df(n, memory))
+      allocate (gamma(memory))
+      x = p
+      columns = 0
+      newest = 0
+      inner_tol = max(0.1_wp*tol, 1.0e-4_wp)
+      s_inner = s
+
+      do k = 1, size(history)
+         call op%apply_difference(x, nw)
+         b = r - nw
+         tx = p   ! warm start from the previous output of T
+         call constrained_cg(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
+            & max_iter - outcome%cg_iterations, tx, w, gap, inner)
+         outcome%cg_iterations = outcome%cg_iterations + inner%iterations
+         outcome%fft_pairs = outcome%fft_pairs + inner%fft_pairs + 2
+         outcome%outer_iterations = k
+         p = tx
+
+         ! Residual of the coupled problem at T(x).
+         call op%apply_full(p, w)
+         gap = w - r
+         if (load_control) then
+            s_full = sum(gap, mask=p > 0.0_wp)/max(count(p > 0.0_wp), 1)
+         else
+            s_full = s
+         end if
+         gap = gap - s_full
+         p_ref = merge(mean_pressure, sum(p)/n, load_control)
+         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref)
+         history(k) = outcome%residual
+         if (outcome%residual <= tol) then
+            outcome%converged = .true.
+            s = s_full
+            return
+         end if
+         if (outcome%cg_iterations >= max_iter) exit
+         ! Inner solves only need to be a little more accurate than the outer iterate.
+         inner_tol = max(0.1_wp*tol, min(1.0e-4_wp, 0.01_wp*outcome%residual))
+
+         ! Anderson mixing on f = T(x) - x.
+         f = tx - x
+         if (k > 1) then
+            newest = mod(newest, memory) + 1
+            dx(:, newest) = x - x_old
+            df(:, newest) = f - f_old
+            columns = min(columns + 1, memory)
+         end if
+         x_old = x
+         f_old = f
+         if (columns == 0) then
+            x = tx
+         else
+            call least_squares(df(:, 1:columns), f, gamma(1:columns), error)
+            if (allocated(error)) return
+            x = tx
+            do j = 1, columns
+               x = x - gamma(j)*(dx(:, j) + df(:, j))
+            end do
+         end if
+      end do
+      s = s_full
+   end subroutine anderson_coupled
+
+   !> gamma = argmin || f - df gamma ||_2 (SVD-based, rank-revealing).
+   subroutine least_squares(df, f, gamma, error)
+      real(wp), intent(in) :: df(:, :), f(:)
+      real(wp), intent(out) :: gamma(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: a(:, :), rhs(:, :), sv(:), work(:)
+      integer, allocatable :: iwork(:)
+      real(wp) :: query(1)
+      integer :: m, ncol, rank, info, lwork, iquery(1)
+
+      m = size(df, 1)
+      ncol = size(df, 2)
+      a = df
+      allocate (rhs(m, 1), sv(ncol))
+      rhs(:, 1) = f
+      call dgelsd(m, ncol, 1, a, m, rhs, m, sv, 1.0e-12_wp, rank, query, -1, iquery, info)
+      lwork = int(query(1))
+      allocate (work(lwork), iwork(max(1, iquery(1))))
+      call dgelsd(m, ncol, 1, a, m, rhs, m, sv, 1.0e-12_wp, rank, work, lwork, iwork, info)
+      if (info /= 0) then
+         call fatal_error(error, 'anderson: LAPACK dgelsd failed in the mixing step', code_internal)
+         return
+      end if
+      gamma = rhs(1:ncol, 1)
+   end subroutine least_squares
+end module lc_contact_solver_anderson

@@ -1,0 +1,133 @@
+!> Constrained conjugate gradients (Polonsky & Keer, Wear 231 (1999) 206) for the
+!> symmetric contact problem with the operator's metric M:
+!>    find p >= 0, gap = M p - b - s >= 0, p gap = 0,
+!> under load control (mean(p) = p_m given, the constant s is the Lagrange multiplier)
+!> or displacement control (s given). b is the target (the rigid profile, possibly
+!> shifted by the outer iteration of a coupled problem).
+!>
+!> Stopping rule: the dimensionless complementarity residual
+!>    res = max_j | min(p_j/p_ref, gap_j/g_ref) |
+!> (zero exactly at the solution) falls to tol; p_ref = p_m (load control) or the
+!> current mean pressure, g_ref is given by the caller (the profile's peak-to-valley).
+module lc_contact_solver_cg
+   use lc_kinds, only: wp
+   use lc_contact_operator, only: compliance_operator
+   implicit none (type, external)
+   private
+   public :: constrained_cg, cg_outcome, complementarity_residual
+
+   !> What one constrained CG solve did.
+   type :: cg_outcome
+      logical :: converged = .false.
+      integer :: iterations = 0
+      integer :: fft_pairs = 0
+      real(wp) :: residual = huge(1.0_wp)
+   end type cg_outcome
+
+contains
+
+   !> Solve the symmetric problem with metric M. On entry p is the starting guess
+   !> (any array; it is made feasible), on exit the solution; w = M p, gap and s as above.
+   !> history(1:outcome%iterations) receives the residual of each iteration when present.
+   subroutine constrained_cg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, &
+         & outcome, history)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: b(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure   !< p_m (load control; ignored otherwise)
+      real(wp), intent(inout) :: s            !< in: given (displacement control); out: the multiplier
+      real(wp), intent(in) :: g_ref, tol
+      integer, intent(in) :: max_iter
+      real(wp), intent(inout) :: p(:)
+      real(wp), intent(out) :: w(:), gap(:)
+      type(cg_outcome), intent(out) :: outcome
+      real(wp), intent(inout), optional :: history(:)
+      real(wp), allocatable :: t(:), r(:)
+      logical, allocatable :: contact(:), overlap(:)
+      real(wp) :: gnorm, gnorm_old, tau, denominator, diagonal, p_ref
+      integer :: it, n, n_contact
+      logical :: restart
+
+      n = size(p)
+      allocate (t(n), r(n), contact(n), overlap(n))
+      t = 0.0_wp
+      gnorm_old = 1.0_wp
+      restart = .true.
+      ! The real-space diagonal of the circulant M: a natural scale for a first step.
+      diagonal = (op%metric(1) + 2*sum(op%metric(2:op%nk)) - merge(op%metric(op%nk), 0.0_wp, &
+         & mod(n, 2) == 0))/n
+      p = max(p, 0.0_wp)
+      if (load_control) call normalise(p, mean_pressure)
+
+      do it = 1, max_iter
+         call op%apply_metric(p, w)
+         outcome%fft_pairs = outcome%fft_pairs + 1
+         gap = w - b
+         contact = p > 0.0_wp
+         n_contact = count(contact)
+         if (load_control) s = sum(gap, mask=contact)/max(n_contact, 1)
+         gap = gap - s
+         p_ref = merge(mean_pressure, sum(p)/n, load_control)
+         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref)
+         outcome%iterations = it
+         if (present(history)) then
+            if (it <= size(history)) history(it) = outcome%residual
+         end if
+         if (outcome%residual <= tol) then
+            outcome%converged = .true.
+            return
+         end if
+
+         if (n_contact == 0) then
+            ! Displacement control with nothing in contact yet: load the overlapping points.
+            p = max(-gap, 0.0_wp)/diagonal
+            restart = .true.
+            cycle
+         end if
+         gnorm = sum(gap**2, mask=contact)
+         if (restart) then
+            t = merge(gap, 0.0_wp, contact)
+         else
+            t = merge(gap + (gnorm/gnorm_old)*t, 0.0_wp, contact)
+         end if
+         gnorm_old = gnorm
+         call op%apply_metric(t, r)
+         outcome%fft_pairs = outcome%fft_pairs + 1
+         if (load_control) r = r - sum(r, mask=contact)/n_contact
+         denominator = sum(r*t, mask=contact)
+         if (.not. denominator > 0.0_wp) then
+            ! t is (numerically) in the null space of the projected operator: start afresh.
+            restart = .true.
+            cycle
+         end if
+         tau = sum(gap*t, mask=contact)/denominator
+         where (contact) p = p - tau*t
+         p = max(p, 0.0_wp)
+         overlap = p <= 0.0_wp .and. gap < 0.0_wp
+         restart = any(overlap)
+         if (restart) where (overlap) p = p - tau*gap
+         if (load_control) call normalise(p, mean_pressure)
+      end do
+   end subroutine constrained_cg
+
+   !> max_j |min(p_j/p_ref, gap_j/g_ref)|: zero iff p >= 0, gap >= 0 and p gap = 0.
+   pure real(wp) function complementarity_residual(p, gap, p_ref, g_ref) result(res)
+      real(wp), intent(in) :: p(:), gap(:), p_ref, g_ref
+      real(wp) :: pscale
+      pscale = 1.0_wp/max(p_ref, tiny(1.0_wp))
+      res = maxval(abs(min(p*pscale, gap/g_ref)))
+   end function complementarity_residual
+
+   !> Scale p to mean p_m (uniform if p vanished altogether).
+   pure subroutine normalise(p, mean_pressure)
+      real(wp), intent(inout) :: p(:)
+      real(wp), intent(in) :: mean_pressure
+      real(wp) :: total
+      total = sum(p)
+      if (total > 0.0_wp) then
+         p = p*(mean_pressure*size(p)/total)
+      else
+         p = mean_pressure
+      end if
+   end subroutine normalise
+end module lc_contact_solver_cg

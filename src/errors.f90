@@ -1,0 +1,34 @@
+!> Error handling: every library routine that can fail returns an allocatable
+!> `error_type` (allocated = failed) instead of stopping. Only `app/main.f90` stops.
+!>
+!> Codes follow the executable's exit codes: 2 = bad input, 3 = not converged (used as a
+!> status, not an error), 4 = I/O failure, 5 = internal/numerical failure.
+module lc_errors
+   implicit none (type, external)
+   private
+   public :: error_type, fatal_error
+   public :: code_input, code_not_converged, code_io, code_internal
+
+   integer, parameter :: code_input = 2
+   integer, parameter :: code_not_converged = 3
+   integer, parameter :: code_io = 4
+   integer, parameter :: code_internal = 5
+
+   !> An error: a message that says what, where and the allowed range, and a code.
+   type :: error_type
+      integer :: code = code_internal
+      character(len=:), allocatable :: message
+   end type error_type
+
+contains
+
+   !> Allocate `error` with `message` (and `code`, default: internal failure).
+   pure subroutine fatal_error(error, message, code)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: message
+      integer, intent(in), optional :: code
+      allocate (error)
+      error%message = message
+      if (present(code)) error%code = code
+   end subroutine fatal_error
+end module lc_errors

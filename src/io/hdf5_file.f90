@@ -1,0 +1,581 @@
+!> HDF5 output (self-describing result file, written atomically) and profile input.
+!>
+!> Layout written by `write_results` (units: lengths L, stresses S, as in the input):
+!>   /                     attrs layercontact_version, geometry, convention, units
+!>   /input/namelist       the namelist text; /input attrs: every parsed scene value
+!>   /profile/x, height    grid positions j*period/n and the rigid profile r(x)
+!>   /fields/pressure, gap, displacement_z
+!>   /results              attrs: scalar observables, solver record, the seed's normalised values
+!>   /convergence/residual residual per iteration
+!>   /companion/...        the same fields/results/convergence for the frictionless companion
+!>
+!> HDF5 1.10 Fortran API only. Every public routine opens and closes the library itself
+!> (h5open_f/h5close_f) and switches off HDF5's own error printing: failures come back as
+!> `error_type` messages naming the file and the object instead.
+module lc_io_hdf5
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+   use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5close_f, h5eset_auto_f, &
+      & h5fcreate_f, h5fopen_f, h5fclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5F_CLOSE_STRONG_F, &
+      & h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, &
+      & h5gcreate_f, h5gclose_f, h5iget_name_f, &
+      & h5screate_f, h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
+      & h5sget_simple_extent_dims_f, H5S_SCALAR_F, &
+      & h5tcopy_f, h5tset_size_f, h5tset_strpad_f, h5tclose_f, h5tget_class_f, &
+      & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
+      & h5acreate_f, h5awrite_f, h5aclose_f, &
+      & h5dcreate_f, h5dopen_f, h5dwrite_f, h5dread_f, h5dclose_f, h5dget_space_f, h5dget_type_f
+   use lc_kinds, only: wp
+   use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
+   use lc_scene, only: scene_type
+   use lc_result, only: contact_result
+   implicit none (type, external)
+   private
+   public :: check_output, write_results, read_profile_heights
+
+   character(len=*), parameter :: convention = 'P: x = sliding direction of the indenter, z into the layer, ' // &
+      & 'p > 0 compressive, w = u_z > 0 indentation, tau = +mu_c p'
+   character(len=*), parameter :: units_note = "lengths in the input's length unit L, " // &
+      & 'pressures/moduli in its stress unit S'
+   character(len=*), parameter :: overwrite_hint = 'set &output overwrite = .true.'
+
+   !> Sticky status of a sequence of HDF5 calls: after the first failure every helper does
+   !> nothing, so a writer reads as a plain list of objects and is checked once at the end.
+   type :: h5_status
+      integer :: hdferr = 0
+      character(len=:), allocatable :: object   !< path of the object that failed
+   end type h5_status
+
+   interface
+      !> int mkdir(const char *path, mode_t mode); mode_t is a 32-bit unsigned on Linux
+      integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value, intent(in) :: mode
+      end function c_mkdir
+      !> int access(const char *path, int mode)
+      integer(c_int) function c_access(path, mode) bind(C, name='access')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value, intent(in) :: mode
+      end function c_access
+      !> int rename(const char *old, const char *new): atomic within one file system
+      integer(c_int) function c_rename(old, new) bind(C, name='rename')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: old(*), new(*)
+      end function c_rename
+      !> int remove(const char *path)
+      integer(c_int) function c_remove(path) bind(C, name='remove')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: path(*)
+      end function c_remove
+   end interface
+
+   !> access() modes: write and search permission on a directory
+   integer(c_int), parameter :: w_ok = 2_c_int, x_ok = 1_c_int
+   !> rwxrwxrwx, reduced by the process umask as `mkdir -p` does
+   integer(c_int), parameter :: dir_mode = int(o'777', c_int)
+
+contains
+
+   !> Fail early (before any computing) if the output cannot be written:
+   !> existing file and not overwrite -> error code_io with the file name and the hint
+   !> "set &output overwrite = .true."; parent directory missing -> create it (mkdir -p).
+   subroutine check_output(filename, overwrite, error)
+      !> the result file to be written
+      character(len=*), intent(in) :: filename
+      !> whether an existing file may be replaced
+      logical, intent(in) :: overwrite
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: parent
+      logical :: exists
+      integer :: k, ignore
+
+      if (len_trim(filename) == 0) then
+         call fatal_error(error, "&output: file = '' is not allowed; allowed: a file name", code_input)
+         return
+      end if
+      inquire (file=filename, exist=exists)
+      if (exists .and. .not. overwrite) then
+         call fatal_error(error, "output file '" // filename // "' exists; choose another name or " &
+            & // overwrite_hint, code_io)
+         return
+      end if
+
+      k = index(filename, '/', back=.true.)
+      if (k == 0) then
+         parent = '.'
+      else if (k == 1) then
+         parent = '/'
+      else
+         parent = filename(:k - 1)
+      end if
+      ! mkdir -p: create every prefix; failures for existing prefixes are expected, so the
+      ! result is judged once, by whether the parent is now a writable directory.
+      do k = 2, len(parent)
+         if (parent(k:k) == '/') ignore = c_mkdir(parent(:k - 1) // c_null_char, dir_mode)
+      end do
+      ignore = c_mkdir(parent // c_null_char, dir_mode)
+      if (c_access(parent // c_null_char, ior(w_ok, x_ok)) /= 0) then
+         call fatal_error(error, "cannot create or write to the directory '" // parent // "' of output file '" &
+            & // filename // "'", code_io)
+      end if
+   end subroutine check_output
+
+   !> Write a complete, self-describing result file atomically: write filename.tmp (delete a
+   !> stale one first), close, rename to filename. On any HDF5 failure: close, delete the
+   !> .tmp, return error code_io naming file and object.
+   subroutine write_results(filename, scene, namelist_text, height, result, companion, version, error)
+      character(len=*), intent(in) :: filename
+      type(scene_type), intent(in) :: scene
+      !> the input namelist text, echoed to /input/namelist
+      character(len=*), intent(in) :: namelist_text
+      !> the rigid profile r(x) (L)
+      real(wp), intent(in) :: height(:)
+      type(contact_result), intent(in) :: result
+      !> frictionless companion run
+      type(contact_result), intent(in), optional :: companion
+      !> layercontact version string
+      character(len=*), intent(in) :: version
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: tmp
+      type(h5_status) :: st
+      integer(hid_t) :: fapl, file, group
+      integer :: ignore, j, n
+
+      n = size(height)
+      call check_sizes(result, n, 'result', error)
+      if (allocated(error)) return
+      if (present(companion)) then
+         call check_sizes(companion, n, 'companion', error)
+         if (allocated(error)) return
+      end if
+
+      tmp = filename // '.tmp'
+      call delete_file(tmp, error)
+      if (allocated(error)) return
+
+      call h5open_f(st%hdferr)
+      call h5eset_auto_f(0, ignore)
+      ! strong close degree: closing the file also closes whatever a failed sequence left open
+      call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, ignore)
+      call h5pset_fclose_degree_f(fapl, H5F_CLOSE_STRONG_F, ignore)
+      if (st%hdferr == 0) then
+         call h5fcreate_f(tmp, H5F_ACC_TRUNC_F, file, st%hdferr, access_prp=fapl)
+         if (st%hdferr /= 0) st%object = 'the file itself'
+      end if
+      if (st%hdferr == 0) then
+         call write_attr_string(file, 'layercontact_version', version, st)
+         call write_attr_string(file, 'geometry', trim(scene%geometry), st)
+         call write_attr_string(file, 'convention', convention, st)
+         call write_attr_string(file, 'units', units_note, st)
+
+         call create_group(file, 'input', group, st)
+         call write_dataset_string(group, 'namelist', namelist_text, st)
+         call write_scene_attrs(group, scene, st)
+         call close_group(group, st)
+
+         call create_group(file, 'profile', group, st)
+         call write_dataset_1d(group, 'x', [(j*scene%period/n, j=0, n - 1)], 'L', st)
+         call write_dataset_1d(group, 'height', height, 'L', st)
+         call close_group(group, st)
+
+         if (present(companion)) then
+            call write_solution(file, result, scene, height, st, &
+               & a_over_a0=result%contact_fraction / companion%contact_fraction)
+            call create_group(file, 'companion', group, st)
+            call write_solution(group, companion, scene, height, st)
+            call close_group(group, st)
+         else
+            call write_solution(file, result, scene, height, st)
+         end if
+         call h5fclose_f(file, ignore)
+      end if
+      call h5pclose_f(fapl, ignore)
+      call h5close_f(ignore)
+
+      if (st%hdferr /= 0) then
+         ignore = c_remove(tmp // c_null_char)
+         if (.not. allocated(st%object)) st%object = 'the HDF5 library'
+         call fatal_error(error, "cannot write result file '" // filename // "': HDF5 failed at " // st%object, code_io)
+         return
+      end if
+      if (c_rename(tmp // c_null_char, filename // c_null_char) /= 0) then
+         ignore = c_remove(tmp // c_null_char)
+         call fatal_error(error, "cannot rename '" // tmp // "' to result file '" // filename // "'", code_io)
+      end if
+   end subroutine write_results
+
+   !> Read n heights from an HDF5 file/dataset (1D float64 dataset of exactly n values).
+   subroutine read_profile_heights(filename, dataset, n, height, error)
+      character(len=*), intent(in) :: filename
+      !> path of the dataset inside the file, e.g. /profile/height
+      character(len=*), intent(in) :: dataset
+      !> number of heights expected (the scene's grid size)
+      integer, intent(in) :: n
+      !> the heights (L)
+      real(wp), intent(out) :: height(n)
+      type(error_type), allocatable, intent(out) :: error
+      integer(hid_t) :: fapl, file, dset, space, dtype
+      integer(hsize_t) :: dims(1), maxdims(1)
+      integer :: hdferr, ignore, rank, class
+      character(len=:), allocatable :: where
+
+      where = "profile file '" // filename // "', dataset '" // dataset // "'"
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, ignore)
+      call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, ignore)
+      call h5pset_fclose_degree_f(fapl, H5F_CLOSE_STRONG_F, ignore)
+      read: block
+         if (hdferr /= 0) then
+            call fatal_error(error, 'cannot initialise HDF5 to read ' // where, code_io)
+            exit read
+         end if
+         call h5fopen_f(filename, H5F_ACC_RDONLY_F, file, hdferr, access_prp=fapl)
+         if (hdferr /= 0) then
+            call fatal_error(error, "cannot open profile file '" // filename // "' as HDF5", code_io)
+            exit read
+         end if
+         call h5dopen_f(file, dataset, dset, hdferr)
+         if (hdferr /= 0) then
+            call fatal_error(error, 'cannot open ' // where, code_io)
+         else
+            call h5dget_space_f(dset, space, hdferr)
+            call h5sget_simple_extent_ndims_f(space, rank, ignore)
+            dims = 0
+            if (rank == 1) call h5sget_simple_extent_dims_f(space, dims, maxdims, ignore)
+            call h5sclose_f(space, ignore)
+            call h5dget_type_f(dset, dtype, ignore)
+            call h5tget_class_f(dtype, class, ignore)
+            call h5tclose_f(dtype, ignore)
+            if (rank /= 1 .or. dims(1) /= n .or. class /= H5T_FLOAT_F) then
+               call fatal_error(error, where // ' holds ' // shape_str(rank, dims, class == H5T_FLOAT_F) &
+                  & // '; expected a 1D float64 dataset of n = ' // int_str(int(n, hsize_t)) // ' values', &
+                  & code_input)
+            else
+               dims(1) = n
+               call h5dread_f(dset, H5T_NATIVE_DOUBLE, height, dims, hdferr)
+               if (hdferr /= 0) call fatal_error(error, 'cannot read ' // where, code_io)
+            end if
+            call h5dclose_f(dset, ignore)
+         end if
+         call h5fclose_f(file, ignore)
+      end block read
+      call h5pclose_f(fapl, ignore)
+      call h5close_f(ignore)
+   end subroutine read_profile_heights
+
+   ! ---------------------------------------------------------------------------------------
+   ! Pieces of the layout.
+
+   !> Every parsed scene value as an attribute of /input.
+   subroutine write_scene_attrs(loc, scene, st)
+      integer(hid_t), intent(in) :: loc
+      type(scene_type), intent(in) :: scene
+      type(h5_status), intent(inout) :: st
+
+      call write_attr_string(loc, 'geometry', trim(scene%geometry), st)
+      call write_attr_string(loc, 'title', trim(scene%title), st)
+      call write_attr_real(loc, 'period', scene%period, st)
+      call write_attr_int(loc, 'n', scene%n, st)
+      call write_attr_real(loc, 'thickness', scene%thickness, st)
+      call write_attr_real(loc, 'young', scene%young, st)
+      call write_attr_real(loc, 'poisson', scene%poisson, st)
+      call write_attr_real(loc, 'friction', scene%friction, st)
+      call write_attr_int(loc, 'companion', merge(1, 0, scene%companion), st)
+      associate (p => scene%profile)
+         call write_attr_string(loc, 'profile_kind', trim(p%kind), st)
+         call write_attr_real(loc, 'hurst', p%hurst, st)
+         ! the seed is a 64-bit integer; stored as a double it stays exact below 2**53
+         call write_attr_real(loc, 'seed', real(p%seed, wp), st)
+         call write_attr_real(loc, 'rolloff_wavelength', p%rolloff_wavelength, st)
+         call write_attr_real(loc, 'short_wavelength', p%short_wavelength, st)
+         call write_attr_real(loc, 'rms_gradient', p%rms_gradient, st)
+         call write_attr_real(loc, 'rms_height', p%rms_height, st)
+         call write_attr_real(loc, 'amplitude', p%amplitude, st)
+         call write_attr_int(loc, 'mode', p%mode, st)
+         call write_attr_string(loc, 'profile_file', trim(p%file), st)
+         call write_attr_string(loc, 'profile_dataset', trim(p%dataset), st)
+      end associate
+      call write_attr_string(loc, 'control', trim(scene%control), st)
+      call write_attr_real(loc, 'mean_pressure', scene%mean_pressure, st)
+      call write_attr_real(loc, 'normalised_pressure', scene%normalised_pressure, st)
+      call write_attr_real(loc, 'penetration', scene%penetration, st)
+      associate (s => scene%solver)
+         call write_attr_string(loc, 'solver_method', trim(s%method), st)
+         call write_attr_real(loc, 'tol', s%tol, st)
+         call write_attr_int(loc, 'max_iter', s%max_iter, st)
+         call write_attr_int(loc, 'memory', s%memory, st)
+         call write_attr_int(loc, 'threads', s%threads, st)
+      end associate
+      call write_attr_string(loc, 'output_file', trim(scene%output_file), st)
+      call write_attr_int(loc, 'overwrite', merge(1, 0, scene%overwrite), st)
+   end subroutine write_scene_attrs
+
+   !> fields/, results (attributes) and convergence/ of one solve, under `loc`.
+   subroutine write_solution(loc, res, scene, height, st, a_over_a0)
+      integer(hid_t), intent(in) :: loc
+      type(contact_result), intent(in) :: res
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:)
+      type(h5_status), intent(inout) :: st
+      !> contact area relative to the frictionless companion's
+      real(wp), intent(in), optional :: a_over_a0
+      integer(hid_t) :: group
+      real(wp) :: e_star, lambda_max
+
+      call create_group(loc, 'fields', group, st)
+      call write_dataset_1d(group, 'pressure', res%pressure, 'S', st)
+      call write_dataset_1d(group, 'gap', res%gap, 'L', st)
+      call write_dataset_1d(group, 'displacement_z', res%displacement_z, 'L', st)
+      call close_group(group, st)
+
+      call create_group(loc, 'results', group, st)
+      call write_attr_real(group, 'mean_pressure', res%mean_pressure, st)
+      call write_attr_real(group, 'penetration', res%penetration, st)
+      call write_attr_real(group, 'contact_fraction', res%contact_fraction, st)
+      call write_attr_real(group, 'delta_mu', res%delta_mu, st)
+      call write_attr_real(group, 'delta_mu_spectral', res%delta_mu_spectral, st)
+      call write_attr_real(group, 'delta_mu_energy', res%delta_mu_energy, st)
+      call write_attr_int(group, 'converged', merge(1, 0, res%converged), st)
+      call write_attr_int(group, 'iterations', res%iterations, st)
+      call write_attr_int(group, 'fft_pairs', res%fft_pairs, st)
+      call write_attr_real(group, 'residual', res%residual, st)
+      call write_attr_real(group, 'wall_time', res%wall_time, st)
+      call write_attr_real(group, 'friction', res%friction, st)
+      ! the seed's scales: Lambda = highest asperity above the mean plane (heights have zero
+      ! mean), p_m normalised by E* Lambda / lambda, thickness by lambda
+      e_star = scene%young / (1.0_wp - scene%poisson**2)
+      lambda_max = maxval(height)
+      if (lambda_max > 0.0_wp) then
+         call write_attr_real(group, 'normalised_pressure', res%mean_pressure / (e_star*lambda_max/scene%period), st)
+      else
+         call write_attr_real(group, 'normalised_pressure', ieee_value(1.0_wp, ieee_quiet_nan), st)
+      end if
+      call write_attr_real(group, 'normalised_thickness', scene%thickness / scene%period, st)
+      if (present(a_over_a0)) call write_attr_real(group, 'a_over_a0', a_over_a0, st)
+      call close_group(group, st)
+
+      call create_group(loc, 'convergence', group, st)
+      if (allocated(res%residual_history)) then
+         call write_dataset_1d(group, 'residual', res%residual_history, '1', st)
+      else
+         call write_dataset_1d(group, 'residual', [real(wp) ::], '1', st)
+      end if
+      call close_group(group, st)
+   end subroutine write_solution
+
+   !> Fields must match the profile's grid (a mismatch is a bug in the caller).
+   subroutine check_sizes(res, n, label, error)
+      type(contact_result), intent(in) :: res
+      integer, intent(in) :: n
+      character(len=*), intent(in) :: label
+      type(error_type), allocatable, intent(out) :: error
+      logical :: ok
+      ok = allocated(res%pressure) .and. allocated(res%gap) .and. allocated(res%displacement_z)
+      if (ok) ok = size(res%pressure) == n .and. size(res%gap) == n .and. size(res%displacement_z) == n
+      if (.not. ok) call fatal_error(error, 'write_results: the ' // label // &
+         & ' fields (pressure, gap, displacement_z) must be allocated with the size of the profile, n = ' &
+         & // int_str(int(n, hsize_t)), code_internal)
+   end subroutine check_sizes
+
+   ! ---------------------------------------------------------------------------------------
+   ! HDF5 helpers: each does nothing once `st` has failed, and records the failing object.
+
+   subroutine create_group(loc, name, group, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(out) :: group
+      type(h5_status), intent(inout) :: st
+      group = -1
+      if (st%hdferr /= 0) return
+      call h5gcreate_f(loc, name, group, st%hdferr)
+      if (st%hdferr /= 0) call failed(loc, name, st)
+   end subroutine create_group
+
+   subroutine close_group(group, st)
+      integer(hid_t), intent(in) :: group
+      type(h5_status), intent(inout) :: st
+      if (st%hdferr /= 0) return
+      call h5gclose_f(group, st%hdferr)
+      if (st%hdferr /= 0) call failed(group, '', st)
+   end subroutine close_group
+
+   subroutine write_attr_real(loc, name, value, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      real(wp), intent(in) :: value
+      type(h5_status), intent(inout) :: st
+      integer(hid_t) :: space, attr
+      integer :: ignore
+      if (st%hdferr /= 0) return
+      call h5screate_f(H5S_SCALAR_F, space, st%hdferr)
+      if (st%hdferr == 0) then
+         call h5acreate_f(loc, name, H5T_NATIVE_DOUBLE, space, attr, st%hdferr)
+         if (st%hdferr == 0) then
+            call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, [1_hsize_t], st%hdferr)
+            call h5aclose_f(attr, ignore)
+         end if
+         call h5sclose_f(space, ignore)
+      end if
+      if (st%hdferr /= 0) call failed(loc, '@' // name, st)
+   end subroutine write_attr_real
+
+   subroutine write_attr_int(loc, name, value, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: value
+      type(h5_status), intent(inout) :: st
+      integer(hid_t) :: space, attr
+      integer :: ignore
+      if (st%hdferr /= 0) return
+      call h5screate_f(H5S_SCALAR_F, space, st%hdferr)
+      if (st%hdferr == 0) then
+         call h5acreate_f(loc, name, H5T_NATIVE_INTEGER, space, attr, st%hdferr)
+         if (st%hdferr == 0) then
+            call h5awrite_f(attr, H5T_NATIVE_INTEGER, value, [1_hsize_t], st%hdferr)
+            call h5aclose_f(attr, ignore)
+         end if
+         call h5sclose_f(space, ignore)
+      end if
+      if (st%hdferr /= 0) call failed(loc, '@' // name, st)
+   end subroutine write_attr_int
+
+   !> Null-terminated fixed-length string attribute (h5py reads it as bytes).
+   subroutine write_attr_string(loc, name, value, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name, value
+      type(h5_status), intent(inout) :: st
+      integer(hid_t) :: space, attr, stype
+      integer :: ignore
+      if (st%hdferr /= 0) return
+      call string_type(len(value), stype, st%hdferr)
+      if (st%hdferr == 0) then
+         call h5screate_f(H5S_SCALAR_F, space, st%hdferr)
+         if (st%hdferr == 0) then
+            call h5acreate_f(loc, name, stype, space, attr, st%hdferr)
+            if (st%hdferr == 0) then
+               call h5awrite_f(attr, stype, value // c_null_char, [1_hsize_t], st%hdferr)
+               call h5aclose_f(attr, ignore)
+            end if
+            call h5sclose_f(space, ignore)
+         end if
+         call h5tclose_f(stype, ignore)
+      end if
+      if (st%hdferr /= 0) call failed(loc, '@' // name, st)
+   end subroutine write_attr_string
+
+   !> Scalar string dataset.
+   subroutine write_dataset_string(loc, name, value, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name, value
+      type(h5_status), intent(inout) :: st
+      integer(hid_t) :: space, dset, stype
+      integer :: ignore
+      if (st%hdferr /= 0) return
+      call string_type(len(value), stype, st%hdferr)
+      if (st%hdferr == 0) then
+         call h5screate_f(H5S_SCALAR_F, space, st%hdferr)
+         if (st%hdferr == 0) then
+            call h5dcreate_f(loc, name, stype, space, dset, st%hdferr)
+            if (st%hdferr == 0) then
+               call h5dwrite_f(dset, stype, value // c_null_char, [1_hsize_t], st%hdferr)
+               call h5dclose_f(dset, ignore)
+            end if
+            call h5sclose_f(space, ignore)
+         end if
+         call h5tclose_f(stype, ignore)
+      end if
+      if (st%hdferr /= 0) call failed(loc, name, st)
+   end subroutine write_dataset_string
+
+   !> 1D float64 dataset with a `units` attribute (L, S or 1).
+   subroutine write_dataset_1d(loc, name, values, units, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      real(wp), intent(in) :: values(:)
+      character(len=*), intent(in) :: units
+      type(h5_status), intent(inout) :: st
+      integer(hid_t) :: space, dset
+      integer(hsize_t) :: dims(1)
+      integer :: ignore
+      if (st%hdferr /= 0) return
+      dims = size(values, kind=hsize_t)
+      call h5screate_simple_f(1, dims, space, st%hdferr)
+      if (st%hdferr == 0) then
+         call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, st%hdferr)
+         if (st%hdferr == 0) then
+            ! nothing to transfer for an empty history (and no element to point the C call at)
+            if (size(values) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, st%hdferr)
+            if (st%hdferr == 0) call write_attr_string(dset, 'units', units, st)
+            call h5dclose_f(dset, ignore)
+         end if
+         call h5sclose_f(space, ignore)
+      end if
+      if (st%hdferr /= 0 .and. .not. allocated(st%object)) call failed(loc, name, st)
+   end subroutine write_dataset_1d
+
+   !> A fixed-length, null-terminated string type for `length` characters.
+   subroutine string_type(length, stype, hdferr)
+      integer, intent(in) :: length
+      integer(hid_t), intent(out) :: stype
+      integer, intent(out) :: hdferr
+      call h5tcopy_f(H5T_FORTRAN_S1, stype, hdferr)
+      if (hdferr == 0) call h5tset_size_f(stype, int(length + 1, size_t), hdferr)
+      if (hdferr == 0) call h5tset_strpad_f(stype, H5T_STR_NULLTERM_F, hdferr)
+   end subroutine string_type
+
+   !> Record the path of the object that failed: the location's path plus `name`.
+   subroutine failed(loc, name, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      type(h5_status), intent(inout) :: st
+      character(len=256) :: path
+      integer(size_t) :: path_len
+      integer :: ignore
+      if (allocated(st%object)) return
+      path = ''
+      call h5iget_name_f(loc, path, len(path, kind=size_t), path_len, ignore)
+      if (name(1:min(1, len(name))) == '@') then
+         st%object = "attribute '" // name(2:) // "' of '" // trim(path) // "'"
+      else if (trim(path) == '/') then
+         st%object = "'/" // name // "'"
+      else
+         st%object = "'" // trim(path) // merge('/', ' ', len(name) > 0) // name // "'"
+      end if
+   end subroutine failed
+
+   !> Delete a stale file if there is one.
+   subroutine delete_file(filename, error)
+      character(len=*), intent(in) :: filename
+      type(error_type), allocatable, intent(out) :: error
+      logical :: exists
+      inquire (file=filename, exist=exists)
+      if (.not. exists) return
+      if (c_remove(filename // c_null_char) /= 0) &
+         & call fatal_error(error, "cannot delete the stale temporary file '" // filename // "'", code_io)
+   end subroutine delete_file
+
+   !> What a dataset holds, for messages.
+   pure function shape_str(space_rank, dims, is_float) result(s)
+      integer, intent(in) :: space_rank
+      integer(hsize_t), intent(in) :: dims(1)
+      logical, intent(in) :: is_float
+      character(len=:), allocatable :: s
+      if (.not. is_float) then
+         s = 'values that are not floating point'
+      else if (space_rank == 1) then
+         s = int_str(dims(1)) // ' values'
+      else
+         s = 'a rank-' // int_str(int(space_rank, hsize_t)) // ' dataset'
+      end if
+   end function shape_str
+
+   pure function int_str(i) result(s)
+      integer(hsize_t), intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=24) :: buffer
+      write (buffer, '(i0)') i
+      s = trim(buffer)
+   end function int_str
+end module lc_io_hdf5

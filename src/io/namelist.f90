@@ -1,0 +1,665 @@
+!> Namelist input: a text file of up to seven optional groups (&scene, &layer, &friction,
+!> &profile, &loading, &solver, &output) -> `scene_type`, and back (`write_scene_namelist`).
+!>
+!> Defaults live only in `scene_type`: each group is read into local variables that start
+!> from the scene's current (default) values. A Fortran namelist read silently skips groups
+!> it does not know, so the text is pre-scanned for `&name` tokens first; unknown or
+!> repeated groups are errors that name the line.
+module lc_io_namelist
+   use, intrinsic :: iso_fortran_env, only: iostat_end
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+   use lc_kinds, only: wp, i8
+   use lc_errors, only: error_type, fatal_error, code_input, code_io
+   use lc_scene, only: scene_type, check_scene, not_set, max_string
+   implicit none (type, external)
+   private
+   public :: read_scene, read_scene_text, write_scene_namelist
+
+   integer, parameter :: n_groups = 7
+   character(len=*), parameter :: group_names(n_groups) = [character(len=8) :: &
+      & 'scene', 'layer', 'friction', 'profile', 'loading', 'solver', 'output']
+   !> Variables allowed in each group, in the order of `group_names` (for messages).
+   character(len=*), parameter :: group_variables(n_groups) = [character(len=128) :: &
+      & 'geometry, title, period, n', &
+      & 'thickness, young, poisson', &
+      & 'coefficient, companion', &
+      & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
+      & 'amplitude, mode, file, dataset', &
+      & 'control, mean_pressure, normalised_pressure, penetration', &
+      & 'method, tol, max_iter, memory, threads', &
+      & 'file, overwrite']
+
+   character(len=*), parameter :: newline = new_line('a')
+
+   interface int_str
+      module procedure int_str_default, int_str_i8
+   end interface int_str
+
+   !> Where one group sits in the text: characters first..last, starting on `line`.
+   type :: group_span
+      integer :: index = 0   !< position in `group_names`
+      integer :: line = 0
+      integer :: first = 0
+      integer :: last = 0
+   end type group_span
+
+contains
+
+   !> Read a namelist file into a scene (defaults from scene_type), keep the file text.
+   subroutine read_scene(filename, scene, text, error)
+      !> namelist file
+      character(len=*), intent(in) :: filename
+      !> the scene: defaults, overridden by the file, validated by `check_scene`
+      type(scene_type), intent(out) :: scene
+      !> the whole file, for /input/namelist
+      character(len=:), allocatable, intent(out) :: text
+      type(error_type), allocatable, intent(out) :: error
+      integer :: unit, stat, nbytes
+      character(len=512) :: msg
+
+      open (newunit=unit, file=filename, access='stream', form='unformatted', action='read', &
+         & status='old', iostat=stat, iomsg=msg)
+      if (stat /= 0) then
+         call fatal_error(error, "cannot open namelist file '" // filename // "': " // trim(msg), code_io)
+         return
+      end if
+      inquire (unit=unit, size=nbytes)
+      allocate (character(len=max(nbytes, 0)) :: text)
+      if (nbytes > 0) read (unit, iostat=stat, iomsg=msg) text
+      close (unit)
+      if (stat /= 0 .or. nbytes < 0) then
+         call fatal_error(error, "cannot read namelist file '" // filename // "': " // trim(msg), code_io)
+         return
+      end if
+      call read_scene_text(text, filename, scene, error)
+   end subroutine read_scene
+
+   !> Parse namelist text into a scene and validate it (`check_scene`).
+   subroutine read_scene_text(text, source, scene, error)
+      !> the namelist text (lines separated by LF or CR LF)
+      character(len=*), intent(in) :: text
+      !> where the text came from, for messages (a file name)
+      character(len=*), intent(in) :: source
+      type(scene_type), intent(out) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      type(group_span) :: groups(n_groups)
+      character(len=512) :: msg
+      character(len=:), allocatable :: name
+      integer :: n_found, i, stat, line
+
+      call find_groups(text, source, groups, n_found, error)
+      if (allocated(error)) return
+
+      do i = 1, n_found
+         call read_group(text(groups(i)%first:groups(i)%last), groups(i)%index, scene, stat, msg, line)
+         if (stat /= 0) then
+            if (stat == iostat_end) msg = trim(msg) // " (is the closing '/' of the group missing?)"
+            name = trim(group_names(groups(i)%index))
+            call fatal_error(error, source // ', line ' // int_str(groups(i)%line - 1 + line) &
+               & // ', group &' // name // ': ' // trim(msg) // '; allowed variables in &' // name // ': ' &
+               & // trim(group_variables(groups(i)%index)), code_input)
+            return
+         end if
+      end do
+
+      call check_scene(scene, error)
+   end subroutine read_scene_text
+
+   !> The scene as a complete namelist text with all seven groups; `read_scene_text` of it
+   !> gives the same scene back (reals are written with 17 significant digits).
+   subroutine write_scene_namelist(scene, text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable, intent(out) :: text
+
+      associate (p => scene%profile, s => scene%solver)
+         text = '! layercontact scene: every value as parsed (-1 = not set)' // newline &
+            & // '&scene' // newline &
+            & // entry('geometry', str_value(scene%geometry)) &
+            & // entry('title', str_value(scene%title)) &
+            & // entry('period', real_value(scene%period)) &
+            & // entry('n', int_str(scene%n)) &
+            & // '/' // newline // '&layer' // newline &
+            & // entry('thickness', real_value(scene%thickness)) &
+            & // entry('young', real_value(scene%young)) &
+            & // entry('poisson', real_value(scene%poisson)) &
+            & // '/' // newline // '&friction' // newline &
+            & // entry('coefficient', real_value(scene%friction)) &
+            & // entry('companion', logical_value(scene%companion)) &
+            & // '/' // newline // '&profile' // newline &
+            & // entry('kind', str_value(p%kind)) &
+            & // entry('hurst', real_value(p%hurst)) &
+            & // entry('seed', int_str(p%seed)) &
+            & // entry('rolloff_wavelength', real_value(p%rolloff_wavelength)) &
+            & // entry('short_wavelength', real_value(p%short_wavelength)) &
+            & // entry('rms_gradient', real_value(p%rms_gradient)) &
+            & // entry('rms_height', real_value(p%rms_height)) &
+            & // entry('amplitude', real_value(p%amplitude)) &
+            & // entry('mode', int_str(p%mode)) &
+            & // entry('file', str_value(p%file)) &
+            & // entry('dataset', str_value(p%dataset)) &
+            & // '/' // newline // '&loading' // newline &
+            & // entry('control', str_value(scene%control)) &
+            & // entry('mean_pressure', real_value(scene%mean_pressure)) &
+            & // entry('normalised_pressure', real_value(scene%normalised_pressure)) &
+            & // entry('penetration', real_value(scene%penetration)) &
+            & // '/' // newline // '&solver' // newline &
+            & // entry('method', str_value(s%method)) &
+            & // entry('tol', real_value(s%tol)) &
+            & // entry('max_iter', int_str(s%max_iter)) &
+            & // entry('memory', int_str(s%memory)) &
+            & // entry('threads', int_str(s%threads)) &
+            & // '/' // newline // '&output' // newline &
+            & // entry('file', str_value(scene%output_file)) &
+            & // entry('overwrite', logical_value(scene%overwrite)) &
+            & // '/' // newline
+      end associate
+   end subroutine write_scene_namelist
+
+   !> Read one group from its piece of text (one record per line); on failure `line` is the
+   !> line within the piece of the entry that failed.
+   subroutine read_group(segment, group, config, stat, msg, line)
+      character(len=*), intent(in) :: segment
+      integer, intent(in) :: group
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(out) :: msg
+      integer, intent(out) :: line
+      character(len=line_width(segment)) :: lines(count_char(segment, newline) + 1)
+
+      call split_lines(segment, lines)
+      msg = ''
+      select case (trim(group_names(group)))
+      case ('scene')
+         call read_group_scene(lines, config, stat, msg)
+      case ('layer')
+         call read_group_layer(lines, config, stat, msg)
+      case ('friction')
+         call read_group_friction(lines, config, stat, msg)
+      case ('profile')
+         call read_group_profile(lines, config, stat, msg)
+      case ('loading')
+         call read_group_loading(lines, config, stat, msg)
+      case ('solver')
+         call read_group_solver(lines, config, stat, msg)
+      case ('output')
+         call read_group_output(lines, config, stat, msg)
+      end select
+      line = 1
+      if (stat /= 0) line = offending_line(lines, msg)
+   end subroutine read_group
+
+   ! ---------------------------------------------------------------------------------------
+   ! One reader per group. Each declares the group's variables locally, starts them from the
+   ! scene (so the defaults stay in scene_type) and copies them back only after a clean read.
+   ! The dummy is called `config` because a namelist group may not share a local's name.
+
+   subroutine read_group_scene(lines, config, stat, msg)
+      character(len=*), intent(in) :: lines(:)
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      character(len=max_string) :: geometry, title
+      real(wp) :: period
+      integer :: n
+      namelist /scene/ geometry, title, period, n
+
+      geometry = config%geometry
+      title = config%title
+      period = config%period
+      n = config%n
+      read (lines, nml=scene, iostat=stat, iomsg=msg)
+      if (stat /= 0) return
+      config%geometry = geometry
+      config%title = title
+      config%period = period
+      config%n = n
+   end subroutine read_group_scene
+
+   subroutine read_group_layer(lines, config, stat, msg)
+      character(len=*), intent(in) :: lines(:)
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      real(wp) :: thickness, young, poisson
+      namelist /layer/ thickness, young, poisson
+
+      thickness = config%thickness
+      young = config%young
+      poisson = config%poisson
+      read (lines, nml=layer, iostat=stat, iomsg=msg)
+      if (stat /= 0) return
+      config%thickness = thickness
+      config%young = young
+      config%poisson = poisson
+   end subroutine read_group_layer
+
+   subroutine read_group_friction(lines, config, stat, msg)
+      character(len=*), intent(in) :: lines(:)
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      real(wp) :: coefficient
+      logical :: companion
+      namelist /friction/ coefficient, companion
+
+      coefficient = config%friction
+      companion = config%companion
+      read (lines, nml=friction, iostat=stat, iomsg=msg)
+      if (stat /= 0) return
+      config%friction = coefficient
+      config%companion = companion
+   end subroutine read_group_friction
+
+   subroutine read_group_profile(lines, config, stat, msg)
+      character(len=*), intent(in) :: lines(:)
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      character(len=max_string) :: kind, file, dataset
+      real(wp) :: hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, amplitude
+      integer(i8) :: seed
+      integer :: mode
+      namelist /profile/ kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
+         & rms_height, amplitude, mode, file, dataset
+
+      associate (p => config%profile)
+         kind = p%kind
+         hurst = p%hurst
+         seed = p%seed
+         rolloff_wavelength = p%rolloff_wavelength
+         short_wavelength = p%short_wavelength
+         rms_gradient = p%rms_gradient
+         rms_height = p%rms_height
+         amplitude = p%amplitude
+         mode = p%mode
+         file = p%file
+         dataset = p%dataset
+         read (lines, nml=profile, iostat=stat, iomsg=msg)
+         if (stat /= 0) return
+         p%kind = kind
+         p%hurst = hurst
+         p%seed = seed
+         p%rolloff_wavelength = rolloff_wavelength
+         p%short_wavelength = short_wavelength
+         p%rms_gradient = rms_gradient
+         p%rms_height = rms_height
+         p%amplitude = amplitude
+         p%mode = mode
+         p%file = file
+         p%dataset = dataset
+      end associate
+   end subroutine read_group_profile
+
+   subroutine read_group_loading(lines, config, stat, msg)
+      character(len=*), intent(in) :: lines(:)
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      character(len=max_string) :: control
+      real(wp) :: mean_pressure, normalised_pressure, penetration
+      namelist /loading/ control, mean_pressure, normalised_pressure, penetration
+
+      control = config%control
+      mean_pressure = config%mean_pressure
+      normalised_pressure = config%normalised_pressure
+      penetration = config%penetration
+      read (lines, nml=loading, iostat=stat, iomsg=msg)
+      if (stat /= 0) return
+      config%control = control
+      config%mean_pressure = mean_pressure
+      config%normalised_pressure = normalised_pressure
+      config%penetration = penetration
+   end subroutine read_group_loading
+
+   subroutine read_group_solver(lines, config, stat, msg)
+      character(len=*), intent(in) :: lines(:)
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      character(len=max_string) :: method
+      real(wp) :: tol
+      integer :: max_iter, memory, threads
+      namelist /solver/ method, tol, max_iter, memory, threads
+
+      method = config%solver%method
+      tol = config%solver%tol
+      max_iter = config%solver%max_iter
+      memory = config%solver%memory
+      threads = config%solver%threads
+      read (lines, nml=solver, iostat=stat, iomsg=msg)
+      if (stat /= 0) return
+      config%solver%method = method
+      config%solver%tol = tol
+      config%solver%max_iter = max_iter
+      config%solver%memory = memory
+      config%solver%threads = threads
+   end subroutine read_group_solver
+
+   subroutine read_group_output(lines, config, stat, msg)
+      character(len=*), intent(in) :: lines(:)
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      character(len=max_string) :: file
+      logical :: overwrite
+      namelist /output/ file, overwrite
+
+      file = config%output_file
+      overwrite = config%overwrite
+      read (lines, nml=output, iostat=stat, iomsg=msg)
+      if (stat /= 0) return
+      config%output_file = file
+      config%overwrite = overwrite
+   end subroutine read_group_output
+
+   ! ---------------------------------------------------------------------------------------
+   ! Scanning the text.
+
+   !> Find every `&name` outside comments and quotes; unknown or repeated names are errors.
+   !> `&end` is skipped: gfortran accepts it as a legacy group terminator.
+   subroutine find_groups(text, source, groups, n_found, error)
+      character(len=*), intent(in) :: text, source
+      type(group_span), intent(out) :: groups(n_groups)
+      integer, intent(out) :: n_found
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: name
+      character :: quote
+      integer :: i, j, line, k
+
+      n_found = 0
+      line = 1
+      quote = ' '
+      i = 1
+      do while (i <= len(text))
+         if (text(i:i) == newline) then
+            line = line + 1
+         else if (quote /= ' ') then
+            ! a doubled quote inside a string is an escaped quote, not the end of the string
+            if (text(i:i) == quote) then
+               if (text(i:min(i + 1, len(text))) == quote // quote) then
+                  i = i + 1
+               else
+                  quote = ' '
+               end if
+            end if
+         else if (text(i:i) == '!') then
+            j = index(text(i:), newline)
+            if (j == 0) exit
+            i = i + j - 2
+         else if (text(i:i) == '"' .or. text(i:i) == "'") then
+            quote = text(i:i)
+         else if (text(i:i) == '&') then
+            j = i + 1
+            do while (j <= len(text))
+               if (.not. is_name_char(text(j:j))) exit
+               j = j + 1
+            end do
+            name = lower(text(i + 1:j - 1))
+            if (name /= 'end') then
+               k = group_index(name)
+               if (k == 0) then
+                  call fatal_error(error, source // ', line ' // int_str(line) // ": unknown namelist group '&" &
+                     & // name // "'; allowed groups: " // allowed_groups(), code_input)
+                  return
+               end if
+               if (any(groups(:n_found)%index == k)) then
+                  call fatal_error(error, source // ', line ' // int_str(line) // ": namelist group '&" &
+                     & // name // "' given twice (at most once each); allowed groups: " // allowed_groups(), &
+                     & code_input)
+                  return
+               end if
+               if (n_found > 0) groups(n_found)%last = i - 1
+               n_found = n_found + 1
+               groups(n_found) = group_span(index=k, line=line, first=i, last=len(text))
+            end if
+            i = j - 1
+         end if
+         i = i + 1
+      end do
+   end subroutine find_groups
+
+   !> Length of the longest line of `text` (at least 1).
+   pure integer function line_width(text)
+      character(len=*), intent(in) :: text
+      integer :: start, stop
+      line_width = 1
+      start = 1
+      do while (start <= len(text))
+         stop = line_end(text, start)
+         line_width = max(line_width, stop - start + 1)
+         start = stop + 2
+      end do
+   end function line_width
+
+   !> Split text at LF into lines (one record each, trailing CR removed); `lines` is sized
+   !> by `line_width` and `count_char(text, newline) + 1`.
+   pure subroutine split_lines(text, lines)
+      character(len=*), intent(in) :: text
+      character(len=*), intent(out) :: lines(:)
+      integer :: start, stop, i
+
+      start = 1
+      do i = 1, size(lines)
+         stop = min(line_end(text, start), len(text))
+         lines(i) = text(min(start, len(text) + 1):stop)
+         if (stop >= start) then
+            if (text(stop:stop) == achar(13)) lines(i) = text(start:stop - 1)
+         end if
+         start = stop + 2
+      end do
+   end subroutine split_lines
+
+   !> Last character of the line that starts at `start` (before its LF or the end).
+   pure integer function line_end(text, start)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: start
+      line_end = index(text(min(start, len(text) + 1):), newline)
+      if (line_end == 0) then
+         line_end = len(text)
+      else
+         line_end = start + line_end - 2
+      end if
+   end function line_end
+
+   !> Line (1-based, within the group) of the entry gfortran's iomsg complains about.
+   !> gfortran names the token it could not match ("Cannot match namelist object name X"):
+   !> a misspelt variable (`X =`) or, for a bad value, a piece of the value. Look for
+   !> `X =` first, then for X anywhere outside comments; fall back to the group's first line.
+   pure integer function offending_line(lines, msg) result(line)
+      character(len=*), intent(in) :: lines(:), msg
+      character(len=*), parameter :: marker = 'object name '
+      character(len=:), allocatable :: token
+      integer :: k
+
+      line = 1
+      k = index(msg, marker)
+      if (k == 0) return
+      token = lower(trim(msg(k + len(marker):)))
+      if (len(token) == 0) return
+      do k = 1, size(lines)
+         if (is_assigned(code_of(lines(k), k == 1), token)) then
+            line = k
+            return
+         end if
+      end do
+      do k = 1, size(lines)
+         if (index(code_of(lines(k), k == 1), token) > 0) then
+            line = k
+            return
+         end if
+      end do
+   end function offending_line
+
+   !> A line in lower case without its comment (and without the `&name` on the first line).
+   pure function code_of(line, first) result(code)
+      character(len=*), intent(in) :: line
+      logical, intent(in) :: first
+      character(len=:), allocatable :: code
+      code = lower(strip_comment(line))
+      if (first) code = skip_group_name(code)
+   end function code_of
+
+   !> True when `name` appears in `code` as a whole word followed by `=`, `(` or `%`.
+   pure logical function is_assigned(code, name)
+      character(len=*), intent(in) :: code, name
+      integer :: pos, k, after
+      is_assigned = .false.
+      pos = 0
+      do
+         k = index(code(pos + 1:), name)
+         if (k == 0) return
+         pos = pos + k
+         after = pos + len(name)
+         if (pos > 1) then
+            if (is_name_char(code(pos - 1:pos - 1))) cycle
+         end if
+         if (after > len(code)) return
+         if (scan(adjustl(code(after:)), '=(%') == 1) then
+            is_assigned = .true.
+            return
+         end if
+      end do
+   end function is_assigned
+
+   !> The line with the leading `&name` token blanked (so a bad value is not found there).
+   pure function skip_group_name(code) result(rest)
+      character(len=*), intent(in) :: code
+      character(len=:), allocatable :: rest
+      integer :: i
+      rest = code
+      i = index(code, '&')
+      if (i == 0) return
+      do while (i <= len(code))
+         if (code(i:i) /= '&' .and. .not. is_name_char(code(i:i))) exit
+         rest(i:i) = ' '
+         i = i + 1
+      end do
+   end function skip_group_name
+
+   !> The line up to a `!` that is not inside quotes.
+   pure function strip_comment(line) result(code)
+      character(len=*), intent(in) :: line
+      character(len=:), allocatable :: code
+      character :: quote
+      integer :: i
+      quote = ' '
+      code = line
+      do i = 1, len(line)
+         if (quote /= ' ') then
+            if (line(i:i) == quote) quote = ' '
+         else if (line(i:i) == '"' .or. line(i:i) == "'") then
+            quote = line(i:i)
+         else if (line(i:i) == '!') then
+            code = line(:i - 1)
+            return
+         end if
+      end do
+   end function strip_comment
+
+   ! ---------------------------------------------------------------------------------------
+   ! Small text helpers.
+
+   !> Position of `name` in `group_names`, 0 if it is not a group.
+   pure integer function group_index(name)
+      character(len=*), intent(in) :: name
+      do group_index = n_groups, 1, -1
+         if (trim(group_names(group_index)) == name) return
+      end do
+   end function group_index
+
+   pure function allowed_groups() result(list)
+      character(len=:), allocatable :: list
+      integer :: k
+      list = '&' // trim(group_names(1))
+      do k = 2, n_groups
+         list = list // ', &' // trim(group_names(k))
+      end do
+   end function allowed_groups
+
+   pure function entry(name, value) result(line)
+      character(len=*), intent(in) :: name, value
+      character(len=:), allocatable :: line
+      line = '   ' // name // ' = ' // value // newline
+   end function entry
+
+   !> A real that reads back bit for bit (17 significant digits); Inf/NaN as gfortran reads them.
+   pure function real_value(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: s
+      character(len=32) :: buffer
+      if (ieee_is_nan(x)) then
+         s = 'NaN'
+      else if (.not. ieee_is_finite(x)) then
+         s = merge('Inf ', '-Inf', x > 0.0_wp)
+         s = trim(s)
+      else
+         write (buffer, '(es24.16e3)') x
+         s = trim(adjustl(buffer))
+      end if
+      if (x == not_set) s = s // '  ! not set'
+   end function real_value
+
+   !> A quoted string, inner apostrophes doubled.
+   pure function str_value(word) result(s)
+      character(len=*), intent(in) :: word
+      character(len=:), allocatable :: s
+      integer :: i
+      s = "'"
+      do i = 1, len_trim(word)
+         s = s // word(i:i)
+         if (word(i:i) == "'") s = s // "'"
+      end do
+      s = s // "'"
+   end function str_value
+
+   pure function logical_value(flag) result(s)
+      logical, intent(in) :: flag
+      character(len=:), allocatable :: s
+      if (flag) then
+         s = '.true.'
+      else
+         s = '.false.'
+      end if
+   end function logical_value
+
+   pure function int_str_default(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=24) :: buffer
+      write (buffer, '(i0)') i
+      s = trim(buffer)
+   end function int_str_default
+
+   pure function int_str_i8(i) result(s)
+      integer(i8), intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=24) :: buffer
+      write (buffer, '(i0)') i
+      s = trim(buffer)
+   end function int_str_i8
+
+   pure logical function is_name_char(c)
+      character, intent(in) :: c
+      is_name_char = verify(c, 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_') == 0
+   end function is_name_char
+
+   pure integer function count_char(text, c)
+      character(len=*), intent(in) :: text
+      character, intent(in) :: c
+      integer :: i
+      count_char = 0
+      do i = 1, len(text)
+         if (text(i:i) == c) count_char = count_char + 1
+      end do
+   end function count_char
+
+   pure function lower(word) result(low)
+      character(len=*), intent(in) :: word
+      character(len=len(word)) :: low
+      integer :: i
+      low = word
+      do i = 1, len(word)
+         if (word(i:i) >= 'A' .and. word(i:i) <= 'Z') low(i:i) = achar(iachar(word(i:i)) + 32)
+      end do
+   end function lower
+end module lc_io_namelist

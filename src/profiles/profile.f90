@@ -1,0 +1,108 @@
+!> The rigid indenter profile of a scene (DESIGN.md §1 "Profiles"): made from
+!> scene%profile (self_affine | sinusoid | file) on the scene's grid, and its statistics.
+!>
+!> Statistics of heights r_j on x_j = j*period/n, with mean r0 = sum_j r_j / n:
+!>   rms height   = sqrt(sum_j (r_j - r0)^2 / n)
+!>   rms gradient = sqrt(sum_j (r'_j)^2 / n), r' the spectral derivative
+!>                = sqrt(2 sum_{k=1}^{kmax} q_k^2 |f^(k)|^2) by Parseval, with f^(k) the
+!>                  Fourier coefficients (lc_fft_plans) and kmax = (n-1)/2: the Nyquist
+!>                  mode of even n is left out, as its derivative vanishes on the grid
+!>   max height   = max_j r_j - r0, measured from the mean line (the seed's Lambda).
+!> For a self-affine profile (lc_profiles_self_affine) these equal its scaling target to
+!> roundoff.
+module lc_profiles_profile
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use lc_kinds, only: wp
+   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_scene, only: scene_type
+   use lc_fft_plans, only: fft_plan
+   use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
+   use lc_io_hdf5, only: read_profile_heights
+   implicit none (type, external)
+   private
+   public :: make_profile, profile_statistics
+
+   real(wp), parameter :: pi = acos(-1.0_wp)
+
+contains
+
+   !> Heights of the scene's profile on its grid, dispatching on scene%profile%kind.
+   subroutine make_profile(scene, height, error)
+      !> Scene whose %n, %period and %profile are used
+      type(scene_type), intent(in) :: scene
+      !> Heights r(x_j) (L)
+      real(wp), intent(out) :: height(scene%n)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=16) :: buffer
+
+      height = 0.0_wp
+      associate (p => scene%profile)
+         select case (trim(p%kind))
+         case ('self_affine')
+            call self_affine_profile(scene%n, scene%period, p%hurst, p%seed, p%rolloff_wavelength, &
+               & p%short_wavelength, p%rms_gradient, p%rms_height, height, error)
+         case ('sinusoid')
+            ! sinusoid_profile is pure and cannot report errors: check its inputs here.
+            if (.not. (ieee_is_finite(p%amplitude) .and. p%amplitude > 0.0_wp)) then
+               write (buffer, '(es12.5)') p%amplitude
+               call fatal_error(error, '&profile: amplitude = ' // trim(adjustl(buffer)) // &
+                  & ' is not allowed; allowed: > 0 and finite', code_input)
+               return
+            else if (p%mode < 1 .or. 2*p%mode >= scene%n) then
+               write (buffer, '(i0)') p%mode
+               call fatal_error(error, '&profile: mode = ' // trim(buffer) // ' is not allowed; allowed: 1 <= mode < n/2', &
+                  & code_input)
+               return
+            end if
+            call sinusoid_profile(scene%n, scene%period, p%amplitude, p%mode, height)
+         case ('file')
+            call read_profile_heights(trim(p%file), trim(p%dataset), scene%n, height, error)
+         case default
+            call fatal_error(error, "&profile: kind = '" // trim(p%kind) // "' is not allowed; allowed: " // &
+               & "'self_affine', 'sinusoid' or 'file'", code_input)
+         end select
+      end associate
+   end subroutine make_profile
+
+   !> Rms height, rms gradient and maximum height above the mean line (definitions in the
+   !> module header). A plain subroutine: the gradient needs an FFT plan.
+   subroutine profile_statistics(height, period, rms_height, rms_gradient, max_height, error)
+      !> Heights r(x_j) on a uniform grid over one period (L)
+      real(wp), intent(in) :: height(:)
+      !> Period lambda (L)
+      real(wp), intent(in) :: period
+      !> Rms height about the mean line (L)
+      real(wp), intent(out) :: rms_height
+      !> Rms gradient (-)
+      real(wp), intent(out) :: rms_gradient
+      !> max_j r_j minus the mean height (L)
+      real(wp), intent(out) :: max_height
+      type(error_type), allocatable, intent(out) :: error
+
+      type(fft_plan) :: plan
+      real(wp) :: mean
+      integer :: n, k
+
+      rms_height = 0.0_wp
+      rms_gradient = 0.0_wp
+      max_height = 0.0_wp
+      n = size(height)
+      if (n < 2) then
+         call fatal_error(error, 'profile_statistics: need at least 2 heights', code_input)
+         return
+      end if
+
+      mean = sum(height)/n
+      rms_height = sqrt(sum((height - mean)**2)/n)
+      max_height = maxval(height) - mean
+
+      call plan%init(n, 1, error)
+      if (allocated(error)) return
+      plan%real_buffer = height
+      call plan%forward()
+      do k = 1, (n - 1)/2
+         rms_gradient = rms_gradient + (2*pi*k/period)**2*abs(plan%spectrum(k + 1))**2
+      end do
+      rms_gradient = sqrt(2*rms_gradient)
+   end subroutine profile_statistics
+end module lc_profiles_profile

@@ -1,0 +1,29 @@
+!> What a contact solve returns: fields on the grid, scalar observables, and the
+!> convergence record. Units are the scene's (lengths L, pressures S).
+module lc_result
+   use lc_kinds, only: wp
+   implicit none (type, external)
+   private
+   public :: contact_result
+
+   !> One solved contact problem (a scene, or its frictionless companion).
+   type :: contact_result
+      real(wp), allocatable :: pressure(:)         !< p >= 0 (S), compressive positive
+      real(wp), allocatable :: gap(:)              !< g >= 0 (L), zero in contact
+      real(wp), allocatable :: displacement_z(:)   !< w = u_z (L), positive into the layer
+      real(wp), allocatable :: residual_history(:) !< complementarity residual per iteration
+      real(wp) :: friction = 0.0_wp           !< mu_c used for this solve
+      real(wp) :: mean_pressure = 0.0_wp      !< p_m (S)
+      real(wp) :: penetration = 0.0_wp        !< Delta (L) of the highest asperity
+      real(wp) :: contact_fraction = 0.0_wp   !< fraction of grid points in contact
+      real(wp) :: delta_mu = 0.0_wp           !< interlocking friction -<p r'>/p_m (seed Eq. 11)
+      real(wp) :: delta_mu_spectral = 0.0_wp  !< the same from the Fourier multiplier
+      real(wp) :: delta_mu_energy = 0.0_wp    !< mu_c <p du_x/dx>/p_m (elastic layers)
+      logical :: converged = .false.
+      integer :: iterations = 0               !< constrained-CG iterations (all inner solves)
+      integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for a symmetric scene
+      integer :: fft_pairs = 0                !< FFT r2c+c2r pairs spent
+      real(wp) :: residual = huge(1.0_wp)     !< final dimensionless complementarity residual
+      real(wp) :: wall_time = 0.0_wp          !< seconds spent in the solver
+   end type contact_result
+end module lc_result

@@ -1,0 +1,102 @@
+!> The main job of the executable (and of `layercontact.run` in Python): namelist file in,
+!> HDF5 result out, a short summary on a unit.
+!>
+!> Order matters for "bad input loses nothing": the input is read and validated and the
+!> output checked (an existing result is never overwritten unless &output overwrite) before
+!> anything is computed; the result file appears only when it is complete.
+module lc_run
+   use lc_kinds, only: wp
+   use lc_errors, only: error_type
+   use lc_scene, only: scene_type
+   use lc_result, only: contact_result
+   use lc_io_namelist, only: read_scene
+   use lc_io_hdf5, only: check_output, write_results
+   use lc_profiles_profile, only: make_profile
+   use lc_contact_solve, only: solve_line_contact
+   use lc_version, only: version_string
+   implicit none (type, external)
+   private
+   public :: run_scene_file
+
+contains
+
+   !> Run the scene in `input`. converged = .false. means the solver stopped before its
+   !> tolerance (results are still written). `unit` < 0 prints nothing.
+   subroutine run_scene_file(input, unit, output_file, converged, error)
+      character(len=*), intent(in) :: input
+      integer, intent(in) :: unit
+      character(len=:), allocatable, intent(out) :: output_file
+      logical, intent(out) :: converged
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(contact_result) :: result, companion
+      character(len=:), allocatable :: text
+      real(wp), allocatable :: height(:)
+
+      converged = .false.
+      call read_scene(input, scene, text, error)
+      if (allocated(error)) return
+      output_file = trim(scene%output_file)
+      call check_output(output_file, scene%overwrite, error)
+      if (allocated(error)) return
+      allocate (height(scene%n))
+      call make_profile(scene, height, error)
+      if (allocated(error)) return
+
+      call solve_line_contact(scene, height, scene%friction, result, error)
+      if (allocated(error)) return
+      converged = result%converged
+      if (scene%companion) then
+         call solve_line_contact(scene, height, 0.0_wp, companion, error)
+         if (allocated(error)) return
+         converged = converged .and. companion%converged
+         call write_results(output_file, scene, text, height, result, companion, version_string, error)
+      else
+         call write_results(output_file, scene, text, height, result, version=version_string, error=error)
+      end if
+      if (allocated(error)) return
+      if (unit >= 0) then
+         if (scene%companion) then
+            call print_summary(unit, input, output_file, scene, result, companion)
+         else
+            call print_summary(unit, input, output_file, scene, result)
+         end if
+      end if
+   end subroutine run_scene_file
+
+   subroutine print_summary(unit, input, output_file, scene, result, companion)
+      integer, intent(in) :: unit
+      character(len=*), intent(in) :: input, output_file
+      type(scene_type), intent(in) :: scene
+      type(contact_result), intent(in) :: result
+      type(contact_result), intent(in), optional :: companion
+      character(len=*), parameter :: real_fmt = '(2x, a, t34, es14.6, 1x, a)'
+      character(len=*), parameter :: int_fmt = '(2x, a, t34, i14, 1x, a)'
+
+      write (unit, '(a)') 'layercontact ' // version_string // ': ' // trim(input)
+      if (len_trim(scene%title) > 0) write (unit, '(2x, a)') trim(scene%title)
+      write (unit, real_fmt) 'thickness h/lambda', scene%thickness/scene%period
+      write (unit, real_fmt) 'Coulomb friction mu_c', result%friction
+      write (unit, real_fmt) 'mean pressure p_m', result%mean_pressure, '(S)'
+      write (unit, real_fmt) 'contact fraction', result%contact_fraction
+      if (present(companion)) then
+         write (unit, real_fmt) 'contact fraction, mu_c = 0', companion%contact_fraction
+         write (unit, real_fmt) 'a/a0', result%contact_fraction/companion%contact_fraction
+      end if
+      write (unit, real_fmt) 'penetration Delta', result%penetration, '(L)'
+      if (present(companion)) write (unit, real_fmt) 'penetration Delta, mu_c = 0', companion%penetration, '(L)'
+      write (unit, real_fmt) 'interlocking friction Delta mu', result%delta_mu
+      write (unit, real_fmt) 'total friction mu_c + Delta mu', result%friction + result%delta_mu
+      write (unit, int_fmt) 'CG iterations', result%iterations
+      write (unit, int_fmt) 'outer (Anderson) iterations', result%outer_iterations
+      write (unit, real_fmt) 'residual', result%residual
+      write (unit, '(2x, a, t34, l14)') 'converged', result%converged
+      if (present(companion)) write (unit, '(2x, a, t34, l14)') 'converged, mu_c = 0', companion%converged
+      if (present(companion)) then
+         write (unit, real_fmt) 'solver time (both runs)', result%wall_time + companion%wall_time, '(s)'
+      else
+         write (unit, real_fmt) 'solver time', result%wall_time, '(s)'
+      end if
+      write (unit, '(2x, a, t34, a)') 'result file', output_file
+   end subroutine print_summary
+end module lc_run

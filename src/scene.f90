@@ -1,0 +1,212 @@
+!> A scene is data: geometry, layer, friction, profile, loading, solver settings and
+!> output of one contact problem, as read from a namelist file or built from Python.
+!> The operator and the solver are built from it (only what it needs); `check_scene`
+!> validates it and names the namelist group and variable of every bad value.
+!>
+!> Units: any consistent set. Lengths (period, thickness, heights, penetration) in one
+!> length unit L, moduli and pressures in one stress unit S. The results are in the same
+!> units; the seed's normalised values are stored next to them.
+module lc_scene
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+   use lc_kinds, only: wp, i8
+   use lc_errors, only: error_type, fatal_error, code_input
+   implicit none (type, external)
+   private
+   public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set
+   public :: max_string
+
+   !> Sentinel for "not given" in optional positive quantities.
+   real(wp), parameter :: not_set = -1.0_wp
+   !> Length of the fixed-size character components (file names, keywords).
+   integer, parameter :: max_string = 512
+
+   !> Rigid indenter profile: how it is made (kind = self_affine | sinusoid | file).
+   type :: profile_spec
+      character(len=max_string) :: kind = 'self_affine'
+      !> self_affine: Hurst exponent, seed, roll-off and shortest wavelengths (L)
+      real(wp) :: hurst = 0.8_wp
+      integer(i8) :: seed = 1_i8
+      real(wp) :: rolloff_wavelength = not_set   !< default: the period
+      real(wp) :: short_wavelength = not_set     !< default: period/128
+      !> scale: give exactly one of rms_gradient (-) and rms_height (L)
+      real(wp) :: rms_gradient = not_set
+      real(wp) :: rms_height = not_set
+      !> sinusoid r(x) = amplitude cos(2 pi mode x / period)
+      real(wp) :: amplitude = not_set
+      integer :: mode = 1
+      !> file: HDF5 file and dataset holding n heights (L)
+      character(len=max_string) :: file = ''
+      character(len=max_string) :: dataset = '/profile/height'
+   end type profile_spec
+
+   !> Solver choice and stopping rule.
+   type :: solver_settings
+      !> auto | cg | anderson: auto picks cg for symmetric operators, anderson otherwise
+      character(len=max_string) :: method = 'auto'
+      !> tolerance on the dimensionless complementarity residual
+      real(wp) :: tol = 1.0e-10_wp
+      integer :: max_iter = 20000
+      !> Anderson memory (number of previous iterates mixed) for coupled problems
+      integer :: memory = 12
+      !> FFTW threads (1 = no threading)
+      integer :: threads = 1
+   end type solver_settings
+
+   !> One contact problem.
+   type :: scene_type
+      character(len=max_string) :: geometry = 'line'
+      character(len=max_string) :: title = ''
+      real(wp) :: period = 1.0_wp          !< lambda (L)
+      integer :: n = 4096                  !< grid points per period
+      real(wp) :: thickness = 0.16_wp      !< h (L); +Inf = half-space
+      real(wp) :: young = 1.0_wp           !< E (S)
+      real(wp) :: poisson = 0.5_wp         !< nu
+      real(wp) :: friction = 0.0_wp        !< Coulomb coefficient mu_c
+      logical :: companion = .false.       !< also solve the frictionless companion
+      type(profile_spec) :: profile
+      character(len=max_string) :: control = 'load'   !< load | displacement
+      real(wp) :: mean_pressure = not_set       !< p_m (S)
+      real(wp) :: normalised_pressure = not_set !< p_m/(E* Lambda/lambda), the seed's scale
+      real(wp) :: penetration = not_set         !< Delta (L), displacement control
+      type(solver_settings) :: solver
+      character(len=max_string) :: output_file = 'layercontact.h5'
+      logical :: overwrite = .false.
+   end type scene_type
+
+contains
+
+   !> True when the layer is a half-space (thickness = +Inf).
+   pure logical function is_halfspace(scene)
+      type(scene_type), intent(in) :: scene
+      is_halfspace = .not. ieee_is_finite(scene%thickness) .and. .not. ieee_is_nan(scene%thickness)
+   end function is_halfspace
+
+   !> Validate a scene; the message names the namelist group, the variable, the value
+   !> and the allowed range.
+   subroutine check_scene(scene, error)
+      type(scene_type), intent(in) :: scene
+      type(error_type), allocatable, intent(out) :: error
+
+      associate (p => scene%profile, s => scene%solver)
+         if (.not. one_of(scene%geometry, [character(len=8) :: 'line'])) then
+            call bad(error, 'scene', 'geometry', trim(scene%geometry), "'line' (areal contacts come later)")
+         else if (.not. positive(scene%period)) then
+            call bad(error, 'scene', 'period', real_str(scene%period), '> 0 and finite')
+         else if (scene%n < 8 .or. scene%n > 2**26) then
+            call bad(error, 'scene', 'n', int_str(scene%n), '8 <= n <= 2**26')
+         else if (ieee_is_nan(scene%thickness) .or. scene%thickness <= 0.0_wp) then
+            call bad(error, 'layer', 'thickness', real_str(scene%thickness), '> 0, or Inf for a half-space')
+         else if (.not. positive(scene%young)) then
+            call bad(error, 'layer', 'young', real_str(scene%young), '> 0 and finite')
+         else if (.not. (scene%poisson > -1.0_wp .and. scene%poisson <= 0.5_wp)) then
+            call bad(error, 'layer', 'poisson', real_str(scene%poisson), '-1 < poisson <= 0.5')
+         else if (.not. (scene%friction >= 0.0_wp .and. scene%friction <= 10.0_wp)) then
+            call bad(error, 'friction', 'coefficient', real_str(scene%friction), '0 <= coefficient <= 10')
+         else if (.not. one_of(p%kind, [character(len=16) :: 'self_affine', 'sinusoid', 'file'])) then
+            call bad(error, 'profile', 'kind', trim(p%kind), "'self_affine', 'sinusoid' or 'file'")
+         end if
+         if (allocated(error)) return
+
+         select case (trim(p%kind))
+         case ('self_affine')
+            if (.not. (p%hurst > 0.0_wp .and. p%hurst < 1.0_wp)) then
+               call bad(error, 'profile', 'hurst', real_str(p%hurst), '0 < hurst < 1')
+            else if (p%seed < 0_i8) then
+               call bad(error, 'profile', 'seed', int_str(int(p%seed)), '>= 0')
+            else if (p%rolloff_wavelength /= not_set .and. .not. (positive(p%rolloff_wavelength) &
+               & .and. p%rolloff_wavelength <= scene%period)) then
+               call bad(error, 'profile', 'rolloff_wavelength', real_str(p%rolloff_wavelength), &
+                  & '0 < rolloff_wavelength <= period')
+            else if (p%short_wavelength /= not_set .and. .not. (p%short_wavelength >= 2*scene%period/scene%n &
+               & .and. p%short_wavelength <= scene%period)) then
+               call bad(error, 'profile', 'short_wavelength', real_str(p%short_wavelength), &
+                  & '2*period/n <= short_wavelength <= period (at least two grid points per wavelength)')
+            else if (count([p%rms_gradient /= not_set, p%rms_height /= not_set]) /= 1) then
+               call bad(error, 'profile', 'rms_gradient/rms_height', 'both or neither given', 'exactly one of them')
+            else if (p%rms_gradient /= not_set .and. .not. positive(p%rms_gradient)) then
+               call bad(error, 'profile', 'rms_gradient', real_str(p%rms_gradient), '> 0 and finite')
+            else if (p%rms_height /= not_set .and. .not. positive(p%rms_height)) then
+               call bad(error, 'profile', 'rms_height', real_str(p%rms_height), '> 0 and finite')
+            end if
+         case ('sinusoid')
+            if (.not. positive(p%amplitude)) then
+               call bad(error, 'profile', 'amplitude', real_str(p%amplitude), '> 0 and finite')
+            else if (p%mode < 1 .or. 2*p%mode >= scene%n) then
+               call bad(error, 'profile', 'mode', int_str(p%mode), '1 <= mode < n/2')
+            end if
+         case ('file')
+            if (len_trim(p%file) == 0) then
+               call bad(error, 'profile', 'file', "''", 'the name of an HDF5 file holding the heights')
+            end if
+         end select
+         if (allocated(error)) return
+
+         if (.not. one_of(scene%control, [character(len=16) :: 'load', 'displacement'])) then
+            call bad(error, 'loading', 'control', trim(scene%control), "'load' or 'displacement'")
+         else if (trim(scene%control) == 'load' .and. &
+            & count([scene%mean_pressure /= not_set, scene%normalised_pressure /= not_set]) /= 1) then
+            call bad(error, 'loading', 'mean_pressure/normalised_pressure', 'both or neither given', &
+               & "exactly one of them with control = 'load'")
+         else if (trim(scene%control) == 'load' .and. scene%mean_pressure /= not_set &
+            & .and. .not. positive(scene%mean_pressure)) then
+            call bad(error, 'loading', 'mean_pressure', real_str(scene%mean_pressure), '> 0 and finite')
+         else if (trim(scene%control) == 'load' .and. scene%normalised_pressure /= not_set &
+            & .and. .not. positive(scene%normalised_pressure)) then
+            call bad(error, 'loading', 'normalised_pressure', real_str(scene%normalised_pressure), '> 0 and finite')
+         else if (trim(scene%control) == 'displacement' .and. .not. positive(scene%penetration)) then
+            call bad(error, 'loading', 'penetration', real_str(scene%penetration), "> 0 and finite with control = 'displacement'")
+         else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'anderson'])) then
+            call bad(error, 'solver', 'method', trim(s%method), "'auto', 'cg' or 'anderson'")
+         else if (.not. (s%tol >= 1.0e-14_wp .and. s%tol <= 1.0e-2_wp)) then
+            call bad(error, 'solver', 'tol', real_str(s%tol), '1e-14 <= tol <= 1e-2')
+         else if (s%max_iter < 1) then
+            call bad(error, 'solver', 'max_iter', int_str(s%max_iter), '>= 1')
+         else if (s%memory < 1 .or. s%memory > 100) then
+            call bad(error, 'solver', 'memory', int_str(s%memory), '1 <= memory <= 100')
+         else if (s%threads < 1 .or. s%threads > 1024) then
+            call bad(error, 'solver', 'threads', int_str(s%threads), '1 <= threads <= 1024')
+         else if (trim(s%method) == 'cg' .and. scene%friction > 0.0_wp) then
+            call bad(error, 'solver', 'method', 'cg', "'auto' or 'anderson' when friction coefficient > 0 " // &
+               & '(the coupled operator is not symmetric)')
+         end if
+      end associate
+   end subroutine check_scene
+
+   pure logical function positive(x)
+      real(wp), intent(in) :: x
+      positive = ieee_is_finite(x) .and. x > 0.0_wp
+   end function positive
+
+   pure logical function one_of(word, words)
+      character(len=*), intent(in) :: word
+      character(len=*), intent(in) :: words(:)
+      integer :: i
+      one_of = .false.
+      do i = 1, size(words)
+         if (trim(word) == trim(words(i))) one_of = .true.
+      end do
+   end function one_of
+
+   subroutine bad(error, group, variable, value, allowed)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: group, variable, value, allowed
+      call fatal_error(error, '&' // group // ': ' // variable // ' = ' // value // ' is not allowed; allowed: ' &
+         & // allowed, code_input)
+   end subroutine bad
+
+   pure function real_str(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: s
+      character(len=32) :: buffer
+      write (buffer, '(es12.5)') x
+      s = trim(adjustl(buffer))
+   end function real_str
+
+   pure function int_str(i) result(s)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buffer
+      write (buffer, '(i0)') i
+      s = trim(buffer)
+   end function int_str
+end module lc_scene

@@ -1,0 +1,318 @@
+!> Unit tests of the input/output modules: namelist parsing and its error messages,
+!> the namelist echo round trip, the output pre-check, the HDF5 writer and profile reader.
+!> Run in a scratch directory: files are created under ./test_io_scratch/.
+program test_io
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf
+   use lc_kinds, only: wp, i8
+   use lc_errors, only: error_type, code_input, code_io
+   use lc_scene, only: scene_type, not_set
+   use lc_result, only: contact_result
+   use lc_io_namelist, only: read_scene, read_scene_text, write_scene_namelist
+   use lc_io_hdf5, only: check_output, write_results, read_profile_heights
+   implicit none (type, external)
+
+   character(len=*), parameter :: dir = 'test_io_scratch'
+   character(len=*), parameter :: nl = new_line('a')
+   integer :: failures
+
+   failures = 0
+   call test_valid_namelist()
+   call test_namelist_errors()
+   call test_round_trip()
+   call test_check_output()
+   call test_write_and_read()
+   if (failures > 0) then
+      write (*, '(i0, a)') failures, ' check(s) failed'
+      error stop 1
+   end if
+   write (*, '(a)') 'test_io: all checks passed'
+
+contains
+
+   subroutine check(condition, label)
+      logical, intent(in) :: condition
+      character(len=*), intent(in) :: label
+      if (.not. condition) then
+         failures = failures + 1
+         write (*, '(a)') 'FAILED: ' // label
+      end if
+   end subroutine check
+
+   !> The error exists, has `code` and its message contains every one of `parts`.
+   subroutine check_error(error, code, parts, label)
+      type(error_type), allocatable, intent(in) :: error
+      integer, intent(in) :: code
+      character(len=*), intent(in) :: parts(:)
+      character(len=*), intent(in) :: label
+      integer :: i
+      call check(allocated(error), label // ': an error is returned')
+      if (.not. allocated(error)) return
+      call check(error%code == code, label // ': error code')
+      do i = 1, size(parts)
+         call check(index(error%message, trim(parts(i))) > 0, label // ": message contains '" // trim(parts(i)) &
+            & // "'; got: " // error%message)
+      end do
+   end subroutine check_error
+
+   subroutine write_text(filename, text)
+      character(len=*), intent(in) :: filename, text
+      integer :: unit
+      open (newunit=unit, file=filename, access='stream', form='unformatted', status='replace', action='write')
+      write (unit) text
+      close (unit)
+   end subroutine write_text
+
+   logical function file_exists(filename)
+      character(len=*), intent(in) :: filename
+      inquire (file=filename, exist=file_exists)
+   end function file_exists
+
+   subroutine test_valid_namelist()
+      type(scene_type) :: scene
+      type(error_type), allocatable :: error
+      character(len=:), allocatable :: text, input
+
+      call make_dir()
+      ! comments, quotes holding '&' and '!', upper case, CR LF and an `&end` terminator
+      input = '! a comment naming &nothing' // nl &
+         & // "&scene title = 'A & B ! not a comment', n = 64 /" // nl &
+         & // '&LAYER thickness = Inf, young = 2.5 ! modulus' // achar(13) // nl &
+         & // '  poisson = 0.3 /' // nl &
+         & // '&profile kind = "sinusoid", amplitude = 0.01, mode = 3' // nl &
+         & // '&end' // nl &
+         & // '&loading normalised_pressure = 0.2 /' // nl &
+         & // '&friction coefficient = 0.4, companion = .true. /' // nl
+      call write_text(dir // '/valid.nml', input)
+      call read_scene(dir // '/valid.nml', scene, text, error)
+      call check(.not. allocated(error), 'valid namelist is accepted')
+      if (allocated(error)) then
+         write (*, '(a)') error%message
+         return
+      end if
+      call check(text == input, 'the file text is kept')
+      call check(trim(scene%title) == 'A & B ! not a comment', 'title')
+      call check(scene%n == 64, 'n')
+      call check(scene%thickness > huge(1.0_wp), 'thickness = Inf')
+      call check(scene%young == 2.5_wp .and. scene%poisson == 0.3_wp, 'young, poisson')
+      call check(trim(scene%profile%kind) == 'sinusoid' .and. scene%profile%mode == 3, 'profile')
+      call check(scene%normalised_pressure == 0.2_wp .and. scene%mean_pressure == not_set, 'loading')
+      call check(scene%friction == 0.4_wp .and. scene%companion, 'friction')
+      call check(scene%period == 1.0_wp .and. scene%solver%max_iter == 20000, 'defaults from scene_type')
+   end subroutine test_valid_namelist
+
+   subroutine test_namelist_errors()
+      type(scene_type) :: scene
+      type(error_type), allocatable :: error
+      character(len=:), allocatable :: text
+      character(len=*), parameter :: loading = '&loading mean_pressure = 0.1 /' // nl
+
+      call read_scene_text('&scene n = 64 /' // nl // nl // '&layr thickness = 1 /' // nl, 'a.nml', scene, error)
+      call check_error(error, code_input, [character(len=40) :: 'a.nml', 'line 3', "'&layr'", &
+         & '&scene, &layer, &friction, &profile', '&output'], 'unknown group')
+
+      call read_scene_text('&layer young = 2 /' // nl // "&scene title = '&x' /" // nl // '&layer /' // nl, &
+         & 'b.nml', scene, error)
+      call check_error(error, code_input, [character(len=40) :: 'b.nml', 'line 3', "'&layer'", 'twice'], &
+         & 'repeated group')
+
+      call read_scene_text(loading // '&layer' // nl // '   young = 2,' // nl // '   thicknes = 1' // nl // '/' // nl, &
+         & 'c.nml', scene, error)
+      call check_error(error, code_input, [character(len=60) :: 'c.nml', 'line 4', 'group &layer', &
+         & 'Cannot match namelist object name thicknes', 'allowed variables in &layer: thickness, young, poisson'], &
+         & 'unknown variable')
+
+      call read_scene_text(loading // '&layer thickness = 1' // nl // nl // '  young = abc /' // nl, &
+         & 'd.nml', scene, error)
+      call check_error(error, code_input, [character(len=40) :: 'd.nml', 'line 4', 'group &layer', 'abc'], &
+         & 'bad real value')
+
+      call read_scene_text(loading // '&scene' // nl // '  period = 2.0' // nl // '  n = 2.5' // nl // '/', &
+         & 'e.nml', scene, error)
+      call check_error(error, code_input, [character(len=40) :: 'e.nml', 'line 4', 'group &scene', &
+         & 'allowed variables in &scene'], 'bad integer value')
+
+      call read_scene_text(loading // '&friction companion = yes /', 'f.nml', scene, error)
+      call check_error(error, code_input, [character(len=40) :: 'f.nml', 'line 2', 'group &friction'], &
+         & 'bad logical value')
+
+      call read_scene_text(loading // '&solver tol = 1e-8' // nl // 'max_iter = 10' // nl, 'g.nml', scene, error)
+      call check_error(error, code_input, [character(len=40) :: 'g.nml', 'line 2', 'group &solver', "'/'"], &
+         & 'missing terminator')
+
+      call read_scene_text(loading // '&layer poisson = 0.7 /', 'h.nml', scene, error)
+      call check_error(error, code_input, [character(len=40) :: '&layer: poisson'], 'check_scene error is returned')
+
+      call read_scene(dir // '/does_not_exist.nml', scene, text, error)
+      call check_error(error, code_io, [character(len=40) :: 'does_not_exist.nml'], 'missing file')
+   end subroutine test_namelist_errors
+
+   subroutine test_round_trip()
+      type(scene_type) :: scene, back
+      type(error_type), allocatable :: error
+      character(len=:), allocatable :: text, again
+
+      scene%title = "it's a test, with & and !"
+      scene%period = 3.0_wp
+      scene%n = 512
+      scene%thickness = ieee_value(1.0_wp, ieee_positive_inf)
+      scene%young = 1.0_wp / 3.0_wp
+      scene%poisson = 0.25_wp
+      scene%friction = 0.3_wp
+      scene%companion = .true.
+      scene%profile%hurst = 0.7_wp
+      scene%profile%seed = 123456789012_i8
+      scene%profile%rolloff_wavelength = 0.5_wp
+      scene%profile%short_wavelength = 0.1_wp
+      scene%profile%rms_height = 1.0e-3_wp / 7.0_wp
+      scene%profile%file = 'heights.h5'
+      scene%control = 'displacement'
+      scene%penetration = 2.0e-3_wp
+      scene%solver%method = 'anderson'
+      scene%solver%tol = 1.0e-9_wp
+      scene%solver%memory = 7
+      scene%output_file = 'out/result.h5'
+      scene%overwrite = .true.
+
+      call write_scene_namelist(scene, text)
+      call read_scene_text(text, 'echo', back, error)
+      call check(.not. allocated(error), 'the echo is a valid namelist')
+      if (allocated(error)) then
+         write (*, '(a)') error%message
+         return
+      end if
+      call check(same_scene(scene, back), 'read_scene_text(write_scene_namelist(scene)) == scene')
+      call write_scene_namelist(back, again)
+      call check(text == again, 'the echo of the echo is identical')
+
+      call write_text(dir // '/echo.nml', text)
+      call read_scene(dir // '/echo.nml', back, again, error)
+      call check(.not. allocated(error), 'the echo reads back from a file')
+      call check(same_scene(scene, back), 'read_scene(echo file) == scene')
+
+      ! the defaults too: a default scene fails check_scene (no load, no roughness scale)
+      back = scene_type()
+      back%normalised_pressure = 0.1_wp
+      back%profile%rms_gradient = 0.1_wp
+      call write_scene_namelist(back, text)
+      call read_scene_text(text, 'default echo', scene, error)
+      call check(.not. allocated(error), 'the echo of the default scene is valid')
+      call check(same_scene(scene, back), 'default scene round trip')
+   end subroutine test_round_trip
+
+   logical function same_scene(a, b)
+      type(scene_type), intent(in) :: a, b
+      same_scene = a%geometry == b%geometry .and. a%title == b%title .and. a%period == b%period &
+         & .and. a%n == b%n .and. a%thickness == b%thickness .and. a%young == b%young &
+         & .and. a%poisson == b%poisson .and. a%friction == b%friction .and. (a%companion .eqv. b%companion) &
+         & .and. a%profile%kind == b%profile%kind .and. a%profile%hurst == b%profile%hurst &
+         & .and. a%profile%seed == b%profile%seed .and. a%profile%rolloff_wavelength == b%profile%rolloff_wavelength &
+         & .and. a%profile%short_wavelength == b%profile%short_wavelength &
+         & .and. a%profile%rms_gradient == b%profile%rms_gradient .and. a%profile%rms_height == b%profile%rms_height &
+         & .and. a%profile%amplitude == b%profile%amplitude .and. a%profile%mode == b%profile%mode &
+         & .and. a%profile%file == b%profile%file .and. a%profile%dataset == b%profile%dataset &
+         & .and. a%control == b%control .and. a%mean_pressure == b%mean_pressure &
+         & .and. a%normalised_pressure == b%normalised_pressure .and. a%penetration == b%penetration &
+         & .and. a%solver%method == b%solver%method .and. a%solver%tol == b%solver%tol &
+         & .and. a%solver%max_iter == b%solver%max_iter .and. a%solver%memory == b%solver%memory &
+         & .and. a%solver%threads == b%solver%threads .and. a%output_file == b%output_file &
+         & .and. (a%overwrite .eqv. b%overwrite)
+   end function same_scene
+
+   subroutine test_check_output()
+      type(error_type), allocatable :: error
+      logical :: exists
+
+      call write_text(dir // '/existing.h5', 'x')
+      call check_output(dir // '/existing.h5', .false., error)
+      call check_error(error, code_io, [character(len=40) :: 'existing.h5', 'set &output overwrite = .true.'], &
+         & 'existing output file is refused')
+      call check_output(dir // '/existing.h5', .true., error)
+      call check(.not. allocated(error), 'existing output file with overwrite is accepted')
+
+      call check_output(dir // '/new/deeper/result.h5', .false., error)
+      call check(.not. allocated(error), 'missing parent directories are created')
+      inquire (file=dir // '/new/deeper/.', exist=exists)
+      call check(exists, 'the parent directory exists afterwards')
+
+      call check_output(dir // '/existing.h5/result.h5', .false., error)
+      call check_error(error, code_io, [character(len=40) :: 'existing.h5'], 'a file in the way of the directory')
+   end subroutine test_check_output
+
+   subroutine test_write_and_read()
+      integer, parameter :: n = 16
+      character(len=*), parameter :: file = dir // '/new/deeper/result.h5'
+      type(scene_type) :: scene
+      type(contact_result) :: result, companion
+      type(error_type), allocatable :: error
+      real(wp) :: height(n), back(n), short(n/2)
+      integer :: j
+
+      scene%n = n
+      scene%friction = 0.2_wp
+      scene%companion = .true.
+      scene%normalised_pressure = 0.1_wp
+      height = [(0.01_wp*cos(8*atan(1.0_wp)*j/n), j=0, n - 1)]
+      call fake_result(n, 0.2_wp, 0.5_wp, result)
+      call fake_result(n, 0.0_wp, 0.4_wp, companion)
+
+      call write_text(file // '.tmp', 'stale')
+      call write_results(file, scene, '&scene n = 16 /', height, result, companion, '0.1.0-test', error)
+      call check(.not. allocated(error), 'write_results succeeds')
+      if (allocated(error)) write (*, '(a)') error%message
+      call check(file_exists(file), 'the result file exists')
+      call check(.not. file_exists(file // '.tmp'), 'no .tmp remains')
+
+      ! again, over the existing file and without a companion (HDF5 opened and closed again)
+      call write_results(dir // '/plain.h5', scene, '', height, result, version='0.1.0-test', error=error)
+      call check(.not. allocated(error), 'write_results succeeds a second time')
+
+      call write_results(dir // '/no_such_dir/result.h5', scene, '', height, result, version='x', error=error)
+      call check_error(error, code_io, [character(len=40) :: 'no_such_dir/result.h5', 'HDF5 failed at'], &
+         & 'write into a missing directory')
+      call check(.not. file_exists(dir // '/no_such_dir/result.h5.tmp'), 'no .tmp after a failure')
+
+      call read_profile_heights(file, '/profile/height', n, back, error)
+      call check(.not. allocated(error), 'read_profile_heights succeeds')
+      call check(all(back == height), 'the heights read back exactly')
+
+      call read_profile_heights(file, '/profile/height', n/2, short, error)
+      call check_error(error, code_input, [character(len=40) :: 'result.h5', '/profile/height', '16 values', &
+         & 'n = 8'], 'wrong number of heights')
+      call read_profile_heights(file, '/profile/nothing', n, back, error)
+      call check_error(error, code_io, [character(len=40) :: 'result.h5', '/profile/nothing'], 'missing dataset')
+      call read_profile_heights(dir // '/valid.nml', '/profile/height', n, back, error)
+      call check_error(error, code_io, [character(len=40) :: 'valid.nml'], 'not an HDF5 file')
+   end subroutine test_write_and_read
+
+   !> A made-up result with recognisable values (no solver involved).
+   subroutine fake_result(n, friction, fraction, res)
+      integer, intent(in) :: n
+      real(wp), intent(in) :: friction, fraction
+      type(contact_result), intent(out) :: res
+      integer :: j
+      allocate (res%pressure(n), res%gap(n), res%displacement_z(n), res%residual_history(3))
+      do j = 1, n
+         res%pressure(j) = max(0.0_wp, real(n/2 - j, wp))
+         res%gap(j) = max(0.0_wp, real(j - n/2, wp))
+         res%displacement_z(j) = 1.0e-3_wp*j
+      end do
+      res%residual_history(:) = [1.0_wp, 1.0e-4_wp, 1.0e-11_wp]
+      res%friction = friction
+      res%mean_pressure = 0.1_wp
+      res%penetration = 0.02_wp
+      res%contact_fraction = fraction
+      res%delta_mu = 0.01_wp
+      res%converged = .true.
+      res%iterations = 3
+      res%fft_pairs = 4
+      res%residual = 1.0e-11_wp
+      res%wall_time = 0.5_wp
+   end subroutine fake_result
+
+   subroutine make_dir()
+      type(error_type), allocatable :: error
+      ! check_output creates the directory (mkdir -p) and is itself under test below
+      call check_output(dir // '/placeholder', .true., error)
+      call check(.not. allocated(error), 'scratch directory')
+   end subroutine make_dir
+end program test_io

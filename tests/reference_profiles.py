@@ -1,0 +1,107 @@
+"""Pure-numpy reference of the self-affine profile synthesis.
+
+Implements the algorithm documented in the header of
+``src/profiles/self_affine.f90`` (module ``lc_profiles_self_affine``), so that tests can
+check that the Fortran library and Python produce the same profile to roundoff. Change
+both together.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_GAMMA = np.uint64(0x9E3779B97F4A7C15)
+_MIX1 = np.uint64(0xBF58476D1CE4E5B9)
+_MIX2 = np.uint64(0x94D049BB133111EB)
+
+
+def splitmix64(seed: int, m: np.ndarray) -> np.ndarray:
+    """Return the m-th SplitMix64 outputs (m = 1, 2, ...) for ``seed`` as uint64.
+
+    Parameters
+    ----------
+    seed : int
+        Seed, 0 <= seed < 2**64.
+    m : array_like of int
+        Output indices, 1 for the first output.
+
+    Returns
+    -------
+    numpy.ndarray of uint64
+        ``state_m = seed + m*0x9E3779B97F4A7C15 mod 2**64`` passed through the
+        SplitMix64 mixing function; uint64 arithmetic wraps mod 2**64.
+    """
+    m = np.asarray(m, dtype=np.uint64)
+    with np.errstate(over="ignore"):
+        z = np.uint64(seed) + m * _GAMMA
+        z = (z ^ (z >> np.uint64(30))) * _MIX1
+        z = (z ^ (z >> np.uint64(27))) * _MIX2
+    return z ^ (z >> np.uint64(31))
+
+
+def splitmix64_uniform(seed: int, m: np.ndarray) -> np.ndarray:
+    """Return the m-th SplitMix64 outputs mapped to [0, 1): ``(z >> 11) * 2**-53``."""
+    return (splitmix64(seed, m) >> np.uint64(11)).astype(np.float64) * 2.0**-53
+
+
+def self_affine_reference(
+    n: int,
+    period: float,
+    hurst: float,
+    seed: int,
+    rolloff_wavelength: float | None = None,
+    short_wavelength: float | None = None,
+    rms_gradient: float | None = None,
+    rms_height: float | None = None,
+) -> np.ndarray:
+    """Return the heights of a random self-affine line profile.
+
+    Parameters
+    ----------
+    n : int
+        Grid points per period; x_j = j*period/n, j = 0..n-1.
+    period : float
+        Period lambda (length unit L).
+    hurst : float
+        Hurst exponent H, 0 < H < 1; the spectrum is C(q) ~ q**(-1-2H).
+    seed : int
+        SplitMix64 seed, >= 0.
+    rolloff_wavelength : float, optional
+        Roll-off wavelength (L); default: the period.
+    short_wavelength : float, optional
+        Shortest wavelength (L); default: period/128.
+    rms_gradient, rms_height : float, optional
+        Scale target; give exactly one.
+
+    Returns
+    -------
+    numpy.ndarray
+        The n heights (L), zero mean.
+    """
+    if (rms_gradient is None) == (rms_height is None):
+        raise ValueError("give exactly one of rms_gradient and rms_height")
+    if rolloff_wavelength is None:
+        rolloff_wavelength = period
+    if short_wavelength is None:
+        short_wavelength = period / 128
+    m_max = n // 2 - 1
+    # Python's round() rounds half to even; Fortran's nint rounds half away from zero.
+    m_r = int(np.floor(period / rolloff_wavelength + 0.5))
+    m_s = min(int(np.floor(period / short_wavelength + 0.5)), m_max)
+    if m_r > m_s:
+        raise ValueError("roll-off mode above the shortest mode")
+
+    m = np.arange(1, m_max + 1)
+    q = 2 * np.pi * m / period
+    amplitude = np.where(m < m_r, 1.0, (m / m_r) ** (-0.5 * (1 + 2 * hurst)))
+    amplitude[m > m_s] = 0.0
+    if rms_gradient is not None:
+        scale = rms_gradient / np.sqrt(np.sum((q * amplitude) ** 2) / 2)
+    else:
+        scale = rms_height / np.sqrt(np.sum(amplitude**2) / 2)
+
+    phase = 2 * np.pi * splitmix64_uniform(seed, m)
+    spectrum = np.zeros(n // 2 + 1, dtype=np.complex128)
+    spectrum[1 : m_max + 1] = scale * amplitude / 2 * np.exp(1j * phase)
+    # irfft divides by n; the Fortran c2r transform does not.
+    return np.fft.irfft(spectrum, n) * n
