@@ -65,7 +65,7 @@ end subroutine py_self_affine_profile
 !> Solve a line contact on the given heights. control: 0 load, 1 displacement;
 !> method: 0 auto, 1 cg, 2 anderson. scalars: mean_pressure, penetration, contact_fraction,
 !> delta_mu, delta_mu_spectral, delta_mu_energy, converged (0/1), iterations,
-!> outer_iterations, fft_pairs, residual, wall_time, history length.
+!> outer_iterations, fft_pairs, residual, wall_time, history length, delta_mu_profile.
 subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
       & penetration, method, tol, max_iter, memory, threads, pressure, gap, displacement_z, scalars, history, &
       & stat, errmsg)
@@ -76,7 +76,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    implicit none (type, external)
    integer, intent(in) :: n, control, method, max_iter, memory, threads
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
-   real(8), intent(out) :: pressure(n), gap(n), displacement_z(n), scalars(13), history(max_iter)
+   real(8), intent(out) :: pressure(n), gap(n), displacement_z(n), scalars(14), history(max_iter)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
@@ -118,7 +118,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    scalars = [res%mean_pressure, res%penetration, res%contact_fraction, res%delta_mu, res%delta_mu_spectral, &
       & res%delta_mu_energy, merge(1.0d0, 0.0d0, res%converged), real(res%iterations, 8), &
       & real(res%outer_iterations, 8), real(res%fft_pairs, 8), res%residual, res%wall_time, &
-      & real(size(res%residual_history), 8)]
+      & real(size(res%residual_history), 8), res%delta_mu_profile]
 end subroutine py_solve_line
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless

@@ -16,9 +16,10 @@ module lc_result
       real(wp) :: mean_pressure = 0.0_wp      !< p_m (S)
       real(wp) :: penetration = 0.0_wp        !< Delta (L) of the highest asperity
       real(wp) :: contact_fraction = 0.0_wp   !< fraction of grid points in contact
-      real(wp) :: delta_mu = 0.0_wp           !< interlocking friction -<p r'>/p_m (seed Eq. 11)
+      real(wp) :: delta_mu = 0.0_wp           !< interlocking friction <p v_z'>/p_m (seed Eq. 11)
       real(wp) :: delta_mu_spectral = 0.0_wp  !< the same from the Fourier multiplier
       real(wp) :: delta_mu_energy = 0.0_wp    !< mu_c <p du_x/dx>/p_m (elastic layers)
+      real(wp) :: delta_mu_profile = 0.0_wp   !< -<p r'>/p_m: force balance on the rigid profile
       logical :: converged = .false.
       integer :: iterations = 0               !< constrained-CG iterations (all inner solves)
       integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for a symmetric scene

@@ -73,6 +73,7 @@ class LineResult:
     delta_mu: float
     delta_mu_spectral: float
     delta_mu_energy: float
+    delta_mu_profile: float
     converged: bool
     iterations: int
     outer_iterations: int
@@ -130,7 +131,7 @@ def solve_line(
     return LineResult(
         pressure=p, gap=g, displacement_z=w, height=h.copy(), period=float(period), friction=float(friction),
         mean_pressure=s[0], penetration=s[1], contact_fraction=s[2], delta_mu=s[3], delta_mu_spectral=s[4],
-        delta_mu_energy=s[5], converged=bool(s[6]), iterations=int(s[7]), outer_iterations=int(s[8]),
+        delta_mu_energy=s[5], delta_mu_profile=s[13], converged=bool(s[6]), iterations=int(s[7]), outer_iterations=int(s[8]),
         fft_pairs=int(s[9]), residual=s[10], wall_time=s[11], residual_history=hist[: int(s[12])].copy(),
     )
 
@@ -150,7 +151,8 @@ def read_result(filename: str | os.PathLike, companion: bool = False) -> LineRes
             friction=float(r["friction"]), mean_pressure=float(r["mean_pressure"]),
             penetration=float(r["penetration"]), contact_fraction=float(r["contact_fraction"]),
             delta_mu=float(r["delta_mu"]), delta_mu_spectral=float(r["delta_mu_spectral"]),
-            delta_mu_energy=float(r["delta_mu_energy"]), converged=bool(r["converged"]),
+            delta_mu_energy=float(r["delta_mu_energy"]), delta_mu_profile=float(r["delta_mu_profile"]),
+            converged=bool(r["converged"]),
             iterations=int(r["iterations"]), outer_iterations=int(r.get("outer_iterations", 1)),
             fft_pairs=int(r["fft_pairs"]), residual=float(r["residual"]), wall_time=float(r["wall_time"]),
             residual_history=base["convergence/residual"][()],

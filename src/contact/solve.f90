@@ -119,8 +119,8 @@ contains
       result%penetration = s + lambda_max
       result%contact_fraction = real(count(p > 0.0_wp), wp)/n
       if (result%mean_pressure > 0.0_wp) then
-         call interlocking_friction(op, p, height, scene%thickness, scene%young, scene%poisson, &
-            & result%delta_mu, result%delta_mu_spectral, result%delta_mu_energy)
+         call interlocking_friction(op, p, w, height, scene%thickness, scene%young, scene%poisson, &
+            & result%delta_mu, result%delta_mu_spectral, result%delta_mu_energy, result%delta_mu_profile)
       end if
       call system_clock(finish)
       result%wall_time = real(finish - start, wp)/real(rate, wp)

@@ -13,9 +13,9 @@
 !> (h5open_f/h5close_f) and switches off HDF5's own error printing: failures come back as
 !> `error_type` messages naming the file and the object instead.
 module lc_io_hdf5
-   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_loc
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-   use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5close_f, h5eset_auto_f, &
+   use hdf5, only: hid_t, hsize_t, size_t, h5kind_to_type, H5_INTEGER_KIND, h5open_f, h5close_f, h5eset_auto_f, &
       & h5fcreate_f, h5fopen_f, h5fclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5F_CLOSE_STRONG_F, &
       & h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, &
       & h5gcreate_f, h5gclose_f, h5iget_name_f, &
@@ -25,7 +25,7 @@ module lc_io_hdf5
       & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
       & h5acreate_f, h5awrite_f, h5aclose_f, &
       & h5dcreate_f, h5dopen_f, h5dwrite_f, h5dread_f, h5dclose_f, h5dget_space_f, h5dget_type_f
-   use lc_kinds, only: wp
+   use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
    use lc_scene, only: scene_type
    use lc_result, only: contact_result
@@ -226,15 +226,15 @@ contains
       call h5eset_auto_f(0, ignore)
       call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, ignore)
       call h5pset_fclose_degree_f(fapl, H5F_CLOSE_STRONG_F, ignore)
-      read: block
+      reading: block
          if (hdferr /= 0) then
             call fatal_error(error, 'cannot initialise HDF5 to read ' // where, code_io)
-            exit read
+            exit reading
          end if
          call h5fopen_f(filename, H5F_ACC_RDONLY_F, file, hdferr, access_prp=fapl)
          if (hdferr /= 0) then
             call fatal_error(error, "cannot open profile file '" // filename // "' as HDF5", code_io)
-            exit read
+            exit reading
          end if
          call h5dopen_f(file, dataset, dset, hdferr)
          if (hdferr /= 0) then
@@ -260,7 +260,7 @@ contains
             call h5dclose_f(dset, ignore)
          end if
          call h5fclose_f(file, ignore)
-      end block read
+      end block reading
       call h5pclose_f(fapl, ignore)
       call h5close_f(ignore)
    end subroutine read_profile_heights
@@ -286,8 +286,7 @@ contains
       associate (p => scene%profile)
          call write_attr_string(loc, 'profile_kind', trim(p%kind), st)
          call write_attr_real(loc, 'hurst', p%hurst, st)
-         ! the seed is a 64-bit integer; stored as a double it stays exact below 2**53
-         call write_attr_real(loc, 'seed', real(p%seed, wp), st)
+         call write_attr_int64(loc, 'seed', p%seed, st)
          call write_attr_real(loc, 'rolloff_wavelength', p%rolloff_wavelength, st)
          call write_attr_real(loc, 'short_wavelength', p%short_wavelength, st)
          call write_attr_real(loc, 'rms_gradient', p%rms_gradient, st)
@@ -337,8 +336,10 @@ contains
       call write_attr_real(group, 'delta_mu', res%delta_mu, st)
       call write_attr_real(group, 'delta_mu_spectral', res%delta_mu_spectral, st)
       call write_attr_real(group, 'delta_mu_energy', res%delta_mu_energy, st)
+      call write_attr_real(group, 'delta_mu_profile', res%delta_mu_profile, st)
       call write_attr_int(group, 'converged', merge(1, 0, res%converged), st)
       call write_attr_int(group, 'iterations', res%iterations, st)
+      call write_attr_int(group, 'outer_iterations', res%outer_iterations, st)
       call write_attr_int(group, 'fft_pairs', res%fft_pairs, st)
       call write_attr_real(group, 'residual', res%residual, st)
       call write_attr_real(group, 'wall_time', res%wall_time, st)
@@ -404,66 +405,67 @@ contains
    subroutine write_attr_real(loc, name, value, st)
       integer(hid_t), intent(in) :: loc
       character(len=*), intent(in) :: name
-      real(wp), intent(in) :: value
+      real(wp), intent(in), target :: value
       type(h5_status), intent(inout) :: st
-      integer(hid_t) :: space, attr
-      integer :: ignore
-      if (st%hdferr /= 0) return
-      call h5screate_f(H5S_SCALAR_F, space, st%hdferr)
-      if (st%hdferr == 0) then
-         call h5acreate_f(loc, name, H5T_NATIVE_DOUBLE, space, attr, st%hdferr)
-         if (st%hdferr == 0) then
-            call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, [1_hsize_t], st%hdferr)
-            call h5aclose_f(attr, ignore)
-         end if
-         call h5sclose_f(space, ignore)
-      end if
-      if (st%hdferr /= 0) call failed(loc, '@' // name, st)
+      call write_attr(loc, name, H5T_NATIVE_DOUBLE, c_loc(value), st)
    end subroutine write_attr_real
 
    subroutine write_attr_int(loc, name, value, st)
       integer(hid_t), intent(in) :: loc
       character(len=*), intent(in) :: name
-      integer, intent(in) :: value
+      integer, intent(in), target :: value
       type(h5_status), intent(inout) :: st
-      integer(hid_t) :: space, attr
-      integer :: ignore
-      if (st%hdferr /= 0) return
-      call h5screate_f(H5S_SCALAR_F, space, st%hdferr)
-      if (st%hdferr == 0) then
-         call h5acreate_f(loc, name, H5T_NATIVE_INTEGER, space, attr, st%hdferr)
-         if (st%hdferr == 0) then
-            call h5awrite_f(attr, H5T_NATIVE_INTEGER, value, [1_hsize_t], st%hdferr)
-            call h5aclose_f(attr, ignore)
-         end if
-         call h5sclose_f(space, ignore)
-      end if
-      if (st%hdferr /= 0) call failed(loc, '@' // name, st)
+      call write_attr(loc, name, H5T_NATIVE_INTEGER, c_loc(value), st)
    end subroutine write_attr_int
+
+   !> 64-bit integer attribute (a seed need not fit the 53 bits of a double).
+   subroutine write_attr_int64(loc, name, value, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      integer(i8), intent(in), target :: value
+      type(h5_status), intent(inout) :: st
+      call write_attr(loc, name, h5kind_to_type(i8, H5_INTEGER_KIND), c_loc(value), st)
+   end subroutine write_attr_int64
 
    !> Null-terminated fixed-length string attribute (h5py reads it as bytes).
    subroutine write_attr_string(loc, name, value, st)
       integer(hid_t), intent(in) :: loc
       character(len=*), intent(in) :: name, value
       type(h5_status), intent(inout) :: st
-      integer(hid_t) :: space, attr, stype
+      character(len=len(value) + 1), target :: buffer
+      integer(hid_t) :: stype
       integer :: ignore
       if (st%hdferr /= 0) return
       call string_type(len(value), stype, st%hdferr)
+      if (st%hdferr /= 0) then
+         call failed(loc, '@' // name, st)
+         return
+      end if
+      buffer = value // c_null_char
+      call write_attr(loc, name, stype, c_loc(buffer), st)
+      call h5tclose_f(stype, ignore)
+   end subroutine write_attr_string
+
+   !> Scalar attribute `name` of type `dtype` (file and memory) holding the value at `buffer`.
+   subroutine write_attr(loc, name, dtype, buffer, st)
+      integer(hid_t), intent(in) :: loc, dtype
+      character(len=*), intent(in) :: name
+      type(c_ptr), intent(in) :: buffer
+      type(h5_status), intent(inout) :: st
+      integer(hid_t) :: space, attr
+      integer :: ignore
+      if (st%hdferr /= 0) return
+      call h5screate_f(H5S_SCALAR_F, space, st%hdferr)
       if (st%hdferr == 0) then
-         call h5screate_f(H5S_SCALAR_F, space, st%hdferr)
+         call h5acreate_f(loc, name, dtype, space, attr, st%hdferr)
          if (st%hdferr == 0) then
-            call h5acreate_f(loc, name, stype, space, attr, st%hdferr)
-            if (st%hdferr == 0) then
-               call h5awrite_f(attr, stype, value // c_null_char, [1_hsize_t], st%hdferr)
-               call h5aclose_f(attr, ignore)
-            end if
-            call h5sclose_f(space, ignore)
+            call h5awrite_f(attr, dtype, buffer, st%hdferr)
+            call h5aclose_f(attr, ignore)
          end if
-         call h5tclose_f(stype, ignore)
+         call h5sclose_f(space, ignore)
       end if
       if (st%hdferr /= 0) call failed(loc, '@' // name, st)
-   end subroutine write_attr_string
+   end subroutine write_attr
 
    !> Scalar string dataset.
    subroutine write_dataset_string(loc, name, value, st)

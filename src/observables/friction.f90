@@ -1,11 +1,16 @@
-!> Interlocking friction Delta mu (seed Eq. 11) by three independent routes:
-!>  - force balance:  Delta mu = -<p r'>/p_m (in contact w' = r', so <p v_z'> = -<p r'>);
-!>  - spectral:       Delta mu = (2/p_m) sum_{k>0} k Im G_eff(k) |p^(k)|^2, which holds for
-!>                    any linear multiplier, elastic or viscoelastic;
+!> Interlocking friction Delta mu (seed Eq. 11) by four routes:
+!>  - Eq. 11 as written: Delta mu = <p v_z'>/p_m = -<p w'>/p_m from the computed surface
+!>                    displacement w (derivative by FFT, average on the grid);
+!>  - spectral:       Delta mu = (2/p_m) sum_{k>0} k Im G_eff(k) |p^(k)|^2 (any linear
+!>                    multiplier, elastic or viscoelastic): equal to the first to rounding;
 !>  - energy:         Delta mu = mu_c <p du_x/dx>/p_m for elastic layers (the work of the
-!>                    normal load over a period equals that of the shear: nothing is stored).
-!> They agree only when the contact problem is solved (complementarity), so comparing them
-!> checks the solver and the sign conventions (DESIGN.md §3).
+!>                    normal load over a period equals that of the shear: nothing is stored);
+!>  - profile (force balance on the rigid indenter): Delta mu = -<p r'>/p_m, equal to the
+!>                    others only where w' = r', i.e. when the contact problem is solved; on
+!>                    a grid it differs by a discretisation error that vanishes as the grid
+!>                    is refined (the spectral slope of w - r is not zero at contact nodes
+!>                    next to an edge), which makes it a per-run accuracy indicator.
+!> Comparing them checks the solver and the sign conventions (DESIGN.md §3).
 module lc_observables_friction
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
@@ -18,11 +23,12 @@ module lc_observables_friction
 contains
 
    !> The three routes for pressure p on profile r (line contact of the operator's scene).
-   subroutine interlocking_friction(op, p, r, thickness, young, poisson, by_force, by_spectrum, by_energy)
+   subroutine interlocking_friction(op, p, w, r, thickness, young, poisson, by_displacement, by_spectrum, &
+         & by_energy, by_profile)
       type(compliance_operator), intent(inout) :: op
-      real(wp), intent(in) :: p(:), r(:), thickness, young, poisson
-      real(wp), intent(out) :: by_force, by_spectrum, by_energy
-      complex(wp), allocatable :: ph(:), rh(:)
+      real(wp), intent(in) :: p(:), w(:), r(:), thickness, young, poisson
+      real(wp), intent(out) :: by_displacement, by_spectrum, by_energy, by_profile
+      complex(wp), allocatable :: ph(:), rh(:), wh(:)
       real(wp) :: pm, k, estar, one_minus_a, one_minus_b, c, im_g
       complex(wp) :: uxh
       integer :: m, nk, n
@@ -33,15 +39,19 @@ contains
       pm = sum(p)/n
       estar = young/(1.0_wp - poisson**2)
       halfspace = .not. ieee_is_finite(thickness)
-      allocate (ph(nk), rh(nk))
+      allocate (ph(nk), rh(nk), wh(nk))
       op%fft%real_buffer = p
       call op%fft%forward()
       ph = op%fft%spectrum
       op%fft%real_buffer = r
       call op%fft%forward()
       rh = op%fft%spectrum
+      op%fft%real_buffer = w
+      call op%fft%forward()
+      wh = op%fft%spectrum
 
-      by_force = 0.0_wp
+      by_displacement = 0.0_wp
+      by_profile = 0.0_wp
       by_spectrum = 0.0_wp
       by_energy = 0.0_wp
       ! Parseval on the half spectrum: <f g'> = sum_{k>0} 2 Re[conj(f^) i k g^]; the
@@ -55,13 +65,15 @@ contains
          else
             call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
          end if
-         by_force = by_force - 2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*rh(m + 1), wp)
+         by_displacement = by_displacement - 2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*wh(m + 1), wp)
+         by_profile = by_profile - 2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*rh(m + 1), wp)
          im_g = -2.0_wp/(estar*k)*op%friction*c
          by_spectrum = by_spectrum + 2*k*im_g*abs(ph(m + 1))**2
          uxh = 2.0_wp/(estar*k)*cmplx(op%friction*one_minus_b, c, wp)*ph(m + 1)
          by_energy = by_energy + op%friction*2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*uxh, wp)
       end do
-      by_force = by_force/pm
+      by_displacement = by_displacement/pm
+      by_profile = by_profile/pm
       by_spectrum = by_spectrum/pm
       by_energy = by_energy/pm
    end subroutine interlocking_friction
