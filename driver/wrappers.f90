@@ -83,7 +83,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    type(error_type), allocatable :: error
    type(scene_type) :: scene
    type(contact_result) :: res
-   character(len=8), parameter :: controls(0:1) = [character(len=8) :: 'load', 'displacement']
+   character(len=12), parameter :: controls(0:1) = [character(len=12) :: 'load', 'displacement']
    character(len=8), parameter :: methods(0:2) = [character(len=8) :: 'auto', 'cg', 'anderson']
    stat = 0
    errmsg = ''

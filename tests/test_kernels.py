@@ -66,7 +66,7 @@ def test_closed_form_matches_lapack_mode_solve(nu):
     scale = np.abs(closed)
     # c is compared on the scale of the 2x2 compliance: where it decays like exp(-2x) its
     # relative digits are not meaningful for the operator
-    scale[:, 2] = np.maximum(scale[:, 2], 1e-6 * np.sqrt(closed[:, 0] * closed[:, 1]))
+    scale[:, 2] = np.maximum(scale[:, 2], 1e-4 * np.sqrt(closed[:, 0] * closed[:, 1]))
     assert np.all(np.abs(lapack - closed) / scale <= tol[:, None])
 
 
