@@ -13,10 +13,13 @@ module lc_scene
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set
-   public :: max_string
+   public :: max_string, default_rms_gradient
 
    !> Sentinel for "not given" in optional positive quantities.
    real(wp), parameter :: not_set = -1.0_wp
+   !> rms gradient of a self-affine profile when neither rms_gradient nor rms_height is given
+   !> (under linear elasticity the scale only matters relative to the pressure).
+   real(wp), parameter :: default_rms_gradient = 0.1_wp
    !> Length of the fixed-size character components (file names, keywords).
    integer, parameter :: max_string = 512
 
@@ -28,7 +31,7 @@ module lc_scene
       integer(i8) :: seed = 1_i8
       real(wp) :: rolloff_wavelength = not_set   !< default: the period
       real(wp) :: short_wavelength = not_set     !< default: period/128
-      !> scale: give exactly one of rms_gradient (-) and rms_height (L)
+      !> scale: give at most one of rms_gradient (-) and rms_height (L); default rms_gradient 0.1
       real(wp) :: rms_gradient = not_set
       real(wp) :: rms_height = not_set
       !> sinusoid r(x) = amplitude cos(2 pi mode x / period)
@@ -121,8 +124,8 @@ contains
                & .and. p%short_wavelength <= scene%period)) then
                call bad(error, 'profile', 'short_wavelength', real_str(p%short_wavelength), &
                   & '2*period/n <= short_wavelength <= period (at least two grid points per wavelength)')
-            else if (count([p%rms_gradient /= not_set, p%rms_height /= not_set]) /= 1) then
-               call bad(error, 'profile', 'rms_gradient/rms_height', 'both or neither given', 'exactly one of them')
+            else if (p%rms_gradient /= not_set .and. p%rms_height /= not_set) then
+               call bad(error, 'profile', 'rms_gradient/rms_height', 'both given', 'at most one of them')
             else if (p%rms_gradient /= not_set .and. .not. positive(p%rms_gradient)) then
                call bad(error, 'profile', 'rms_gradient', real_str(p%rms_gradient), '> 0 and finite')
             else if (p%rms_height /= not_set .and. .not. positive(p%rms_height)) then

@@ -14,7 +14,7 @@ module lc_profiles_profile
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_input
-   use lc_scene, only: scene_type
+   use lc_scene, only: scene_type, not_set, default_rms_gradient
    use lc_fft_plans, only: fft_plan
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
    use lc_io_hdf5, only: read_profile_heights
@@ -39,8 +39,13 @@ contains
       associate (p => scene%profile)
          select case (trim(p%kind))
          case ('self_affine')
-            call self_affine_profile(scene%n, scene%period, p%hurst, p%seed, p%rolloff_wavelength, &
-               & p%short_wavelength, p%rms_gradient, p%rms_height, height, error)
+            if (p%rms_gradient == not_set .and. p%rms_height == not_set) then
+               call self_affine_profile(scene%n, scene%period, p%hurst, p%seed, p%rolloff_wavelength, &
+                  & p%short_wavelength, default_rms_gradient, not_set, height, error)
+            else
+               call self_affine_profile(scene%n, scene%period, p%hurst, p%seed, p%rolloff_wavelength, &
+                  & p%short_wavelength, p%rms_gradient, p%rms_height, height, error)
+            end if
          case ('sinusoid')
             ! sinusoid_profile is pure and cannot report errors: check its inputs here.
             if (.not. (ieee_is_finite(p%amplitude) .and. p%amplitude > 0.0_wp)) then

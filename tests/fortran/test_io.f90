@@ -16,6 +16,8 @@ program test_io
    integer :: failures
 
    failures = 0
+   ! start from an empty scratch directory: the checks below expect files not to exist
+   call execute_command_line('rm -rf ' // dir)
    call test_valid_namelist()
    call test_namelist_errors()
    call test_round_trip()

@@ -1,0 +1,100 @@
+"""Every scene in inputs/ runs, through the executable and through Python, with the same
+result; bad input gives a clear error naming group and variable, exit code 2, and
+writes nothing; an existing result is not overwritten unless the input says so."""
+
+import os
+import shutil
+import subprocess
+import sysconfig
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import layercontact as lc
+from conftest import ROOT
+
+INPUTS = sorted((ROOT / "inputs").glob("*.nml"))
+
+
+def executable() -> str:
+    """The installed `layercontact` program (next to this Python's scripts)."""
+    found = shutil.which("layercontact") or shutil.which("layercontact", path=sysconfig.get_path("scripts"))
+    assert found, "the layercontact executable is not installed (pip install . puts it in the venv's bin/)"
+    return found
+
+
+def run_exe(nml: Path, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([executable(), str(nml)], cwd=cwd, capture_output=True, text=True, timeout=600)
+
+
+@pytest.mark.parametrize("nml", INPUTS, ids=[p.stem for p in INPUTS])
+def test_every_input_runs_the_same_in_fortran_and_python(nml, tmp_path, monkeypatch):
+    exe_dir, py_dir = tmp_path / "exe", tmp_path / "py"
+    exe_dir.mkdir()
+    py_dir.mkdir()
+    proc = run_exe(nml, exe_dir)
+    assert proc.returncode == 0, proc.stderr
+    assert "contact fraction" in proc.stdout
+    monkeypatch.chdir(py_dir)
+    res = lc.run(nml)
+    assert res.converged and res.residual <= 1e-8
+    out = next(exe_dir.rglob("*.h5"))
+    ref = lc.read_result(out)
+    assert not list(exe_dir.rglob("*.tmp"))
+    np.testing.assert_array_equal(res.pressure, ref.pressure)
+    assert res.penetration == ref.penetration and res.delta_mu == ref.delta_mu
+    with h5py.File(out) as f:
+        assert f.attrs["layercontact_version"].decode() == lc.__version__
+        assert f["input/namelist"][()].decode() == nml.read_text()
+        assert f["fields/pressure"].shape == (f["input"].attrs["n"],)
+
+
+BAD = [
+    ("&layer\n thickness = -1.0\n/\n", "&layer: thickness"),
+    ("&layer\n poisson = 0.7\n/\n", "-1 < poisson <= 0.5"),
+    ("&layr\n thickness = 1.0\n/\n", "line 1: unknown namelist group '&layr'"),
+    ("&scene\n n = 64\n/\n&layer\n thicknes = 1.0\n/\n", "line 5, group &layer: Cannot match namelist object name thicknes"),
+    ("&friction\n coefficient = -0.1\n/\n", "&friction: coefficient"),
+    ("&loading\n mean_pressure = 0.1\n normalised_pressure = 1.0\n/\n", "exactly one of them"),
+    ("&profile\n hurst = 1.2\n/\n", "&profile: hurst"),
+    ("&solver\n tol = 0.5\n/\n", "&solver: tol"),
+    ("&loading\n control = 'displacement'\n penetration = 1e-3\n/\n", "needs a finite layer"),
+]
+
+
+@pytest.mark.parametrize("text, message", BAD, ids=[m for _, m in BAD])
+def test_bad_input_is_refused_and_writes_nothing(text, message, tmp_path):
+    base = "&loading\n normalised_pressure = 1.0\n/\n" if "&loading" not in text else ""
+    nml = tmp_path / "bad.nml"
+    nml.write_text(text + base + "&output\n file = 'bad.h5'\n/\n")
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert message in proc.stderr
+    assert not (tmp_path / "bad.h5").exists() and not (tmp_path / "bad.h5.tmp").exists()
+    with pytest.raises(lc.LayercontactError) as err:
+        os.chdir(tmp_path)
+        lc.run(nml)
+    assert err.value.code == 2 and message in str(err.value)
+
+
+def test_existing_result_is_not_overwritten(tmp_path):
+    nml = tmp_path / "scene.nml"
+    nml.write_text("&scene\n n = 256\n/\n&loading\n normalised_pressure = 1.0\n/\n&output\n file = 'r.h5'\n/\n")
+    (tmp_path / "r.h5").write_bytes(b"precious")
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode != 0 and "overwrite" in proc.stderr
+    assert (tmp_path / "r.h5").read_bytes() == b"precious"
+
+
+def test_not_converged_exits_3_and_writes_flagged_result(tmp_path):
+    nml = tmp_path / "scene.nml"
+    nml.write_text(
+        "&scene\n n = 1024\n/\n&layer\n thickness = 0.01\n/\n&friction\n coefficient = 1.0\n/\n"
+        "&loading\n normalised_pressure = 30.0\n/\n&solver\n max_iter = 10\n/\n&output\n file = 'r.h5'\n/\n"
+    )
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 3
+    with h5py.File(tmp_path / "r.h5") as f:
+        assert f["results"].attrs["converged"] == 0 and f["results"].attrs["residual"] > 1e-10
