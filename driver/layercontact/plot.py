@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import os
 
-import numpy as np
-
 
 def plot_result(h5file: str | os.PathLike, png: str | os.PathLike) -> None:
     """The seed's Fig. 2(a) view: the rigid profile and the deformed layer surface (with
@@ -27,14 +25,14 @@ def plot_result(h5file: str | os.PathLike, png: str | os.PathLike) -> None:
 
     fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(8, 6), constrained_layout=True)
     lam = r.max()
-    top.plot(x / period, r - lam, color="0.3", lw=0.8, label="rigid profile r - Lambda")
-    for name, attrs, fields in runs:
+    # Heights point out of the layer, in the indenter's frame: the indenter is Lambda - r
+    # (its highest asperity at 0), the deformed layer surface Delta - w (equal in contact).
+    top.plot(x / period, lam - r, color="0.2", lw=0.9, label="rigid indenter  Lambda - r")
+    for _, attrs, fields in runs:
         mu = attrs["friction"]
-        delta = attrs["penetration"]
-        # surface of the layer in the indenter's frame: -(w) + Delta, so the indenter is r - Lambda
-        surface = fields["displacement_z"] - delta
-        top.plot(x / period, -surface - 0 * surface, lw=1.0, label=f"layer surface, mu_c = {mu:g}")
-        bottom.plot(x / period, fields["pressure"], lw=1.0, label=f"mu_c = {mu:g}")
+        surface = attrs["penetration"] - fields["displacement_z"]
+        top.plot(x / period, surface, lw=0.9, label=f"layer surface  Delta - w,  mu_c = {mu:g}")
+        bottom.plot(x / period, fields["pressure"], lw=0.9, label=f"mu_c = {mu:g}")
     top.set_ylabel("height (L)")
     top.legend(fontsize=8)
     bottom.set_ylabel("pressure p (S)")
@@ -42,7 +40,3 @@ def plot_result(h5file: str | os.PathLike, png: str | os.PathLike) -> None:
     bottom.legend(fontsize=8)
     fig.savefig(png, dpi=120)
     plt.close(fig)
-    return None
-
-
-__all__ = ["plot_result", "np"]
