@@ -98,3 +98,28 @@ def test_not_converged_exits_3_and_writes_flagged_result(tmp_path):
     assert proc.returncode == 3
     with h5py.File(tmp_path / "r.h5") as f:
         assert f["results"].attrs["converged"] == 0 and f["results"].attrs["residual"] > 1e-10
+
+
+def test_profile_from_hdf5_file(tmp_path):
+    """&profile kind = 'file': heights read from an HDF5 dataset, stored unchanged, and
+    the same solution as solving the array from Python."""
+    h = lc.self_affine_profile(512, 0.6, seed=9, short_wavelength=1 / 32)
+    with h5py.File(tmp_path / "measured.h5", "w") as f:
+        f["/topography/heights"] = h
+    nml = tmp_path / "scene.nml"
+    nml.write_text(
+        "&scene\n n = 512\n/\n&layer\n thickness = 0.3\n poisson = 0.4\n/\n&friction\n coefficient = 0.4\n/\n"
+        "&profile\n kind = 'file'\n file = 'measured.h5'\n dataset = '/topography/heights'\n/\n"
+        "&loading\n mean_pressure = 0.002\n/\n&output\n file = 'r.h5'\n/\n"
+    )
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    res = lc.read_result(tmp_path / "r.h5")
+    np.testing.assert_array_equal(res.height, h)
+    ref = lc.solve_line(h, thickness=0.3, poisson=0.4, friction=0.4, mean_pressure=0.002)
+    np.testing.assert_allclose(res.pressure, ref.pressure, rtol=0, atol=1e-12 * ref.pressure.max())
+
+    wrong = tmp_path / "wrong.nml"
+    wrong.write_text(nml.read_text().replace("n = 512", "n = 256").replace("'r.h5'", "'w.h5'"))
+    proc = run_exe(wrong, tmp_path)
+    assert proc.returncode == 2 and "512" in proc.stderr and not (tmp_path / "w.h5").exists()

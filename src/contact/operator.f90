@@ -35,6 +35,7 @@ module lc_contact_operator
       real(wp) :: friction = 0.0_wp
       logical :: coupled = .false.          !< complex multiplier (not symmetric)
       real(wp), allocatable :: metric(:)    !< M(k) = |G_eff(k)|, k = 0..n/2 (L/S)
+      real(wp) :: diagonal = 0.0_wp         !< real-space diagonal of the circulant M (L/S)
       complex(wp), allocatable :: full(:)   !< G_eff(k), only when coupled
       type(fft_plan) :: fft
    contains
@@ -96,6 +97,9 @@ contains
          op%metric(m + 1) = abs(g)
          if (op%coupled) op%full(m + 1) = g
       end do
+      ! (1/n) sum over the whole spectrum: modes 1..ceil(n/2)-1 appear twice, Nyquist once
+      op%diagonal = (op%metric(1) + 2*sum(op%metric(2:op%nk)) - merge(op%metric(op%nk), 0.0_wp, &
+         & mod(n, 2) == 0))/n
    end subroutine build_operator
 
    !> Wavenumber k = 2 pi m / period of mode index m (0..n/2).

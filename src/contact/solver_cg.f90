@@ -44,7 +44,7 @@ contains
       real(wp), intent(inout), optional :: history(:)
       real(wp), allocatable :: t(:), r(:)
       logical, allocatable :: contact(:), overlap(:)
-      real(wp) :: gnorm, gnorm_old, tau, denominator, diagonal, p_ref
+      real(wp) :: gnorm, gnorm_old, tau, denominator, p_ref
       integer :: it, n, n_contact
       logical :: restart
 
@@ -53,9 +53,6 @@ contains
       t = 0.0_wp
       gnorm_old = 1.0_wp
       restart = .true.
-      ! The real-space diagonal of the circulant M: a natural scale for a first step.
-      diagonal = (op%metric(1) + 2*sum(op%metric(2:op%nk)) - merge(op%metric(op%nk), 0.0_wp, &
-         & mod(n, 2) == 0))/n
       p = max(p, 0.0_wp)
       if (load_control) call normalise(p, mean_pressure)
 
@@ -79,8 +76,9 @@ contains
          end if
 
          if (n_contact == 0) then
-            ! Displacement control with nothing in contact yet: load the overlapping points.
-            p = max(-gap, 0.0_wp)/diagonal
+            ! Displacement control with nothing in contact yet: load the overlapping points
+            ! (the diagonal of M is the natural scale of a first step).
+            p = max(-gap, 0.0_wp)/op%diagonal
             restart = .true.
             cycle
          end if
