@@ -31,17 +31,20 @@ def main() -> None:
     args = parser.parse_args()
     sizes = [1024, 2048, 4096, 8192] if args.quick else [1024, 4096, 16384, 65536]
     print(f"tol = {args.tol:g}; pressure in the seed's scale p_m/(E* Lambda/lambda); nu = 0.5")
-    print(f"{'scene':<30}{'n':>7}{'CG it':>8}{'outer':>7}{'FFT pairs':>11}{'time (s)':>10}{'contact':>9}")
+    print(f"{'scene':<30}{'precond':>8}{'n':>7}{'CG it':>8}{'outer':>7}{'FFT pairs':>11}{'time (s)':>10}"
+          f"{'contact':>9}")
     for name, s in SCENES.items():
-        for n in sizes:
-            h = lc.self_affine_profile(n, 0.8, seed=1, short_wavelength=1 / 64, rms_gradient=0.1)
-            pm = s["pressure"] * (4 / 3) * h.max()
-            t = time.perf_counter()
-            r = lc.solve_line(h, thickness=s["thickness"], friction=s["friction"], mean_pressure=pm, tol=args.tol)
-            t = time.perf_counter() - t
-            flag = "" if r.converged else "  NOT CONVERGED"
-            print(f"{name:<30}{n:>7}{r.iterations:>8}{r.outer_iterations:>7}{r.fft_pairs:>11}{t:>10.3f}"
-                  f"{r.contact_fraction:>9.4f}{flag}")
+        for precondition in (False, True):
+            for n in sizes:
+                h = lc.self_affine_profile(n, 0.8, seed=1, short_wavelength=1 / 64, rms_gradient=0.1)
+                pm = s["pressure"] * (4 / 3) * h.max()
+                t = time.perf_counter()
+                r = lc.solve_line(h, thickness=s["thickness"], friction=s["friction"], mean_pressure=pm,
+                                  tol=args.tol, precondition=precondition)
+                t = time.perf_counter() - t
+                flag = "" if r.converged else "  NOT CONVERGED"
+                print(f"{name:<30}{str(precondition):>8}{n:>7}{r.iterations:>8}{r.outer_iterations:>7}"
+                      f"{r.fft_pairs:>11}{t:>10.3f}{r.contact_fraction:>9.4f}{flag}")
 
 
 if __name__ == "__main__":

@@ -63,18 +63,18 @@ subroutine py_self_affine_profile(n, period, hurst, seed, rolloff_wavelength, sh
 end subroutine py_self_affine_profile
 
 !> Solve a line contact on the given heights. control: 0 load, 1 displacement;
-!> method: 0 auto, 1 cg, 2 anderson. scalars: mean_pressure, penetration, contact_fraction,
+!> method: 0 auto, 1 cg, 2 anderson; precondition: 0/1. scalars: mean_pressure, penetration, contact_fraction,
 !> delta_mu, delta_mu_spectral, delta_mu_energy, converged (0/1), iterations,
 !> outer_iterations, fft_pairs, residual, wall_time, history length, delta_mu_profile.
 subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
-      & penetration, method, tol, max_iter, memory, threads, pressure, gap, displacement_z, scalars, history, &
+      & penetration, method, precondition, tol, max_iter, memory, threads, pressure, gap, displacement_z, scalars, history, &
       & stat, errmsg)
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, check_scene
    use lc_result, only: contact_result
    use lc_contact_solve, only: solve_line_contact
    implicit none (type, external)
-   integer, intent(in) :: n, control, method, max_iter, memory, threads
+   integer, intent(in) :: n, control, method, precondition, max_iter, memory, threads
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
    real(8), intent(out) :: pressure(n), gap(n), displacement_z(n), scalars(14), history(max_iter)
    integer, intent(out) :: stat
@@ -103,6 +103,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    scene%solver%max_iter = max_iter
    scene%solver%memory = memory
    scene%solver%threads = threads
+   scene%solver%precondition = precondition == 1
    call check_scene(scene, error)
    if (.not. allocated(error)) call solve_line_contact(scene, height, friction, res, error)
    if (allocated(error)) then

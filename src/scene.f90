@@ -51,6 +51,9 @@ module lc_scene
       integer :: max_iter = 20000
       !> Anderson memory (number of previous iterates mixed) for coupled problems
       integer :: memory = 12
+      !> precondition the constrained CG with the stiffness 1/M (Fourier) on the contact set:
+      !> one more FFT pair per iteration, 3-6x fewer iterations on fine grids (bench/iterations.py)
+      logical :: precondition = .true.
       !> FFTW threads (1 = no threading)
       integer :: threads = 1
    end type solver_settings

@@ -146,3 +146,17 @@ def test_odd_grid_and_first_mode_profile():
     res = lc.solve_line(lc.sinusoid_profile(n, h0), thickness=0.1, friction=0.7, mean_pressure=pm)
     assert np.abs(res.pressure - p_ref).max() <= 10 * TOL * pm
     assert res.delta_mu == pytest.approx(dmu_ref, rel=1e-8)
+
+
+@pytest.mark.parametrize("thickness, friction", [(np.inf, 0.0), (0.16, 0.5), (0.01, 1.0)])
+def test_preconditioned_and_plain_cg_agree(rough_profile, thickness, friction):
+    """Two iterations to the same fixed point: the Fourier-preconditioned constrained CG
+    and the plain Polonsky-Keer one give the same pressure to the solver tolerance."""
+    pm = rough_profile.max() * (1.0 if thickness > 0.1 else 16.0)
+    kw = dict(thickness=thickness, friction=friction, mean_pressure=pm, tol=1e-11)
+    a = lc.solve_line(rough_profile, precondition=True, **kw)
+    b = lc.solve_line(rough_profile, precondition=False, **kw)
+    assert a.converged and b.converged
+    assert a.iterations < b.iterations
+    assert np.abs(a.pressure - b.pressure).max() <= 1e-8 * a.pressure.max()
+    assert a.penetration == pytest.approx(b.penetration, rel=1e-9)

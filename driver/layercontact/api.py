@@ -99,6 +99,7 @@ def solve_line(
     mean_pressure: float | None = None,
     penetration: float | None = None,
     method: str = "auto",
+    precondition: bool = True,
     tol: float = 1e-10,
     max_iter: int = 20000,
     memory: int = 12,
@@ -108,7 +109,9 @@ def solve_line(
     periodic grid of one ``period``) on a layer of ``thickness`` (``inf``: half-space)
     bonded to a rigid base, with Coulomb friction ``tau = friction * p``.
 
-    Give ``mean_pressure`` (load control) or ``penetration`` (displacement control, finite
+    ``precondition`` applies the Fourier stiffness 1/M to the residual on the contact set
+    (fewer iterations, nearly flat in the grid size; see bench/iterations.py). Give
+    ``mean_pressure`` (load control) or ``penetration`` (displacement control, finite
     compressible layers only). Raises :class:`LayercontactError` with the library's
     message for bad input. A run that did not reach ``tol`` returns with
     ``converged = False``.
@@ -125,7 +128,8 @@ def solve_line(
     pen = NOT_SET if penetration is None else float(penetration)
     p, g, w, s, hist, stat, errmsg = _core.py_solve_line(
         h, float(period), float(thickness), float(young), float(poisson), float(friction),
-        _CONTROLS[control], pm, pen, _METHODS[method], float(tol), int(max_iter), int(memory), int(threads),
+        _CONTROLS[control], pm, pen, _METHODS[method], int(bool(precondition)), float(tol), int(max_iter),
+        int(memory), int(threads),
     )
     _check(stat, errmsg)
     return LineResult(

@@ -42,6 +42,7 @@ module lc_contact_operator
       procedure :: apply_metric
       procedure :: apply_full
       procedure :: apply_difference
+      procedure :: apply_inverse_metric
       procedure :: wavenumber
    end type compliance_operator
 
@@ -152,4 +153,19 @@ contains
       call self%fft%backward()
       w = self%fft%real_buffer
    end subroutine apply_difference
+   !> w = M^-1 p on the modes where M > 0 (the k = 0 mode of a half-space is dropped).
+   subroutine apply_inverse_metric(self, p, w)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), intent(in) :: p(:)
+      real(wp), intent(out) :: w(:)
+      self%fft%real_buffer = p
+      call self%fft%forward()
+      where (self%metric > 0.0_wp)
+         self%fft%spectrum = self%fft%spectrum/self%metric
+      elsewhere
+         self%fft%spectrum = 0.0_wp
+      end where
+      call self%fft%backward()
+      w = self%fft%real_buffer
+   end subroutine apply_inverse_metric
 end module lc_contact_operator

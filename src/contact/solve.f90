@@ -92,7 +92,7 @@ contains
 
       if (op%coupled) then
          call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & scene%solver%memory, p, w, gap, outer, history, error)
+            & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error)
          if (allocated(error)) return
          result%converged = outer%converged
          result%iterations = outer%cg_iterations
@@ -102,7 +102,7 @@ contains
          result%residual_history = history(1:outer%outer_iterations)
       else
          call constrained_cg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & p, w, gap, cg, history)
+            & scene%solver%precondition, p, w, gap, cg, history)
          result%converged = cg%converged
          result%iterations = cg%iterations
          result%outer_iterations = 1

@@ -44,7 +44,7 @@ contains
    !> Solve the coupled problem. p: starting guess in, solution out; w = G_eff p;
    !> gap and s as in lc_contact_solver_cg. history(k) = residual after outer iteration k.
    subroutine anderson_coupled(op, r, load_control, mean_pressure, s, g_ref, tol, max_iter, memory, &
-         & p, w, gap, outcome, history, error)
+         & precondition, p, w, gap, outcome, history, error)
       type(compliance_operator), intent(inout) :: op
       real(wp), intent(in) :: r(:)
       logical, intent(in) :: load_control
@@ -52,6 +52,7 @@ contains
       real(wp), intent(inout) :: s
       integer, intent(in) :: max_iter   !< budget of inner CG iterations
       integer, intent(in) :: memory
+      logical, intent(in) :: precondition   !< passed to the inner constrained CG
       real(wp), intent(inout) :: p(:)
       real(wp), intent(out) :: w(:), gap(:)
       type(anderson_outcome), intent(out) :: outcome
@@ -77,7 +78,7 @@ contains
          b = r - nw
          tx = p   ! warm start from the previous output of T
          call constrained_cg(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
-            & max_iter - outcome%cg_iterations, tx, w, gap, inner)
+            & max_iter - outcome%cg_iterations, precondition, tx, w, gap, inner)
          outcome%cg_iterations = outcome%cg_iterations + inner%iterations
          outcome%fft_pairs = outcome%fft_pairs + inner%fft_pairs + 2
          outcome%outer_iterations = k

@@ -29,8 +29,8 @@ contains
    !> Solve the symmetric problem with metric M. On entry p is the starting guess
    !> (any array; it is made feasible), on exit the solution; w = M p, gap and s as above.
    !> history(1:outcome%iterations) receives the residual of each iteration when present.
-   subroutine constrained_cg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, &
-         & outcome, history)
+   subroutine constrained_cg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, precondition, p, w, &
+         & gap, outcome, history)
       type(compliance_operator), intent(inout) :: op
       real(wp), intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -38,18 +38,20 @@ contains
       real(wp), intent(inout) :: s            !< in: given (displacement control); out: the multiplier
       real(wp), intent(in) :: g_ref, tol
       integer, intent(in) :: max_iter
+      !> precondition the residual with the stiffness 1/M on the contact set
+      logical, intent(in) :: precondition
       real(wp), intent(inout) :: p(:)
       real(wp), intent(out) :: w(:), gap(:)
       type(cg_outcome), intent(out) :: outcome
       real(wp), intent(inout), optional :: history(:)
-      real(wp), allocatable :: t(:), r(:)
+      real(wp), allocatable :: t(:), r(:), z(:)
       logical, allocatable :: contact(:), overlap(:)
       real(wp) :: gnorm, gnorm_old, tau, denominator, p_ref
       integer :: it, n, n_contact
       logical :: restart
 
       n = size(p)
-      allocate (t(n), r(n), contact(n), overlap(n))
+      allocate (t(n), r(n), z(n), contact(n), overlap(n))
       t = 0.0_wp
       gnorm_old = 1.0_wp
       restart = .true.
@@ -82,11 +84,18 @@ contains
             restart = .true.
             cycle
          end if
-         gnorm = sum(gap**2, mask=contact)
+         z = merge(gap, 0.0_wp, contact)
+         if (precondition) then
+            call op%apply_inverse_metric(z, r)
+            outcome%fft_pairs = outcome%fft_pairs + 1
+            z = merge(r, 0.0_wp, contact)
+            if (load_control) where (contact) z = z - sum(z, mask=contact)/n_contact
+         end if
+         gnorm = sum(gap*z, mask=contact)
          if (restart) then
-            t = merge(gap, 0.0_wp, contact)
+            t = z
          else
-            t = merge(gap + (gnorm/gnorm_old)*t, 0.0_wp, contact)
+            t = merge(z + (gnorm/gnorm_old)*t, 0.0_wp, contact)
          end if
          gnorm_old = gnorm
          call op%apply_metric(t, r)

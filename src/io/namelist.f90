@@ -26,7 +26,7 @@ module lc_io_namelist
       & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
       & 'amplitude, mode, file, dataset', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
-      & 'method, tol, max_iter, memory, threads', &
+      & 'method, tol, max_iter, memory, precondition, threads', &
       & 'file, overwrite']
 
    character(len=*), parameter :: newline = new_line('a')
@@ -147,6 +147,7 @@ contains
             & // entry('tol', real_value(s%tol)) &
             & // entry('max_iter', int_str(s%max_iter)) &
             & // entry('memory', int_str(s%memory)) &
+            & // entry('precondition', logical_value(s%precondition)) &
             & // entry('threads', int_str(s%threads)) &
             & // '/' // newline // '&output' // newline &
             & // entry('file', str_value(scene%output_file)) &
@@ -319,12 +320,14 @@ contains
       character(len=max_string) :: method
       real(wp) :: tol
       integer :: max_iter, memory, threads
-      namelist /solver/ method, tol, max_iter, memory, threads
+      logical :: precondition
+      namelist /solver/ method, tol, max_iter, memory, precondition, threads
 
       method = config%solver%method
       tol = config%solver%tol
       max_iter = config%solver%max_iter
       memory = config%solver%memory
+      precondition = config%solver%precondition
       threads = config%solver%threads
       read (lines, nml=solver, iostat=stat, iomsg=msg)
       if (stat /= 0) return
@@ -332,6 +335,7 @@ contains
       config%solver%tol = tol
       config%solver%max_iter = max_iter
       config%solver%memory = memory
+      config%solver%precondition = precondition
       config%solver%threads = threads
    end subroutine read_group_solver
 

@@ -217,7 +217,7 @@ contains
          & .and. a%solver%method == b%solver%method .and. a%solver%tol == b%solver%tol &
          & .and. a%solver%max_iter == b%solver%max_iter .and. a%solver%memory == b%solver%memory &
          & .and. a%solver%threads == b%solver%threads .and. a%output_file == b%output_file &
-         & .and. (a%overwrite .eqv. b%overwrite)
+         & .and. (a%overwrite .eqv. b%overwrite) .and. (a%solver%precondition .eqv. b%solver%precondition)
    end function same_scene
 
    subroutine test_check_output()
