@@ -160,3 +160,9 @@ def test_preconditioned_and_plain_cg_agree(rough_profile, thickness, friction):
     assert a.iterations < b.iterations
     assert np.abs(a.pressure - b.pressure).max() <= 1e-8 * a.pressure.max()
     assert a.penetration == pytest.approx(b.penetration, rel=1e-9)
+
+
+def test_threads_need_an_openmp_build(rough_profile):
+    with pytest.raises(lc.LayercontactError, match="-Dopenmp=true") as err:
+        lc.solve_line(rough_profile, mean_pressure=0.01, threads=2)
+    assert err.value.code == 2

@@ -18,8 +18,8 @@
 module lc_contact_operator
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
-   use lc_errors, only: error_type
-   use lc_fft_plans, only: fft_plan
+   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_fft_plans, only: fft_plan, fft_threads_available
    use lc_greens_layer, only: layer_coefficients, halfspace_coupling
    implicit none (type, external)
    private
@@ -60,6 +60,12 @@ contains
       integer :: m
       logical :: halfspace
 
+      if (threads > 1 .and. .not. fft_threads_available()) then
+         call fatal_error(error, '&solver: threads > 1 needs a build with FFTW threads ' // &
+            & '(meson option -Dopenmp=true, e.g. pip install . -Csetup-args=-Dopenmp=true); allowed here: threads = 1', &
+            & code_input)
+         return
+      end if
       call op%fft%init(n, threads, error)
       if (allocated(error)) return
       op%n = n
