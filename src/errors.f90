@@ -6,7 +6,7 @@
 module lc_errors
    implicit none (type, external)
    private
-   public :: error_type, fatal_error
+   public :: error_type, fatal_error, input_error
    public :: code_input, code_not_converged, code_io, code_internal
 
    integer, parameter :: code_input = 2
@@ -31,4 +31,13 @@ contains
       error%message = message
       if (present(code)) error%code = code
    end subroutine fatal_error
+
+   !> A bad input value: the message names the namelist group, the variable, the value
+   !> and the allowed range (code: bad input).
+   pure subroutine input_error(error, group, variable, value, allowed)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: group, variable, value, allowed
+      call fatal_error(error, '&' // group // ': ' // variable // ' = ' // value // ' is not allowed; allowed: ' &
+         & // allowed, code_input)
+   end subroutine input_error
 end module lc_errors

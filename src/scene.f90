@@ -9,7 +9,8 @@
 module lc_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_errors, only: error_type, input_error
+   use lc_strings, only: to_string
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set
@@ -95,84 +96,85 @@ contains
 
       associate (p => scene%profile, s => scene%solver)
          if (.not. one_of(scene%geometry, [character(len=8) :: 'line'])) then
-            call bad(error, 'scene', 'geometry', trim(scene%geometry), "'line' (areal contacts come later)")
+            call input_error(error, 'scene', 'geometry', trim(scene%geometry), "'line' (areal contacts come later)")
          else if (.not. positive(scene%period)) then
-            call bad(error, 'scene', 'period', real_str(scene%period), '> 0 and finite')
+            call input_error(error, 'scene', 'period', to_string(scene%period), '> 0 and finite')
          else if (scene%n < 8 .or. scene%n > 2**26) then
-            call bad(error, 'scene', 'n', int_str(scene%n), '8 <= n <= 2**26')
+            call input_error(error, 'scene', 'n', to_string(scene%n), '8 <= n <= 2**26')
          else if (ieee_is_nan(scene%thickness) .or. scene%thickness <= 0.0_wp) then
-            call bad(error, 'layer', 'thickness', real_str(scene%thickness), '> 0, or Inf for a half-space')
+            call input_error(error, 'layer', 'thickness', to_string(scene%thickness), '> 0, or Inf for a half-space')
          else if (.not. positive(scene%young)) then
-            call bad(error, 'layer', 'young', real_str(scene%young), '> 0 and finite')
+            call input_error(error, 'layer', 'young', to_string(scene%young), '> 0 and finite')
          else if (.not. (scene%poisson > -1.0_wp .and. scene%poisson <= 0.5_wp)) then
-            call bad(error, 'layer', 'poisson', real_str(scene%poisson), '-1 < poisson <= 0.5')
+            call input_error(error, 'layer', 'poisson', to_string(scene%poisson), '-1 < poisson <= 0.5')
          else if (.not. (scene%friction >= 0.0_wp .and. scene%friction <= 10.0_wp)) then
-            call bad(error, 'friction', 'coefficient', real_str(scene%friction), '0 <= coefficient <= 10')
+            call input_error(error, 'friction', 'coefficient', to_string(scene%friction), '0 <= coefficient <= 10')
          else if (.not. one_of(p%kind, [character(len=16) :: 'self_affine', 'sinusoid', 'file'])) then
-            call bad(error, 'profile', 'kind', trim(p%kind), "'self_affine', 'sinusoid' or 'file'")
+            call input_error(error, 'profile', 'kind', trim(p%kind), "'self_affine', 'sinusoid' or 'file'")
          end if
          if (allocated(error)) return
 
          select case (trim(p%kind))
          case ('self_affine')
             if (.not. (p%hurst > 0.0_wp .and. p%hurst < 1.0_wp)) then
-               call bad(error, 'profile', 'hurst', real_str(p%hurst), '0 < hurst < 1')
+               call input_error(error, 'profile', 'hurst', to_string(p%hurst), '0 < hurst < 1')
             else if (p%seed < 0_i8) then
-               call bad(error, 'profile', 'seed', int_str(int(p%seed)), '>= 0')
+               call input_error(error, 'profile', 'seed', to_string(int(p%seed)), '>= 0')
             else if (p%rolloff_wavelength /= not_set .and. .not. (positive(p%rolloff_wavelength) &
                & .and. p%rolloff_wavelength <= scene%period)) then
-               call bad(error, 'profile', 'rolloff_wavelength', real_str(p%rolloff_wavelength), &
+               call input_error(error, 'profile', 'rolloff_wavelength', to_string(p%rolloff_wavelength), &
                   & '0 < rolloff_wavelength <= period')
             else if (p%short_wavelength /= not_set .and. .not. (p%short_wavelength >= 2*scene%period/scene%n &
                & .and. p%short_wavelength <= scene%period)) then
-               call bad(error, 'profile', 'short_wavelength', real_str(p%short_wavelength), &
+               call input_error(error, 'profile', 'short_wavelength', to_string(p%short_wavelength), &
                   & '2*period/n <= short_wavelength <= period (at least two grid points per wavelength)')
             else if (p%rms_gradient /= not_set .and. p%rms_height /= not_set) then
-               call bad(error, 'profile', 'rms_gradient/rms_height', 'both given', 'at most one of them')
+               call input_error(error, 'profile', 'rms_gradient/rms_height', 'both given', 'at most one of them')
             else if (p%rms_gradient /= not_set .and. .not. positive(p%rms_gradient)) then
-               call bad(error, 'profile', 'rms_gradient', real_str(p%rms_gradient), '> 0 and finite')
+               call input_error(error, 'profile', 'rms_gradient', to_string(p%rms_gradient), '> 0 and finite')
             else if (p%rms_height /= not_set .and. .not. positive(p%rms_height)) then
-               call bad(error, 'profile', 'rms_height', real_str(p%rms_height), '> 0 and finite')
+               call input_error(error, 'profile', 'rms_height', to_string(p%rms_height), '> 0 and finite')
             end if
          case ('sinusoid')
             if (.not. positive(p%amplitude)) then
-               call bad(error, 'profile', 'amplitude', real_str(p%amplitude), '> 0 and finite')
+               call input_error(error, 'profile', 'amplitude', to_string(p%amplitude), '> 0 and finite')
             else if (p%mode < 1 .or. 2*p%mode >= scene%n) then
-               call bad(error, 'profile', 'mode', int_str(p%mode), '1 <= mode < n/2')
+               call input_error(error, 'profile', 'mode', to_string(p%mode), '1 <= mode < n/2')
             end if
          case ('file')
             if (len_trim(p%file) == 0) then
-               call bad(error, 'profile', 'file', "''", 'the name of an HDF5 file holding the heights')
+               call input_error(error, 'profile', 'file', "''", 'the name of an HDF5 file holding the heights')
             end if
          end select
          if (allocated(error)) return
 
          if (.not. one_of(scene%control, [character(len=16) :: 'load', 'displacement'])) then
-            call bad(error, 'loading', 'control', trim(scene%control), "'load' or 'displacement'")
+            call input_error(error, 'loading', 'control', trim(scene%control), "'load' or 'displacement'")
          else if (trim(scene%control) == 'load' .and. &
             & count([scene%mean_pressure /= not_set, scene%normalised_pressure /= not_set]) /= 1) then
-            call bad(error, 'loading', 'mean_pressure/normalised_pressure', 'both or neither given', &
+            call input_error(error, 'loading', 'mean_pressure/normalised_pressure', 'both or neither given', &
                & "exactly one of them with control = 'load'")
          else if (trim(scene%control) == 'load' .and. scene%mean_pressure /= not_set &
             & .and. .not. positive(scene%mean_pressure)) then
-            call bad(error, 'loading', 'mean_pressure', real_str(scene%mean_pressure), '> 0 and finite')
+            call input_error(error, 'loading', 'mean_pressure', to_string(scene%mean_pressure), '> 0 and finite')
          else if (trim(scene%control) == 'load' .and. scene%normalised_pressure /= not_set &
             & .and. .not. positive(scene%normalised_pressure)) then
-            call bad(error, 'loading', 'normalised_pressure', real_str(scene%normalised_pressure), '> 0 and finite')
+            call input_error(error, 'loading', 'normalised_pressure', to_string(scene%normalised_pressure), '> 0 and finite')
          else if (trim(scene%control) == 'displacement' .and. .not. positive(scene%penetration)) then
-            call bad(error, 'loading', 'penetration', real_str(scene%penetration), "> 0 and finite with control = 'displacement'")
+            call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
+               & "> 0 and finite with control = 'displacement'")
          else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'anderson'])) then
-            call bad(error, 'solver', 'method', trim(s%method), "'auto', 'cg' or 'anderson'")
+            call input_error(error, 'solver', 'method', trim(s%method), "'auto', 'cg' or 'anderson'")
          else if (.not. (s%tol >= 1.0e-14_wp .and. s%tol <= 1.0e-2_wp)) then
-            call bad(error, 'solver', 'tol', real_str(s%tol), '1e-14 <= tol <= 1e-2')
+            call input_error(error, 'solver', 'tol', to_string(s%tol), '1e-14 <= tol <= 1e-2')
          else if (s%max_iter < 1) then
-            call bad(error, 'solver', 'max_iter', int_str(s%max_iter), '>= 1')
+            call input_error(error, 'solver', 'max_iter', to_string(s%max_iter), '>= 1')
          else if (s%memory < 1 .or. s%memory > 100) then
-            call bad(error, 'solver', 'memory', int_str(s%memory), '1 <= memory <= 100')
+            call input_error(error, 'solver', 'memory', to_string(s%memory), '1 <= memory <= 100')
          else if (s%threads < 1 .or. s%threads > 1024) then
-            call bad(error, 'solver', 'threads', int_str(s%threads), '1 <= threads <= 1024')
+            call input_error(error, 'solver', 'threads', to_string(s%threads), '1 <= threads <= 1024')
          else if (trim(s%method) == 'cg' .and. scene%friction > 0.0_wp) then
-            call bad(error, 'solver', 'method', 'cg', "'auto' or 'anderson' when friction coefficient > 0 " // &
+            call input_error(error, 'solver', 'method', 'cg', "'auto' or 'anderson' when friction coefficient > 0 " // &
                & '(the coupled operator is not symmetric)')
          end if
       end associate
@@ -193,26 +195,6 @@ contains
       end do
    end function one_of
 
-   subroutine bad(error, group, variable, value, allowed)
-      type(error_type), allocatable, intent(out) :: error
-      character(len=*), intent(in) :: group, variable, value, allowed
-      call fatal_error(error, '&' // group // ': ' // variable // ' = ' // value // ' is not allowed; allowed: ' &
-         & // allowed, code_input)
-   end subroutine bad
 
-   pure function real_str(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: s
-      character(len=32) :: buffer
-      write (buffer, '(es12.5)') x
-      s = trim(adjustl(buffer))
-   end function real_str
 
-   pure function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buffer
-      write (buffer, '(i0)') i
-      s = trim(buffer)
-   end function int_str
 end module lc_scene

@@ -9,6 +9,7 @@
 module lc_contact_solve
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
+   use lc_strings, only: to_string
    use lc_scene, only: scene_type, is_halfspace, not_set
    use lc_result, only: contact_result
    use lc_contact_operator, only: compliance_operator, build_operator
@@ -55,8 +56,8 @@ contains
       call system_clock(start, rate)
       n = scene%n
       if (size(height) /= n) then
-         call fatal_error(error, 'solve: the profile has ' // itoa(size(height)) // ' heights, &scene n = ' &
-            & // itoa(n), code_input)
+         call fatal_error(error, 'solve: the profile has ' // to_string(size(height)) // ' heights, &scene n = ' &
+            & // to_string(n), code_input)
          return
       end if
       load_control = trim(scene%control) == 'load'
@@ -126,11 +127,4 @@ contains
       result%wall_time = real(finish - start, wp)/real(rate, wp)
    end subroutine solve_line_contact
 
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buffer
-      write (buffer, '(i0)') i
-      s = trim(buffer)
-   end function itoa
 end module lc_contact_solve

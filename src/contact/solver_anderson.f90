@@ -72,6 +72,7 @@ contains
       newest = 0
       inner_tol = max(0.1_wp*tol, 1.0e-4_wp)
       s_inner = s
+      s_full = s
 
       do k = 1, size(history)
          call op%apply_difference(x, nw)
@@ -141,8 +142,8 @@ contains
 
       m = size(df, 1)
       ncol = size(df, 2)
+      allocate (a(m, ncol), rhs(m, 1), sv(ncol))
       a = df
-      allocate (rhs(m, 1), sv(ncol))
       rhs(:, 1) = f
       call dgelsd(m, ncol, 1, a, m, rhs, m, sv, 1.0e-12_wp, rank, query, -1, iquery, info)
       lwork = int(query(1))

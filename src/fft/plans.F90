@@ -11,6 +11,7 @@ module lc_fft_plans
       & fftw_init_threads, fftw_plan_with_nthreads, FFTW_ESTIMATE, FFTW_DESTROY_INPUT
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_internal
+   use lc_strings, only: to_string
    implicit none (type, external)
    private
    public :: fft_plan, fft_threads_available
@@ -62,7 +63,7 @@ contains
       self%real_memory = fftw_alloc_real(int(n, c_size_t))
       self%complex_memory = fftw_alloc_complex(int(self%nk, c_size_t))
       if (.not. (c_associated(self%real_memory) .and. c_associated(self%complex_memory))) then
-         call fatal_error(error, 'fft: cannot allocate FFTW buffers of size ' // itoa(n), code_internal)
+         call fatal_error(error, 'fft: cannot allocate FFTW buffers of size ' // to_string(n), code_internal)
          return
       end if
       call c_f_pointer(self%real_memory, self%real_buffer, [n])
@@ -72,7 +73,7 @@ contains
       self%c2r = fftw_plan_dft_c2r_1d(int(n, c_int), self%spectrum, self%real_buffer, &
          & ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
       if (.not. (c_associated(self%r2c) .and. c_associated(self%c2r))) then
-         call fatal_error(error, 'fft: FFTW could not plan a transform of size ' // itoa(n), code_internal)
+         call fatal_error(error, 'fft: FFTW could not plan a transform of size ' // to_string(n), code_internal)
       end if
       self%real_buffer = 0.0_wp
    end subroutine init
@@ -111,11 +112,4 @@ contains
       call self%destroy()
    end subroutine finalize
 
-   pure function itoa(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buffer
-      write (buffer, '(i0)') i
-      s = trim(buffer)
-   end function itoa
 end module lc_fft_plans

@@ -27,6 +27,7 @@ module lc_io_hdf5
       & h5dcreate_f, h5dopen_f, h5dwrite_f, h5dread_f, h5dclose_f, h5dget_space_f, h5dget_type_f
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
+   use lc_strings, only: to_string
    use lc_scene, only: scene_type
    use lc_result, only: contact_result
    implicit none (type, external)
@@ -250,7 +251,7 @@ contains
             call h5tclose_f(dtype, ignore)
             if (rank /= 1 .or. dims(1) /= n .or. class /= H5T_FLOAT_F) then
                call fatal_error(error, where // ' holds ' // shape_str(rank, dims, class == H5T_FLOAT_F) &
-                  & // '; expected a 1D float64 dataset of n = ' // int_str(int(n, hsize_t)) // ' values', &
+                  & // '; expected a 1D float64 dataset of n = ' // to_string(int(n, hsize_t)) // ' values', &
                   & code_input)
             else
                dims(1) = n
@@ -378,7 +379,7 @@ contains
       if (ok) ok = size(res%pressure) == n .and. size(res%gap) == n .and. size(res%displacement_z) == n
       if (.not. ok) call fatal_error(error, 'write_results: the ' // label // &
          & ' fields (pressure, gap, displacement_z) must be allocated with the size of the profile, n = ' &
-         & // int_str(int(n, hsize_t)), code_internal)
+         & // to_string(int(n, hsize_t)), code_internal)
    end subroutine check_sizes
 
    ! ---------------------------------------------------------------------------------------
@@ -568,17 +569,10 @@ contains
       if (.not. is_float) then
          s = 'values that are not floating point'
       else if (space_rank == 1) then
-         s = int_str(dims(1)) // ' values'
+         s = to_string(dims(1)) // ' values'
       else
-         s = 'a rank-' // int_str(int(space_rank, hsize_t)) // ' dataset'
+         s = 'a rank-' // to_string(int(space_rank, hsize_t)) // ' dataset'
       end if
    end function shape_str
 
-   pure function int_str(i) result(s)
-      integer(hsize_t), intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=24) :: buffer
-      write (buffer, '(i0)') i
-      s = trim(buffer)
-   end function int_str
 end module lc_io_hdf5

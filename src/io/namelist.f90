@@ -10,6 +10,7 @@ module lc_io_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input, code_io
+   use lc_strings, only: to_string
    use lc_scene, only: scene_type, check_scene, not_set, max_string
    implicit none (type, external)
    private
@@ -30,10 +31,6 @@ module lc_io_namelist
       & 'file, overwrite']
 
    character(len=*), parameter :: newline = new_line('a')
-
-   interface int_str
-      module procedure int_str_default, int_str_i8
-   end interface int_str
 
    !> Where one group sits in the text: characters first..last, starting on `line`.
    type :: group_span
@@ -95,7 +92,7 @@ contains
          if (stat /= 0) then
             if (stat == iostat_end) msg = trim(msg) // " (is the closing '/' of the group missing?)"
             name = trim(group_names(groups(i)%index))
-            call fatal_error(error, source // ', line ' // int_str(groups(i)%line - 1 + line) &
+            call fatal_error(error, source // ', line ' // to_string(groups(i)%line - 1 + line) &
                & // ', group &' // name // ': ' // trim(msg) // '; allowed variables in &' // name // ': ' &
                & // trim(group_variables(groups(i)%index)), code_input)
             return
@@ -117,7 +114,7 @@ contains
             & // entry('geometry', str_value(scene%geometry)) &
             & // entry('title', str_value(scene%title)) &
             & // entry('period', real_value(scene%period)) &
-            & // entry('n', int_str(scene%n)) &
+            & // entry('n', to_string(scene%n)) &
             & // '/' // newline // '&layer' // newline &
             & // entry('thickness', real_value(scene%thickness)) &
             & // entry('young', real_value(scene%young)) &
@@ -128,13 +125,13 @@ contains
             & // '/' // newline // '&profile' // newline &
             & // entry('kind', str_value(p%kind)) &
             & // entry('hurst', real_value(p%hurst)) &
-            & // entry('seed', int_str(p%seed)) &
+            & // entry('seed', to_string(p%seed)) &
             & // entry('rolloff_wavelength', real_value(p%rolloff_wavelength)) &
             & // entry('short_wavelength', real_value(p%short_wavelength)) &
             & // entry('rms_gradient', real_value(p%rms_gradient)) &
             & // entry('rms_height', real_value(p%rms_height)) &
             & // entry('amplitude', real_value(p%amplitude)) &
-            & // entry('mode', int_str(p%mode)) &
+            & // entry('mode', to_string(p%mode)) &
             & // entry('file', str_value(p%file)) &
             & // entry('dataset', str_value(p%dataset)) &
             & // '/' // newline // '&loading' // newline &
@@ -145,10 +142,10 @@ contains
             & // '/' // newline // '&solver' // newline &
             & // entry('method', str_value(s%method)) &
             & // entry('tol', real_value(s%tol)) &
-            & // entry('max_iter', int_str(s%max_iter)) &
-            & // entry('memory', int_str(s%memory)) &
+            & // entry('max_iter', to_string(s%max_iter)) &
+            & // entry('memory', to_string(s%memory)) &
             & // entry('precondition', logical_value(s%precondition)) &
-            & // entry('threads', int_str(s%threads)) &
+            & // entry('threads', to_string(s%threads)) &
             & // '/' // newline // '&output' // newline &
             & // entry('file', str_value(scene%output_file)) &
             & // entry('overwrite', logical_value(scene%overwrite)) &
@@ -402,12 +399,12 @@ contains
             if (name /= 'end') then
                k = group_index(name)
                if (k == 0) then
-                  call fatal_error(error, source // ', line ' // int_str(line) // ": unknown namelist group '&" &
+                  call fatal_error(error, source // ', line ' // to_string(line) // ": unknown namelist group '&" &
                      & // name // "'; allowed groups: " // allowed_groups(), code_input)
                   return
                end if
                if (any(groups(:n_found)%index == k)) then
-                  call fatal_error(error, source // ', line ' // int_str(line) // ": namelist group '&" &
+                  call fatal_error(error, source // ', line ' // to_string(line) // ": namelist group '&" &
                      & // name // "' given twice (at most once each); allowed groups: " // allowed_groups(), &
                      & code_input)
                   return
@@ -626,21 +623,7 @@ contains
       end if
    end function logical_value
 
-   pure function int_str_default(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=24) :: buffer
-      write (buffer, '(i0)') i
-      s = trim(buffer)
-   end function int_str_default
 
-   pure function int_str_i8(i) result(s)
-      integer(i8), intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=24) :: buffer
-      write (buffer, '(i0)') i
-      s = trim(buffer)
-   end function int_str_i8
 
    pure logical function is_name_char(c)
       character, intent(in) :: c

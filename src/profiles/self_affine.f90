@@ -24,7 +24,8 @@
 module lc_profiles_self_affine
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_errors, only: error_type, fatal_error, code_input, input_error
+   use lc_strings, only: to_string
    use lc_scene, only: not_set
    use lc_fft_plans, only: fft_plan
    use lc_profiles_random, only: splitmix64_uniform
@@ -73,23 +74,23 @@ contains
       if (short_wavelength /= not_set) short = short_wavelength
 
       if (n < 4) then
-         call bad(error, 'scene', 'n', int_str(n), '>= 4 (at least one mode below Nyquist)')
+         call input_error(error, 'scene', 'n', to_string(n), '>= 4 (at least one mode below Nyquist)')
       else if (.not. positive(period)) then
-         call bad(error, 'scene', 'period', real_str(period), '> 0 and finite')
+         call input_error(error, 'scene', 'period', to_string(period), '> 0 and finite')
       else if (.not. (hurst > 0.0_wp .and. hurst < 1.0_wp)) then
-         call bad(error, 'profile', 'hurst', real_str(hurst), '0 < hurst < 1')
+         call input_error(error, 'profile', 'hurst', to_string(hurst), '0 < hurst < 1')
       else if (seed < 0_i8) then
-         call bad(error, 'profile', 'seed', int8_str(seed), '>= 0')
+         call input_error(error, 'profile', 'seed', to_string(seed), '>= 0')
       else if (.not. (positive(rolloff) .and. rolloff <= period)) then
-         call bad(error, 'profile', 'rolloff_wavelength', real_str(rolloff), '0 < rolloff_wavelength <= period')
+         call input_error(error, 'profile', 'rolloff_wavelength', to_string(rolloff), '0 < rolloff_wavelength <= period')
       else if (.not. (positive(short) .and. short <= period)) then
-         call bad(error, 'profile', 'short_wavelength', real_str(short), '0 < short_wavelength <= period')
+         call input_error(error, 'profile', 'short_wavelength', to_string(short), '0 < short_wavelength <= period')
       else if (count([rms_gradient /= not_set, rms_height /= not_set]) /= 1) then
-         call bad(error, 'profile', 'rms_gradient/rms_height', 'both or neither given', 'exactly one of them')
+         call input_error(error, 'profile', 'rms_gradient/rms_height', 'both or neither given', 'exactly one of them')
       else if (rms_gradient /= not_set .and. .not. positive(rms_gradient)) then
-         call bad(error, 'profile', 'rms_gradient', real_str(rms_gradient), '> 0 and finite')
+         call input_error(error, 'profile', 'rms_gradient', to_string(rms_gradient), '> 0 and finite')
       else if (rms_height /= not_set .and. .not. positive(rms_height)) then
-         call bad(error, 'profile', 'rms_height', real_str(rms_height), '> 0 and finite')
+         call input_error(error, 'profile', 'rms_height', to_string(rms_height), '> 0 and finite')
       end if
       if (allocated(error)) return
 
@@ -98,9 +99,9 @@ contains
       m_s = min(nint(period/short), m_max)
       if (m_r > m_s) then
          ! Otherwise the modes between m_s and m_r would be both flat and cut off.
-         call bad(error, 'profile', 'rolloff_wavelength', real_str(rolloff), &
-            & 'a roll-off mode nint(period/rolloff_wavelength) = ' // int_str(m_r) // &
-            & ' <= the shortest mode min(nint(period/short_wavelength), n/2-1) = ' // int_str(m_s))
+         call input_error(error, 'profile', 'rolloff_wavelength', to_string(rolloff), &
+            & 'a roll-off mode nint(period/rolloff_wavelength) = ' // to_string(m_r) // &
+            & ' <= the shortest mode min(nint(period/short_wavelength), n/2-1) = ' // to_string(m_s))
          return
       end if
 
@@ -161,34 +162,7 @@ contains
       positive = ieee_is_finite(x) .and. x > 0.0_wp
    end function positive
 
-   pure subroutine bad(error, group, variable, value, allowed)
-      type(error_type), allocatable, intent(out) :: error
-      character(len=*), intent(in) :: group, variable, value, allowed
-      call fatal_error(error, '&' // group // ': ' // variable // ' = ' // value // ' is not allowed; allowed: ' &
-         & // allowed, code_input)
-   end subroutine bad
 
-   pure function real_str(x) result(s)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: s
-      character(len=32) :: buffer
-      write (buffer, '(es12.5)') x
-      s = trim(adjustl(buffer))
-   end function real_str
 
-   pure function int_str(i) result(s)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=16) :: buffer
-      write (buffer, '(i0)') i
-      s = trim(buffer)
-   end function int_str
 
-   pure function int8_str(i) result(s)
-      integer(i8), intent(in) :: i
-      character(len=:), allocatable :: s
-      character(len=24) :: buffer
-      write (buffer, '(i0)') i
-      s = trim(buffer)
-   end function int8_str
 end module lc_profiles_self_affine

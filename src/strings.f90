@@ -1,0 +1,39 @@
+!> Numbers as text for messages: one `to_string` for every kind the code prints.
+module lc_strings
+   use lc_kinds, only: wp
+   use, intrinsic :: iso_fortran_env, only: int32, int64
+   implicit none (type, external)
+   private
+   public :: to_string
+
+   !> Shortest text of an integer; a real with 6 significant digits (es12.5).
+   interface to_string
+      module procedure int32_string, int64_string, real_string
+   end interface to_string
+
+contains
+
+   pure function int32_string(i) result(s)
+      integer(int32), intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=16) :: buffer
+      write (buffer, '(i0)') i
+      s = trim(buffer)
+   end function int32_string
+
+   pure function int64_string(i) result(s)
+      integer(int64), intent(in) :: i
+      character(len=:), allocatable :: s
+      character(len=24) :: buffer
+      write (buffer, '(i0)') i
+      s = trim(buffer)
+   end function int64_string
+
+   pure function real_string(x) result(s)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: s
+      character(len=32) :: buffer
+      write (buffer, '(es12.5)') x
+      s = trim(adjustl(buffer))
+   end function real_string
+end module lc_strings
