@@ -113,3 +113,24 @@ def test_sign_check_2_thin_incompressible_coupling_is_negative():
     for x in [1e-4, 1e-2, 0.1]:
         _, _, c = lc.layer_multipliers([x], 0.5)
         assert c[0] < 0 and c[0] == pytest.approx(-(x**2), rel=2 * x**2 + 1e-12)
+
+
+@pytest.mark.parametrize("nu", [-0.5, 0.0, 0.3, 0.45])
+def test_uniform_mode_of_a_layer_is_h_over_constrained_modulus(nu):
+    """k -> 0: 2(1-A)/(E* k) -> h/M, M = E(1-nu)/((1+nu)(1-2nu)) (uniaxial strain)."""
+    young, h = 2.0, 0.3
+    m_mod = young * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+    k = 1e-7 / h
+    a, _, _ = lc.layer_multipliers([k * h], nu)
+    assert 2 * a[0] / (young / (1 - nu**2) * k) == pytest.approx(h / m_mod, rel=1e-12)
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3])
+def test_flat_punch_on_layer_compresses_by_p_h_over_m(nu):
+    """A flat rigid surface on a compressible layer: uniform pressure, Delta = p_m h/M."""
+    young, h, pm = 2.0, 0.3, 0.01
+    res = lc.solve_line(np.zeros(64), thickness=h, young=young, poisson=nu, friction=0.5, mean_pressure=pm)
+    m_mod = young * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+    assert res.converged and res.contact_fraction == 1.0
+    assert np.allclose(res.pressure, pm, rtol=1e-13)
+    assert res.penetration == pytest.approx(pm * h / m_mod, rel=1e-13)
