@@ -149,3 +149,24 @@ subroutine py_run(input, verbose, output_file, converged, stat, errmsg)
    end if
    flush (output_unit)
 end subroutine py_run
+
+!> Read and validate a namelist file without solving (what the executable checks first).
+subroutine py_check_scene_file(input, stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_scene, only: scene_type
+   use lc_io_namelist, only: read_scene
+   implicit none (type, external)
+   character(len=*), intent(in) :: input
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   type(scene_type) :: scene
+   character(len=:), allocatable :: text
+   stat = 0
+   errmsg = ''
+   call read_scene(input, scene, text, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+   end if
+end subroutine py_check_scene_file

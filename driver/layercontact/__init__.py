@@ -9,6 +9,7 @@ friction traction on the layer is ``tau = +mu_c p``.
 from .api import (
     LayercontactError,
     LineResult,
+    check_scene_file,
     layer_multipliers,
     layer_multipliers_lapack,
     read_result,
@@ -20,6 +21,7 @@ from .profiles import load_profile, self_affine_profile, sinusoid_profile
 __all__ = [
     "LayercontactError",
     "LineResult",
+    "check_scene_file",
     "layer_multipliers",
     "layer_multipliers_lapack",
     "load_profile",

@@ -163,6 +163,13 @@ def read_result(filename: str | os.PathLike, companion: bool = False) -> LineRes
         )
 
 
+def check_scene_file(filename: str | os.PathLike) -> None:
+    """Read and validate a namelist file without solving; raises :class:`LayercontactError`
+    with the message the executable would print."""
+    stat, errmsg = _core.py_check_scene_file(os.fspath(filename))
+    _check(stat, errmsg)
+
+
 def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult:
     """Run a namelist file exactly as the ``layercontact`` executable does (same library
     routine): the HDF5 result is written where ``&output file`` says, and read back.
