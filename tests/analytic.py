@@ -28,8 +28,12 @@ def westergaard_half_width(p_m, Es, h0, lam):
 
 def westergaard_pressure(x, p_m, Es, h0, lam):
     """p(x) = (2 p_m/sin^2 psi) cos(pi x/lam) sqrt(sin^2 psi - sin^2(pi x/lam)) for
-    |x| < a (periodic), zero elsewhere; psi = pi a/lam. Partial contact only."""
-    s2 = p_m / westergaard_full_contact_pressure(Es, h0, lam)
+    |x| < a (periodic), zero elsewhere; psi = pi a/lam. In full contact (p_m >= p*)
+    p = p_m + p* cos(2 pi x/lam)."""
+    pstar = westergaard_full_contact_pressure(Es, h0, lam)
+    if p_m >= pstar:
+        return p_m + pstar * np.cos(2 * np.pi * np.asarray(x) / lam)
+    s2 = p_m / pstar
     theta = np.pi * (np.mod(np.asarray(x) / lam + 0.5, 1.0) - 0.5)
     inside = np.sin(theta) ** 2 < s2
     root = np.sqrt(np.where(inside, s2 - np.sin(theta) ** 2, 0.0))
@@ -45,4 +49,5 @@ def westergaard_mean_gap(p_m, Es, h0, lam):
     Delta = (lam p_m/(pi Es)) (1 - ln P) = h0 P (1 - ln P), and g_bar = h0 - Delta.
     """
     ratio = np.minimum(np.asarray(p_m, dtype=float) / westergaard_full_contact_pressure(Es, h0, lam), 1.0)
-    return h0 * (1 - ratio + ratio * np.log(ratio))
+    ratio_log_ratio = ratio * np.log(np.where(ratio > 0, ratio, 1.0))  # P ln P -> 0 as P -> 0
+    return h0 * (1 - ratio + ratio_log_ratio)
