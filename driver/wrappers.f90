@@ -63,41 +63,36 @@ subroutine py_self_affine_profile(n, period, hurst, seed, rolloff_wavelength, sh
 end subroutine py_self_affine_profile
 
 !> Solve a line contact on the given heights. control: 0 load, 1 displacement;
-!> method: 0 auto, 1 cg, 2 anderson; precondition: 0/1. scalars: mean_pressure, penetration, contact_fraction,
-!> delta_mu, delta_mu_spectral, delta_mu_energy, converged (0/1), iterations,
-!> outer_iterations, fft_pairs, residual, wall_time, history length, delta_mu_profile.
+!> method: 0 auto, 1 cg, 2 anderson; precondition, stress: 0/1.
+!> fields(:, 1:5): pressure, gap, displacement_z, displacement_x, stress_xx (the last two
+!> zero unless stress = 1); spots(1:n_spots, 1:2): trailing and leading edges;
+!> scalars: in the order of layercontact.api._SCALARS.
 subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
-      & penetration, method, precondition, tol, max_iter, memory, threads, pressure, gap, displacement_z, scalars, history, &
-      & stat, errmsg)
+      & penetration, method, precondition, tol, max_iter, memory, threads, stress, fields, spots, scalars, &
+      & history, stat, errmsg)
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, check_scene
    use lc_result, only: contact_result
    use lc_contact_solve, only: solve_line_contact
    implicit none (type, external)
-   integer, intent(in) :: n, control, method, precondition, max_iter, memory, threads
+   integer, intent(in) :: n, control, method, precondition, max_iter, memory, threads, stress
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
-   real(8), intent(out) :: pressure(n), gap(n), displacement_z(n), scalars(14), history(max_iter)
+   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 2), scalars(24), history(max_iter)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
    type(error_type), allocatable :: error
    type(scene_type) :: scene
-   type(contact_result) :: res
+   type(contact_result) :: r
    character(len=12), parameter :: controls(0:1) = [character(len=12) :: 'load', 'displacement']
    character(len=8), parameter :: methods(0:2) = [character(len=8) :: 'auto', 'cg', 'anderson']
    stat = 0
    errmsg = ''
-   scene%n = n
-   scene%period = period
-   scene%thickness = thickness
-   scene%young = young
-   scene%poisson = poisson
-   scene%friction = friction
+   scene = scene_type(n=n, period=period, thickness=thickness, young=young, poisson=poisson, friction=friction, &
+      & control=controls(max(0, min(1, control))), mean_pressure=mean_pressure, penetration=penetration, &
+      & stress=stress == 1, gap_bins=0)
    scene%profile%kind = 'file'
    scene%profile%file = '(array from Python)'
-   scene%control = controls(max(0, min(1, control)))
-   scene%mean_pressure = mean_pressure
-   scene%penetration = penetration
    scene%solver%method = methods(max(0, min(2, method)))
    scene%solver%tol = tol
    scene%solver%max_iter = max_iter
@@ -105,21 +100,28 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    scene%solver%threads = threads
    scene%solver%precondition = precondition == 1
    call check_scene(scene, error)
-   if (.not. allocated(error)) call solve_line_contact(scene, height, friction, res, error)
+   if (.not. allocated(error)) call solve_line_contact(scene, height, friction, r, error)
    if (allocated(error)) then
       stat = error%code
       errmsg = error%message
       return
    end if
-   pressure = res%pressure
-   gap = res%gap
-   displacement_z = res%displacement_z
+   fields = 0
+   fields(:, 1) = r%pressure
+   fields(:, 2) = r%gap
+   fields(:, 3) = r%displacement_z
+   if (allocated(r%stress_xx)) fields(:, 4) = r%displacement_x
+   if (allocated(r%stress_xx)) fields(:, 5) = r%stress_xx
+   spots = 0
+   spots(1:r%n_spots, 1) = r%spot_trailing
+   spots(1:r%n_spots, 2) = r%spot_leading
    history = 0
-   history(1:size(res%residual_history)) = res%residual_history
-   scalars = [res%mean_pressure, res%penetration, res%contact_fraction, res%delta_mu, res%delta_mu_spectral, &
-      & res%delta_mu_energy, merge(1.0d0, 0.0d0, res%converged), real(res%iterations, 8), &
-      & real(res%outer_iterations, 8), real(res%fft_pairs, 8), res%residual, res%wall_time, &
-      & real(size(res%residual_history), 8), res%delta_mu_profile]
+   history(1:size(r%residual_history)) = r%residual_history
+   scalars = [r%mean_pressure, r%penetration, r%contact_fraction, r%delta_mu, r%delta_mu_spectral, &
+      & r%delta_mu_energy, r%delta_mu_profile, merge(1.0d0, 0.0d0, r%converged), real(r%iterations, 8), &
+      & real(r%outer_iterations, 8), real(r%fft_pairs, 8), r%residual, r%wall_time, &
+      & real(size(r%residual_history), 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
+      & r%max_tension, r%max_tension_x, r%max_tension_offset, 0d0, 0d0, 0d0]
 end subroutine py_solve_line
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless
@@ -170,3 +172,30 @@ subroutine py_check_scene_file(input, stat, errmsg)
       errmsg = error%message
    end if
 end subroutine py_check_scene_file
+
+!> Surface displacement u_x and stress sigma_xx for a prescribed pressure p (no contact
+!> solve): tau = friction p on a layer (thickness = Inf: half-space).
+subroutine py_surface_fields(n, p, period, thickness, young, poisson, friction, displacement_x, stress_xx, &
+      & stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_fft_plans, only: fft_plan
+   use lc_observables_surface, only: surface_fields
+   implicit none (type, external)
+   integer, intent(in) :: n
+   real(8), intent(in) :: p(n), period, thickness, young, poisson, friction
+   real(8), intent(out) :: displacement_x(n), stress_xx(n)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   !f2py intent(hide) :: n
+   type(error_type), allocatable :: error
+   type(fft_plan) :: fft
+   stat = 0
+   errmsg = ''
+   call fft%init(n, 1, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+      return
+   end if
+   call surface_fields(fft, period, thickness, young, poisson, friction, p, displacement_x, stress_xx)
+end subroutine py_surface_fields

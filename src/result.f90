@@ -12,6 +12,14 @@ module lc_result
       real(wp), allocatable :: gap(:)              !< g >= 0 (L), zero in contact
       real(wp), allocatable :: displacement_z(:)   !< w = u_z (L), positive into the layer
       real(wp), allocatable :: residual_history(:) !< complementarity residual per iteration
+      !> only when the scene asks for surface stress (&output stress):
+      real(wp), allocatable :: displacement_x(:)   !< u_x (L), along the sliding direction
+      real(wp), allocatable :: shear(:)            !< tau = mu_c p (S), on the layer along +x
+      real(wp), allocatable :: stress_xx(:)        !< sigma_xx at the surface (S), tension positive
+      real(wp), allocatable :: spot_trailing(:)    !< trailing (-x) edge of each contact spot (L)
+      real(wp), allocatable :: spot_leading(:)     !< leading (+x) edge of each contact spot (L)
+      real(wp), allocatable :: gap_edges(:)        !< gap histogram bin edges (L)
+      integer, allocatable :: gap_counts(:)        !< gap histogram counts (grid nodes)
       real(wp) :: friction = 0.0_wp           !< mu_c used for this solve
       real(wp) :: mean_pressure = 0.0_wp      !< p_m (S)
       real(wp) :: penetration = 0.0_wp        !< Delta (L) of the highest asperity
@@ -20,6 +28,13 @@ module lc_result
       real(wp) :: delta_mu_spectral = 0.0_wp  !< the same from the Fourier multiplier
       real(wp) :: delta_mu_energy = 0.0_wp    !< mu_c <p du_x/dx>/p_m (elastic layers)
       real(wp) :: delta_mu_profile = 0.0_wp   !< -<p r'>/p_m: force balance on the rigid profile
+      integer :: n_spots = 0                  !< number of contact spots
+      real(wp) :: contact_length = 0.0_wp     !< a = total length in contact (L)
+      real(wp) :: mean_gap = 0.0_wp           !< <g> (L)
+      real(wp) :: leak_rate = 0.0_wp          !< <g^3>/12 (L^3): flow across x per unit gradient and 1/viscosity
+      real(wp) :: max_tension = 0.0_wp        !< max sigma_xx (S), if stress was asked for
+      real(wp) :: max_tension_x = 0.0_wp      !< where it sits (L)
+      real(wp) :: max_tension_offset = 0.0_wp !< its offset from the nearest spot's trailing edge (L)
       logical :: converged = .false.
       integer :: iterations = 0               !< constrained-CG iterations (all inner solves)
       integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for a symmetric scene

@@ -78,6 +78,8 @@ module lc_scene
       type(solver_settings) :: solver
       character(len=max_string) :: output_file = 'layercontact.h5'
       logical :: overwrite = .false.
+      logical :: stress = .true.      !< compute u_x, tau and the surface stress sigma_xx
+      integer :: gap_bins = 64        !< bins of the gap histogram (0: none)
    end type scene_type
 
 contains
@@ -167,6 +169,8 @@ contains
             call input_error(error, 'solver', 'method', trim(s%method), "'auto', 'cg' or 'anderson'")
          else if (.not. (s%tol >= 1.0e-14_wp .and. s%tol <= 1.0e-2_wp)) then
             call input_error(error, 'solver', 'tol', to_string(s%tol), '1e-14 <= tol <= 1e-2')
+         else if (scene%gap_bins < 0 .or. scene%gap_bins > 100000) then
+            call input_error(error, 'output', 'gap_bins', to_string(scene%gap_bins), '0 <= gap_bins <= 100000')
          else if (s%max_iter < 1) then
             call input_error(error, 'solver', 'max_iter', to_string(s%max_iter), '>= 1')
          else if (s%memory < 1 .or. s%memory > 100) then

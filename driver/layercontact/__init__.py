@@ -15,8 +15,10 @@ from .api import (
     read_result,
     run,
     solve_line,
+    surface_fields,
 )
 from .profiles import load_profile, self_affine_profile, sinusoid_profile
+from .sweep import read_summary, sweep
 
 __all__ = [
     "LayercontactError",
@@ -26,9 +28,12 @@ __all__ = [
     "layer_multipliers_lapack",
     "load_profile",
     "read_result",
+    "read_summary",
     "run",
     "self_affine_profile",
     "sinusoid_profile",
     "solve_line",
+    "sweep",
+    "surface_fields",
 ]
 __version__ = "0.1.0"

@@ -1,4 +1,5 @@
-"""Command line: ``python -m layercontact run FILE.nml [--png PICTURE]``.
+"""Command line: ``python -m layercontact run FILE.nml [--png PICTURE]``, or
+``python -m layercontact sweep FILE.nml [--processes N] [--no-progress]``.
 
 Runs the scene like the ``layercontact`` executable (same library routine, same HDF5
 file, same summary and exit codes) and draws the seed's Fig. 2(a) view next to the
@@ -22,7 +23,15 @@ def main(argv: list[str] | None = None) -> int:
     run_p.add_argument("nml", help="namelist input file")
     run_p.add_argument("--png", help="picture to draw (default: the result file with .png)")
     run_p.add_argument("--no-png", action="store_true", help="do not draw a picture")
+    sweep_p = sub.add_parser(
+        "sweep", help="run a parameter sweep (a scene plus a &sweep group); exit 1 if a scene failed, 2 bad input"
+    )
+    sweep_p.add_argument("nml", help="sweep namelist file")
+    sweep_p.add_argument("--processes", type=int, help="worker processes (default: &sweep processes, else all CPUs)")
+    sweep_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
+    if args.command == "sweep":
+        return sweep_command(args.nml, args.processes, not args.no_progress)
 
     out, converged, stat, errmsg = _core.py_run(args.nml, 1)
     try:
@@ -41,6 +50,26 @@ def main(argv: list[str] | None = None) -> int:
         print("layercontact: warning: the solver did not reach its tolerance", file=sys.stderr)
         return 3
     return 0
+
+
+def sweep_command(nml: str, processes: int | None, progress: bool) -> int:
+    """``python -m layercontact sweep``: run the sweep, print where the summary is and
+    which scenes failed. Exit code 0 all converged, 1 some scene failed or did not
+    converge (the others ran), 2 bad sweep (nothing ran)."""
+    from .sweep import execute, failed, read_sweep
+
+    try:
+        plan = read_sweep(nml)
+        rows = execute(plan, processes=processes, progress=progress)
+    except (ValueError, LayercontactError, OSError) as err:
+        print(f"layercontact: error: {err}", file=sys.stderr)
+        return 2
+    bad = failed(rows)
+    print(f"sweep '{plan.name}': {len(rows)} scenes, {len(bad)} failed")
+    print(f"  {'summary':<32}{plan.summary_file('csv')}, {plan.summary_file('h5')}")
+    for row in bad:
+        print(f"layercontact: scene {row['scene_file']}: {row['error']}", file=sys.stderr)
+    return 1 if bad else 0
 
 
 if __name__ == "__main__":

@@ -13,6 +13,14 @@ from . import _core
 NOT_SET = -1.0
 _CONTROLS = {"load": 0, "displacement": 1}
 _METHODS = {"auto": 0, "cg": 1, "anderson": 2}
+# Order of the scalars returned by the wrapper py_solve_line (driver/wrappers.f90).
+_SCALARS = (
+    "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
+    "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
+    "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
+    "max_tension_offset",
+)
+_INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
 
 
 class LayercontactError(RuntimeError):
@@ -58,7 +66,12 @@ def layer_multipliers_lapack(kh, nu: float):
 class LineResult:
     """A solved line contact. Units are those of the inputs: lengths L, pressures S.
 
-    Fields are on the grid ``x_j = j period/n``; ``gap = w - (r - Lambda + Delta)``.
+    Fields are on the grid ``x_j = j period/n``; ``gap = w - (r - Lambda + Delta)``;
+    ``displacement_x``, ``shear`` and ``stress_xx`` (surface in-plane stress, tension
+    positive) are ``None`` when not asked for. ``spots`` is an ``(n_spots, 2)`` array of
+    trailing (-x) and leading (+x) edges; ``leak_rate = <g^3>/12`` is the flow across the
+    sliding direction per unit length, per unit pressure gradient, times the viscosity.
+    ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
     """
 
     pressure: np.ndarray
@@ -70,6 +83,7 @@ class LineResult:
     mean_pressure: float
     penetration: float
     contact_fraction: float
+    contact_length: float
     delta_mu: float
     delta_mu_spectral: float
     delta_mu_energy: float
@@ -81,6 +95,18 @@ class LineResult:
     residual: float
     wall_time: float
     residual_history: np.ndarray = field(repr=False)
+    n_spots: int = 0
+    spots: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
+    mean_gap: float = float("nan")
+    leak_rate: float = float("nan")
+    displacement_x: np.ndarray | None = field(default=None, repr=False)
+    shear: np.ndarray | None = field(default=None, repr=False)
+    stress_xx: np.ndarray | None = field(default=None, repr=False)
+    max_tension: float = float("nan")
+    max_tension_x: float = float("nan")
+    max_tension_offset: float = float("nan")
+    a_over_a0: float | None = None
+    companion: "LineResult | None" = field(default=None, repr=False)
 
     @property
     def x(self) -> np.ndarray:
@@ -98,6 +124,8 @@ def solve_line(
     friction: float = 0.0,
     mean_pressure: float | None = None,
     penetration: float | None = None,
+    companion: bool = False,
+    stress: bool = True,
     method: str = "auto",
     precondition: bool = True,
     tol: float = 1e-10,
@@ -109,12 +137,14 @@ def solve_line(
     periodic grid of one ``period``) on a layer of ``thickness`` (``inf``: half-space)
     bonded to a rigid base, with Coulomb friction ``tau = friction * p``.
 
+    Give ``mean_pressure`` (load control) or ``penetration`` (displacement control, finite
+    compressible layers only). ``companion=True`` also solves the frictionless problem at
+    the same load and sets ``a_over_a0`` and ``companion``. ``stress`` computes
+    ``displacement_x``, ``shear`` and the surface stress ``stress_xx`` (one more FFT pair).
     ``precondition`` applies the Fourier stiffness 1/M to the residual on the contact set
-    (fewer iterations, nearly flat in the grid size; see bench/iterations.py). Give
-    ``mean_pressure`` (load control) or ``penetration`` (displacement control, finite
-    compressible layers only). Raises :class:`LayercontactError` with the library's
-    message for bad input. A run that did not reach ``tol`` returns with
-    ``converged = False``.
+    (fewer iterations, nearly flat in the grid size; see bench/iterations.py).
+    Raises :class:`LayercontactError` with the library's message for bad input. A run that
+    did not reach ``tol`` returns with ``converged = False``.
     """
     h = np.ascontiguousarray(np.asarray(heights, dtype=np.float64))
     if h.ndim != 1:
@@ -123,44 +153,82 @@ def solve_line(
         raise ValueError("give exactly one of mean_pressure (load control) and penetration")
     if method not in _METHODS:
         raise ValueError(f"method = {method!r} is not allowed; allowed: {sorted(_METHODS)}")
+    settings = dict(period=period, thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
+                    penetration=penetration, stress=stress, method=method, precondition=precondition, tol=tol,
+                    max_iter=max_iter, memory=memory, threads=threads)
+    result = _solve_once(h, friction=friction, **settings)
+    if companion:
+        if mean_pressure is None:
+            raise ValueError("companion=True compares at the same load: give mean_pressure")
+        result.companion = _solve_once(h, friction=0.0, **settings)
+        result.a_over_a0 = result.contact_fraction / result.companion.contact_fraction
+    return result
+
+
+def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure, penetration, stress, method,
+                precondition, tol, max_iter, memory, threads) -> LineResult:
     control = "load" if mean_pressure is not None else "displacement"
-    pm = NOT_SET if mean_pressure is None else float(mean_pressure)
-    pen = NOT_SET if penetration is None else float(penetration)
-    p, g, w, s, hist, stat, errmsg = _core.py_solve_line(
-        h, float(period), float(thickness), float(young), float(poisson), float(friction),
-        _CONTROLS[control], pm, pen, _METHODS[method], int(bool(precondition)), float(tol), int(max_iter),
-        int(memory), int(threads),
+    fields, spots, s, hist, stat, errmsg = _core.py_solve_line(
+        h, float(period), float(thickness), float(young), float(poisson), float(friction), _CONTROLS[control],
+        NOT_SET if mean_pressure is None else float(mean_pressure),
+        NOT_SET if penetration is None else float(penetration),
+        _METHODS[method], int(bool(precondition)), float(tol), int(max_iter), int(memory), int(threads),
+        int(bool(stress)),
     )
     _check(stat, errmsg)
+    scalars = {name: (int(v) if name in _INTEGERS else float(v)) for name, v in zip(_SCALARS, s)}
+    n_hist = int(scalars.pop("history_length"))
+    scalars["converged"] = bool(scalars["converged"])
+    if not stress:
+        for name in ("max_tension", "max_tension_x", "max_tension_offset"):
+            scalars[name] = float("nan")
     return LineResult(
-        pressure=p, gap=g, displacement_z=w, height=h.copy(), period=float(period), friction=float(friction),
-        mean_pressure=s[0], penetration=s[1], contact_fraction=s[2], delta_mu=s[3], delta_mu_spectral=s[4],
-        delta_mu_energy=s[5], delta_mu_profile=s[13], converged=bool(s[6]), iterations=int(s[7]), outer_iterations=int(s[8]),
-        fft_pairs=int(s[9]), residual=s[10], wall_time=s[11], residual_history=hist[: int(s[12])].copy(),
+        pressure=fields[:, 0].copy(), gap=fields[:, 1].copy(), displacement_z=fields[:, 2].copy(),
+        displacement_x=fields[:, 3].copy() if stress else None, shear=friction * fields[:, 0] if stress else None,
+        stress_xx=fields[:, 4].copy() if stress else None, height=h.copy(), period=float(period),
+        friction=float(friction), spots=spots[: scalars["n_spots"]].copy(), residual_history=hist[:n_hist].copy(),
+        **scalars,
     )
 
 
-def read_result(filename: str | os.PathLike, companion: bool = False) -> LineResult:
-    """Read a result file written by the executable or :func:`run` (``companion=True``:
-    the frictionless companion run stored in it)."""
+def surface_fields(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson=0.5, friction=0.0):
+    """Surface displacement ``u_x`` (L) and in-plane stress ``sigma_xx`` (S, tension
+    positive) of the layer under a prescribed pressure (S) and shear ``friction * p``,
+    without solving a contact problem."""
+    p = np.ascontiguousarray(np.asarray(pressure, dtype=np.float64))
+    ux, sxx, stat, errmsg = _core.py_surface_fields(p, float(period), float(thickness), float(young),
+                                                    float(poisson), float(friction))
+    _check(stat, errmsg)
+    return ux, sxx
+
+
+def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResult:
+    """Read a result file written by the executable or :func:`run`; the frictionless
+    companion run stored in it (if any) becomes ``result.companion``."""
     import h5py
 
-    with h5py.File(filename, "r") as f:
-        base = f["companion"] if companion else f
+    def one(f, base) -> LineResult:
         r = dict(base["results"].attrs)
-        fields = base["fields"]
+        fields = {k: base["fields"][k][()] for k in base["fields"]}
+        spots = (np.column_stack([base["spots/trailing_edge"][()], base["spots/leading_edge"][()]])
+                 if "spots" in base else np.zeros((0, 2)))
+        names = set(_SCALARS) - {"history_length"}
+        values = {k: (int(r[k]) if k in _INTEGERS else float(r[k])) for k in names if k in r}
+        values["converged"] = bool(r["converged"])
         return LineResult(
-            pressure=fields["pressure"][()], gap=fields["gap"][()], displacement_z=fields["displacement_z"][()],
-            height=f["profile/height"][()], period=float(f["input"].attrs["period"]),
-            friction=float(r["friction"]), mean_pressure=float(r["mean_pressure"]),
-            penetration=float(r["penetration"]), contact_fraction=float(r["contact_fraction"]),
-            delta_mu=float(r["delta_mu"]), delta_mu_spectral=float(r["delta_mu_spectral"]),
-            delta_mu_energy=float(r["delta_mu_energy"]), delta_mu_profile=float(r["delta_mu_profile"]),
-            converged=bool(r["converged"]),
-            iterations=int(r["iterations"]), outer_iterations=int(r.get("outer_iterations", 1)),
-            fft_pairs=int(r["fft_pairs"]), residual=float(r["residual"]), wall_time=float(r["wall_time"]),
+            pressure=fields["pressure"], gap=fields["gap"], displacement_z=fields["displacement_z"],
+            displacement_x=fields.get("displacement_x"), shear=fields.get("shear"),
+            stress_xx=fields.get("stress_xx"), height=f["profile/height"][()],
+            period=float(f["input"].attrs["period"]), friction=float(r["friction"]), spots=spots,
             residual_history=base["convergence/residual"][()],
+            a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values,
         )
+
+    with h5py.File(filename, "r") as f:
+        result = one(f, f)
+        if companion and "companion" in f:
+            result.companion = one(f, f["companion"])
+        return result
 
 
 def check_scene_file(filename: str | os.PathLike) -> None:

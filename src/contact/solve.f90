@@ -16,6 +16,8 @@ module lc_contact_solve
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome
    use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
    use lc_observables_friction, only: interlocking_friction
+   use lc_observables_surface, only: surface_fields
+   use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset
    implicit none (type, external)
    private
    public :: solve_line_contact, scene_mean_pressure
@@ -119,12 +121,45 @@ contains
       result%mean_pressure = sum(p)/n
       result%penetration = s + lambda_max
       result%contact_fraction = real(count(p > 0.0_wp), wp)/n
-      if (result%mean_pressure > 0.0_wp) then
-         call interlocking_friction(op, p, w, height, scene%thickness, scene%young, scene%poisson, &
-            & result%delta_mu, result%delta_mu_spectral, result%delta_mu_energy, result%delta_mu_profile)
-      end if
       call system_clock(finish)
       result%wall_time = real(finish - start, wp)/real(rate, wp)
+      call observe(scene, op, height, result)
    end subroutine solve_line_contact
+
+   !> The observables of a solved contact, computed only as the scene asks.
+   subroutine observe(scene, op, height, result)
+      type(scene_type), intent(in) :: scene
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: height(:)
+      type(contact_result), intent(inout) :: result
+      integer :: where_max
+
+      associate (p => result%pressure)
+         call contact_spots(p, scene%period, result%n_spots, result%spot_trailing, result%spot_leading)
+         result%contact_length = scene%period*count(p > 0.0_wp)/size(p)
+         result%mean_gap = sum(result%gap)/size(p)
+         result%leak_rate = leak_rate(result%gap)
+         if (scene%gap_bins > 0) then
+            allocate (result%gap_edges(scene%gap_bins + 1), result%gap_counts(scene%gap_bins))
+            call gap_histogram(result%gap, result%gap_edges, result%gap_counts)
+         end if
+         if (result%mean_pressure > 0.0_wp) then
+            call interlocking_friction(op, p, result%displacement_z, height, scene%thickness, scene%young, &
+               & scene%poisson, result%delta_mu, result%delta_mu_spectral, result%delta_mu_energy, &
+               & result%delta_mu_profile)
+         end if
+         if (scene%stress) then
+            allocate (result%displacement_x(size(p)), result%stress_xx(size(p)))
+            result%shear = result%friction*p
+            call surface_fields(op%fft, scene%period, scene%thickness, scene%young, scene%poisson, &
+               & result%friction, p, result%displacement_x, result%stress_xx)
+            where_max = maxloc(result%stress_xx, dim=1)
+            result%max_tension = result%stress_xx(where_max)
+            result%max_tension_x = (where_max - 1)*scene%period/size(p)
+            result%max_tension_offset = nearest_trailing_offset(result%max_tension_x, result%spot_trailing, &
+               & scene%period)
+         end if
+      end associate
+   end subroutine observe
 
 end module lc_contact_solve

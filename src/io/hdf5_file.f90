@@ -329,7 +329,25 @@ contains
       call write_dataset_1d(group, 'pressure', res%pressure, 'S', st)
       call write_dataset_1d(group, 'gap', res%gap, 'L', st)
       call write_dataset_1d(group, 'displacement_z', res%displacement_z, 'L', st)
+      if (allocated(res%stress_xx)) then
+         call write_dataset_1d(group, 'displacement_x', res%displacement_x, 'L', st)
+         call write_dataset_1d(group, 'shear', res%shear, 'S', st)
+         call write_dataset_1d(group, 'stress_xx', res%stress_xx, 'S', st)
+      end if
       call close_group(group, st)
+
+      if (allocated(res%spot_trailing)) then
+         call create_group(loc, 'spots', group, st)
+         call write_dataset_1d(group, 'trailing_edge', res%spot_trailing, 'L', st)
+         call write_dataset_1d(group, 'leading_edge', res%spot_leading, 'L', st)
+         call close_group(group, st)
+      end if
+      if (allocated(res%gap_counts)) then
+         call create_group(loc, 'gap_histogram', group, st)
+         call write_dataset_1d(group, 'edges', res%gap_edges, 'L', st)
+         call write_dataset_1d(group, 'counts', real(res%gap_counts, wp), '1', st)
+         call close_group(group, st)
+      end if
 
       call create_group(loc, 'results', group, st)
       call write_attr_real(group, 'mean_pressure', res%mean_pressure, st)
@@ -346,6 +364,15 @@ contains
       call write_attr_real(group, 'residual', res%residual, st)
       call write_attr_real(group, 'wall_time', res%wall_time, st)
       call write_attr_real(group, 'friction', res%friction, st)
+      call write_attr_int(group, 'n_spots', res%n_spots, st)
+      call write_attr_real(group, 'contact_length', res%contact_length, st)
+      call write_attr_real(group, 'mean_gap', res%mean_gap, st)
+      call write_attr_real(group, 'leak_rate', res%leak_rate, st)
+      if (allocated(res%stress_xx)) then
+         call write_attr_real(group, 'max_tension', res%max_tension, st)
+         call write_attr_real(group, 'max_tension_x', res%max_tension_x, st)
+         call write_attr_real(group, 'max_tension_offset', res%max_tension_offset, st)
+      end if
       ! the seed's scales: Lambda = highest asperity above the mean plane (heights have zero
       ! mean), p_m normalised by E* Lambda / lambda, thickness by lambda
       e_star = scene%young / (1.0_wp - scene%poisson**2)

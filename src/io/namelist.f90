@@ -28,7 +28,7 @@ module lc_io_namelist
       & 'amplitude, mode, file, dataset', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
       & 'method, tol, max_iter, memory, precondition, threads', &
-      & 'file, overwrite']
+      & 'file, overwrite, stress, gap_bins']
 
    character(len=*), parameter :: newline = new_line('a')
 
@@ -149,6 +149,8 @@ contains
             & // '/' // newline // '&output' // newline &
             & // entry('file', str_value(scene%output_file)) &
             & // entry('overwrite', logical_value(scene%overwrite)) &
+            & // entry('stress', logical_value(scene%stress)) &
+            & // entry('gap_bins', to_string(scene%gap_bins)) &
             & // '/' // newline
       end associate
    end subroutine write_scene_namelist
@@ -342,15 +344,20 @@ contains
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
       character(len=max_string) :: file
-      logical :: overwrite
-      namelist /output/ file, overwrite
+      logical :: overwrite, stress
+      integer :: gap_bins
+      namelist /output/ file, overwrite, stress, gap_bins
 
       file = config%output_file
       overwrite = config%overwrite
+      stress = config%stress
+      gap_bins = config%gap_bins
       read (lines, nml=output, iostat=stat, iomsg=msg)
       if (stat /= 0) return
       config%output_file = file
       config%overwrite = overwrite
+      config%stress = stress
+      config%gap_bins = gap_bins
    end subroutine read_group_output
 
    ! ---------------------------------------------------------------------------------------

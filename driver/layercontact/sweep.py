@@ -1,0 +1,615 @@
+"""Parameter sweeps: one namelist file with a base scene and a ``&sweep`` group, run as the
+cartesian product of the swept values in parallel worker processes, resumable, with a
+CSV and an HDF5 summary.
+
+A sweep file holds the usual groups (``&scene &layer &friction &profile &loading &solver
+&output``) plus::
+
+    &sweep
+       name = 'fig2b'                    ! used in file names; default: the file's stem
+       directory = 'out/fig2b'           ! default: 'out/NAME' (relative to the cwd)
+       friction = 0.0, 0.2, 0.5          ! -> &friction coefficient
+       normalised_pressure = 0.3, 1, 3   ! -> &loading (or mean_pressure; load control)
+       thickness = 0.16, 0.01            ! -> &layer thickness
+       seed = 1, 2, 3                    ! -> &profile seed (or realisations = N: 1..N)
+       processes = 2                     ! worker processes (default: os.cpu_count())
+    /
+
+Layout of ``DIRECTORY``: ``scenes/NAME_XXXX.nml`` (one complete scene each),
+``results/NAME_XXXX.h5`` (written by the library, complete or absent) and
+``NAME_summary.csv`` / ``NAME_summary.h5`` (one row per scene).
+
+Note: ``layercontact.sweep`` is the function :func:`sweep`; this module is
+``sys.modules['layercontact.sweep']``.
+"""
+
+from __future__ import annotations
+
+import copy
+import csv
+import io
+import itertools
+import multiprocessing
+import os
+import sys
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import f90nml
+import numpy as np
+
+from .api import LayercontactError, check_scene_file, run
+
+SWEEP_GROUP = "sweep"
+SUMMARY_GROUP = "summary"
+_SETTINGS = ("name", "directory", "realisations", "processes")
+_PRESSURES = ("mean_pressure", "normalised_pressure")
+
+
+@dataclass(frozen=True)
+class _Parameter:
+    """Where a swept variable goes in the scene namelist.
+
+    Attributes
+    ----------
+    group, variable : str
+        The namelist group and variable it overrides.
+    kind : type
+        ``float`` or ``int`` (the values' type).
+    replaces : tuple of str
+        Variables of ``group`` removed first (the alternatives of this one).
+    sets : tuple of (str, object)
+        Other variables of ``group`` set with it.
+    """
+
+    group: str
+    variable: str
+    kind: type
+    replaces: tuple[str, ...] = ()
+    sets: tuple[tuple[str, object], ...] = ()
+
+    def apply(self, nml: f90nml.Namelist, value: float | int) -> None:
+        """Override this parameter in ``nml`` (in place)."""
+        if self.group not in nml:
+            nml[self.group] = {}
+        group = nml[self.group]
+        for variable in self.replaces:
+            group.pop(variable, None)
+        for variable, fixed in self.sets:
+            group[variable] = fixed
+        group[self.variable] = value
+
+
+_LOAD = (("control", "load"),)
+_LOADING = ("mean_pressure", "normalised_pressure", "penetration")
+#: The &sweep lists, in the order of the product (the last one varies fastest).
+PARAMETERS: dict[str, _Parameter] = {
+    "friction": _Parameter("friction", "coefficient", float),
+    "normalised_pressure": _Parameter("loading", "normalised_pressure", float, _LOADING, _LOAD),
+    "mean_pressure": _Parameter("loading", "mean_pressure", float, _LOADING, _LOAD),
+    "thickness": _Parameter("layer", "thickness", float),
+    "seed": _Parameter("profile", "seed", int),
+}
+
+
+@dataclass(frozen=True)
+class SweepPlan:
+    """A parsed sweep file.
+
+    Attributes
+    ----------
+    source : Path
+        The sweep file.
+    name : str
+        Prefix of the scene, result and summary file names.
+    directory : Path
+        Where everything is written (relative to the cwd unless absolute).
+    base : f90nml.Namelist
+        The base scene (every group except ``&sweep``).
+    values : dict of str to list
+        The swept variables (``realisations`` already turned into ``seed``), in product
+        order.
+    processes : int or None
+        Worker processes asked for in the file.
+    """
+
+    source: Path
+    name: str
+    directory: Path
+    base: f90nml.Namelist
+    values: dict[str, list]
+    processes: int | None
+
+    def summary_file(self, suffix: str) -> Path:
+        """``DIRECTORY/NAME_summary.SUFFIX`` (suffix ``'csv'`` or ``'h5'``)."""
+        return self.directory / f"{self.name}_summary.{suffix}"
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One scene of a sweep: its swept values, files and namelist text."""
+
+    index: int
+    values: dict[str, float | int]
+    scene_file: Path
+    result_file: Path
+    text: str
+
+    def planned_row(self) -> dict[str, object]:
+        """The swept values and the file names (the first columns of the summary)."""
+        return {**self.values, "scene_file": str(self.scene_file), "result_file": str(self.result_file)}
+
+
+# ---------------------------------------------------------------------------------------
+# reading the sweep file
+
+
+def _sweep_error(source: Path, variable: str, message: str) -> ValueError:
+    return ValueError(f"{source}: &sweep {variable}: {message}")
+
+
+def _as_list(value: object) -> list:
+    return list(value) if isinstance(value, list) else [value]
+
+
+def _typed_values(source: Path, variable: str, raw: object, kind: type) -> list:
+    """The list ``variable = raw`` of a &sweep group, checked to be ``kind`` numbers."""
+    values = [v for v in _as_list(raw) if v is not None]
+    if not values:
+        raise _sweep_error(source, variable, "no values given")
+    for value in values:
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not number or (kind is int and not isinstance(value, int)):
+            expected = "an integer" if kind is int else "a number"
+            raise _sweep_error(source, variable, f"value {value!r} is not {expected}")
+    return [kind(v) for v in values]
+
+
+def _positive_int(source: Path, variable: str, raw: object) -> int:
+    if isinstance(raw, bool) or not isinstance(raw, int) or raw < 1:
+        raise _sweep_error(source, variable, f"{raw!r} is not allowed; allowed: an integer >= 1")
+    return raw
+
+
+def _name_setting(source: Path, variable: str, raw: object) -> str:
+    if not isinstance(raw, str) or not raw.strip():
+        raise _sweep_error(source, variable, f"{raw!r} is not allowed; allowed: a non-empty string")
+    return raw.strip()
+
+
+def _read_namelist(source: Path) -> f90nml.Namelist:
+    try:
+        return f90nml.read(os.fspath(source))
+    except FileNotFoundError:
+        raise
+    except Exception as err:  # f90nml raises several types for syntax errors
+        raise ValueError(f"{source}: cannot parse the namelist file: {err}") from err
+
+
+def _swept_values(source: Path, group: f90nml.Namelist) -> dict[str, list]:
+    """The swept lists of a &sweep group, in product order, ``realisations`` -> ``seed``."""
+    for first, second in (_PRESSURES, ("seed", "realisations")):
+        if first in group and second in group:
+            raise _sweep_error(source, f"{first}, {second}", "give at most one of them")
+    values = {var: _typed_values(source, var, group[var], p.kind) for var, p in PARAMETERS.items() if var in group}
+    if "realisations" in group:
+        values["seed"] = list(range(1, _positive_int(source, "realisations", group["realisations"]) + 1))
+    return values
+
+
+def read_sweep(path: str | os.PathLike) -> SweepPlan:
+    """Read and check a sweep file (the &sweep group only; the scenes are checked by the
+    library once written).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The sweep namelist file.
+
+    Returns
+    -------
+    SweepPlan
+
+    Raises
+    ------
+    ValueError
+        For a missing &sweep group or a bad &sweep variable (named in the message).
+    """
+    source = Path(path)
+    nml = _read_namelist(source)
+    if SWEEP_GROUP not in nml:
+        raise ValueError(f"{source}: no &sweep group (a sweep file is a scene plus a &sweep group)")
+    group = nml.pop(SWEEP_GROUP)
+    unknown = [var for var in group if var not in PARAMETERS and var not in _SETTINGS]
+    if unknown:
+        allowed = ", ".join([*PARAMETERS, *_SETTINGS])
+        raise _sweep_error(source, unknown[0], f"unknown variable; allowed: {allowed}")
+    name = _name_setting(source, "name", group.get("name", source.stem))
+    if "/" in name or os.sep in name:
+        raise _sweep_error(source, "name", f"{name!r} must not contain a path separator")
+    directory = _name_setting(source, "directory", group.get("directory", f"out/{name}"))
+    processes = _positive_int(source, "processes", group["processes"]) if "processes" in group else None
+    return SweepPlan(source, name, Path(directory), nml, _swept_values(source, group), processes)
+
+
+# ---------------------------------------------------------------------------------------
+# writing and checking the scenes
+
+
+def _scene_text(plan: SweepPlan, index: int, values: dict, result_file: Path) -> str:
+    """The namelist text of one scene: the base with the overrides and its result file."""
+    nml = copy.deepcopy(plan.base)
+    for variable, value in values.items():
+        PARAMETERS[variable].apply(nml, value)
+    if "output" not in nml:
+        nml["output"] = {}
+    nml["output"]["file"] = str(result_file)
+    nml["output"]["overwrite"] = True
+    described = ", ".join(f"{k} = {v!r}" for k, v in values.items()) or "the base scene"
+    out = io.StringIO()
+    out.write(f"! sweep '{plan.name}' ({plan.source}), scene {index}: {described}\n")
+    nml.write(out)
+    return out.getvalue()
+
+
+def plan_scenes(plan: SweepPlan) -> list[Scene]:
+    """The scenes of a sweep: the cartesian product of its lists (none: the base alone).
+
+    Parameters
+    ----------
+    plan : SweepPlan
+
+    Returns
+    -------
+    list of Scene
+        In product order (the last swept variable varies fastest), numbered from 0.
+    """
+    combos = list(itertools.product(*plan.values.values()))
+    width = max(4, len(str(len(combos) - 1)))
+    scenes = []
+    for index, combo in enumerate(combos):
+        values = dict(zip(plan.values, combo))
+        stem = f"{plan.name}_{index:0{width}d}"
+        scene_file = plan.directory / "scenes" / f"{stem}.nml"
+        result_file = plan.directory / "results" / f"{stem}.h5"
+        scenes.append(Scene(index, values, scene_file, result_file, _scene_text(plan, index, values, result_file)))
+    return scenes
+
+
+def _temporary(path: Path) -> Path:
+    return path.with_name(f".{path.name}.{os.getpid()}.tmp")
+
+
+@contextmanager
+def _atomic(path: Path) -> Iterator[Path]:
+    """Yield a temporary name next to ``path``; on success it replaces ``path``, on
+    failure it is removed (``path`` is then untouched)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = _temporary(path)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _write_scene(scene: Scene) -> None:
+    """Write the scene file unless it already holds the same text (keeps its mtime)."""
+    if scene.scene_file.is_file() and scene.scene_file.read_text() == scene.text:
+        return
+    with _atomic(scene.scene_file) as tmp:
+        tmp.write_text(scene.text)
+
+
+def _check_scene(plan: SweepPlan, scene: Scene) -> None:
+    try:
+        check_scene_file(scene.scene_file)
+    except LayercontactError as err:
+        described = ", ".join(f"{k} = {v!r}" for k, v in scene.values.items()) or "base scene"
+        raise LayercontactError(
+            f"&sweep '{plan.name}' ({plan.source}): scene file {scene.scene_file} ({described}): {err}", err.code
+        ) from err
+
+
+def write_scenes(plan: SweepPlan) -> list[Scene]:
+    """Write every scene file of ``plan`` and check all of them with the library.
+
+    Raises
+    ------
+    LayercontactError
+        For the first invalid scene, naming its scene file, its swept values and the
+        library's message (group, variable, value, allowed range).
+    """
+    scenes = plan_scenes(plan)
+    for scene in scenes:
+        _write_scene(scene)
+    for scene in scenes:
+        _check_scene(plan, scene)
+    return scenes
+
+
+# ---------------------------------------------------------------------------------------
+# running
+
+
+def _scalar_attributes(attrs, prefix: str = "") -> dict[str, object]:
+    """Scalar attributes as Python values (strings decoded), names prefixed."""
+    out = {}
+    for key, value in attrs.items():
+        value = np.asarray(value)
+        if value.ndim != 0:
+            continue
+        item = value.item()
+        out[prefix + key] = item.decode() if isinstance(item, bytes) else item
+    return out
+
+
+def _result_columns(result_file: Path) -> dict[str, object]:
+    """Every scalar attribute of ``/results`` and of ``/companion/results``
+    (``companion_`` prefix) of a result file."""
+    import h5py
+
+    with h5py.File(result_file, "r") as f:
+        columns = _scalar_attributes(f["results"].attrs)
+        if "companion/results" in f:
+            columns.update(_scalar_attributes(f["companion/results"].attrs, "companion_"))
+    return columns
+
+
+def _outcome(columns: dict[str, object]) -> dict[str, object]:
+    """Add the ``error`` column: empty for a converged run, else why not."""
+    failed = [prefix for prefix in ("", "companion_") if columns.get(f"{prefix}converged", 1) == 0]
+    if failed:
+        what = "companion run" if failed[0] else "solver"
+        residual = columns.get(f"{failed[0]}residual", float("nan"))
+        return {**columns, "error": f"{what} did not converge (residual {residual:.3e})"}
+    return {**columns, "error": ""}
+
+
+def _failure(message: str) -> dict[str, object]:
+    return {"converged": 0, "error": message}
+
+
+def _solve(scene_file: str, result_file: str) -> dict[str, object]:
+    """Worker: run one scene file, return its result columns (or its error)."""
+    try:
+        run(scene_file)
+        return _outcome(_result_columns(Path(result_file)))
+    except Exception as err:  # reported in the summary, the other scenes go on
+        return _failure(f"{type(err).__name__}: {err}")
+
+
+def _is_complete(scene: Scene) -> bool:
+    """True if the scene's result file is readable and was made from the same text."""
+    import h5py
+
+    try:
+        with h5py.File(scene.result_file, "r") as f:
+            stored = f["input/namelist"][()]
+    except (OSError, KeyError):
+        return False
+    return (stored.decode() if isinstance(stored, bytes) else str(stored)) == scene.text
+
+
+def _pool_context() -> multiprocessing.context.BaseContext:
+    methods = multiprocessing.get_all_start_methods()
+    return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+
+
+def _run_pending(
+    name: str, pending: list[Scene], total: int, processes: int, progress: bool
+) -> dict[int, dict[str, object]]:
+    """Run ``pending`` scenes in a process pool; outcomes by scene index."""
+    from tqdm import tqdm
+
+    outcomes: dict[int, dict[str, object]] = {}
+    bar = tqdm(total=total, initial=total - len(pending), desc=name, unit="scene", file=sys.stderr,
+               disable=not progress)
+    # the workers run in the caller's working directory (a forkserver keeps its own)
+    pool = ProcessPoolExecutor(max_workers=min(processes, len(pending)), mp_context=_pool_context(),
+                               initializer=os.chdir, initargs=(os.getcwd(),))
+    try:
+        futures = {pool.submit(_solve, str(s.scene_file), str(s.result_file)): s for s in pending}
+        for future in as_completed(futures):
+            try:
+                outcomes[futures[future].index] = future.result()
+            except Exception as err:  # a worker died (e.g. killed): report, go on
+                outcomes[futures[future].index] = _failure(f"{type(err).__name__}: {err}")
+            bar.update()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+        bar.close()
+    return outcomes
+
+
+def _resolve_processes(plan: SweepPlan, processes: int | None) -> int:
+    chosen = processes if processes is not None else plan.processes
+    if chosen is None:
+        return os.cpu_count() or 1
+    if isinstance(chosen, bool) or not isinstance(chosen, int) or chosen < 1:
+        raise ValueError(f"processes = {chosen!r} is not allowed; allowed: an integer >= 1")
+    return chosen
+
+
+def execute(plan: SweepPlan, processes: int | None = None, progress: bool = True,
+            dry_run: bool = False) -> list[dict[str, object]]:
+    """Write and check the scenes of ``plan``, run those without a matching result,
+    write the summary. See :func:`sweep`."""
+    workers = _resolve_processes(plan, processes)
+    scenes = write_scenes(plan)
+    if dry_run:
+        return [scene.planned_row() for scene in scenes]
+    pending = [scene for scene in scenes if not _is_complete(scene)]
+    outcomes = _run_pending(plan.name, pending, len(scenes), workers, progress) if pending else {}
+    rows = [_row(scene, outcomes) for scene in scenes]
+    write_summary(rows, plan)
+    return rows
+
+
+def _row(scene: Scene, outcomes: dict[int, dict[str, object]]) -> dict[str, object]:
+    """The summary row of a scene: its planned columns, then its outcome (just run, or
+    read from its existing result file); a swept input value wins over a result
+    attribute of the same name (e.g. ``normalised_pressure``, recomputed by the library
+    to rounding)."""
+    outcome = outcomes[scene.index] if scene.index in outcomes else _outcome(_result_columns(scene.result_file))
+    row = scene.planned_row()
+    row.update({key: value for key, value in outcome.items() if key not in row})
+    return row
+
+
+def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool = True,
+          dry_run: bool = False) -> list[dict[str, object]]:
+    """Run a parameter sweep file (a scene plus a ``&sweep`` group).
+
+    Every scene is written to ``DIRECTORY/scenes/NAME_XXXX.nml`` and checked by the
+    library before anything runs. Scenes whose result file exists and was made from the
+    same namelist text are not run again (an interrupted sweep resumes); the others run
+    in ``processes`` worker processes. The summary is written to
+    ``DIRECTORY/NAME_summary.csv`` and ``.h5``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The sweep file.
+    processes : int, optional
+        Worker processes; default: ``&sweep processes``, else ``os.cpu_count()``.
+    progress : bool
+        Show a progress bar on stderr.
+    dry_run : bool
+        Only write and check the scenes; return the planned rows (swept values and file
+        names), solve nothing, write no summary.
+
+    Returns
+    -------
+    list of dict
+        One row per scene: the swept values, ``scene_file``, ``result_file``, every
+        scalar attribute of ``/results`` and of ``/companion/results`` (``companion_``
+        prefix) and ``error`` (empty if the scene ran and converged). A swept value is
+        the input value; a result attribute of the same name is not repeated. A scene
+        that failed has ``converged = 0`` and its message in ``error``.
+
+    Raises
+    ------
+    ValueError
+        A bad ``&sweep`` group (the message names the variable).
+    LayercontactError
+        A scene the library refuses (the message names the scene file and the variable).
+    """
+    return execute(read_sweep(path), processes=processes, progress=progress, dry_run=dry_run)
+
+
+def failed(rows: list[dict[str, object]]) -> list[dict[str, object]]:
+    """The rows of scenes that raised or did not converge."""
+    return [row for row in rows if row.get("error")]
+
+
+# ---------------------------------------------------------------------------------------
+# summary
+
+
+def _column_names(rows: list[dict[str, object]]) -> list[str]:
+    """Planned columns first (in row order), then the results, the companion, error."""
+    head = list(rows[0]) if rows else []
+    rest = {key for row in rows for key in row} - set(head) - {"error"}
+    own = sorted(k for k in rest if not k.startswith("companion_"))
+    companion = sorted(k for k in rest if k.startswith("companion_"))
+    return [k for k in head if k != "error"] + own + companion + ["error"]
+
+
+def _column_array(values: list[object]) -> np.ndarray:
+    """A typed column: strings, int64 (all present integers) or float64 (NaN if missing)."""
+    present = [v for v in values if v is not None]
+    if any(isinstance(v, str) for v in present):
+        return np.array(["" if v is None else str(v) for v in values], dtype=str)
+    if len(present) == len(values) and all(isinstance(v, (int, np.integer)) for v in present):
+        return np.array(values, dtype=np.int64)
+    return np.array([np.nan if v is None else v for v in values], dtype=np.float64)
+
+
+def summary_columns(rows: list[dict[str, object]]) -> dict[str, np.ndarray]:
+    """The rows as typed columns (see :func:`read_summary`)."""
+    return {name: _column_array([row.get(name) for row in rows]) for name in _column_names(rows)}
+
+
+def _cell(value: object) -> str:
+    return repr(float(value)) if isinstance(value, (float, np.floating)) else str(value)
+
+
+def _write_csv(columns: dict[str, np.ndarray], path: Path) -> None:
+    with _atomic(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f)
+        writer.writerow(columns)
+        writer.writerows(zip(*([_cell(v) for v in col.tolist()] for col in columns.values())))
+
+
+def _write_h5(columns: dict[str, np.ndarray], path: Path, plan: SweepPlan) -> None:
+    import h5py
+
+    with _atomic(path) as tmp:
+        with h5py.File(tmp, "w") as f:
+            group = f.create_group(SUMMARY_GROUP, track_order=True)
+            group.attrs["name"] = plan.name
+            group.attrs["sweep_file"] = str(plan.source)
+            for name, col in columns.items():
+                if col.dtype.kind == "U":
+                    group.create_dataset(name, data=col.astype(object), dtype=h5py.string_dtype("utf-8"))
+                else:
+                    group.create_dataset(name, data=col)
+
+
+def write_summary(rows: list[dict[str, object]], plan: SweepPlan) -> None:
+    """Write ``NAME_summary.csv`` and ``NAME_summary.h5`` of ``plan`` atomically."""
+    columns = summary_columns(rows)
+    _write_csv(columns, plan.summary_file("csv"))
+    _write_h5(columns, plan.summary_file("h5"), plan)
+
+
+def _parse_column(cells: list[str]) -> np.ndarray:
+    """A CSV column back to int64, float64 or str (the narrowest that fits every cell)."""
+    for parse, dtype in ((int, np.int64), (float, np.float64)):
+        try:
+            return np.array([parse(c) for c in cells], dtype=dtype)
+        except ValueError:
+            continue
+    return np.array(cells, dtype=str)
+
+
+def _read_csv(path: Path) -> dict[str, np.ndarray]:
+    with open(path, newline="", encoding="utf-8") as f:
+        header, *body = list(csv.reader(f))
+    cells = list(zip(*body)) if body else [() for _ in header]
+    return {name: _parse_column(list(col)) for name, col in zip(header, cells)}
+
+
+def _read_h5(path: Path) -> dict[str, np.ndarray]:
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        group = f[SUMMARY_GROUP]
+        return {
+            name: np.array(ds.asstr()[()], dtype=str) if h5py.check_string_dtype(ds.dtype) else ds[()]
+            for name, ds in group.items()
+        }
+
+
+def read_summary(path: str | os.PathLike) -> dict[str, np.ndarray]:
+    """Read a sweep summary (``NAME_summary.csv`` or ``NAME_summary.h5``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.csv`` or ``.h5`` / ``.hdf5`` summary file.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        One array per column, in the file's column order: int64, float64 or str.
+    """
+    path = Path(path)
+    readers = {".csv": _read_csv, ".h5": _read_h5, ".hdf5": _read_h5}
+    if path.suffix.lower() not in readers:
+        raise ValueError(f"{path}: unknown summary format; expected .csv, .h5 or .hdf5")
+    return readers[path.suffix.lower()](path)

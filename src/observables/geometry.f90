@@ -1,0 +1,108 @@
+!> Contact geometry and gap statistics of a line contact on a periodic grid.
+!>
+!> Contact spots are maximal runs of grid nodes with p > 0, joined across the periodic
+!> boundary. The indenter slides along +x, so a spot's leading edge is its +x end and its
+!> trailing edge its -x end (seed Fig. 2(a)); edges are reported as the positions of the
+!> end nodes +-dx/2, so that leading - trailing = (number of nodes) dx and the total
+!> contact length a = (contact nodes) dx.
+!>
+!> Leakage across the sliding direction: the gap g(x) is uniform along the grooves (y), so a
+!> pressure gradient dP/dy drives the Poiseuille flow q = -(g^3/(12 eta)) dP/dy per unit
+!> length in x; averaged over x, the flow per unit length, per unit pressure gradient and
+!> per unit inverse viscosity is <g^3>/12 (L^3). Along x a line contact does not leak once
+!> any point touches.
+module lc_observables_geometry
+   use lc_kinds, only: wp
+   implicit none (type, external)
+   private
+   public :: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset
+
+contains
+
+   !> Spots of the contact set p > 0: count, trailing and leading edges (L, in [0, period)
+   !> for the trailing edge; the leading edge may exceed the period for a spot that wraps).
+   subroutine contact_spots(p, period, n_spots, trailing, leading)
+      real(wp), intent(in) :: p(:), period
+      integer, intent(out) :: n_spots
+      real(wp), allocatable, intent(out) :: trailing(:), leading(:)
+      logical, allocatable :: contact(:)
+      integer, allocatable :: first(:), length(:)
+      integer :: n, j, start, i
+      real(wp) :: dx
+
+      n = size(p)
+      dx = period/n
+      contact = p > 0.0_wp
+      allocate (first(n/2 + 1), length(n/2 + 1))
+      n_spots = 0
+      if (all(contact)) then
+         ! full contact: one spot covering the period
+         n_spots = 1
+         first(1) = 1
+         length(1) = n
+      else if (any(contact)) then
+         ! start scanning just after a gap node, so that no spot is cut by the boundary
+         start = findloc(contact, .false., dim=1)
+         j = 0
+         do while (j < n)
+            i = mod(start - 1 + j, n) + 1
+            if (contact(i) .and. .not. contact(mod(i - 2 + n, n) + 1)) then
+               n_spots = n_spots + 1
+               first(n_spots) = i
+               length(n_spots) = 0
+            end if
+            if (contact(i)) length(n_spots) = length(n_spots) + 1
+            j = j + 1
+         end do
+      end if
+      allocate (trailing(n_spots), leading(n_spots))
+      do i = 1, n_spots
+         trailing(i) = (first(i) - 1)*dx - 0.5_wp*dx
+         if (trailing(i) < 0.0_wp) trailing(i) = trailing(i) + period
+         leading(i) = trailing(i) + length(i)*dx
+      end do
+   end subroutine contact_spots
+
+   !> Offset (L) of position x from the trailing edge closest to it (periodic, in
+   !> [-period/2, period/2)); zero when there are no spots.
+   pure real(wp) function nearest_trailing_offset(x, trailing, period) result(offset)
+      real(wp), intent(in) :: x, trailing(:), period
+      real(wp) :: d
+      integer :: i
+      offset = 0.0_wp
+      if (size(trailing) == 0) return
+      offset = huge(1.0_wp)
+      do i = 1, size(trailing)
+         d = modulo(x - trailing(i) + 0.5_wp*period, period) - 0.5_wp*period
+         if (abs(d) < abs(offset)) offset = d
+      end do
+   end function nearest_trailing_offset
+
+   !> <g^3>/12: flow across the sliding direction per unit length, per unit pressure
+   !> gradient, times the viscosity (L^3).
+   pure real(wp) function leak_rate(gap)
+      real(wp), intent(in) :: gap(:)
+      leak_rate = sum(max(gap, 0.0_wp)**3)/(12.0_wp*size(gap))
+   end function leak_rate
+
+   !> Histogram of the gap over the whole period: `counts(i)` nodes with
+   !> edges(i) <= g < edges(i+1), uniform bins from 0 to the largest gap (contact nodes,
+   !> g = 0, fall in the first bin).
+   pure subroutine gap_histogram(gap, edges, counts)
+      real(wp), intent(in) :: gap(:)
+      real(wp), intent(out) :: edges(:)
+      integer, intent(out) :: counts(:)
+      real(wp) :: top, width
+      integer :: j, bin, bins
+
+      bins = size(counts)
+      top = max(maxval(gap), tiny(1.0_wp))
+      width = top/bins
+      edges = [(width*j, j = 0, bins)]
+      counts = 0
+      do j = 1, size(gap)
+         bin = min(max(int(max(gap(j), 0.0_wp)/width) + 1, 1), bins)
+         counts(bin) = counts(bin) + 1
+      end do
+   end subroutine gap_histogram
+end module lc_observables_geometry
