@@ -7,7 +7,7 @@
 module lc_run
    use lc_kinds, only: wp
    use lc_errors, only: error_type
-   use lc_scene, only: scene_type
+   use lc_scene, only: scene_type, not_set
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results
@@ -28,7 +28,7 @@ contains
       character(len=:), allocatable, intent(out) :: output_file
       logical, intent(out) :: converged
       type(error_type), allocatable, intent(out) :: error
-      type(scene_type) :: scene
+      type(scene_type) :: scene, companion_scene
       type(contact_result) :: result, companion
       character(len=:), allocatable :: text
       real(wp), allocatable :: height(:)
@@ -47,7 +47,15 @@ contains
       if (allocated(error)) return
       converged = result%converged
       if (scene%companion) then
-         call solve_line_contact(scene, height, 0.0_wp, companion, error)
+         ! the frictionless companion at the same load (whatever the scene's control)
+         associate (c => companion_scene)
+            c = scene
+            c%control = 'load'
+            c%mean_pressure = result%mean_pressure
+            c%normalised_pressure = not_set
+            c%penetration = not_set
+         end associate
+         call solve_line_contact(companion_scene, height, 0.0_wp, companion, error)
          if (allocated(error)) return
          converged = converged .and. companion%converged
          call write_results(output_file, scene, text, height, result, companion, version_string, error)

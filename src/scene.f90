@@ -21,6 +21,8 @@ module lc_scene
    !> rms gradient of a self-affine profile when neither rms_gradient nor rms_height is given
    !> (under linear elasticity the scale only matters relative to the pressure).
    real(wp), parameter :: default_rms_gradient = 0.1_wp
+   !> Largest solver iteration budget (the residual history is kept for every iteration).
+   integer, parameter :: max_iterations = 10000000
    !> Length of the fixed-size character components (file names, keywords).
    integer, parameter :: max_string = 512
 
@@ -121,7 +123,7 @@ contains
             if (.not. (p%hurst > 0.0_wp .and. p%hurst < 1.0_wp)) then
                call input_error(error, 'profile', 'hurst', to_string(p%hurst), '0 < hurst < 1')
             else if (p%seed < 0_i8) then
-               call input_error(error, 'profile', 'seed', to_string(int(p%seed)), '>= 0')
+               call input_error(error, 'profile', 'seed', to_string(p%seed), '>= 0')
             else if (p%rolloff_wavelength /= not_set .and. .not. (positive(p%rolloff_wavelength) &
                & .and. p%rolloff_wavelength <= scene%period)) then
                call input_error(error, 'profile', 'rolloff_wavelength', to_string(p%rolloff_wavelength), &
@@ -140,8 +142,8 @@ contains
          case ('sinusoid')
             if (.not. positive(p%amplitude)) then
                call input_error(error, 'profile', 'amplitude', to_string(p%amplitude), '> 0 and finite')
-            else if (p%mode < 1 .or. 2*p%mode >= scene%n) then
-               call input_error(error, 'profile', 'mode', to_string(p%mode), '1 <= mode < n/2')
+            else if (p%mode < 1 .or. p%mode > (scene%n - 1)/2) then
+               call input_error(error, 'profile', 'mode', to_string(p%mode), '1 <= mode <= (n-1)/2')
             end if
          case ('file')
             if (len_trim(p%file) == 0) then
@@ -162,6 +164,13 @@ contains
          else if (trim(scene%control) == 'load' .and. scene%normalised_pressure /= not_set &
             & .and. .not. positive(scene%normalised_pressure)) then
             call input_error(error, 'loading', 'normalised_pressure', to_string(scene%normalised_pressure), '> 0 and finite')
+         else if (trim(scene%control) == 'load' .and. scene%penetration /= not_set) then
+            call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
+               & "not set with control = 'load' (the load fixes the penetration)")
+         else if (trim(scene%control) == 'displacement' .and. &
+            & (scene%mean_pressure /= not_set .or. scene%normalised_pressure /= not_set)) then
+            call input_error(error, 'loading', 'mean_pressure/normalised_pressure', 'given', &
+               & "neither with control = 'displacement' (the penetration fixes the load)")
          else if (trim(scene%control) == 'displacement' .and. .not. positive(scene%penetration)) then
             call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
                & "> 0 and finite with control = 'displacement'")
@@ -171,15 +180,12 @@ contains
             call input_error(error, 'solver', 'tol', to_string(s%tol), '1e-14 <= tol <= 1e-2')
          else if (scene%gap_bins < 0 .or. scene%gap_bins > 100000) then
             call input_error(error, 'output', 'gap_bins', to_string(scene%gap_bins), '0 <= gap_bins <= 100000')
-         else if (s%max_iter < 1) then
-            call input_error(error, 'solver', 'max_iter', to_string(s%max_iter), '>= 1')
+         else if (s%max_iter < 1 .or. s%max_iter > max_iterations) then
+            call input_error(error, 'solver', 'max_iter', to_string(s%max_iter), '1 <= max_iter <= 10000000')
          else if (s%memory < 1 .or. s%memory > 100) then
             call input_error(error, 'solver', 'memory', to_string(s%memory), '1 <= memory <= 100')
          else if (s%threads < 1 .or. s%threads > 1024) then
             call input_error(error, 'solver', 'threads', to_string(s%threads), '1 <= threads <= 1024')
-         else if (trim(s%method) == 'cg' .and. scene%friction > 0.0_wp) then
-            call input_error(error, 'solver', 'method', 'cg', "'auto' or 'anderson' when friction coefficient > 0 " // &
-               & '(the coupled operator is not symmetric)')
          end if
       end associate
    end subroutine check_scene

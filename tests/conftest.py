@@ -1,6 +1,10 @@
 """Shared helpers for the pytest suite: an independent numpy implementation of the
 convention-P operator (numpy FFT + the kernel factors), used to check the Fortran solver's
-output against the contact conditions without going through the Fortran operator."""
+output against the contact conditions without going through the Fortran operator.
+
+The kernel factors themselves come from `lc.layer_multipliers`, so these checks test the
+operator assembly and the solver, not the kernels: those are tested against mpmath and the
+LAPACK mode solve in test_kernels.py."""
 
 from __future__ import annotations
 

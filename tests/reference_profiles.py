@@ -84,7 +84,7 @@ def self_affine_reference(
         rolloff_wavelength = period
     if short_wavelength is None:
         short_wavelength = period / 128
-    m_max = n // 2 - 1
+    m_max = (n - 1) // 2
     # Python's round() rounds half to even; Fortran's nint rounds half away from zero.
     m_r = int(np.floor(period / rolloff_wavelength + 0.5))
     m_s = min(int(np.floor(period / short_wavelength + 0.5)), m_max)

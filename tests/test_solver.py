@@ -83,9 +83,14 @@ def test_delta_mu_identities_in_partial_contact(rough_profile):
 
 
 def test_incompressible_halfspace_friction_changes_nothing(rough_profile):
+    """c = 0 on an incompressible half-space: the scene is built without coupling; and
+    approaching nu = 1/2 through the coupled solver (c ~ 1e-9) gives the same answer."""
     pm = 0.3 * rough_profile.max()
     r0 = lc.solve_line(rough_profile, poisson=0.5, friction=0.0, mean_pressure=pm)
     r1 = lc.solve_line(rough_profile, poisson=0.5, friction=0.9, mean_pressure=pm)
+    near = lc.solve_line(rough_profile, poisson=0.5 - 1e-9, friction=0.9, mean_pressure=pm)
+    assert r1.outer_iterations == 1 and near.outer_iterations > 1  # really the coupled path
+    assert np.abs(near.pressure - r0.pressure).max() <= 1e-6 * r0.pressure.max()
     assert np.array_equal(r0.pressure, r1.pressure)
     assert r1.delta_mu_spectral == 0.0 and abs(r1.delta_mu) < 1e-14
     assert r1.penetration == r0.penetration
@@ -130,6 +135,27 @@ def test_not_converged_is_reported_honestly(rough_profile):
                         max_iter=20)
     assert not res.converged and res.residual > 1e-10
     assert np.all(np.isfinite(res.pressure))
+    # the fields written for a stopped run belong together
+    assert contact_violation(res, 0.01, 1.0, 0.5)["w_error"] <= 1e-12
+    sym = lc.solve_line(rough_profile, thickness=0.16, mean_pressure=rough_profile.max(), max_iter=7)
+    assert not sym.converged and contact_violation(sym, 0.16, 1.0, 0.5)["w_error"] <= 1e-12
+
+
+def test_extreme_load_full_contact_converges():
+    """At loads far beyond full contact the gap is rounding noise of a large w - r; the
+    residual treats gaps below that floor as zero instead of iterating forever."""
+    h = lc.self_affine_profile(1024, 0.8, short_wavelength=1 / 32)
+    for thickness, nu in ((0.16, 0.5), (0.16, 0.3), (np.inf, 0.5)):
+        res = lc.solve_line(h, thickness=thickness, poisson=nu, mean_pressure=1e8 * h.max(), max_iter=200)
+        assert res.converged and res.contact_fraction == 1.0
+
+
+def test_partial_contact_on_odd_grid(rough_profile):
+    h = lc.self_affine_profile(501, 0.8, seed=4, short_wavelength=1 / 32)
+    res = lc.solve_line(h, thickness=0.05, friction=0.8, mean_pressure=2 * h.max())
+    assert res.converged and 0.05 < res.contact_fraction < 0.95
+    v = contact_violation(res, 0.05, 1.0, 0.5)
+    assert v["overlap"] <= 2 * TOL and v["gap_in_contact"] <= 2 * TOL
 
 
 def test_cg_refuses_coupled_problem(rough_profile):

@@ -24,10 +24,12 @@ def main(argv: list[str] | None = None) -> int:
     run_p.add_argument("--png", help="picture to draw (default: the result file with .png)")
     run_p.add_argument("--no-png", action="store_true", help="do not draw a picture")
     sweep_p = sub.add_parser(
-        "sweep", help="run a parameter sweep (a scene plus a &sweep group); exit 1 if a scene failed, 2 bad input"
+        "sweep", help="run a parameter sweep (a scene plus &sweep); exit 1 if a scene failed, 2 bad input"
     )
     sweep_p.add_argument("nml", help="sweep namelist file")
-    sweep_p.add_argument("--processes", type=int, help="worker processes (default: &sweep processes, else all CPUs)")
+    sweep_p.add_argument(
+        "--processes", type=int, help="worker processes (default: &sweep processes, or all CPUs)"
+    )
     sweep_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
     if args.command == "sweep":

@@ -194,7 +194,9 @@ def _swept_values(source: Path, group: f90nml.Namelist) -> dict[str, list]:
     for first, second in (_PRESSURES, ("seed", "realisations")):
         if first in group and second in group:
             raise _sweep_error(source, f"{first}, {second}", "give at most one of them")
-    values = {var: _typed_values(source, var, group[var], p.kind) for var, p in PARAMETERS.items() if var in group}
+    values = {
+        var: _typed_values(source, var, group[var], p.kind) for var, p in PARAMETERS.items() if var in group
+    }
     if "realisations" in group:
         values["seed"] = list(range(1, _positive_int(source, "realisations", group["realisations"]) + 1))
     return values
@@ -239,6 +241,11 @@ def read_sweep(path: str | os.PathLike) -> SweepPlan:
 # writing and checking the scenes
 
 
+def _describe(values: dict[str, float | int]) -> str:
+    """``'friction = 0.5, seed = 2'`` (the swept values of a scene)."""
+    return ", ".join(f"{k} = {v!r}" for k, v in values.items()) or "the base scene"
+
+
 def _scene_text(plan: SweepPlan, index: int, values: dict, result_file: Path) -> str:
     """The namelist text of one scene: the base with the overrides and its result file."""
     nml = copy.deepcopy(plan.base)
@@ -248,9 +255,8 @@ def _scene_text(plan: SweepPlan, index: int, values: dict, result_file: Path) ->
         nml["output"] = {}
     nml["output"]["file"] = str(result_file)
     nml["output"]["overwrite"] = True
-    described = ", ".join(f"{k} = {v!r}" for k, v in values.items()) or "the base scene"
     out = io.StringIO()
-    out.write(f"! sweep '{plan.name}' ({plan.source}), scene {index}: {described}\n")
+    out.write(f"! sweep '{plan.name}' ({plan.source.name}), scene {index}: {_describe(values)}\n")
     nml.write(out)
     return out.getvalue()
 
@@ -275,7 +281,8 @@ def plan_scenes(plan: SweepPlan) -> list[Scene]:
         stem = f"{plan.name}_{index:0{width}d}"
         scene_file = plan.directory / "scenes" / f"{stem}.nml"
         result_file = plan.directory / "results" / f"{stem}.h5"
-        scenes.append(Scene(index, values, scene_file, result_file, _scene_text(plan, index, values, result_file)))
+        text = _scene_text(plan, index, values, result_file)
+        scenes.append(Scene(index, values, scene_file, result_file, text))
     return scenes
 
 
@@ -308,10 +315,8 @@ def _check_scene(plan: SweepPlan, scene: Scene) -> None:
     try:
         check_scene_file(scene.scene_file)
     except LayercontactError as err:
-        described = ", ".join(f"{k} = {v!r}" for k, v in scene.values.items()) or "base scene"
-        raise LayercontactError(
-            f"&sweep '{plan.name}' ({plan.source}): scene file {scene.scene_file} ({described}): {err}", err.code
-        ) from err
+        where = f"&sweep '{plan.name}' ({plan.source}): scene file {scene.scene_file}"
+        raise LayercontactError(f"{where} ({_describe(scene.values)}): {err}", err.code) from err
 
 
 def write_scenes(plan: SweepPlan) -> list[Scene]:
@@ -454,7 +459,10 @@ def _row(scene: Scene, outcomes: dict[int, dict[str, object]]) -> dict[str, obje
     read from its existing result file); a swept input value wins over a result
     attribute of the same name (e.g. ``normalised_pressure``, recomputed by the library
     to rounding)."""
-    outcome = outcomes[scene.index] if scene.index in outcomes else _outcome(_result_columns(scene.result_file))
+    if scene.index in outcomes:
+        outcome = outcomes[scene.index]
+    else:
+        outcome = _outcome(_result_columns(scene.result_file))
     row = scene.planned_row()
     row.update({key: value for key, value in outcome.items() if key not in row})
     return row

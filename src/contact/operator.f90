@@ -20,7 +20,7 @@ module lc_contact_operator
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_fft_plans, only: fft_plan, fft_threads_available
-   use lc_greens_layer, only: layer_coefficients, halfspace_coupling
+   use lc_greens_layer, only: layer_coefficients
    implicit none (type, external)
    private
    public :: compliance_operator, build_operator
@@ -55,7 +55,7 @@ contains
       integer, intent(in) :: n, threads
       real(wp), intent(in) :: period, thickness, young, poisson, friction
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: estar, k, x, one_minus_a, one_minus_b, c, scale
+      real(wp) :: estar, k, one_minus_a, one_minus_b, c, scale
       complex(wp) :: g
       integer :: m
       logical :: halfspace
@@ -90,13 +90,8 @@ contains
       do m = 1, op%nk - 1
          k = op%wavenumber(m)
          scale = 2.0_wp/(estar*k)
-         if (halfspace) then
-            one_minus_a = 1.0_wp
-            c = halfspace_coupling(poisson)
-         else
-            x = k*thickness
-            call layer_coefficients(x, poisson, one_minus_a, one_minus_b, c)
-         end if
+         ! x = +Inf (half-space) gives 1-A = 1-B = 1 and Dundurs' c
+         call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
          ! sgn(k) = +1 on the half spectrum; the Nyquist mode is its own mirror image
          ! (sgn averages to 0), so its multiplier must be real.
          if (2*m == n) c = 0.0_wp

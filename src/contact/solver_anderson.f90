@@ -14,7 +14,7 @@ module lc_contact_solver_anderson
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_internal
    use lc_contact_operator, only: compliance_operator
-   use lc_contact_solver_cg, only: constrained_cg, cg_outcome, complementarity_residual
+   use lc_contact_solver_cg, only: constrained_cg, cg_outcome, complementarity_residual, rounding_floor
    implicit none (type, external)
    private
    public :: anderson_coupled, anderson_outcome
@@ -61,8 +61,9 @@ contains
       real(wp), allocatable :: x(:), f(:), x_old(:), f_old(:), tx(:), dx(:, :), df(:, :), b(:), nw(:)
       real(wp), allocatable :: gamma(:)
       type(cg_outcome) :: inner
-      real(wp) :: inner_tol, p_ref, s_full, s_inner
-      integer :: n, k, columns, newest, j
+      real(wp) :: inner_tol, p_ref, s_full, s_inner, best
+      integer :: n, k, columns, newest, j, last_progress
+      logical :: restarted
 
       n = size(p)
       allocate (x(n), f(n), x_old(n), f_old(n), tx(n), b(n), nw(n), dx(n, memory), df(n, memory))
@@ -73,6 +74,9 @@ contains
       inner_tol = max(0.1_wp*tol, 1.0e-4_wp)
       s_inner = s
       s_full = s
+      best = huge(1.0_wp)
+      last_progress = 0
+      restarted = .false.
 
       do k = 1, size(history)
          call op%apply_difference(x, nw)
@@ -95,7 +99,7 @@ contains
          end if
          gap = gap - s_full
          p_ref = merge(mean_pressure, sum(p)/n, load_control)
-         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref)
+         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref, rounding_floor(w, r))
          history(k) = outcome%residual
          if (outcome%residual <= tol) then
             outcome%converged = .true.
@@ -103,6 +107,18 @@ contains
             return
          end if
          if (outcome%cg_iterations >= max_iter) exit
+         ! Stagnation (seen only at the edge of the parameter space, e.g. h/lambda = 1e-4 with
+         ! mu_c = 10): forget the history once; if that does not help either, stop and report.
+         if (outcome%residual < 0.5_wp*best) then
+            best = outcome%residual
+            last_progress = k
+         else if (k - last_progress > 4*memory) then
+            if (restarted) exit
+            restarted = .true.
+            last_progress = k
+            columns = 0
+            newest = 0
+         end if
          ! Inner solves only need to be a little more accurate than the outer iterate.
          inner_tol = max(0.1_wp*tol, min(1.0e-4_wp, 0.01_wp*outcome%residual))
 

@@ -14,7 +14,7 @@ module lc_contact_solver_cg
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private
-   public :: constrained_cg, cg_outcome, complementarity_residual
+   public :: constrained_cg, cg_outcome, complementarity_residual, rounding_floor
 
    !> What one constrained CG solve did.
    type :: cg_outcome
@@ -58,7 +58,9 @@ contains
       p = max(p, 0.0_wp)
       if (load_control) call normalise(p, mean_pressure)
 
-      do it = 1, max_iter
+      do it = 1, max_iter + 1
+         ! state (w, gap, s, residual) of the current p; on the last pass only this, so that
+         ! a run stopped by max_iter returns fields that belong together
          call op%apply_metric(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
          gap = w - b
@@ -67,15 +69,13 @@ contains
          if (load_control) s = sum(gap, mask=contact)/max(n_contact, 1)
          gap = gap - s
          p_ref = merge(mean_pressure, sum(p)/n, load_control)
-         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref)
-         outcome%iterations = it
+         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref, rounding_floor(w, b))
+         outcome%converged = outcome%residual <= tol
+         outcome%iterations = min(it, max_iter)
          if (present(history)) then
             if (it <= size(history)) history(it) = outcome%residual
          end if
-         if (outcome%residual <= tol) then
-            outcome%converged = .true.
-            return
-         end if
+         if (outcome%converged .or. it > max_iter) return
 
          if (n_contact == 0) then
             ! Displacement control with nothing in contact yet: load the overlapping points
@@ -118,12 +118,26 @@ contains
    end subroutine constrained_cg
 
    !> max_j |min(p_j/p_ref, gap_j/g_ref)|: zero iff p >= 0, gap >= 0 and p gap = 0.
-   pure real(wp) function complementarity_residual(p, gap, p_ref, g_ref) result(res)
-      real(wp), intent(in) :: p(:), gap(:), p_ref, g_ref
+   !> Gaps within `g_floor` of zero count as zero: below that the gap is rounding noise of
+   !> w - b (see rounding_floor), and no iteration can make it smaller.
+   pure real(wp) function complementarity_residual(p, gap, p_ref, g_ref, g_floor) result(res)
+      real(wp), intent(in) :: p(:), gap(:), p_ref, g_ref, g_floor
       real(wp) :: pscale
+      integer :: j
       pscale = 1.0_wp/max(p_ref, tiny(1.0_wp))
-      res = maxval(abs(min(p*pscale, gap/g_ref)))
+      res = 0.0_wp
+      do j = 1, size(p)
+         if (abs(gap(j)) > g_floor) res = max(res, abs(min(p(j)*pscale, gap(j)/g_ref)))
+         if (p(j) < 0.0_wp) res = max(res, -p(j)*pscale)
+      end do
    end function complementarity_residual
+
+   !> Attainable accuracy of a gap g = w - b computed through FFTs: a few hundred ulps of the
+   !> largest term (matters only when the load makes w much larger than the profile).
+   pure real(wp) function rounding_floor(w, b) result(floor)
+      real(wp), intent(in) :: w(:), b(:)
+      floor = 256*epsilon(1.0_wp)*max(maxval(abs(w)), maxval(abs(b)))
+   end function rounding_floor
 
    !> Scale p to mean p_m (uniform if p vanished altogether).
    pure subroutine normalise(p, mean_pressure)

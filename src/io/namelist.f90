@@ -364,19 +364,23 @@ contains
    ! Scanning the text.
 
    !> Find every `&name` outside comments and quotes; unknown or repeated names are errors.
-   !> `&end` is skipped: gfortran accepts it as a legacy group terminator.
+   !> `&end` is skipped: gfortran accepts it as a legacy group terminator. Text outside the
+   !> groups (other than comments) is an error too: gfortran would silently ignore it, as in
+   !> a value written on the line after a group's closing '/'.
    subroutine find_groups(text, source, groups, n_found, error)
       character(len=*), intent(in) :: text, source
       type(group_span), intent(out) :: groups(n_groups)
       integer, intent(out) :: n_found
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: name
+      character(len=max_string) :: name
       character :: quote
       integer :: i, j, line, k
+      logical :: inside
 
       n_found = 0
       line = 1
       quote = ' '
+      inside = .false.
       i = 1
       do while (i <= len(text))
          if (text(i:i) == newline) then
@@ -396,6 +400,14 @@ contains
             i = i + j - 2
          else if (text(i:i) == '"' .or. text(i:i) == "'") then
             quote = text(i:i)
+         else if (inside .and. text(i:i) == '/') then
+            inside = .false.
+         else if (.not. inside .and. text(i:i) /= '&' .and. verify(text(i:i), ' ' // achar(9) // achar(13)) /= 0) &
+            & then
+            call fatal_error(error, source // ', line ' // to_string(line) // ": text outside a namelist group ('" &
+               & // trim(text(i:line_end(text, i))) // "'): every value must stand between '&group' and its " &
+               & // "closing '/'", code_input)
+            return
          else if (text(i:i) == '&') then
             j = i + 1
             do while (j <= len(text))
@@ -403,16 +415,18 @@ contains
                j = j + 1
             end do
             name = lower(text(i + 1:j - 1))
+            inside = .false.
             if (name /= 'end') then
+               inside = .true.
                k = group_index(name)
                if (k == 0) then
                   call fatal_error(error, source // ', line ' // to_string(line) // ": unknown namelist group '&" &
-                     & // name // "'; allowed groups: " // allowed_groups(), code_input)
+                     & // trim(name) // "'; allowed groups: " // allowed_groups(), code_input)
                   return
                end if
                if (any(groups(:n_found)%index == k)) then
                   call fatal_error(error, source // ', line ' // to_string(line) // ": namelist group '&" &
-                     & // name // "' given twice (at most once each); allowed groups: " // allowed_groups(), &
+                     & // trim(name) // "' given twice (at most once each); allowed groups: " // allowed_groups(), &
                      & code_input)
                   return
                end if

@@ -12,10 +12,9 @@
 !>                    next to an edge), which makes it a per-run accuracy indicator.
 !> Comparing them checks the solver and the sign conventions (DESIGN.md §3).
 module lc_observables_friction
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
-   use lc_greens_layer, only: layer_coefficients, halfspace_coupling
+   use lc_greens_layer, only: layer_coefficients
    implicit none (type, external)
    private
    public :: interlocking_friction
@@ -32,13 +31,11 @@ contains
       real(wp) :: pm, k, estar, one_minus_a, one_minus_b, c, im_g
       complex(wp) :: uxh
       integer :: m, nk, n
-      logical :: halfspace
 
       n = op%n
       nk = op%nk
       pm = sum(p)/n
       estar = young/(1.0_wp - poisson**2)
-      halfspace = .not. ieee_is_finite(thickness)
       allocate (ph(nk), rh(nk), wh(nk))
       op%fft%real_buffer = p
       call op%fft%forward()
@@ -59,12 +56,7 @@ contains
       do m = 1, nk - 1
          if (2*m == n) cycle
          k = op%wavenumber(m)
-         if (halfspace) then
-            one_minus_b = 1.0_wp
-            c = halfspace_coupling(poisson)
-         else
-            call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
-         end if
+         call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
          by_displacement = by_displacement - 2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*wh(m + 1), wp)
          by_profile = by_profile - 2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*rh(m + 1), wp)
          im_g = -2.0_wp/(estar*k)*op%friction*c

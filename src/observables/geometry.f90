@@ -32,8 +32,8 @@ contains
 
       n = size(p)
       dx = period/n
+      allocate (contact(n), first(n/2 + 1), length(n/2 + 1))
       contact = p > 0.0_wp
-      allocate (first(n/2 + 1), length(n/2 + 1))
       n_spots = 0
       if (all(contact)) then
          ! full contact: one spot covering the period

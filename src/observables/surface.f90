@@ -13,7 +13,7 @@ module lc_observables_surface
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_fft_plans, only: fft_plan
-   use lc_greens_layer, only: layer_coefficients, halfspace_coupling
+   use lc_greens_layer, only: layer_coefficients
    implicit none (type, external)
    private
    public :: surface_fields
@@ -40,8 +40,8 @@ contains
       contraction = poisson/(1.0_wp - poisson)
       fft%real_buffer = p
       call fft%forward()
+      allocate (ph(fft%nk), uh(fft%nk), sh(fft%nk))
       ph = fft%spectrum
-      allocate (uh(fft%nk), sh(fft%nk))
       pm = real(ph(1), wp)
 
       ! Per mode: u_x^ = 2/(E*k) [i c + mu (1-B)] p^ and, since i k/|k| = i sgn(k),
@@ -56,12 +56,7 @@ contains
       end if
       do m = 1, fft%nk - 1
          k = 2.0_wp*pi*m/period
-         if (halfspace) then
-            one_minus_b = 1.0_wp
-            c = halfspace_coupling(poisson)
-         else
-            call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
-         end if
+         call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
          odd = merge(0.0_wp, 1.0_wp, 2*m == n)
          uh(m + 1) = 2.0_wp/(estar*k)*cmplx(friction*one_minus_b, odd*c, wp)*ph(m + 1)
          sh(m + 1) = cmplx(-contraction - 2.0_wp*c, odd*2.0_wp*friction*one_minus_b, wp)*ph(m + 1)

@@ -11,7 +11,6 @@
 !> For a self-affine profile (lc_profiles_self_affine) these equal its scaling target to
 !> roundoff.
 module lc_profiles_profile
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_scene, only: scene_type, not_set, default_rms_gradient
@@ -33,7 +32,6 @@ contains
       !> Heights r(x_j) (L)
       real(wp), intent(out) :: height(scene%n)
       type(error_type), allocatable, intent(out) :: error
-      character(len=16) :: buffer
 
       height = 0.0_wp
       associate (p => scene%profile)
@@ -47,18 +45,7 @@ contains
                   & p%short_wavelength, p%rms_gradient, p%rms_height, height, error)
             end if
          case ('sinusoid')
-            ! sinusoid_profile is pure and cannot report errors: check its inputs here.
-            if (.not. (ieee_is_finite(p%amplitude) .and. p%amplitude > 0.0_wp)) then
-               write (buffer, '(es12.5)') p%amplitude
-               call fatal_error(error, '&profile: amplitude = ' // trim(adjustl(buffer)) // &
-                  & ' is not allowed; allowed: > 0 and finite', code_input)
-               return
-            else if (p%mode < 1 .or. 2*p%mode >= scene%n) then
-               write (buffer, '(i0)') p%mode
-               call fatal_error(error, '&profile: mode = ' // trim(buffer) // ' is not allowed; allowed: 1 <= mode < n/2', &
-                  & code_input)
-               return
-            end if
+            ! amplitude and mode were validated with the scene (check_scene)
             call sinusoid_profile(scene%n, scene%period, p%amplitude, p%mode, height)
          case ('file')
             call read_profile_heights(trim(p%file), trim(p%dataset), scene%n, height, error)

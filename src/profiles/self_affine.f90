@@ -5,10 +5,10 @@
 !> Self-affine algorithm (tests/reference_profiles.py reproduces it bit for bit up to
 !> roundoff; change both together):
 !>
-!> 1. Grid x_j = j*period/n, j = 0..n-1. Modes m = 1 .. n/2 - 1 (integer division; no
-!>    mean, no Nyquist), wavenumber q_m = 2 pi m / period.
+!> 1. Grid x_j = j*period/n, j = 0..n-1. Modes m = 1 .. (n-1)/2 (integer division; no
+!>    mean, no Nyquist mode of an even n), wavenumber q_m = 2 pi m / period.
 !> 2. Cut-offs m_r = nint(period/rolloff_wavelength) (default rolloff_wavelength = period,
-!>    so m_r = 1) and m_s = min(nint(period/short_wavelength), n/2 - 1) (default
+!>    so m_r = 1) and m_s = min(nint(period/short_wavelength), (n-1)/2) (default
 !>    short_wavelength = period/128).
 !> 3. Spectrum C_m = 1 for m < m_r, (m/m_r)^(-1-2H) for m_r <= m <= m_s, 0 for m > m_s;
 !>    amplitude a_m = sqrt(C_m).
@@ -94,7 +94,7 @@ contains
       end if
       if (allocated(error)) return
 
-      m_max = n/2 - 1
+      m_max = (n - 1)/2
       m_r = nint(period/rolloff)
       m_s = min(nint(period/short), m_max)
       if (m_r > m_s) then

@@ -11,7 +11,7 @@
 program test_profiles
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, code_input
-   use lc_scene, only: scene_type, not_set
+   use lc_scene, only: scene_type, not_set, check_scene
    use lc_fft_plans, only: fft_plan
    use lc_profiles_random, only: splitmix64, splitmix64_uniform
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
@@ -215,8 +215,8 @@ contains
       call report(.not. allocated(error) .and. all(height == direct), 'make_profile sinusoid = sinusoid_profile')
 
       scene%profile%amplitude = not_set
-      call make_profile(scene, height, error)
-      call report(allocated(error), 'make_profile sinusoid without amplitude is an error')
+      call check_scene(scene, error)
+      call report(allocated(error), 'a sinusoid scene without amplitude is refused by check_scene')
 
       scene%profile%kind = 'file'
       scene%profile%file = '/nonexistent/layercontact_profile.h5'

@@ -373,10 +373,10 @@ contains
          call write_attr_real(group, 'max_tension_x', res%max_tension_x, st)
          call write_attr_real(group, 'max_tension_offset', res%max_tension_offset, st)
       end if
-      ! the seed's scales: Lambda = highest asperity above the mean plane (heights have zero
-      ! mean), p_m normalised by E* Lambda / lambda, thickness by lambda
+      ! the seed's scales: Lambda = highest asperity above the mean plane (as the input's
+      ! normalised_pressure), p_m normalised by E* Lambda / lambda, thickness by lambda
       e_star = scene%young / (1.0_wp - scene%poisson**2)
-      lambda_max = maxval(height)
+      lambda_max = maxval(height) - sum(height)/size(height)
       if (lambda_max > 0.0_wp) then
          call write_attr_real(group, 'normalised_pressure', res%mean_pressure / (e_star*lambda_max/scene%period), st)
       else

@@ -1,0 +1,237 @@
+"""Parameter sweeps (layercontact.sweep): the product of the &sweep lists, results equal to
+running each scene alone, resume after an interruption or a change, fail-fast checks of
+the base scene and the lists, CSV and HDF5 summaries that agree, failing scenes reported
+while the others complete, and every sweep in inputs/sweeps/ (dry run; example.nml in
+full)."""
+
+from __future__ import annotations
+
+import itertools
+import shutil
+import sys
+from pathlib import Path
+
+import f90nml
+import numpy as np
+import pytest
+
+import layercontact as lc
+from layercontact.__main__ import main
+from conftest import ROOT
+
+sweep_module = sys.modules["layercontact.sweep"]  # `layercontact.sweep` is the function
+SWEEPS = sorted((ROOT / "inputs" / "sweeps").glob("*.nml"))
+
+BASE = """\
+&scene
+   n = 256
+/
+&layer
+   thickness = 0.16
+   poisson = 0.5
+/
+&friction
+   coefficient = 0.0
+/
+&profile
+   short_wavelength = 0.03125
+/
+&loading
+   normalised_pressure = 1.0
+/
+"""
+LISTS = "friction = 0.0, 0.5\n normalised_pressure = 0.5, 2.0\n seed = 1, 2\n"
+
+
+def write_sweep(directory: Path, lists: str = LISTS, base: str = BASE, name: str = "s") -> Path:
+    """A sweep file ``name.nml`` in ``directory`` writing to ``out/NAME``."""
+    path = directory / f"{name}.nml"
+    path.write_text(base + f"&sweep\n directory = 'out/{name}'\n processes = 2\n {lists}/\n")
+    return path
+
+
+def result_stamps(directory: Path) -> dict[str, tuple[int, int]]:
+    """(inode, mtime) of every result file: changes when a result is rewritten."""
+    return {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in sorted(directory.glob("results/*.h5"))}
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """One sweep of 2 x 2 x 2 scenes, run once for the read-only checks."""
+    root = tmp_path_factory.mktemp("sweep")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.chdir(root)
+        rows = lc.sweep(write_sweep(root), progress=False)
+    return root, rows
+
+
+def test_the_scenes_are_the_product_of_the_lists(finished):
+    root, rows = finished
+    expected = list(itertools.product([0.0, 0.5], [0.5, 2.0], [1, 2]))
+    assert [(r["friction"], r["normalised_pressure"], r["seed"]) for r in rows] == expected
+    for row, (mu, pm, seed) in zip(rows, expected):
+        scene = f90nml.read(root / row["scene_file"])
+        assert scene["friction"]["coefficient"] == mu and scene["profile"]["seed"] == seed
+        assert scene["loading"]["normalised_pressure"] == pm and "sweep" not in scene
+        assert scene["output"]["file"] == row["result_file"] and scene["output"]["overwrite"] is True
+        assert row["converged"] == 1 and row["error"] == ""
+        assert row["contact_fraction"] > 0 and row["normalised_thickness"] == 0.16
+    assert len({r["result_file"] for r in rows}) == 8
+    assert rows[0]["scene_file"] == "out/s/scenes/s_0000.nml"
+
+
+def test_each_result_equals_running_the_scene_alone(finished, tmp_path, monkeypatch):
+    root, rows = finished
+    monkeypatch.chdir(tmp_path)
+    for row in rows[::3]:
+        alone = tmp_path / "alone.nml"
+        alone.write_text((root / row["scene_file"]).read_text().replace(row["result_file"], "alone.h5"))
+        res = lc.run(alone)
+        swept = lc.read_result(root / row["result_file"])
+        np.testing.assert_array_equal(swept.pressure, res.pressure)
+        assert swept.penetration == res.penetration and swept.delta_mu == row["delta_mu"]
+
+
+def test_csv_and_hdf5_summaries_agree(finished):
+    root, rows = finished
+    csv, h5 = lc.read_summary(root / "out/s/s_summary.csv"), lc.read_summary(root / "out/s/s_summary.h5")
+    assert list(csv) == list(h5) == list(rows[0])
+    assert list(csv)[:5] == ["friction", "normalised_pressure", "seed", "scene_file", "result_file"]
+    assert list(csv)[-1] == "error" and "companion_converged" not in csv
+    for name in csv:
+        assert csv[name].dtype.kind == h5[name].dtype.kind, name
+        np.testing.assert_array_equal(csv[name], h5[name], err_msg=name)
+        np.testing.assert_array_equal(csv[name], [row[name] for row in rows], err_msg=name)
+    assert csv["seed"].dtype == np.int64 and csv["scene_file"].dtype.kind == "U"
+
+
+def test_no_temporary_files_are_left(finished):
+    root, _ = finished
+    assert not [p for p in root.rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_resume_skips_completed_scenes_and_reruns_changed_ones(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = write_sweep(tmp_path, lists="friction = 0.0, 0.5\n seed = 1, 2\n")
+    out = tmp_path / "out/s"
+    first = lc.sweep(path, progress=False)
+    stamps = result_stamps(out)
+    assert lc.sweep(path, progress=False) == first and result_stamps(out) == stamps
+
+    # a result made from another namelist is run again, the others are not
+    shutil.copy(out / "results/s_0000.h5", out / "results/s_0001.h5")
+    lc.sweep(path, progress=False)
+    now = result_stamps(out)
+    assert [name for name in now if now[name] != stamps[name]] == ["s_0001.h5"]
+
+    # a changed list value changes the namelists of those scenes only
+    path.write_text(path.read_text().replace("friction = 0.0, 0.5", "friction = 0.0, 0.4"))
+    stamps = now
+    rows = lc.sweep(path, progress=False)
+    now = result_stamps(out)
+    assert [name for name in now if now[name] != stamps[name]] == ["s_0002.h5", "s_0003.h5"]
+    assert [r["friction"] for r in rows] == [0.0, 0.0, 0.4, 0.4]
+    assert lc.read_result(out / "results/s_0003.h5").friction == 0.4
+
+
+def test_interrupted_sweep_completes_only_the_missing_scene(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = write_sweep(tmp_path, lists="realisations = 4\n")
+    out = tmp_path / "out/s"
+    first = lc.sweep(path, progress=False)
+    assert [r["seed"] for r in first] == [1, 2, 3, 4]
+    stamps = result_stamps(out)
+    (out / "results/s_0002.h5").unlink()
+    rows = lc.sweep(path, processes=1, progress=False)
+    now = result_stamps(out)
+    assert [name for name in now if now[name] != stamps[name]] == ["s_0002.h5"]
+    assert [r["penetration"] for r in rows] == [r["penetration"] for r in first]
+
+
+BAD_SCENES = [
+    # (base scene change, &sweep lists, words the message must contain)
+    (("thickness = 0.16", "thickness = -1.0"), "friction = 0.0, 0.5\n", ["&layer: thickness", "s_0000.nml"]),
+    (None, "friction = 0.1, -0.5\n", ["&friction: coefficient", "s_0001.nml", "friction = -0.5"]),
+    (None, "thickness = 0.16, 0.0\n", ["&layer: thickness", "s_0001.nml"]),
+    (("n = 256", "n = 4"), "seed = 1, 2\n", ["&scene: n", "s_0000.nml"]),
+]
+
+
+@pytest.mark.parametrize("change, lists, words", BAD_SCENES, ids=[w[0] for _, _, w in BAD_SCENES])
+def test_a_bad_scene_fails_before_anything_runs(change, lists, words, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    base = BASE.replace(*change) if change else BASE
+    with pytest.raises(lc.LayercontactError) as err:
+        lc.sweep(write_sweep(tmp_path, lists=lists, base=base), progress=False)
+    assert err.value.code == 2
+    for word in words:
+        assert word in str(err.value)
+    assert not (tmp_path / "out/s/results").exists() and not (tmp_path / "out/s/s_summary.csv").exists()
+
+
+BAD_SWEEPS = [
+    ("friction = 0.1, 'a'\n", "&sweep friction: value 'a' is not a number"),
+    ("seed = 1, 2.5\n", "&sweep seed: value 2.5 is not an integer"),
+    ("frictoin = 0.1\n", "&sweep frictoin: unknown variable"),
+    ("seed = 1\n realisations = 3\n", "&sweep seed, realisations: give at most one"),
+    ("mean_pressure = 0.1\n normalised_pressure = 1\n", "&sweep mean_pressure, normalised_pressure"),
+    ("realisations = 0\n", "&sweep realisations: 0 is not allowed"),
+    ("processes = -2\n", "&sweep processes: -2 is not allowed"),
+]
+
+
+@pytest.mark.parametrize("lists, message", BAD_SWEEPS, ids=[m for _, m in BAD_SWEEPS])
+def test_a_bad_sweep_group_is_refused_naming_the_variable(lists, message, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "s.nml"
+    path.write_text(BASE + f"&sweep\n {lists}/\n")
+    with pytest.raises(ValueError, match="^" + str(path).replace(".", r"\.")) as err:
+        lc.sweep(path, progress=False)
+    assert message in str(err.value)
+    assert not (tmp_path / "out").exists()
+    assert main(["sweep", str(path), "--no-progress"]) == 2
+
+
+def test_a_failing_scene_is_reported_and_the_others_complete(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    # thin layer: 30 CG iterations are enough without friction, not with mu_c = 1
+    base = BASE.replace("thickness = 0.16", "thickness = 0.05") + "&solver\n max_iter = 30\n/\n"
+    path = write_sweep(tmp_path, lists="friction = 0.0, 1.0\n seed = 1, 2\n", base=base)
+    (tmp_path / "out/s/results/s_0001.h5").mkdir(parents=True)  # its result cannot be written
+    assert main(["sweep", str(path), "--no-progress"]) == 1
+    assert "4 scenes, 3 failed" in capsys.readouterr().out
+    summary = lc.read_summary(tmp_path / "out/s/s_summary.h5")
+    assert summary["converged"].tolist() == [1, 0, 0, 0]
+    assert summary["error"][0] == ""
+    assert "LayercontactError" in summary["error"][1] and "s_0001.h5" in summary["error"][1]
+    assert "did not converge" in summary["error"][2] and "did not converge" in summary["error"][3]
+    assert np.isnan(summary["penetration"][1]) and summary["penetration"][0] > 0
+    results = sorted(p.name for p in (tmp_path / "out/s/results").glob("*.h5") if p.is_file())
+    assert results == ["s_0000.h5", "s_0002.h5", "s_0003.h5"]
+    assert not [p for p in tmp_path.rglob("*") if p.name.endswith(".tmp")]
+
+
+@pytest.mark.parametrize("path", SWEEPS, ids=[p.stem for p in SWEEPS])
+def test_every_sweep_input_writes_valid_scenes(path, tmp_path, monkeypatch):
+    """Dry run: the scenes are written and each passes the library's check; nothing is
+    solved."""
+    monkeypatch.chdir(tmp_path)
+    rows = lc.sweep(path, dry_run=True, progress=False)
+    plan = sweep_module.read_sweep(path)
+    assert len(rows) == int(np.prod([len(v) for v in plan.values.values()]))
+    for row in rows:
+        lc.check_scene_file(row["scene_file"])
+        assert not Path(row["result_file"]).exists()
+    assert not plan.summary_file("csv").exists()
+
+
+def test_example_sweep_runs(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rows = lc.sweep(ROOT / "inputs/sweeps/example.nml", progress=False)
+    assert len(rows) == 8 and all(r["converged"] == 1 and r["companion_converged"] == 1 for r in rows)
+    assert {(r["friction"], r["normalised_pressure"], r["seed"]) for r in rows} == set(
+        itertools.product([0.0, 0.5], [1.0, 3.0], [1, 2])
+    )
+    assert all(0 < r["a_over_a0"] for r in rows)
+    summary = lc.read_summary("out/sweeps/example/example_summary.csv")
+    assert summary["friction"].size == 8
