@@ -65,7 +65,8 @@ end subroutine py_self_affine_profile
 !> Solve a line contact on the given heights. control: 0 load, 1 displacement;
 !> method: 0 auto, 1 cg, 2 anderson; precondition, stress: 0/1.
 !> fields(:, 1:5): pressure, gap, displacement_z, displacement_x, stress_xx (the last two
-!> zero unless stress = 1); spots(1:n_spots, 1:2): trailing and leading edges;
+!> zero unless stress = 1); spots(1:n_spots, 1:4): trailing and leading edges, largest
+!> sigma_xx around the spot and its offset from the trailing edge (zero unless stress = 1);
 !> scalars: in the order of layercontact.api._SCALARS.
 subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
       & penetration, method, precondition, tol, max_iter, memory, threads, stress, fields, spots, scalars, &
@@ -77,7 +78,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    implicit none (type, external)
    integer, intent(in) :: n, control, method, precondition, max_iter, memory, threads, stress
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
-   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 2), scalars(24), history(max_iter)
+   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 4), scalars(24), history(max_iter)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
@@ -115,6 +116,8 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    spots = 0
    spots(1:r%n_spots, 1) = r%spot_trailing
    spots(1:r%n_spots, 2) = r%spot_leading
+   if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 3) = r%spot_max_tension
+   if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 4) = r%spot_tension_offset
    history = 0
    history(1:size(r%residual_history)) = r%residual_history
    scalars = [r%mean_pressure, r%penetration, r%contact_fraction, r%delta_mu, r%delta_mu_spectral, &

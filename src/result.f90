@@ -18,6 +18,8 @@ module lc_result
       real(wp), allocatable :: stress_xx(:)        !< sigma_xx at the surface (S), tension positive
       real(wp), allocatable :: spot_trailing(:)    !< trailing (-x) edge of each contact spot (L)
       real(wp), allocatable :: spot_leading(:)     !< leading (+x) edge of each contact spot (L)
+      real(wp), allocatable :: spot_max_tension(:) !< largest sigma_xx around each spot (S), with stress
+      real(wp), allocatable :: spot_tension_offset(:) !< its offset from the spot's trailing edge (L)
       real(wp), allocatable :: gap_edges(:)        !< gap histogram bin edges (L)
       integer, allocatable :: gap_counts(:)        !< gap histogram counts (grid nodes)
       real(wp) :: friction = 0.0_wp           !< mu_c used for this solve

@@ -102,6 +102,8 @@ class LineResult:
     displacement_x: np.ndarray | None = field(default=None, repr=False)
     shear: np.ndarray | None = field(default=None, repr=False)
     stress_xx: np.ndarray | None = field(default=None, repr=False)
+    spot_max_tension: np.ndarray | None = field(default=None, repr=False)
+    spot_tension_offset: np.ndarray | None = field(default=None, repr=False)
     max_tension: float = float("nan")
     max_tension_x: float = float("nan")
     max_tension_offset: float = float("nan")
@@ -186,7 +188,9 @@ def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure
         pressure=fields[:, 0].copy(), gap=fields[:, 1].copy(), displacement_z=fields[:, 2].copy(),
         displacement_x=fields[:, 3].copy() if stress else None, shear=friction * fields[:, 0] if stress else None,
         stress_xx=fields[:, 4].copy() if stress else None, height=h.copy(), period=float(period),
-        friction=float(friction), spots=spots[: scalars["n_spots"]].copy(), residual_history=hist[:n_hist].copy(),
+        friction=float(friction), spots=spots[: scalars["n_spots"], :2].copy(), residual_history=hist[:n_hist].copy(),
+        spot_max_tension=spots[: scalars["n_spots"], 2].copy() if stress else None,
+        spot_tension_offset=spots[: scalars["n_spots"], 3].copy() if stress else None,
         **scalars,
     )
 
@@ -219,6 +223,8 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             pressure=fields["pressure"], gap=fields["gap"], displacement_z=fields["displacement_z"],
             displacement_x=fields.get("displacement_x"), shear=fields.get("shear"),
             stress_xx=fields.get("stress_xx"), height=f["profile/height"][()],
+            spot_max_tension=base["spots/max_tension"][()] if "spots/max_tension" in base else None,
+            spot_tension_offset=base["spots/max_tension_offset"][()] if "spots/max_tension_offset" in base else None,
             period=float(f["input"].attrs["period"]), friction=float(r["friction"]), spots=spots,
             residual_history=base["convergence/residual"][()],
             a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values,

@@ -17,7 +17,8 @@ module lc_contact_solve
    use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
    use lc_observables_friction, only: interlocking_friction
    use lc_observables_surface, only: surface_fields
-   use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset
+   use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, &
+      & spot_tension
    implicit none (type, external)
    private
    public :: solve_line_contact, scene_mean_pressure
@@ -158,6 +159,9 @@ contains
             result%max_tension_x = (where_max - 1)*scene%period/size(p)
             result%max_tension_offset = nearest_trailing_offset(result%max_tension_x, result%spot_trailing, &
                & scene%period)
+            allocate (result%spot_max_tension(result%n_spots), result%spot_tension_offset(result%n_spots))
+            call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
+               & result%spot_max_tension, result%spot_tension_offset)
          end if
       end associate
    end subroutine observe

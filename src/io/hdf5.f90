@@ -340,6 +340,10 @@ contains
          call create_group(loc, 'spots', group, st)
          call write_dataset_1d(group, 'trailing_edge', res%spot_trailing, 'L', st)
          call write_dataset_1d(group, 'leading_edge', res%spot_leading, 'L', st)
+         if (allocated(res%spot_max_tension)) then
+            call write_dataset_1d(group, 'max_tension', res%spot_max_tension, 'S', st)
+            call write_dataset_1d(group, 'max_tension_offset', res%spot_tension_offset, 'L', st)
+         end if
          call close_group(group, st)
       end if
       if (allocated(res%gap_counts)) then

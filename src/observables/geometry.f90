@@ -15,7 +15,7 @@ module lc_observables_geometry
    use lc_kinds, only: wp
    implicit none (type, external)
    private
-   public :: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset
+   public :: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, spot_tension
 
 contains
 
@@ -77,6 +77,35 @@ contains
          if (abs(d) < abs(offset)) offset = d
       end do
    end function nearest_trailing_offset
+
+   !> Largest sigma_xx around each spot and its offset from the spot's trailing edge (L,
+   !> negative: behind it). A spot's window runs from the middle of the gap behind it to its
+   !> leading edge, so every node of the period belongs to one window.
+   pure subroutine spot_tension(stress, period, trailing, leading, max_tension, offset)
+      real(wp), intent(in) :: stress(:), period, trailing(:), leading(:)
+      real(wp), intent(out) :: max_tension(:), offset(:)
+      integer :: i, j, n, first, last, previous_last, start, top
+      real(wp) :: dx
+
+      n = size(stress)
+      dx = period/n
+      do i = 1, size(trailing)
+         ! node indices (0-based, unwrapped) of the spot and of the end of the spot behind it
+         first = nint(trailing(i)/dx + 0.5_wp)
+         last = first + nint((leading(i) - trailing(i))/dx) - 1
+         j = modulo(i - 2, size(trailing)) + 1
+         previous_last = nint(trailing(j)/dx + 0.5_wp) + nint((leading(j) - trailing(j))/dx) - 1
+         ! unwrap it to just behind this spot (a single spot is its own predecessor)
+         previous_last = first - modulo(first - previous_last, n)
+         start = (previous_last + first + 1)/2
+         top = start
+         do j = start, last
+            if (stress(modulo(j, n) + 1) > stress(modulo(top, n) + 1)) top = j
+         end do
+         max_tension(i) = stress(modulo(top, n) + 1)
+         offset(i) = (top - first + 0.5_wp)*dx
+      end do
+   end subroutine spot_tension
 
    !> <g^3>/12: flow across the sliding direction per unit length, per unit pressure
    !> gradient, times the viscosity (L^3).
