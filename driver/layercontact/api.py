@@ -111,6 +111,11 @@ class LineResult:
     companion: "LineResult | None" = field(default=None, repr=False)
 
     @property
+    def total_friction(self) -> float:
+        """mu_c + Delta mu: the macroscopic friction coefficient."""
+        return self.friction + self.delta_mu
+
+    @property
     def x(self) -> np.ndarray:
         """Grid positions (L)."""
         return np.arange(self.pressure.size) * (self.period / self.pressure.size)

@@ -361,6 +361,7 @@ contains
       call write_attr_real(group, 'delta_mu_spectral', res%delta_mu_spectral, st)
       call write_attr_real(group, 'delta_mu_energy', res%delta_mu_energy, st)
       call write_attr_real(group, 'delta_mu_profile', res%delta_mu_profile, st)
+      call write_attr_real(group, 'total_friction', res%friction + res%delta_mu, st)
       call write_attr_int(group, 'converged', merge(1, 0, res%converged), st)
       call write_attr_int(group, 'iterations', res%iterations, st)
       call write_attr_int(group, 'outer_iterations', res%outer_iterations, st)
