@@ -69,19 +69,21 @@ end subroutine py_self_affine_profile
 !> sigma_xx around the spot and its offset from the trailing edge (zero unless stress = 1);
 !> scalars: in the order of layercontact.api._SCALARS.
 subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
-      & penetration, method, precondition, tol, max_iter, memory, threads, stress, fields, spots, scalars, &
-      & history, stat, errmsg)
+      & penetration, method, precondition, tol, max_iter, memory, threads, stress, model, form, e0, e_inf, tau, &
+      & equilibrium, nt, times, values, speed, fields, spots, scalars, history, stat, errmsg)
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, check_scene
    use lc_result, only: contact_result
    use lc_contact_solve, only: solve_line_contact
+   use lc_greens_viscoelastic, only: make_material_law
    implicit none (type, external)
-   integer, intent(in) :: n, control, method, precondition, max_iter, memory, threads, stress
+   integer, intent(in) :: n, control, method, precondition, max_iter, memory, threads, stress, model, form, nt
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
+   real(8), intent(in) :: e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
    real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 4), scalars(24), history(max_iter)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
-   !f2py intent(hide) :: n
+   !f2py intent(hide) :: n, nt
    type(error_type), allocatable :: error
    type(scene_type) :: scene
    type(contact_result) :: r
@@ -94,6 +96,8 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
       & stress=stress == 1, gap_bins=0)
    scene%profile%kind = 'file'
    scene%profile%file = '(array from Python)'
+   scene%material = make_material_law(model, form, young, e0, e_inf, tau, equilibrium, times, values)
+   scene%speed = speed
    scene%solver%method = methods(max(0, min(2, method)))
    scene%solver%tol = tol
    scene%solver%max_iter = max_iter
@@ -124,7 +128,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
       & r%delta_mu_energy, r%delta_mu_profile, merge(1.0d0, 0.0d0, r%converged), real(r%iterations, 8), &
       & real(r%outer_iterations, 8), real(r%fft_pairs, 8), r%residual, r%wall_time, &
       & real(size(r%residual_history), 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
-      & r%max_tension, r%max_tension_x, r%max_tension_offset, 0d0, 0d0, 0d0]
+      & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), 0d0]
 end subroutine py_solve_line
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless
@@ -177,11 +181,12 @@ subroutine py_check_scene_file(input, stat, errmsg)
 end subroutine py_check_scene_file
 
 !> Surface displacement u_x and stress sigma_xx for a prescribed pressure p (no contact
-!> solve): tau = friction p on a layer (thickness = Inf: half-space).
+!> solve): tau = friction p on an elastic layer (thickness = Inf: half-space).
 subroutine py_surface_fields(n, p, period, thickness, young, poisson, friction, displacement_x, stress_xx, &
       & stat, errmsg)
    use lc_errors, only: error_type
-   use lc_fft_plans, only: fft_plan
+   use lc_greens_viscoelastic, only: material_law
+   use lc_contact_operator, only: compliance_operator, build_operator
    use lc_observables_surface, only: surface_fields
    implicit none (type, external)
    integer, intent(in) :: n
@@ -191,14 +196,44 @@ subroutine py_surface_fields(n, p, period, thickness, young, poisson, friction, 
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
    type(error_type), allocatable :: error
-   type(fft_plan) :: fft
+   type(compliance_operator) :: op
    stat = 0
    errmsg = ''
-   call fft%init(n, 1, error)
+   call build_operator(op, n, period, thickness, material_law(young=young), poisson, friction, 0d0, 1, error)
    if (allocated(error)) then
       stat = error%code
       errmsg = error%message
       return
    end if
-   call surface_fields(fft, period, thickness, young, poisson, friction, p, displacement_x, stress_xx)
+   call surface_fields(op, thickness, poisson, p, displacement_x, stress_xx)
 end subroutine py_surface_fields
+
+!> J*(k) of seed Eq. (14) at omega = k V for a material law (codes as in py_solve_line).
+subroutine py_creep_compliance(nw, omega, model, form, young, e0, e_inf, tau, equilibrium, nt, times, values, &
+      & compliance, stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_greens_viscoelastic, only: material_law, make_material_law, check_material, creep_compliance
+   implicit none (type, external)
+   integer, intent(in) :: nw, model, form, nt
+   real(8), intent(in) :: omega(nw), young, e0, e_inf, tau, equilibrium, times(nt), values(nt)
+   complex(8), intent(out) :: compliance(nw)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   !f2py intent(hide) :: nw, nt
+   type(error_type), allocatable :: error
+   type(material_law) :: law
+   integer :: i
+   stat = 0
+   errmsg = ''
+   compliance = 0
+   law = make_material_law(model, form, young, e0, e_inf, tau, equilibrium, times, values)
+   call check_material(law, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+      return
+   end if
+   do i = 1, nw
+      compliance(i) = creep_compliance(law, omega(i))
+   end do
+end subroutine py_creep_compliance

@@ -93,6 +93,13 @@ contains
       end if
       write (unit, real_fmt) 'penetration Delta', result%penetration, '(L)'
       if (present(companion)) write (unit, real_fmt) 'penetration Delta, mu_c = 0', companion%penetration, '(L)'
+      if (trim(scene%material%model) /= 'elastic') then
+         write (unit, '(2x, a, t34, a)') 'material', trim(scene%material%model) // ' (viscoelastic)'
+         write (unit, real_fmt) 'sliding speed V', scene%speed, '(L/T)'
+         write (unit, real_fmt) 'dissipated power', result%dissipated_power, '(S L/T)'
+      end if
+      if (.not. result%monotone) write (unit, '(2x, a)') 'WARNING: Re G_eff < 0 on some modes: ' // &
+         & 'the contact solution may not be unique (viscoelastic coupling with friction)'
       write (unit, real_fmt) 'interlocking friction Delta mu', result%delta_mu
       write (unit, real_fmt) 'total friction mu_c + Delta mu', result%friction + result%delta_mu
       write (unit, int_fmt) 'CG iterations', result%iterations

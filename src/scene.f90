@@ -11,9 +11,11 @@ module lc_scene
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, input_error
    use lc_strings, only: to_string
+   use lc_greens_viscoelastic, only: material_law, check_material, static_modulus
    implicit none (type, external)
    private
-   public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set
+   public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
+      & static_contact_modulus
    public :: max_string, default_rms_gradient
 
    !> Sentinel for "not given" in optional positive quantities.
@@ -70,6 +72,11 @@ module lc_scene
       real(wp) :: thickness = 0.16_wp      !< h (L); +Inf = half-space
       real(wp) :: young = 1.0_wp           !< E (S)
       real(wp) :: poisson = 0.5_wp         !< nu
+      !> material law (elastic: young; sls, prony: see lc_greens_viscoelastic) and the
+      !> sliding speed V (L/T) that sets the frequency k V of each mode
+      type(material_law) :: material
+      real(wp) :: speed = 0.0_wp
+      character(len=max_string) :: prony_file = ''   !< two columns: tau_i, value_i
       real(wp) :: friction = 0.0_wp        !< Coulomb coefficient mu_c
       logical :: companion = .false.       !< also solve the frictionless companion
       type(profile_spec) :: profile
@@ -92,6 +99,20 @@ contains
       is_halfspace = .not. ieee_is_finite(scene%thickness) .and. .not. ieee_is_nan(scene%thickness)
    end function is_halfspace
 
+   !> The scene's material law (an elastic law takes &layer young).
+   pure function material_of(scene) result(law)
+      type(scene_type), intent(in) :: scene
+      type(material_law) :: law
+      law = scene%material
+      if (trim(law%model) == 'elastic') law%young = scene%young
+   end function material_of
+
+   !> E* = E/(1 - nu^2) with the static (V -> 0) modulus: the seed's pressure scale (S).
+   pure real(wp) function static_contact_modulus(scene)
+      type(scene_type), intent(in) :: scene
+      static_contact_modulus = static_modulus(material_of(scene))/(1.0_wp - scene%poisson**2)
+   end function static_contact_modulus
+
    !> Validate a scene; the message names the namelist group, the variable, the value
    !> and the allowed range.
    subroutine check_scene(scene, error)
@@ -111,11 +132,15 @@ contains
             call input_error(error, 'layer', 'young', to_string(scene%young), '> 0 and finite')
          else if (.not. (scene%poisson > -1.0_wp .and. scene%poisson <= 0.5_wp)) then
             call input_error(error, 'layer', 'poisson', to_string(scene%poisson), '-1 < poisson <= 0.5')
+         else if (.not. (ieee_is_finite(scene%speed) .and. scene%speed >= 0.0_wp)) then
+            call input_error(error, 'material', 'speed', to_string(scene%speed), '>= 0 and finite')
          else if (.not. (scene%friction >= 0.0_wp .and. scene%friction <= 10.0_wp)) then
             call input_error(error, 'friction', 'coefficient', to_string(scene%friction), '0 <= coefficient <= 10')
          else if (.not. one_of(p%kind, [character(len=16) :: 'self_affine', 'sinusoid', 'file'])) then
             call input_error(error, 'profile', 'kind', trim(p%kind), "'self_affine', 'sinusoid' or 'file'")
          end if
+         if (allocated(error)) return
+         call check_material(scene%material, error)
          if (allocated(error)) return
 
          select case (trim(p%kind))

@@ -17,10 +17,14 @@ from .api import (
     solve_line,
     surface_fields,
 )
+from .materials import Prony, StandardLinearSolid, creep_compliance
 from .profiles import load_profile, self_affine_profile, sinusoid_profile
 from .sweep import read_summary, sweep
 
 __all__ = [
+    "Prony",
+    "StandardLinearSolid",
+    "creep_compliance",
     "LayercontactError",
     "LineResult",
     "check_scene_file",

@@ -18,7 +18,7 @@ _SCALARS = (
     "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
-    "max_tension_offset",
+    "max_tension_offset", "dissipated_power", "monotone",
 )
 _INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
 
@@ -107,6 +107,8 @@ class LineResult:
     max_tension: float = float("nan")
     max_tension_x: float = float("nan")
     max_tension_offset: float = float("nan")
+    dissipated_power: float = 0.0
+    monotone: bool = True
     a_over_a0: float | None = None
     companion: "LineResult | None" = field(default=None, repr=False)
 
@@ -131,6 +133,8 @@ def solve_line(
     friction: float = 0.0,
     mean_pressure: float | None = None,
     penetration: float | None = None,
+    material=None,
+    speed: float = 0.0,
     companion: bool = False,
     stress: bool = True,
     method: str = "auto",
@@ -145,7 +149,10 @@ def solve_line(
     bonded to a rigid base, with Coulomb friction ``tau = friction * p``.
 
     Give ``mean_pressure`` (load control) or ``penetration`` (displacement control, finite
-    compressible layers only). ``companion=True`` also solves the frictionless problem at
+    compressible layers only). ``material`` (a :class:`StandardLinearSolid` or
+    :class:`Prony`; ``young`` is then ignored) makes the layer viscoelastic, sliding at
+    ``speed`` (L/T); ``dissipated_power`` and ``monotone`` (``Re G_eff >= 0`` on every mode,
+    hence a unique solution) are reported. ``companion=True`` also solves the frictionless problem at
     the same load and sets ``a_over_a0`` and ``companion``. ``stress`` computes
     ``displacement_x``, ``shear`` and the surface stress ``stress_xx`` (one more FFT pair).
     ``precondition`` applies the Fourier stiffness 1/M to the residual on the contact set
@@ -162,7 +169,7 @@ def solve_line(
         raise ValueError(f"method = {method!r} is not allowed; allowed: {sorted(_METHODS)}")
     settings = dict(period=period, thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
                     penetration=penetration, stress=stress, method=method, precondition=precondition, tol=tol,
-                    max_iter=max_iter, memory=memory, threads=threads)
+                    max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
     result = _solve_once(h, friction=friction, **settings)
     if companion:
         if mean_pressure is None:
@@ -173,19 +180,23 @@ def solve_line(
 
 
 def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure, penetration, stress, method,
-                precondition, tol, max_iter, memory, threads) -> LineResult:
+                precondition, tol, max_iter, memory, threads, material, speed) -> LineResult:
+    from .materials import material_codes
+
     control = "load" if mean_pressure is not None else "displacement"
+    model, form, young, e0, e_inf, tau, eq, times, values = material_codes(material, young)
     fields, spots, s, hist, stat, errmsg = _core.py_solve_line(
-        h, float(period), float(thickness), float(young), float(poisson), float(friction), _CONTROLS[control],
+        h, float(period), float(thickness), young, float(poisson), float(friction), _CONTROLS[control],
         NOT_SET if mean_pressure is None else float(mean_pressure),
         NOT_SET if penetration is None else float(penetration),
         _METHODS[method], int(bool(precondition)), float(tol), int(max_iter), int(memory), int(threads),
-        int(bool(stress)),
+        int(bool(stress)), model, form, e0, e_inf, tau, eq, times, values, float(speed),
     )
     _check(stat, errmsg)
     scalars = {name: (int(v) if name in _INTEGERS else float(v)) for name, v in zip(_SCALARS, s)}
     n_hist = int(scalars.pop("history_length"))
     scalars["converged"] = bool(scalars["converged"])
+    scalars["monotone"] = bool(scalars["monotone"])
     if not stress:
         for name in ("max_tension", "max_tension_x", "max_tension_offset"):
             scalars[name] = float("nan")
@@ -224,6 +235,7 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
         names = set(_SCALARS) - {"history_length"}
         values = {k: (int(r[k]) if k in _INTEGERS else float(r[k])) for k in names if k in r}
         values["converged"] = bool(r["converged"])
+        values["monotone"] = bool(r.get("monotone", 1))
         return LineResult(
             pressure=fields["pressure"], gap=fields["gap"], displacement_z=fields["displacement_z"],
             displacement_x=fields.get("displacement_x"), shear=fields.get("shear"),

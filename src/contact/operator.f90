@@ -2,6 +2,8 @@
 !>
 !> Convention P (DESIGN.md §1): for a mode k of p(x) = sum_k p^(k) exp(i k x),
 !>    w^(k) = 2/(E*|k|) [ (1-A) - i sgn(k) mu_c c ] p^(k),
+!> and for a viscoelastic layer sliding at speed V (seed Eq. 14) 1/E* -> (1 - nu^2) J*(k V)
+!> (lc_greens_viscoelastic),
 !> with 1-A and c from seed Eqs. (7)-(9) (lc_greens_layer), tau = mu_c p. The k = 0
 !> mode of a finite layer is h/M (M = E(1-nu)/((1+nu)(1-2nu)), zero for nu = 0.5); for
 !> a half-space it is set to zero (the penetration is then measured from the mean
@@ -21,6 +23,7 @@ module lc_contact_operator
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_fft_plans, only: fft_plan, fft_threads_available
    use lc_greens_layer, only: layer_coefficients
+   use lc_greens_viscoelastic, only: material_law, creep_compliance
    implicit none (type, external)
    private
    public :: compliance_operator, build_operator
@@ -36,6 +39,9 @@ module lc_contact_operator
       logical :: coupled = .false.          !< complex multiplier (not symmetric)
       real(wp), allocatable :: metric(:)    !< M(k) = |G_eff(k)|, k = 0..n/2 (L/S)
       real(wp) :: diagonal = 0.0_wp         !< real-space diagonal of the circulant M (L/S)
+      complex(wp), allocatable :: compliance(:)   !< (1 - nu^2) J*(k V) per mode (1/S)
+      logical :: viscoelastic = .false.     !< moving viscoelastic law: complex compliances
+      logical :: monotone = .true.          !< Re G_eff(k) >= 0 for every mode (unique solution)
       complex(wp), allocatable :: full(:)   !< G_eff(k), only when coupled
       type(fft_plan) :: fft
    contains
@@ -49,13 +55,15 @@ module lc_contact_operator
 contains
 
    !> Build the operator of a line contact: n points on a period, layer thickness
-   !> (+Inf = half-space), Young's modulus, Poisson ratio, Coulomb coefficient.
-   subroutine build_operator(op, n, period, thickness, young, poisson, friction, threads, error)
+   !> (+Inf = half-space), material law (elastic: law%young) and Poisson ratio, Coulomb
+   !> coefficient, sliding speed (for viscoelastic laws).
+   subroutine build_operator(op, n, period, thickness, law, poisson, friction, speed, threads, error)
       type(compliance_operator), intent(out) :: op
       integer, intent(in) :: n, threads
-      real(wp), intent(in) :: period, thickness, young, poisson, friction
+      real(wp), intent(in) :: period, thickness, poisson, friction, speed
+      type(material_law), intent(in) :: law
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: estar, k, one_minus_a, one_minus_b, c, scale
+      real(wp) :: k, one_minus_a, one_minus_b, c
       complex(wp) :: g
       integer :: m
       logical :: halfspace
@@ -73,32 +81,41 @@ contains
       op%period = period
       op%friction = friction
       halfspace = .not. ieee_is_finite(thickness)
-      estar = young/(1.0_wp - poisson**2)
+      ! (1 - nu^2) J*(k V) per mode: 1/E* for an elastic law. A viscoelastic law at rest is
+      ! elastic with its static modulus: only a moving one needs complex compliances.
+      op%viscoelastic = trim(law%model) /= 'elastic' .and. speed > 0.0_wp
+      allocate (op%compliance(op%nk))
+      do m = 0, op%nk - 1
+         op%compliance(m + 1) = (1.0_wp - poisson**2)*creep_compliance(law, op%wavenumber(m)*speed)
+      end do
       ! A half-space of an incompressible material has c = 0: friction changes nothing.
-      op%coupled = friction > 0.0_wp .and. .not. (halfspace .and. poisson == 0.5_wp)
+      op%coupled = op%viscoelastic .or. (friction > 0.0_wp .and. .not. (halfspace .and. poisson == 0.5_wp))
 
       allocate (op%metric(op%nk))
       if (op%coupled) allocate (op%full(op%nk))
       if (halfspace) then
          op%metric(1) = 0.0_wp
       else
-         ! h/M, written so that nu = 0.5 gives exactly zero
-         op%metric(1) = thickness*(1.0_wp + poisson)*(1.0_wp - 2.0_wp*poisson)/(young*(1.0_wp - poisson))
+         ! h/M = h (1+nu)(1-2nu)/((1-nu) E) with the static compliance, exactly zero for nu = 0.5
+         op%metric(1) = thickness*(1.0_wp - 2.0_wp*poisson)/(1.0_wp - poisson)**2*real(op%compliance(1), wp)
       end if
       if (op%coupled) op%full(1) = op%metric(1)
 
       do m = 1, op%nk - 1
          k = op%wavenumber(m)
-         scale = 2.0_wp/(estar*k)
          ! x = +Inf (half-space) gives 1-A = 1-B = 1 and Dundurs' c
          call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
+         g = 2.0_wp/k*op%compliance(m + 1)*cmplx(one_minus_a, -friction*c, kind=wp)
          ! sgn(k) = +1 on the half spectrum; the Nyquist mode is its own mirror image
-         ! (sgn averages to 0), so its multiplier must be real.
-         if (2*m == n) c = 0.0_wp
-         g = scale*cmplx(one_minus_a, -friction*c, kind=wp)
+         ! (odd parts average to 0), so its multiplier must be real.
+         if (2*m == n) g = 2.0_wp/k*real(op%compliance(m + 1), wp)*one_minus_a
          op%metric(m + 1) = abs(g)
          if (op%coupled) op%full(m + 1) = g
       end do
+      ! The solution is unique when the operator is monotone, Re G_eff >= 0 on every mode
+      ! (always for elastic layers; not always for viscoelastic ones with friction).
+      op%monotone = .true.
+      if (op%coupled) op%monotone = all(real(op%full, wp) >= 0.0_wp)
       ! (1/n) sum over the whole spectrum: modes 1..ceil(n/2)-1 appear twice, Nyquist once
       op%diagonal = (op%metric(1) + 2*sum(op%metric(2:op%nk)) - merge(op%metric(op%nk), 0.0_wp, &
          & mod(n, 2) == 0))/n

@@ -10,7 +10,7 @@ module lc_contact_solve
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_strings, only: to_string
-   use lc_scene, only: scene_type, is_halfspace, not_set
+   use lc_scene, only: scene_type, is_halfspace, not_set, material_of, static_contact_modulus
    use lc_result, only: contact_result
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome
@@ -29,13 +29,12 @@ contains
    pure real(wp) function scene_mean_pressure(scene, height) result(pm)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: height(:)
-      real(wp) :: estar, lambda0
+      real(wp) :: lambda0
       if (scene%mean_pressure /= not_set) then
          pm = scene%mean_pressure
       else
-         estar = scene%young/(1.0_wp - scene%poisson**2)
          lambda0 = maxval(height) - sum(height)/size(height)
-         pm = scene%normalised_pressure*estar*lambda0/scene%period
+         pm = scene%normalised_pressure*static_contact_modulus(scene)*lambda0/scene%period
       end if
    end function scene_mean_pressure
 
@@ -70,8 +69,8 @@ contains
             & "so the penetration does not fix the load; use control = 'load'", code_input)
          return
       end if
-      call build_operator(op, n, scene%period, scene%thickness, scene%young, scene%poisson, friction, &
-         & scene%solver%threads, error)
+      call build_operator(op, n, scene%period, scene%thickness, material_of(scene), scene%poisson, friction, &
+         & scene%speed, scene%solver%threads, error)
       if (allocated(error)) return
       if (op%coupled .and. trim(scene%solver%method) == 'cg') then
          call fatal_error(error, "&solver: method = 'cg' cannot solve this scene: friction couples the normal " // &
@@ -122,6 +121,7 @@ contains
       result%mean_pressure = sum(p)/n
       result%penetration = s + lambda_max
       result%contact_fraction = real(count(p > 0.0_wp), wp)/n
+      result%monotone = op%monotone
       call system_clock(finish)
       result%wall_time = real(finish - start, wp)/real(rate, wp)
       call observe(scene, op, height, result)
@@ -145,15 +145,14 @@ contains
             call gap_histogram(result%gap, result%gap_edges, result%gap_counts)
          end if
          if (result%mean_pressure > 0.0_wp) then
-            call interlocking_friction(op, p, result%displacement_z, height, scene%thickness, scene%young, &
-               & scene%poisson, result%delta_mu, result%delta_mu_spectral, result%delta_mu_energy, &
-               & result%delta_mu_profile)
+            call interlocking_friction(op, p, result%displacement_z, height, scene%thickness, scene%poisson, &
+               & scene%speed, result%delta_mu, result%delta_mu_spectral, result%delta_mu_energy, &
+               & result%delta_mu_profile, result%dissipated_power)
          end if
          if (scene%stress) then
             allocate (result%displacement_x(size(p)), result%stress_xx(size(p)))
             result%shear = result%friction*p
-            call surface_fields(op%fft, scene%period, scene%thickness, scene%young, scene%poisson, &
-               & result%friction, p, result%displacement_x, result%stress_xx)
+            call surface_fields(op, scene%thickness, scene%poisson, p, result%displacement_x, result%stress_xx)
             where_max = maxloc(result%stress_xx, dim=1)
             result%max_tension = result%stress_xx(where_max)
             result%max_tension_x = (where_max - 1)*scene%period/size(p)

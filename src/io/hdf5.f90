@@ -28,7 +28,7 @@ module lc_io_hdf5
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
    use lc_strings, only: to_string
-   use lc_scene, only: scene_type
+   use lc_scene, only: scene_type, static_contact_modulus
    use lc_result, only: contact_result
    implicit none (type, external)
    private
@@ -282,6 +282,21 @@ contains
       call write_attr_real(loc, 'thickness', scene%thickness, st)
       call write_attr_real(loc, 'young', scene%young, st)
       call write_attr_real(loc, 'poisson', scene%poisson, st)
+      associate (m => scene%material)
+         call write_attr_string(loc, 'material_model', trim(m%model), st)
+         call write_attr_real(loc, 'speed', scene%speed, st)
+         if (trim(m%model) == 'sls') then
+            call write_attr_real(loc, 'e0', m%e0, st)
+            call write_attr_real(loc, 'e_inf', m%e_inf, st)
+            call write_attr_real(loc, 'tau', m%tau, st)
+         else if (trim(m%model) == 'prony') then
+            call write_attr_string(loc, 'prony_form', trim(m%form), st)
+            call write_attr_real(loc, 'prony_equilibrium', m%equilibrium, st)
+            call write_attr_string(loc, 'prony_file', trim(scene%prony_file), st)
+            call write_dataset_1d(loc, 'prony_times', m%times, 'T', st)
+            call write_dataset_1d(loc, 'prony_values', m%values, merge('S  ', '1/S', trim(m%form) == 'relaxation'), st)
+         end if
+      end associate
       call write_attr_real(loc, 'friction', scene%friction, st)
       call write_attr_int(loc, 'companion', merge(1, 0, scene%companion), st)
       associate (p => scene%profile)
@@ -362,6 +377,8 @@ contains
       call write_attr_real(group, 'delta_mu_energy', res%delta_mu_energy, st)
       call write_attr_real(group, 'delta_mu_profile', res%delta_mu_profile, st)
       call write_attr_real(group, 'total_friction', res%friction + res%delta_mu, st)
+      call write_attr_real(group, 'dissipated_power', res%dissipated_power, st)
+      call write_attr_int(group, 'monotone', merge(1, 0, res%monotone), st)
       call write_attr_int(group, 'converged', merge(1, 0, res%converged), st)
       call write_attr_int(group, 'iterations', res%iterations, st)
       call write_attr_int(group, 'outer_iterations', res%outer_iterations, st)
@@ -380,7 +397,7 @@ contains
       end if
       ! the seed's scales: Lambda = highest asperity above the mean plane (as the input's
       ! normalised_pressure), p_m normalised by E* Lambda / lambda, thickness by lambda
-      e_star = scene%young / (1.0_wp - scene%poisson**2)
+      e_star = static_contact_modulus(scene)
       lambda_max = maxval(height) - sum(height)/size(height)
       if (lambda_max > 0.0_wp) then
          call write_attr_real(group, 'normalised_pressure', res%mean_pressure / (e_star*lambda_max/scene%period), st)

@@ -12,17 +12,19 @@ module lc_io_namelist
    use lc_errors, only: error_type, fatal_error, code_input, code_io
    use lc_strings, only: to_string
    use lc_scene, only: scene_type, check_scene, not_set, max_string
+   use lc_greens_viscoelastic, only: max_prony_terms
    implicit none (type, external)
    private
    public :: read_scene, read_scene_text, write_scene_namelist
 
-   integer, parameter :: n_groups = 7
+   integer, parameter :: n_groups = 8
    character(len=*), parameter :: group_names(n_groups) = [character(len=8) :: &
-      & 'scene', 'layer', 'friction', 'profile', 'loading', 'solver', 'output']
+      & 'scene', 'layer', 'material', 'friction', 'profile', 'loading', 'solver', 'output']
    !> Variables allowed in each group, in the order of `group_names` (for messages).
    character(len=*), parameter :: group_variables(n_groups) = [character(len=128) :: &
       & 'geometry, title, period, n', &
       & 'thickness, young, poisson', &
+      & 'model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, prony_values, prony_file', &
       & 'coefficient, companion', &
       & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
       & 'amplitude, mode, file, dataset', &
@@ -99,10 +101,19 @@ contains
          end if
       end do
 
+      if (len_trim(scene%prony_file) > 0) then
+         if (scene%material%terms() > 0 .or. allocated(scene%material%values)) then
+            call fatal_error(error, '&material: prony_file and prony_times/prony_values are both given; ' // &
+               & 'allowed: one of them', code_input)
+            return
+         end if
+         call read_prony_file(trim(scene%prony_file), scene%material%times, scene%material%values, error)
+         if (allocated(error)) return
+      end if
       call check_scene(scene, error)
    end subroutine read_scene_text
 
-   !> The scene as a complete namelist text with all seven groups; `read_scene_text` of it
+   !> The scene as a complete namelist text with all eight groups; `read_scene_text` of it
    !> gives the same scene back (reals are written with 17 significant digits).
    subroutine write_scene_namelist(scene, text)
       type(scene_type), intent(in) :: scene
@@ -119,6 +130,15 @@ contains
             & // entry('thickness', real_value(scene%thickness)) &
             & // entry('young', real_value(scene%young)) &
             & // entry('poisson', real_value(scene%poisson)) &
+            & // '/' // newline // '&material' // newline &
+            & // entry('model', str_value(scene%material%model)) &
+            & // entry('e0', real_value(scene%material%e0)) &
+            & // entry('e_inf', real_value(scene%material%e_inf)) &
+            & // entry('tau', real_value(scene%material%tau)) &
+            & // entry('speed', real_value(scene%speed)) &
+            & // entry('prony_form', str_value(scene%material%form)) &
+            & // entry('prony_equilibrium', real_value(scene%material%equilibrium)) &
+            & // prony_entries(scene%material%times, scene%material%values) &
             & // '/' // newline // '&friction' // newline &
             & // entry('coefficient', real_value(scene%friction)) &
             & // entry('companion', logical_value(scene%companion)) &
@@ -173,6 +193,8 @@ contains
          call read_group_scene(lines, config, stat, msg)
       case ('layer')
          call read_group_layer(lines, config, stat, msg)
+      case ('material')
+         call read_group_material(lines, config, stat, msg)
       case ('friction')
          call read_group_friction(lines, config, stat, msg)
       case ('profile')
@@ -232,6 +254,101 @@ contains
       config%young = young
       config%poisson = poisson
    end subroutine read_group_layer
+
+   subroutine read_group_material(lines, config, stat, msg)
+      character(len=*), intent(in) :: lines(:)
+      type(scene_type), intent(inout) :: config
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: msg
+      character(len=max_string) :: model, prony_form, prony_file
+      real(wp) :: e0, e_inf, tau, speed, prony_equilibrium
+      real(wp) :: prony_times(max_prony_terms), prony_values(max_prony_terms)
+      namelist /material/ model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, &
+         & prony_values, prony_file
+
+      associate (m => config%material)
+         model = m%model
+         prony_form = m%form
+         prony_file = config%prony_file
+         e0 = m%e0
+         e_inf = m%e_inf
+         tau = m%tau
+         speed = config%speed
+         prony_equilibrium = m%equilibrium
+         prony_times = not_set
+         prony_values = not_set
+         if (allocated(m%times)) prony_times(:size(m%times)) = m%times
+         if (allocated(m%values)) prony_values(:size(m%values)) = m%values
+         read (lines, nml=material, iostat=stat, iomsg=msg)
+         if (stat /= 0) return
+         m%model = model
+         m%form = prony_form
+         config%prony_file = prony_file
+         m%e0 = e0
+         m%e_inf = e_inf
+         m%tau = tau
+         config%speed = speed
+         m%equilibrium = prony_equilibrium
+         ! the terms given are the leading entries that were set
+         if (allocated(m%times)) deallocate (m%times)
+         if (allocated(m%values)) deallocate (m%values)
+         if (count_set(prony_times) > 0) m%times = prony_times(:count_set(prony_times))
+         if (count_set(prony_values) > 0) m%values = prony_values(:count_set(prony_values))
+      end associate
+   end subroutine read_group_material
+
+   !> Number of leading entries that are not `not_set`.
+   pure integer function count_set(values)
+      real(wp), intent(in) :: values(:)
+      count_set = 0
+      do while (count_set < size(values))
+         if (values(count_set + 1) == not_set) exit
+         count_set = count_set + 1
+      end do
+   end function count_set
+
+   !> Prony terms from a text file: one term per line, `tau_i value_i` (comments after '#'
+   !> or '!'). Sorting and positivity are checked with the material (check_material).
+   subroutine read_prony_file(filename, times, values, error)
+      character(len=*), intent(in) :: filename
+      real(wp), allocatable, intent(out) :: times(:), values(:)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=1024) :: line, msg
+      real(wp) :: pair(2)
+      integer :: unit, stat, lineno, cut
+
+      allocate (times(0), values(0))
+      open (newunit=unit, file=filename, status='old', action='read', iostat=stat, iomsg=msg)
+      if (stat /= 0) then
+         call fatal_error(error, "&material: cannot open prony_file '" // filename // "': " // trim(msg), code_io)
+         return
+      end if
+      lineno = 0
+      do
+         read (unit, '(a)', iostat=stat) line
+         if (stat /= 0) exit
+         lineno = lineno + 1
+         cut = scan(line, '#!')
+         if (cut > 0) line(cut:) = ''
+         if (len_trim(line) == 0) cycle
+         read (line, *, iostat=stat) pair
+         if (stat /= 0) then
+            call fatal_error(error, "&material: prony_file '" // filename // "', line " // to_string(lineno) // &
+               & ": expected two numbers 'tau_i value_i', got '" // trim(line) // "'", code_input)
+            close (unit)
+            return
+         end if
+         if (size(times) >= max_prony_terms) then
+            call fatal_error(error, "&material: prony_file '" // filename // "' has more than " // &
+               & to_string(max_prony_terms) // ' terms', code_input)
+            close (unit)
+            return
+         end if
+         times = [times, pair(1)]
+         values = [values, pair(2)]
+      end do
+      close (unit)
+   end subroutine read_prony_file
 
    subroutine read_group_friction(lines, config, stat, msg)
       character(len=*), intent(in) :: lines(:)
@@ -620,6 +737,33 @@ contains
       end if
       if (x == not_set) s = s // '  ! not set'
    end function real_value
+
+   !> The Prony terms as `prony_times = ...` and `prony_values = ...` (nothing if none); the
+   !> echo carries the terms themselves, never the file they came from.
+   pure function prony_entries(times, values) result(s)
+      real(wp), allocatable, intent(in) :: times(:), values(:)
+      character(len=:), allocatable :: s
+      integer :: i
+      s = ''
+      if (allocated(times)) then
+         if (size(times) > 0) then
+            s = '   prony_times = ' // real_value(times(1))
+            do i = 2, size(times)
+               s = s // ', ' // real_value(times(i))
+            end do
+            s = s // newline
+         end if
+      end if
+      if (allocated(values)) then
+         if (size(values) > 0) then
+            s = s // '   prony_values = ' // real_value(values(1))
+            do i = 2, size(values)
+               s = s // ', ' // real_value(values(i))
+            end do
+            s = s // newline
+         end if
+      end if
+   end function prony_entries
 
    !> A quoted string, inner apostrophes doubled.
    pure function str_value(word) result(s)

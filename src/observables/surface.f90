@@ -2,6 +2,7 @@
 !>
 !> Convention P (DESIGN.md §1), tau = mu_c p along +x on the layer:
 !>    u_x^(k) = 2/(E*|k|) [ i sgn(k) c p^(k) + (1-B) tau^(k) ],
+!> with 1/E* -> (1 - nu^2) J*(kV) for a viscoelastic layer (Poisson's ratio constant),
 !> and at z = 0, from Hooke's law in plane strain with sigma_zz = -p (exact at the surface):
 !>    sigma_xx = -(nu/(1-nu)) p + E* du_x/dx.
 !> The uniform modes are set explicitly: a bonded layer sheared by the mean traction moves by
@@ -12,31 +13,29 @@
 module lc_observables_surface
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
-   use lc_fft_plans, only: fft_plan
+   use lc_contact_operator, only: compliance_operator
    use lc_greens_layer, only: layer_coefficients
    implicit none (type, external)
    private
    public :: surface_fields
 
-   real(wp), parameter :: pi = acos(-1.0_wp)
-
 contains
 
    !> u_x (L) and sigma_xx (S) at the surface for pressure p (S) and shear tau = friction p.
-   subroutine surface_fields(fft, period, thickness, young, poisson, friction, p, displacement_x, stress_xx)
-      type(fft_plan), intent(inout) :: fft
-      real(wp), intent(in) :: period, thickness, young, poisson, friction
+   subroutine surface_fields(op, thickness, poisson, p, displacement_x, stress_xx)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: thickness, poisson
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: displacement_x(:), stress_xx(:)
       complex(wp), allocatable :: ph(:), uh(:), sh(:)
-      real(wp) :: estar, k, one_minus_a, one_minus_b, c, pm, shear_modulus, contraction, odd
+      real(wp) :: k, one_minus_a, one_minus_b, c, pm, contraction, odd, friction
       integer :: m, n
       logical :: halfspace
 
+      associate (fft => op%fft)
       n = fft%n
+      friction = op%friction
       halfspace = .not. ieee_is_finite(thickness)
-      estar = young/(1.0_wp - poisson**2)
-      shear_modulus = young/(2.0_wp*(1.0_wp + poisson))
       contraction = poisson/(1.0_wp - poisson)
       fft%real_buffer = p
       call fft%forward()
@@ -51,14 +50,17 @@ contains
          uh(1) = 0.0_wp
          sh(1) = -pm
       else
-         uh(1) = friction*pm*thickness/shear_modulus
+         ! simple shear of the bonded layer: u_x = tau_m h/G, h/G = 2 h (1+nu)/E_static
+         uh(1) = friction*pm*2.0_wp*thickness*real(op%compliance(1), wp)/(1.0_wp - poisson)
          sh(1) = -contraction*pm
       end if
       do m = 1, fft%nk - 1
-         k = 2.0_wp*pi*m/period
+         k = op%wavenumber(m)
          call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
          odd = merge(0.0_wp, 1.0_wp, 2*m == n)
-         uh(m + 1) = 2.0_wp/(estar*k)*cmplx(friction*one_minus_b, odd*c, wp)*ph(m + 1)
+         ! (1 - nu^2) J*(kV) = 1/E* for an elastic layer; sigma_xx does not depend on it
+         uh(m + 1) = 2.0_wp/k*cmplx(real(op%compliance(m + 1), wp), odd*aimag(op%compliance(m + 1)), wp) &
+            & *cmplx(friction*one_minus_b, odd*c, wp)*ph(m + 1)
          sh(m + 1) = cmplx(-contraction - 2.0_wp*c, odd*2.0_wp*friction*one_minus_b, wp)*ph(m + 1)
       end do
 
@@ -68,5 +70,6 @@ contains
       fft%spectrum = sh
       call fft%backward()
       stress_xx = fft%real_buffer
+      end associate
    end subroutine surface_fields
 end module lc_observables_surface

@@ -110,7 +110,7 @@ contains
 
       call read_scene_text('&scene n = 64 /' // nl // nl // '&layr thickness = 1 /' // nl, 'a.nml', scene, error)
       call check_error(error, code_input, [character(len=40) :: 'a.nml', 'line 3', "'&layr'", &
-         & '&scene, &layer, &friction, &profile', '&output'], 'unknown group')
+         & '&scene, &layer, &material, &friction', '&output'], 'unknown group')
 
       call read_scene_text('&layer young = 2 /' // nl // "&scene title = '&x' /" // nl // '&layer /' // nl, &
          & 'b.nml', scene, error)
