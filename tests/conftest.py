@@ -18,18 +18,22 @@ import layercontact as lc
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def g_eff(n: int, period: float, thickness: float, young: float, poisson: float, friction: float):
-    """G_eff(k) for k = 0..n/2 (numpy rfft order), convention P, Nyquist made real."""
-    estar = young / (1 - poisson**2)
+def g_eff(n: int, period: float, thickness: float, young: float, poisson: float, friction: float,
+          material=None, speed: float = 0.0):
+    """G_eff(k) for k = 0..n/2 (numpy rfft order), convention P, Nyquist made real. With a
+    viscoelastic ``material`` 1/E -> J*(k V) (seed Eq. 14)."""
     m = np.arange(n // 2 + 1)
     k = 2 * np.pi * m / period
+    compliance = np.full(m.size, 1 / young, dtype=complex)
+    if material is not None:
+        compliance = lc.creep_compliance(material, k * speed)
     g = np.zeros(m.size, dtype=complex)
     oma, _, c = lc.layer_multipliers(k[1:] * thickness, poisson)
-    g[1:] = 2 / (estar * k[1:]) * (oma - 1j * friction * c)
+    g[1:] = 2 * (1 - poisson**2) * compliance[1:] / k[1:] * (oma - 1j * friction * c)
     if n % 2 == 0:
-        g[-1] = g[-1].real
+        g[-1] = 2 * (1 - poisson**2) * compliance[-1].real / k[-1] * oma[-1]
     if np.isfinite(thickness):
-        g[0] = thickness * (1 + poisson) * (1 - 2 * poisson) / (young * (1 - poisson))
+        g[0] = thickness * (1 + poisson) * (1 - 2 * poisson) * compliance[0].real / (1 - poisson)
     return g
 
 
@@ -38,13 +42,14 @@ def apply(g: np.ndarray, p: np.ndarray) -> np.ndarray:
     return np.fft.irfft(np.fft.rfft(p) * g, n=p.size)
 
 
-def contact_violation(res: lc.LineResult, thickness: float, young: float, poisson: float) -> dict:
+def contact_violation(res: lc.LineResult, thickness: float, young: float, poisson: float, material=None,
+                      speed: float = 0.0) -> dict:
     """Contact conditions of a result, recomputed independently: returns the worst
     overlap and the worst gap in contact, both relative to the profile's peak-to-valley,
     and the relative error of the mean pressure."""
     r = res.height
     n = r.size
-    w = apply(g_eff(n, res.period, thickness, young, poisson, res.friction), res.pressure)
+    w = apply(g_eff(n, res.period, thickness, young, poisson, res.friction, material, speed), res.pressure)
     gap = w - (r - r.max() + res.penetration)
     scale = np.ptp(r)
     contact = res.pressure > 0

@@ -11,6 +11,7 @@ A sweep file holds the usual groups (``&scene &layer &friction &profile &loading
        friction = 0.0, 0.2, 0.5          ! -> &friction coefficient
        normalised_pressure = 0.3, 1, 3   ! -> &loading (or mean_pressure; load control)
        thickness = 0.16, 0.01            ! -> &layer thickness
+       speed = 0.01, 0.1, 1              ! -> &material speed (viscoelastic layers)
        seed = 1, 2, 3                    ! -> &profile seed (or realisations = N: 1..N)
        processes = 2                     ! worker processes (default: os.cpu_count())
     /
@@ -91,6 +92,7 @@ PARAMETERS: dict[str, _Parameter] = {
     "normalised_pressure": _Parameter("loading", "normalised_pressure", float, _LOADING, _LOAD),
     "mean_pressure": _Parameter("loading", "mean_pressure", float, _LOADING, _LOAD),
     "thickness": _Parameter("layer", "thickness", float),
+    "speed": _Parameter("material", "speed", float),
     "seed": _Parameter("profile", "seed", int),
 }
 

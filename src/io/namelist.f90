@@ -33,6 +33,9 @@ module lc_io_namelist
       & 'file, overwrite, stress, gap_bins']
 
    character(len=*), parameter :: newline = new_line('a')
+   !> Marks array entries a namelist did not set (any real a user could type is a value,
+   !> so that a wrong sign is reported rather than taken for "not given").
+   real(wp), parameter :: unset_entry = -huge(1.0_wp)
 
    !> Where one group sits in the text: characters first..last, starting on `line`.
    type :: group_span
@@ -275,8 +278,8 @@ contains
          tau = m%tau
          speed = config%speed
          prony_equilibrium = m%equilibrium
-         prony_times = not_set
-         prony_values = not_set
+         prony_times = unset_entry
+         prony_values = unset_entry
          if (allocated(m%times)) prony_times(:size(m%times)) = m%times
          if (allocated(m%values)) prony_values(:size(m%values)) = m%values
          read (lines, nml=material, iostat=stat, iomsg=msg)
@@ -297,12 +300,12 @@ contains
       end associate
    end subroutine read_group_material
 
-   !> Number of leading entries that are not `not_set`.
+   !> Number of leading entries that were given (not `unset_entry`).
    pure integer function count_set(values)
       real(wp), intent(in) :: values(:)
       count_set = 0
       do while (count_set < size(values))
-         if (values(count_set + 1) == not_set) exit
+         if (values(count_set + 1) == unset_entry) exit
          count_set = count_set + 1
       end do
    end function count_set
