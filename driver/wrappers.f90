@@ -80,7 +80,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    integer, intent(in) :: n, control, method, precondition, max_iter, memory, threads, stress, model, form, nt
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
    real(8), intent(in) :: e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
-   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 4), scalars(24), history(max_iter)
+   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 4), scalars(25), history(max_iter)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n, nt
@@ -128,7 +128,8 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
       & r%delta_mu_energy, r%delta_mu_profile, merge(1.0d0, 0.0d0, r%converged), real(r%iterations, 8), &
       & real(r%outer_iterations, 8), real(r%fft_pairs, 8), r%residual, r%wall_time, &
       & real(size(r%residual_history), 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
-      & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), 0d0]
+      & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), &
+      & r%pressure_shift, r%summit_shift]
 end subroutine py_solve_line
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless

@@ -30,6 +30,8 @@ module lc_result
       real(wp) :: delta_mu_spectral = 0.0_wp  !< the same from the Fourier multiplier
       real(wp) :: delta_mu_energy = 0.0_wp    !< mu_c <p du_x/dx>/p_m (elastic layers)
       real(wp) :: delta_mu_profile = 0.0_wp   !< -<p r'>/p_m: force balance on the rigid profile
+      real(wp) :: pressure_shift = 0.0_wp     !< load-weighted pressure centroid - spot midpoint (L)
+      real(wp) :: summit_shift = 0.0_wp       !< load-weighted spot midpoint - profile summit in it (L)
       real(wp) :: dissipated_power = 0.0_wp   !< power dissipated in a viscoelastic layer per nominal area (S L/T)
       logical :: monotone = .true.            !< Re G_eff >= 0 on every mode: the solution is unique
       integer :: n_spots = 0                  !< number of contact spots

@@ -18,7 +18,7 @@ _SCALARS = (
     "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
-    "max_tension_offset", "dissipated_power", "monotone",
+    "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
 )
 _INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
 
@@ -109,6 +109,8 @@ class LineResult:
     max_tension_offset: float = float("nan")
     dissipated_power: float = 0.0
     monotone: bool = True
+    pressure_shift: float = 0.0
+    summit_shift: float = 0.0
     a_over_a0: float | None = None
     companion: "LineResult | None" = field(default=None, repr=False)
 

@@ -18,7 +18,7 @@ module lc_contact_solve
    use lc_observables_friction, only: interlocking_friction
    use lc_observables_surface, only: surface_fields
    use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, &
-      & spot_tension
+      & spot_tension, spot_asymmetry
    implicit none (type, external)
    private
    public :: solve_line_contact, scene_mean_pressure
@@ -138,6 +138,8 @@ contains
       associate (p => result%pressure)
          call contact_spots(p, scene%period, result%n_spots, result%spot_trailing, result%spot_leading)
          result%contact_length = scene%period*count(p > 0.0_wp)/size(p)
+         call spot_asymmetry(p, height, scene%period, result%spot_trailing, result%spot_leading, &
+            & result%pressure_shift, result%summit_shift)
          result%mean_gap = sum(result%gap)/size(p)
          result%leak_rate = leak_rate(result%gap)
          if (scene%gap_bins > 0) then

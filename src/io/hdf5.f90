@@ -378,6 +378,8 @@ contains
       call write_attr_real(group, 'delta_mu_profile', res%delta_mu_profile, st)
       call write_attr_real(group, 'total_friction', res%friction + res%delta_mu, st)
       call write_attr_real(group, 'dissipated_power', res%dissipated_power, st)
+      call write_attr_real(group, 'pressure_shift', res%pressure_shift, st)
+      call write_attr_real(group, 'summit_shift', res%summit_shift, st)
       call write_attr_int(group, 'monotone', merge(1, 0, res%monotone), st)
       call write_attr_int(group, 'converged', merge(1, 0, res%converged), st)
       call write_attr_int(group, 'iterations', res%iterations, st)

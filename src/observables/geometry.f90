@@ -15,7 +15,7 @@ module lc_observables_geometry
    use lc_kinds, only: wp
    implicit none (type, external)
    private
-   public :: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, spot_tension
+   public :: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, spot_tension, spot_asymmetry
 
 contains
 
@@ -106,6 +106,45 @@ contains
          offset(i) = (top - first + 0.5_wp)*dx
       end do
    end subroutine spot_tension
+
+   !> Asymmetry of the spots, load-weighted over the spots (L, positive = towards the
+   !> leading edge, +x): `pressure_shift`, the offset of each spot's pressure centroid from
+   !> its midpoint, and `summit_shift`, the offset of each spot's midpoint from the highest
+   !> point of the rigid profile within it. Both vanish for symmetric asperities on a
+   !> frictionless elastic layer; friction on thin layers and viscoelasticity shift them.
+   pure subroutine spot_asymmetry(p, r, period, trailing, leading, pressure_shift, summit_shift)
+      real(wp), intent(in) :: p(:), r(:), period, trailing(:), leading(:)
+      real(wp), intent(out) :: pressure_shift, summit_shift
+      integer :: i, j, n, first, last, top
+      real(wp) :: dx, load, moment, middle, total
+
+      n = size(p)
+      dx = period/n
+      pressure_shift = 0.0_wp
+      summit_shift = 0.0_wp
+      total = 0.0_wp
+      do i = 1, size(trailing)
+         first = nint(trailing(i)/dx + 0.5_wp)
+         last = first + nint((leading(i) - trailing(i))/dx) - 1
+         if (last - first + 1 >= n) cycle   ! full contact: no spot edges to compare with
+         load = 0.0_wp
+         moment = 0.0_wp
+         top = first
+         do j = first, last
+            load = load + p(modulo(j, n) + 1)
+            moment = moment + p(modulo(j, n) + 1)*j*dx
+            if (r(modulo(j, n) + 1) > r(modulo(top, n) + 1)) top = j
+         end do
+         middle = 0.5_wp*(first + last)*dx
+         pressure_shift = pressure_shift + (moment - middle*load)
+         summit_shift = summit_shift + load*(middle - top*dx)
+         total = total + load
+      end do
+      if (total > 0.0_wp) then
+         pressure_shift = pressure_shift/total
+         summit_shift = summit_shift/total
+      end if
+   end subroutine spot_asymmetry
 
    !> <g^3>/12: flow across the sliding direction per unit length, per unit pressure
    !> gradient, times the viscosity (L^3).
