@@ -16,6 +16,9 @@ module lc_contact_solver_cg
    private
    public :: constrained_cg, cg_outcome, complementarity_residual, rounding_floor
 
+   !> Iterations without the residual halving after which the preconditioner is dropped.
+   integer, parameter :: stall_window = 100
+
    !> What one constrained CG solve did.
    type :: cg_outcome
       logical :: converged = .false.
@@ -46,9 +49,9 @@ contains
       real(wp), intent(inout), optional :: history(:)
       real(wp), allocatable :: t(:), r(:), z(:)
       logical, allocatable :: contact(:), overlap(:)
-      real(wp) :: gnorm, gnorm_old, tau, denominator, p_ref
-      integer :: it, n, n_contact
-      logical :: restart
+      real(wp) :: gnorm, gnorm_old, tau, denominator, p_ref, best
+      integer :: it, n, n_contact, last_progress
+      logical :: restart, preconditioned
 
       n = size(p)
       allocate (t(n), r(n), z(n), contact(n), overlap(n))
@@ -57,6 +60,9 @@ contains
       restart = .true.
       p = max(p, 0.0_wp)
       if (load_control) call normalise(p, mean_pressure)
+      preconditioned = precondition
+      best = huge(1.0_wp)
+      last_progress = 0
 
       do it = 1, max_iter + 1
          ! state (w, gap, s, residual) of the current p; on the last pass only this, so that
@@ -76,6 +82,18 @@ contains
             if (it <= size(history)) history(it) = outcome%residual
          end if
          if (outcome%converged .or. it > max_iter) return
+         ! The Fourier preconditioner amplifies short waves; where the compliance falls
+         ! steeply with k (a glassy viscoelastic layer) its directions make the contact set
+         ! oscillate. If the residual has not halved in `stall_window` iterations, continue
+         ! with plain Polonsky-Keer steps, which always make progress.
+         if (outcome%residual < 0.5_wp*best) then
+            best = outcome%residual
+            last_progress = it
+         else if (preconditioned .and. it - last_progress > stall_window) then
+            preconditioned = .false.
+            restart = .true.
+            last_progress = it
+         end if
 
          if (n_contact == 0) then
             ! Displacement control with nothing in contact yet: load the overlapping points
@@ -85,7 +103,7 @@ contains
             cycle
          end if
          z = merge(gap, 0.0_wp, contact)
-         if (precondition) then
+         if (preconditioned) then
             call op%apply_inverse_metric(z, r)
             outcome%fft_pairs = outcome%fft_pairs + 1
             z = merge(r, 0.0_wp, contact)
