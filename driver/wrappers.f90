@@ -238,3 +238,39 @@ subroutine py_creep_compliance(nw, omega, model, form, young, e0, e_inf, tau, eq
       compliance(i) = creep_compliance(law, omega(i))
    end do
 end subroutine py_creep_compliance
+
+!> Seconds per FFTW r2c + c2r pair of size n (the cost unit of the benchmarks), the best
+!> of `rounds` timings of `repeats` pairs each.
+subroutine py_fft_pair_seconds(n, repeats, rounds, seconds, stat, errmsg)
+   use, intrinsic :: iso_fortran_env, only: int64
+   use lc_errors, only: error_type
+   use lc_fft_plans, only: fft_plan
+   implicit none (type, external)
+   integer, intent(in) :: n, repeats, rounds
+   real(8), intent(out) :: seconds
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   type(fft_plan) :: fft
+   integer(int64) :: start, finish, rate
+   integer :: i, r
+   stat = 0
+   errmsg = ''
+   call fft%init(n, 1, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+      return
+   end if
+   call random_number(fft%real_buffer)
+   seconds = huge(1d0)
+   do r = 1, rounds
+      call system_clock(start, rate)
+      do i = 1, repeats
+         call fft%forward()
+         call fft%backward()
+      end do
+      call system_clock(finish)
+      seconds = min(seconds, real(finish - start, 8)/rate/repeats)
+   end do
+end subroutine py_fft_pair_seconds

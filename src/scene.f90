@@ -53,7 +53,7 @@ module lc_scene
       character(len=max_string) :: method = 'auto'
       !> tolerance on the dimensionless complementarity residual
       real(wp) :: tol = 1.0e-10_wp
-      integer :: max_iter = 20000
+      integer :: max_iter = 100000
       !> Anderson memory (number of previous iterates mixed) for coupled problems
       integer :: memory = 12
       !> precondition the constrained CG with the stiffness 1/M (Fourier) on the contact set:

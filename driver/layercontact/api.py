@@ -142,7 +142,7 @@ def solve_line(
     method: str = "auto",
     precondition: bool = True,
     tol: float = 1e-10,
-    max_iter: int = 20000,
+    max_iter: int = 100000,
     memory: int = 12,
     threads: int = 1,
 ) -> LineResult:

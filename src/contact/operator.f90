@@ -40,6 +40,11 @@ module lc_contact_operator
       real(wp), allocatable :: metric(:)    !< M(k) = |G_eff(k)|, k = 0..n/2 (L/S)
       real(wp) :: diagonal = 0.0_wp         !< real-space diagonal of the circulant M (L/S)
       complex(wp), allocatable :: compliance(:)   !< (1 - nu^2) J*(k V) per mode (1/S)
+      !> Fourier preconditioner of the constrained CG: 1/M(k) with the material's frequency
+      !> dependence taken out (|J*(kV)| falls by E_inf/E0 across the spectrum of a glassy
+      !> layer, and a preconditioner that amplifies short waves that much makes the contact
+      !> set oscillate); 0 where M = 0 (the k = 0 mode of a half-space)
+      real(wp), allocatable :: preconditioner(:)
       logical :: viscoelastic = .false.     !< moving viscoelastic law: complex compliances
       logical :: monotone = .true.          !< Re G_eff(k) >= 0 for every mode (unique solution)
       complex(wp), allocatable :: full(:)   !< G_eff(k), only when coupled
@@ -112,6 +117,12 @@ contains
          op%metric(m + 1) = abs(g)
          if (op%coupled) op%full(m + 1) = g
       end do
+      allocate (op%preconditioner(op%nk))
+      where (op%metric > 0.0_wp)
+         op%preconditioner = abs(op%compliance)/(abs(op%compliance(1))*op%metric)
+      elsewhere
+         op%preconditioner = 0.0_wp
+      end where
       ! The solution is unique when the operator is monotone, Re G_eff >= 0 on every mode
       ! (always for elastic layers; not always for viscoelastic ones with friction).
       op%monotone = .true.
@@ -171,18 +182,14 @@ contains
       call self%fft%backward()
       w = self%fft%real_buffer
    end subroutine apply_difference
-   !> w = M^-1 p on the modes where M > 0 (the k = 0 mode of a half-space is dropped).
+   !> w = P p with the preconditioner P ~ M^-1 of the constrained CG (see `preconditioner`).
    subroutine apply_inverse_metric(self, p, w)
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
       call self%fft%forward()
-      where (self%metric > 0.0_wp)
-         self%fft%spectrum = self%fft%spectrum/self%metric
-      elsewhere
-         self%fft%spectrum = 0.0_wp
-      end where
+      self%fft%spectrum = self%fft%spectrum*self%preconditioner
       call self%fft%backward()
       w = self%fft%real_buffer
    end subroutine apply_inverse_metric

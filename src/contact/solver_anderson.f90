@@ -63,7 +63,7 @@ contains
       type(cg_outcome) :: inner
       real(wp) :: inner_tol, p_ref, s_full, s_inner, best
       integer :: n, k, columns, newest, j, last_progress
-      logical :: restarted
+      logical :: restarted, preconditioned
 
       n = size(p)
       allocate (x(n), f(n), x_old(n), f_old(n), tx(n), b(n), nw(n), dx(n, memory), df(n, memory))
@@ -77,13 +77,16 @@ contains
       best = huge(1.0_wp)
       last_progress = 0
       restarted = .false.
+      preconditioned = precondition
 
       do k = 1, size(history)
          call op%apply_difference(x, nw)
          b = r - nw
          tx = p   ! warm start from the previous output of T
          call constrained_cg(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
-            & max_iter - outcome%cg_iterations, precondition, tx, w, gap, inner)
+            & max_iter - outcome%cg_iterations, preconditioned, tx, w, gap, inner)
+         ! once the preconditioner has stalled on this operator, do not try it again
+         preconditioned = inner%preconditioned
          outcome%cg_iterations = outcome%cg_iterations + inner%iterations
          outcome%fft_pairs = outcome%fft_pairs + inner%fft_pairs + 2
          outcome%outer_iterations = k

@@ -22,6 +22,7 @@ module lc_contact_solver_cg
    !> What one constrained CG solve did.
    type :: cg_outcome
       logical :: converged = .false.
+      logical :: preconditioned = .false.   !< still preconditioned at the end (not stalled)
       integer :: iterations = 0
       integer :: fft_pairs = 0
       real(wp) :: residual = huge(1.0_wp)
@@ -77,6 +78,7 @@ contains
          p_ref = merge(mean_pressure, sum(p)/n, load_control)
          outcome%residual = complementarity_residual(p, gap, p_ref, g_ref, rounding_floor(w, b))
          outcome%converged = outcome%residual <= tol
+         outcome%preconditioned = preconditioned
          outcome%iterations = min(it, max_iter)
          if (present(history)) then
             if (it <= size(history)) history(it) = outcome%residual
