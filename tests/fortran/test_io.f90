@@ -99,7 +99,7 @@ contains
       call check(trim(scene%profile%kind) == 'sinusoid' .and. scene%profile%mode == 3, 'profile')
       call check(scene%normalised_pressure == 0.2_wp .and. scene%mean_pressure == not_set, 'loading')
       call check(scene%friction == 0.4_wp .and. scene%companion, 'friction')
-      call check(scene%period == 1.0_wp .and. scene%solver%max_iter == 20000, 'defaults from scene_type')
+      call check(scene%period == 1.0_wp .and. scene%solver%max_iter == 100000, 'defaults from scene_type')
    end subroutine test_valid_namelist
 
    subroutine test_namelist_errors()
