@@ -28,9 +28,15 @@ def summary() -> dict[str, np.ndarray]:
         raise SystemExit(f"{path}: run the sweep first (see the docstring)")
     with h5py.File(path, "r") as f:
         cols = {k: f["summary"][k][()] for k in f["summary"]}
-    bad = np.count_nonzero(cols["converged"] != 1)
-    if bad:
-        raise SystemExit(f"{path}: {bad} scenes did not converge")
+    bad = cols["converged"] != 1
+    if np.any(bad):
+        # reported, and left out of the means (not silently averaged in)
+        print(f"{np.count_nonzero(bad)} of {bad.size} scenes did not converge and are left out "
+              f"({np.count_nonzero(bad & (cols['monotone'] == 0))} of them with Re G_eff < 0 on some mode):")
+        for k in np.flatnonzero(bad):
+            print(f"  h/lambda = {cols['thickness'][k]:g}, mu_c = {cols['friction'][k]:g}, V = {cols['speed'][k]:g}, "
+                  f"seed {cols['seed'][k]}: residual {cols['residual'][k]:.1e}")
+        cols = {k: v[~bad] for k, v in cols.items()}
     return cols
 
 
