@@ -50,6 +50,7 @@ module lc_contact_operator
       logical :: coupled = .false.          !< complex multiplier (not symmetric)
       real(wp), allocatable :: metric(:)    !< M(k) = |G_eff(k)|, k = 0..n/2 (L/S)
       real(wp) :: diagonal = 0.0_wp         !< real-space diagonal of the circulant M (L/S)
+      real(wp) :: inv_n = 1.0_wp            !< 1/n, folded into the multipliers when applied
       complex(wp), allocatable :: compliance(:)   !< (1 - nu^2) J*(k V) per mode (1/S)
       !> Fourier preconditioner of the constrained CG: 1/M(k) with the material's frequency
       !> dependence taken out (a preconditioner that amplifies the short waves of a glassy
@@ -94,6 +95,7 @@ contains
       if (allocated(error)) return
       op%n = n
       op%nk = n/2 + 1
+      op%inv_n = 1.0_wp/n
       op%period = period
       op%friction = friction
       halfspace = .not. ieee_is_finite(thickness)
@@ -156,8 +158,8 @@ contains
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
-      call self%fft%forward()
-      self%fft%spectrum = self%fft%spectrum*self%metric
+      call self%fft%forward_unscaled()
+      self%fft%spectrum = self%fft%spectrum*(self%metric*self%inv_n)
       call self%fft%backward()
       w = self%fft%real_buffer
    end subroutine apply_metric
@@ -172,8 +174,8 @@ contains
          return
       end if
       self%fft%real_buffer = p
-      call self%fft%forward()
-      self%fft%spectrum = self%fft%spectrum*self%full
+      call self%fft%forward_unscaled()
+      self%fft%spectrum = self%fft%spectrum*(self%full*self%inv_n)
       call self%fft%backward()
       w = self%fft%real_buffer
    end subroutine apply_full
@@ -188,8 +190,8 @@ contains
          return
       end if
       self%fft%real_buffer = p
-      call self%fft%forward()
-      self%fft%spectrum = self%fft%spectrum*(self%full - self%metric)
+      call self%fft%forward_unscaled()
+      self%fft%spectrum = self%fft%spectrum*((self%full - self%metric)*self%inv_n)
       call self%fft%backward()
       w = self%fft%real_buffer
    end subroutine apply_difference
@@ -199,8 +201,8 @@ contains
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
-      call self%fft%forward()
-      self%fft%spectrum = self%fft%spectrum*self%preconditioner
+      call self%fft%forward_unscaled()
+      self%fft%spectrum = self%fft%spectrum*(self%preconditioner*self%inv_n)
       call self%fft%backward()
       w = self%fft%real_buffer
    end subroutine apply_inverse_metric

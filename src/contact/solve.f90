@@ -52,7 +52,7 @@ contains
       real(wp), allocatable :: p(:), w(:), gap(:), history(:)
       real(wp) :: pm, s, g_ref, lambda_max
       integer(i8) :: start, finish, rate
-      logical :: load_control
+      logical :: load_control, precondition
       integer :: n
 
       call system_clock(start, rate)
@@ -93,9 +93,10 @@ contains
          s = scene%penetration - lambda_max
       end if
 
+      precondition = scene%solver%precondition
       if (op%coupled) then
          call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error)
+            & scene%solver%memory, precondition, p, w, gap, outer, history, error)
          if (allocated(error)) return
          result%converged = outer%converged
          result%iterations = outer%cg_iterations
@@ -105,7 +106,7 @@ contains
          result%residual_history = history(1:outer%outer_iterations)
       else
          call constrained_cg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & scene%solver%precondition, p, w, gap, cg, history)
+            & precondition, p, w, gap, cg, history)
          result%converged = cg%converged
          result%iterations = cg%iterations
          result%outer_iterations = 1

@@ -49,13 +49,16 @@ contains
       type(cg_outcome), intent(out) :: outcome
       real(wp), intent(inout), optional :: history(:)
       real(wp), allocatable :: t(:), r(:), z(:)
-      logical, allocatable :: contact(:), overlap(:)
-      real(wp) :: gnorm, gnorm_old, tau, denominator, p_ref, best
-      integer :: it, n, n_contact, last_progress
-      logical :: restart, preconditioned
+      real(wp) :: gnorm, gnorm_old, tau, denominator, p_ref, best, beta, g_floor, b_max, w_max
+      real(wp) :: gap_sum, p_sum, z_sum, r_sum, rt_sum, t_sum, gt_sum, pscale
+      integer :: it, j, n, n_contact, last_progress
+      logical :: restart, preconditioned, any_overlap
 
+      ! The loops below are written out (one pass over the grid for each group of
+      ! quantities) because at large n the solver is memory-bound: whole-array expressions
+      ! with masks cost a pass each, about as much as the FFTs together.
       n = size(p)
-      allocate (t(n), r(n), z(n), contact(n), overlap(n))
+      allocate (t(n), r(n), z(n))
       t = 0.0_wp
       gnorm_old = 1.0_wp
       restart = .true.
@@ -64,19 +67,38 @@ contains
       preconditioned = precondition
       best = huge(1.0_wp)
       last_progress = 0
+      b_max = maxval(abs(b))
 
       do it = 1, max_iter + 1
          ! state (w, gap, s, residual) of the current p; on the last pass only this, so that
          ! a run stopped by max_iter returns fields that belong together
          call op%apply_metric(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
-         gap = w - b
-         contact = p > 0.0_wp
-         n_contact = count(contact)
-         if (load_control) s = sum(gap, mask=contact)/max(n_contact, 1)
-         gap = gap - s
-         p_ref = merge(mean_pressure, sum(p)/n, load_control)
-         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref, rounding_floor(w, b))
+         n_contact = 0
+         gap_sum = 0.0_wp
+         p_sum = 0.0_wp
+         w_max = 0.0_wp
+         do j = 1, n
+            gap(j) = w(j) - b(j)
+            w_max = max(w_max, abs(w(j)))
+            p_sum = p_sum + p(j)
+            if (p(j) > 0.0_wp) then
+               n_contact = n_contact + 1
+               gap_sum = gap_sum + gap(j)
+            end if
+         end do
+         if (load_control) s = gap_sum/max(n_contact, 1)
+         p_ref = merge(mean_pressure, p_sum/n, load_control)
+         pscale = 1.0_wp/max(p_ref, tiny(1.0_wp))
+         ! gaps below the rounding floor of w - b count as zero (see rounding_floor)
+         g_floor = 256*epsilon(1.0_wp)*max(w_max, b_max)
+         outcome%residual = 0.0_wp
+         gnorm = 0.0_wp
+         do j = 1, n
+            gap(j) = gap(j) - s
+            if (abs(gap(j)) > g_floor) outcome%residual = max(outcome%residual, abs(min(p(j)*pscale, gap(j)/g_ref)))
+            if (p(j) > 0.0_wp) gnorm = gnorm + gap(j)**2
+         end do
          outcome%converged = outcome%residual <= tol
          outcome%preconditioned = preconditioned
          outcome%iterations = min(it, max_iter)
@@ -104,35 +126,74 @@ contains
             restart = .true.
             cycle
          end if
-         z = merge(gap, 0.0_wp, contact)
+
+         ! search direction t: the (preconditioned) residual on the contact set, conjugated
          if (preconditioned) then
+            do j = 1, n
+               z(j) = merge(gap(j), 0.0_wp, p(j) > 0.0_wp)
+            end do
             call op%apply_inverse_metric(z, r)
             outcome%fft_pairs = outcome%fft_pairs + 1
-            z = merge(r, 0.0_wp, contact)
-            if (load_control) where (contact) z = z - sum(z, mask=contact)/n_contact
+            z_sum = 0.0_wp
+            do j = 1, n
+               if (p(j) > 0.0_wp) z_sum = z_sum + r(j)
+            end do
+            if (.not. load_control) z_sum = 0.0_wp
+            gnorm = 0.0_wp
+            do j = 1, n
+               z(j) = merge(r(j) - z_sum/n_contact, 0.0_wp, p(j) > 0.0_wp)
+               gnorm = gnorm + gap(j)*z(j)
+            end do
          end if
-         gnorm = sum(gap*z, mask=contact)
-         if (restart) then
-            t = z
-         else
-            t = merge(z + (gnorm/gnorm_old)*t, 0.0_wp, contact)
-         end if
+         beta = merge(0.0_wp, gnorm/gnorm_old, restart)
          gnorm_old = gnorm
+         if (preconditioned) then
+            do j = 1, n
+               t(j) = merge(z(j) + beta*t(j), 0.0_wp, p(j) > 0.0_wp)
+            end do
+         else
+            do j = 1, n
+               t(j) = merge(gap(j) + beta*t(j), 0.0_wp, p(j) > 0.0_wp)
+            end do
+         end if
          call op%apply_metric(t, r)
          outcome%fft_pairs = outcome%fft_pairs + 1
-         if (load_control) r = r - sum(r, mask=contact)/n_contact
-         denominator = sum(r*t, mask=contact)
+         ! step along t on the contact set; with load control the mean of M t over the
+         ! contact set is removed (the multiplier s absorbs it):
+         ! denominator = sum (r - <r>) t = sum r t - <r> sum t
+         r_sum = 0.0_wp
+         rt_sum = 0.0_wp
+         t_sum = 0.0_wp
+         gt_sum = 0.0_wp
+         do j = 1, n
+            if (p(j) > 0.0_wp) then
+               r_sum = r_sum + r(j)
+               rt_sum = rt_sum + r(j)*t(j)
+               t_sum = t_sum + t(j)
+               gt_sum = gt_sum + gap(j)*t(j)
+            end if
+         end do
+         denominator = rt_sum
+         if (load_control) denominator = rt_sum - r_sum/n_contact*t_sum
          if (.not. denominator > 0.0_wp) then
             ! t is (numerically) in the null space of the projected operator: start afresh.
             restart = .true.
             cycle
          end if
-         tau = sum(gap*t, mask=contact)/denominator
-         where (contact) p = p - tau*t
-         p = max(p, 0.0_wp)
-         overlap = p <= 0.0_wp .and. gap < 0.0_wp
-         restart = any(overlap)
-         if (restart) where (overlap) p = p - tau*gap
+         tau = gt_sum/denominator
+         ! update, clip at zero, and let overlapping points (p = 0, gap < 0) into the contact
+         any_overlap = .false.
+         do j = 1, n
+            if (p(j) > 0.0_wp) p(j) = p(j) - tau*t(j)
+            p(j) = max(p(j), 0.0_wp)
+            if (p(j) <= 0.0_wp .and. gap(j) < 0.0_wp) then
+               ! max(): once the contact set is solved tau is a ratio of rounding noise and
+               ! may be negative; a negative pressure would never be clipped again
+               p(j) = max(-tau*gap(j), 0.0_wp)
+               any_overlap = .true.
+            end if
+         end do
+         restart = any_overlap
          if (load_control) call normalise(p, mean_pressure)
       end do
    end subroutine constrained_cg

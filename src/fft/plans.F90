@@ -28,6 +28,7 @@ module lc_fft_plans
    contains
       procedure :: init
       procedure :: forward
+      procedure :: forward_unscaled
       procedure :: backward
       procedure :: destroy
       final :: finalize
@@ -84,6 +85,13 @@ contains
       call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
       self%spectrum = self%spectrum*(1.0_wp/self%n)
    end subroutine forward
+
+   !> spectrum <- n times the Fourier coefficients (the bare r2c): for operators that fold
+   !> the 1/n into their multipliers and so save a pass over the spectrum.
+   subroutine forward_unscaled(self)
+      class(fft_plan), intent(inout) :: self
+      call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
+   end subroutine forward_unscaled
 
    !> real_buffer <- sum_k spectrum(k) exp(i k x). The spectrum is destroyed.
    subroutine backward(self)
