@@ -131,6 +131,7 @@ def panel_d(ax, cols):
 
 
 def print_table(b, c, d, robustness) -> None:
+    """The README's table: a/a0 extremes, thick-layer limit, Delta mu trends, robustness."""
     print("| quantity | value (mean +- standard error over realisations) |")
     print("|---|---|")
     for mu in (min(b), max(b)):
@@ -147,12 +148,27 @@ def print_table(b, c, d, robustness) -> None:
     for mu, (x, m, s, n) in c.items():
         print(f"| h/lambda = 0.01, mu_c = {mu:g}: Delta mu/(mu_c g_bar) at p = {x[0]:.3g}, {x[len(x) // 2]:.3g}, "
               f"{x[-1]:.3g} | {m[0]:.4f}, {m[len(x) // 2]:.4f}, {m[-1]:.4f} (+- {s.max() / np.sqrt(n.min()):.4f}) |")
-    for name, (bb, cc) in robustness.items():
-        line = ", ".join(f"mu_c {mu:g}: " + " ".join(f"{v:.3f}" for v in bb[mu][1]) for mu in sorted(bb))
-        print(f"| robustness {name}: a/a0 at p = {', '.join(f'{v:g}' for v in bb[max(bb)][0])} | {line} |")
-        if cc:
-            line = ", ".join(f"mu_c {mu:g}: " + " ".join(f"{v:.3f}" for v in cc[mu][1]) for mu in sorted(cc))
-            print(f"| robustness {name}: Delta mu/(mu_c g_bar) (h/lambda = 0.01) | {line} |")
+    for name, (label, stats) in robustness.items():
+        pressures = ", ".join(f"{v:g}" for v in stats[max(stats)][0])
+        line = ", ".join(f"mu_c {mu:g}: " + " ".join(f"{v:.3f}" for v in stats[mu][1]) for mu in sorted(stats))
+        print(f"| robustness {name}: {label} at p = {pressures} | {line} |")
+
+
+def robustness_table() -> dict:
+    """The profile-parameter variants of panels (b) and (c) that have been run."""
+    out = {}
+    for name in ("b_hurst05", "b_short256"):
+        if (SWEEPS / name).exists():
+            cols = summary(name)
+            a = ratio_to_frictionless(cols, "contact_fraction", ("normalised_pressure", "seed"))
+            fr = cols["friction"] > 0
+            out[name] = ("a/a0", mean_spread(cols["normalised_pressure"][fr], a[fr], cols["friction"][fr]))
+    if (SWEEPS / "c_hurst05").exists():
+        cols = summary("c_hurst05")
+        fr = cols["friction"] > 0
+        y = cols["delta_mu"][fr] / (cols["friction"][fr] * rms_gradient("c_hurst05"))
+        out["c_hurst05"] = ("Delta mu/(mu_c g_bar)", mean_spread(cols["normalised_pressure"][fr], y, cols["friction"][fr]))
+    return out
 
 
 def main() -> None:
@@ -173,24 +189,7 @@ def main() -> None:
     fig.savefig(args.out, dpi=110)
     print(f"figure: {args.out}")
 
-    robustness = {}
-    for name in ("b_hurst05", "b_short256"):
-        if (SWEEPS / name).exists():
-            cols = summary(name)
-            a = ratio_to_frictionless(cols, "contact_fraction", ("normalised_pressure", "seed"))
-            fr = cols["friction"] > 0
-            robustness[name] = (mean_spread(cols["normalised_pressure"][fr], a[fr], cols["friction"][fr]), None)
-    if (SWEEPS / "c_hurst05").exists():
-        cols = summary("c_hurst05")
-        fr = cols["friction"] > 0
-        y = cols["delta_mu"][fr] / (cols["friction"][fr] * rms_gradient("c_hurst05"))
-        robustness["c_hurst05"] = ({}, mean_spread(cols["normalised_pressure"][fr], y, cols["friction"][fr]))
-    print_table(b, c, d, {k: v for k, v in robustness.items() if v[0]})
-    if "c_hurst05" in robustness:
-        cc = robustness["c_hurst05"][1]
-        line = ", ".join(f"mu_c {mu:g}: " + " ".join(f"{v:.3f}" for v in cc[mu][1]) for mu in sorted(cc))
-        print(f"| robustness c_hurst05: Delta mu/(mu_c g_bar) at p = "
-              f"{', '.join(f'{v:g}' for v in cc[max(cc)][0])} | {line} |")
+    print_table(b, c, d, robustness_table())
 
 
 if __name__ == "__main__":

@@ -40,6 +40,13 @@ def summary() -> dict[str, np.ndarray]:
     return cols
 
 
+def time_scale() -> float:
+    """tau/lambda of the sweep's material and period (from a result file's /input)."""
+    first = sorted((DIRECTORY / "results").glob("*.h5"))[0]
+    with h5py.File(first, "r") as f:
+        return float(f["input"].attrs["tau"]) / float(f["input"].attrs["period"])
+
+
 def curves(cols):
     """{(thickness, mu): (speeds, mean friction, std, dissipated power mean)}."""
     out = {}
@@ -64,6 +71,7 @@ def main() -> None:
     import matplotlib.pyplot as plt
 
     data = curves(summary())
+    scale = time_scale()
     thicknesses = sorted({h for h, _ in data})
     fig, axes = plt.subplots(1, len(thicknesses), figsize=(4 * len(thicknesses), 3.6), sharey=True,
                              constrained_layout=True)
@@ -74,12 +82,12 @@ def main() -> None:
             if hh != h:
                 continue
             moving = (v > 0) & (v < FAST)
-            line = ax.errorbar(v[moving], m[moving], yerr=s[moving], capsize=2, lw=1, label=f"mu_c = {mu:g}")
+            line = ax.errorbar(v[moving] * scale, m[moving], yerr=s[moving], capsize=2, lw=1, label=f"mu_c = {mu:g}")
             colour = line[0].get_color()
             ax.axhline(m[v == 0][0], color=colour, ls="--", lw=0.8)
             ax.axhline(m[v > FAST][0], color=colour, ls=":", lw=0.8)
             peak = np.argmax(np.where(moving, m, -np.inf))
-            print(f"| {h:g} | {mu:g} | {m[v == 0][0]:.4f} | {m[peak]:.4f} | {v[peak]:.3g} | {m[v > FAST][0]:.4f} |")
+            print(f"| {h:g} | {mu:g} | {m[v == 0][0]:.4f} | {m[peak]:.4f} | {v[peak] * scale:.3g} | {m[v > FAST][0]:.4f} |")
         ax.set_xscale("log")
         ax.set_xlabel("V tau / lambda")
         ax.set_title(f"h/lambda = {h:g}  (dashed: E0, dotted: E_inf)", fontsize=9)

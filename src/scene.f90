@@ -142,6 +142,11 @@ contains
          if (allocated(error)) return
          call check_material(scene%material, error)
          if (allocated(error)) return
+         if (trim(scene%material%model) == 'elastic' .and. scene%speed /= 0.0_wp) then
+            call input_error(error, 'material', 'speed', to_string(scene%speed), &
+               & "0 with model = 'elastic' (an elastic layer does not depend on the speed)")
+            return
+         end if
 
          select case (trim(p%kind))
          case ('self_affine')

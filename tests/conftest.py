@@ -31,7 +31,7 @@ def g_eff(n: int, period: float, thickness: float, young: float, poisson: float,
     oma, _, c = lc.layer_multipliers(k[1:] * thickness, poisson)
     g[1:] = 2 * (1 - poisson**2) * compliance[1:] / k[1:] * (oma - 1j * friction * c)
     if n % 2 == 0:
-        g[-1] = 2 * (1 - poisson**2) * compliance[-1].real / k[-1] * oma[-1]
+        g[-1] = g[-1].real  # the Nyquist mode is its own mirror image: (G(k) + G(-k))/2
     if np.isfinite(thickness):
         g[0] = thickness * (1 + poisson) * (1 - 2 * poisson) * compliance[0].real / (1 - poisson)
     return g

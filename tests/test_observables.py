@@ -120,3 +120,15 @@ def test_tension_peaks_at_each_trailing_edge(rough_profile):
     assert res.max_tension == pytest.approx(res.spot_max_tension.max(), rel=1e-14)
     single = lc.solve_line(lc.sinusoid_profile(512, 1e-3), thickness=0.1, friction=0.5, mean_pressure=0.002)
     assert single.n_spots == 1 and single.spot_tension_offset[0] == pytest.approx(single.max_tension_offset)
+
+
+def test_spot_windows_cover_the_period_and_full_contact_has_no_trailing_edge(rough_profile):
+    """Each spot's tension window runs from the middle of the gap behind to the middle of
+    the gap ahead, so the largest tension of the period is the largest over the spots."""
+    for friction, pm in ((0.3, 0.2), (0.8, 0.6), (0.0, 1.0)):
+        res = lc.solve_line(rough_profile, thickness=0.16, friction=friction,
+                            mean_pressure=pm * rough_profile.max())
+        assert res.n_spots > 1
+        assert res.spot_max_tension.max() == res.stress_xx.max()
+    full = lc.solve_line(lc.sinusoid_profile(256, 1e-4), thickness=0.16, friction=0.5, mean_pressure=1.0)
+    assert full.n_spots == 1 and np.isnan(full.spot_tension_offset[0]) and np.isnan(full.max_tension_offset)

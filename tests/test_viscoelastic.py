@@ -159,3 +159,38 @@ def test_contact_shifts_towards_the_leading_edge():
     assert abs(rest.pressure_shift) < 1e-12 and rest.summit_shift == 0.0
     assert moving.summit_shift > 0.02 and moving.pressure_shift > 0.01
     assert moving.contact_fraction < rest.contact_fraction  # stiffer when moving
+
+
+MORE_BAD = [
+    ("model = 'prony'\n prony_equilibrium = 1.0\n prony_times(1) = 0.1\n prony_times(3) = 5.0\n"
+     " prony_values = 1.0, 1.0, 1.0", "in order from the first, without gaps"),
+    ("model = 'prony'\n prony_equilibrium = 1.0\n prony_file = 'three.txt'", "got more"),
+    ("model = 'prony'\n prony_equilibrium = 1.0\n prony_file = 'empty.txt'", "holds no terms"),
+    ("model = 'prony'\n prony_equilibrium = 1.0\n prony_file = 'one.txt'", "expected two numbers"),
+    ("model = 'elastic'\n speed = 3.0", "&material: speed"),
+    ("model = 'elastic'\n e0 = 5.0", "only with model = 'sls'"),
+    ("model = 'sls'\n e0 = 1.0\n e_inf = 10.0\n tau = 1.0\n prony_equilibrium = 1.0", "only with model = 'prony'"),
+    ("model = 'prony'\n prony_form = 'relaxation'\n prony_equilibrium = 1.0\n prony_times = 1.0\n"
+     " prony_values = 1.0\n speed = 1e306", "non-finite compliances"),
+]
+
+
+@pytest.mark.parametrize("material, message", MORE_BAD, ids=[m for _, m in MORE_BAD])
+def test_more_bad_material_input(material, message, tmp_path):
+    (tmp_path / "three.txt").write_text("0.1 1.0 99\n")
+    (tmp_path / "empty.txt").write_text("# nothing\n")
+    (tmp_path / "one.txt").write_text("0.1\n")
+    nml = tmp_path / "bad.nml"
+    nml.write_text(f"&scene\n n = 256\n/\n&material\n {material}\n/\n&loading\n normalised_pressure = 1.0\n/\n"
+                   "&output\n file = 'r.h5'\n/\n")
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert message in proc.stderr
+    assert not (tmp_path / "r.h5").exists()
+
+
+def test_prony_term_limit_in_python():
+    with pytest.raises(ValueError, match="1 to 64"):
+        lc.Prony(np.arange(1, 66), np.ones(65), 1.0)
+    with pytest.raises(ValueError, match="1 to 64"):
+        lc.Prony([], [], 1.0)

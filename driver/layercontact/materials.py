@@ -16,6 +16,8 @@ import numpy as np
 from . import _core
 
 _FORMS = {"relaxation": 0, "creep": 1}
+#: Largest number of Prony terms (the library's max_prony_terms).
+MAX_TERMS = 64
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,9 @@ class Prony:
             raise ValueError(f"&material: prony_form = {self.form!r} is not allowed; allowed: {sorted(_FORMS)}")
         object.__setattr__(self, "times", tuple(float(t) for t in np.atleast_1d(self.times)))
         object.__setattr__(self, "values", tuple(float(v) for v in np.atleast_1d(self.values)))
+        if not 1 <= len(self.times) <= MAX_TERMS or len(self.times) != len(self.values):
+            raise ValueError(f"&material: prony_times/prony_values = {len(self.times)} times, {len(self.values)} "
+                             f"values is not allowed; allowed: the same number, 1 to {MAX_TERMS}")
 
     @classmethod
     def from_file(cls, path: str | os.PathLike, equilibrium: float, form: str = "relaxation") -> "Prony":

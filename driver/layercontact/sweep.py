@@ -2,7 +2,7 @@
 cartesian product of the swept values in parallel worker processes, resumable, with a
 CSV and an HDF5 summary.
 
-A sweep file holds the usual groups (``&scene &layer &friction &profile &loading &solver
+A sweep file holds the usual groups (``&scene &layer &material &friction &profile &loading &solver
 &output``) plus::
 
     &sweep

@@ -22,6 +22,7 @@ module lc_contact_operator
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_input
+   use lc_strings, only: to_string
    use lc_fft_plans, only: fft_plan, fft_threads_available
    use lc_greens_layer, only: layer_coefficients
    use lc_greens_viscoelastic, only: material_law, creep_compliance
@@ -106,6 +107,12 @@ contains
       do m = 0, op%nk - 1
          op%compliance(m + 1) = (1.0_wp - poisson**2)*creep_compliance(law, op%wavenumber(m)*speed)
       end do
+      if (.not. all(ieee_is_finite(real(op%compliance, wp)) .and. ieee_is_finite(aimag(op%compliance)))) then
+         call fatal_error(error, '&material: speed = ' // to_string(speed) // ' gives non-finite compliances ' // &
+            & '(k V tau overflows); allowed: a speed with k V tau_max well inside the floating-point range', &
+            & code_input)
+         return
+      end if
       ! A half-space of an incompressible material has c = 0: friction changes nothing.
       op%coupled = op%viscoelastic .or. (friction > 0.0_wp .and. .not. (halfspace .and. poisson == 0.5_wp))
 
@@ -124,9 +131,9 @@ contains
          ! x = +Inf (half-space) gives 1-A = 1-B = 1 and Dundurs' c
          call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
          g = 2.0_wp/k*op%compliance(m + 1)*cmplx(one_minus_a, -friction*c, kind=wp)
-         ! sgn(k) = +1 on the half spectrum; the Nyquist mode is its own mirror image
-         ! (odd parts average to 0), so its multiplier must be real.
-         if (2*m == n) g = 2.0_wp/k*real(op%compliance(m + 1), wp)*one_minus_a
+         ! sgn(k) = +1 on the half spectrum; the Nyquist mode is its own mirror image, so its
+         ! multiplier is the mirror average (G(k) + G(-k))/2 = Re G(k)
+         if (2*m == n) g = real(g, wp)
          op%metric(m + 1) = abs(g)*(abs(op%compliance(2))/abs(op%compliance(m + 1)))**metric_exponent
          if (op%coupled) op%full(m + 1) = g
       end do

@@ -160,7 +160,7 @@ contains
             result%max_tension = result%stress_xx(where_max)
             result%max_tension_x = (where_max - 1)*scene%period/size(p)
             result%max_tension_offset = nearest_trailing_offset(result%max_tension_x, result%spot_trailing, &
-               & scene%period)
+               & result%spot_leading, scene%period)
             allocate (result%spot_max_tension(result%n_spots), result%spot_tension_offset(result%n_spots))
             call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
                & result%spot_max_tension, result%spot_tension_offset)

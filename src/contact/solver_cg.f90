@@ -10,6 +10,7 @@
 !> (zero exactly at the solution) falls to tol; p_ref = p_m (load control) or the
 !> current mean pressure, g_ref is given by the caller (the profile's peak-to-valley).
 module lc_contact_solver_cg
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
@@ -97,6 +98,8 @@ contains
          do j = 1, n
             gap(j) = gap(j) - s
             if (abs(gap(j)) > g_floor) outcome%residual = max(outcome%residual, abs(min(p(j)*pscale, gap(j)/g_ref)))
+            ! a NaN gap compares false above: count it (and a NaN pressure) as infinitely wrong
+            if (ieee_is_nan(gap(j)) .or. ieee_is_nan(p(j))) outcome%residual = huge(1.0_wp)
             if (p(j) > 0.0_wp) gnorm = gnorm + gap(j)**2
          end do
          outcome%converged = outcome%residual <= tol
@@ -209,6 +212,7 @@ contains
       res = 0.0_wp
       do j = 1, size(p)
          if (abs(gap(j)) > g_floor) res = max(res, abs(min(p(j)*pscale, gap(j)/g_ref)))
+         if (ieee_is_nan(gap(j)) .or. ieee_is_nan(p(j))) res = huge(1.0_wp)
          if (p(j) < 0.0_wp) res = max(res, -p(j)*pscale)
       end do
    end function complementarity_residual

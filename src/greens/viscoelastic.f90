@@ -26,6 +26,8 @@ module lc_greens_viscoelastic
    private
    public :: material_law, creep_compliance, static_modulus, check_material, max_prony_terms, make_material_law
 
+   !> The value of a parameter that was not given.
+   real(wp), parameter :: unset = -1.0_wp
    !> Largest number of Prony terms.
    integer, parameter :: max_prony_terms = 64
 
@@ -98,9 +100,11 @@ contains
       law%e_inf = e_inf
       law%tau = tau
       law%equilibrium = equilibrium
-      allocate (law%times(size(times)), law%values(size(values)))
-      law%times = times
-      law%values = values
+      if (trim(law%model) == 'prony') then
+         allocate (law%times(size(times)), law%values(size(values)))
+         law%times = times
+         law%values = values
+      end if
    end function make_material_law
 
    !> The low-frequency (V -> 0) modulus: the elastic limit used for normalisations (S).
@@ -115,6 +119,18 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: i
 
+      ! values that the chosen model does not use are refused rather than ignored
+      select case (trim(law%model))
+      case ('elastic', 'sls', 'prony')
+         if (trim(law%model) /= 'sls' .and. any([law%e0, law%e_inf, law%tau] /= unset)) then
+            call input_error(error, 'material', 'e0/e_inf/tau', 'given', "only with model = 'sls'")
+         else if (trim(law%model) /= 'prony' .and. (law%equilibrium /= unset .or. law%terms() > 0 .or. &
+            & allocated(law%values))) then
+            call input_error(error, 'material', 'prony_equilibrium/prony_times/prony_values', 'given', &
+               & "only with model = 'prony'")
+         end if
+         if (allocated(error)) return
+      end select
       select case (trim(law%model))
       case ('elastic')
       case ('sls')
@@ -133,7 +149,8 @@ contains
             call input_error(error, 'material', 'prony_form', trim(law%form), "'creep' or 'relaxation'")
          else if (.not. allocated(law%times) .or. .not. allocated(law%values)) then
             call input_error(error, 'material', 'prony_times/prony_values', 'not given', 'at least one term')
-         else if (size(law%times) < 1 .or. size(law%times) /= size(law%values)) then
+         else if (size(law%times) < 1 .or. size(law%times) > max_prony_terms .or. &
+            & size(law%times) /= size(law%values)) then
             call input_error(error, 'material', 'prony_times/prony_values', &
                & to_string(size(law%times)) // ' times, ' // to_string(size(law%values)) // ' values', &
                & 'the same number of times and values, 1 to ' // to_string(max_prony_terms))
@@ -148,14 +165,17 @@ contains
             if (.not. positive(law%times(i))) then
                call input_error(error, 'material', 'prony_times(' // to_string(i) // ')', to_string(law%times(i)), &
                   & '> 0 and finite')
-            else if (i > 1 .and. .not. law%times(i) > law%times(max(i - 1, 1))) then
-               call input_error(error, 'material', 'prony_times(' // to_string(i) // ')', to_string(law%times(i)), &
-                  & '> prony_times(' // to_string(i - 1) // ') (sorted, increasing, no repeats)')
             else if (.not. positive(law%values(i))) then
                call input_error(error, 'material', 'prony_values(' // to_string(i) // ')', to_string(law%values(i)), &
                   & '> 0 and finite (a Prony series must be positive)')
             end if
             if (allocated(error)) return
+            if (i == 1) cycle
+            if (.not. law%times(i) > law%times(i - 1)) then
+               call input_error(error, 'material', 'prony_times(' // to_string(i) // ')', to_string(law%times(i)), &
+                  & '> prony_times(' // to_string(i - 1) // ') (sorted, increasing, no repeats)')
+               return
+            end if
          end do
          if (trim(law%form) == 'creep' .and. law%equilibrium == 0.0_wp) then
             call input_error(error, 'material', 'prony_equilibrium', '0', &

@@ -1,5 +1,5 @@
-!> Namelist input: a text file of up to seven optional groups (&scene, &layer, &friction,
-!> &profile, &loading, &solver, &output) -> `scene_type`, and back (`write_scene_namelist`).
+!> Namelist input: a text file of up to eight optional groups (&scene, &layer, &material,
+!> &friction, &profile, &loading, &solver, &output) -> `scene_type`, and back (`write_scene_namelist`).
 !>
 !> Defaults live only in `scene_type`: each group is read into local variables that start
 !> from the scene's current (default) values. A Fortran namelist read silently skips groups
@@ -284,6 +284,12 @@ contains
          if (allocated(m%values)) prony_values(:size(m%values)) = m%values
          read (lines, nml=material, iostat=stat, iomsg=msg)
          if (stat /= 0) return
+         if (count_set(prony_times) /= count(prony_times /= unset_entry) .or. &
+            & count_set(prony_values) /= count(prony_values /= unset_entry)) then
+            stat = -1
+            msg = 'prony_times/prony_values: give the entries in order from the first, without gaps'
+            return
+         end if
          m%model = model
          m%form = prony_form
          config%prony_file = prony_file
@@ -317,7 +323,7 @@ contains
       real(wp), allocatable, intent(out) :: times(:), values(:)
       type(error_type), allocatable, intent(out) :: error
       character(len=1024) :: line, msg
-      real(wp) :: pair(2)
+      real(wp) :: pair(2), extra
       integer :: unit, stat, lineno, cut
 
       allocate (times(0), values(0))
@@ -334,6 +340,13 @@ contains
          cut = scan(line, '#!')
          if (cut > 0) line(cut:) = ''
          if (len_trim(line) == 0) cycle
+         read (line, *, iostat=stat) pair, extra
+         if (stat == 0) then
+            call fatal_error(error, "&material: prony_file '" // filename // "', line " // to_string(lineno) // &
+               & ": expected two numbers 'tau_i value_i', got more: '" // trim(line) // "'", code_input)
+            close (unit)
+            return
+         end if
          read (line, *, iostat=stat) pair
          if (stat /= 0) then
             call fatal_error(error, "&material: prony_file '" // filename // "', line " // to_string(lineno) // &
@@ -351,6 +364,10 @@ contains
          values = [values, pair(2)]
       end do
       close (unit)
+      if (size(times) == 0) then
+         call fatal_error(error, "&material: prony_file '" // filename // "' holds no terms; allowed: lines " // &
+            & "'tau_i value_i', 1 to " // to_string(max_prony_terms), code_input)
+      end if
    end subroutine read_prony_file
 
    subroutine read_group_friction(lines, config, stat, msg)

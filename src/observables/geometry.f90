@@ -12,6 +12,7 @@
 !> per unit inverse viscosity is <g^3>/12 (L^3). Along x a line contact does not leak once
 !> any point touches.
 module lc_observables_geometry
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use lc_kinds, only: wp
    implicit none (type, external)
    private
@@ -64,13 +65,16 @@ contains
    end subroutine contact_spots
 
    !> Offset (L) of position x from the trailing edge closest to it (periodic, in
-   !> [-period/2, period/2)); zero when there are no spots.
-   pure real(wp) function nearest_trailing_offset(x, trailing, period) result(offset)
-      real(wp), intent(in) :: x, trailing(:), period
+   !> [-period/2, period/2)); zero when there are no spots, NaN in full contact.
+   pure real(wp) function nearest_trailing_offset(x, trailing, leading, period) result(offset)
+      real(wp), intent(in) :: x, trailing(:), leading(:), period
       real(wp) :: d
       integer :: i
       offset = 0.0_wp
       if (size(trailing) == 0) return
+      ! full contact (one spot as long as the period) has no trailing edge
+      offset = ieee_value(1.0_wp, ieee_quiet_nan)
+      if (size(trailing) == 1 .and. leading(1) - trailing(1) > (1.0_wp - 1.0e-12_wp)*period) return
       offset = huge(1.0_wp)
       do i = 1, size(trailing)
          d = modulo(x - trailing(i) + 0.5_wp*period, period) - 0.5_wp*period
@@ -79,32 +83,50 @@ contains
    end function nearest_trailing_offset
 
    !> Largest sigma_xx around each spot and its offset from the spot's trailing edge (L,
-   !> negative: behind it). A spot's window runs from the middle of the gap behind it to its
-   !> leading edge, so every node of the period belongs to one window.
+   !> negative: behind it). The gap between two spots is split in the middle, so a spot's
+   !> window runs from the middle of the gap behind it to the middle of the gap ahead and the
+   !> windows cover the period. In full contact there is no trailing edge: offset = NaN.
    pure subroutine spot_tension(stress, period, trailing, leading, max_tension, offset)
       real(wp), intent(in) :: stress(:), period, trailing(:), leading(:)
       real(wp), intent(out) :: max_tension(:), offset(:)
-      integer :: i, j, n, first, last, previous_last, start, top
-      real(wp) :: dx
+      integer :: i, j, n, spots, first, last, behind, ahead, top
 
       n = size(stress)
-      dx = period/n
-      do i = 1, size(trailing)
-         ! node indices (0-based, unwrapped) of the spot and of the end of the spot behind it
-         first = nint(trailing(i)/dx + 0.5_wp)
-         last = first + nint((leading(i) - trailing(i))/dx) - 1
-         j = modulo(i - 2, size(trailing)) + 1
-         previous_last = nint(trailing(j)/dx + 0.5_wp) + nint((leading(j) - trailing(j))/dx) - 1
-         ! unwrap it to just behind this spot (a single spot is its own predecessor)
-         previous_last = first - modulo(first - previous_last, n)
-         start = (previous_last + first + 1)/2
-         top = start
-         do j = start, last
+      spots = size(trailing)
+      do i = 1, spots
+         call spot_nodes(i, first, last)
+         ! gap lengths (nodes) behind and ahead, from the neighbouring spots (a single spot
+         ! is its own neighbour)
+         behind = gap_behind(i)
+         ahead = gap_behind(modulo(i, spots) + 1)
+         top = first
+         do j = first - (behind - behind/2), last + ahead/2
             if (stress(modulo(j, n) + 1) > stress(modulo(top, n) + 1)) top = j
          end do
          max_tension(i) = stress(modulo(top, n) + 1)
-         offset(i) = (top - first + 0.5_wp)*dx
+         offset(i) = (top - first + 0.5_wp)*period/n
+         if (last - first + 1 >= n) offset(i) = ieee_value(1.0_wp, ieee_quiet_nan)
       end do
+
+   contains
+
+      !> 0-based node indices of spot i (last >= first, unwrapped).
+      pure subroutine spot_nodes(i, first, last)
+         integer, intent(in) :: i
+         integer, intent(out) :: first, last
+         first = nint(trailing(i)*n/period + 0.5_wp)
+         last = first + nint((leading(i) - trailing(i))*n/period) - 1
+      end subroutine spot_nodes
+
+      !> Number of gap nodes between spot i and the spot behind it.
+      pure integer function gap_behind(i)
+         integer, intent(in) :: i
+         integer :: first, last, previous_first, previous_last
+         call spot_nodes(i, first, last)
+         call spot_nodes(modulo(i - 2, spots) + 1, previous_first, previous_last)
+         gap_behind = modulo(first - previous_last - 1, n)
+         if (spots == 1 .and. last - first + 1 >= n) gap_behind = 0
+      end function gap_behind
    end subroutine spot_tension
 
    !> Asymmetry of the spots, load-weighted over the spots (L, positive = towards the

@@ -28,7 +28,7 @@ contains
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: displacement_x(:), stress_xx(:)
       complex(wp), allocatable :: ph(:), uh(:), sh(:)
-      real(wp) :: k, one_minus_a, one_minus_b, c, pm, contraction, odd, friction
+      real(wp) :: k, one_minus_a, one_minus_b, c, pm, contraction, friction
       integer :: m, n
       logical :: halfspace
 
@@ -44,8 +44,7 @@ contains
       pm = real(ph(1), wp)
 
       ! Per mode: u_x^ = 2/(E*k) [i c + mu (1-B)] p^ and, since i k/|k| = i sgn(k),
-      ! E* i k u_x^ = [-2 c + 2 i mu (1-B)] p^. On the Nyquist mode the odd parts (i sgn(k))
-      ! average to zero; the even parts stay.
+      ! E* i k u_x^ = [-2 c + 2 i mu (1-B)] p^.
       if (halfspace) then
          uh(1) = 0.0_wp
          sh(1) = -pm
@@ -57,11 +56,15 @@ contains
       do m = 1, fft%nk - 1
          k = op%wavenumber(m)
          call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
-         odd = merge(0.0_wp, 1.0_wp, 2*m == n)
          ! (1 - nu^2) J*(kV) = 1/E* for an elastic layer; sigma_xx does not depend on it
-         uh(m + 1) = 2.0_wp/k*cmplx(real(op%compliance(m + 1), wp), odd*aimag(op%compliance(m + 1)), wp) &
-            & *cmplx(friction*one_minus_b, odd*c, wp)*ph(m + 1)
-         sh(m + 1) = cmplx(-contraction - 2.0_wp*c, odd*2.0_wp*friction*one_minus_b, wp)*ph(m + 1)
+         uh(m + 1) = 2.0_wp/k*op%compliance(m + 1)*cmplx(friction*one_minus_b, c, wp)*ph(m + 1)
+         sh(m + 1) = cmplx(-contraction - 2.0_wp*c, 2.0_wp*friction*one_minus_b, wp)*ph(m + 1)
+         if (2*m == n) then
+            ! the Nyquist mode is its own mirror image: mirror averages (real parts) of the
+            ! multipliers
+            uh(m + 1) = real(2.0_wp/k*op%compliance(m + 1)*cmplx(friction*one_minus_b, c, wp), wp)*ph(m + 1)
+            sh(m + 1) = (-contraction - 2.0_wp*c)*ph(m + 1)
+         end if
       end do
 
       fft%spectrum = uh

@@ -161,6 +161,12 @@ contains
       scene%poisson = 0.25_wp
       scene%friction = 0.3_wp
       scene%companion = .true.
+      scene%material%model = 'prony'
+      scene%material%form = 'creep'
+      scene%material%equilibrium = 0.5_wp
+      scene%material%times = [0.1_wp, 1.0_wp/3.0_wp, 10.0_wp]
+      scene%material%values = [0.2_wp, 0.3_wp, 1.0_wp/7.0_wp]
+      scene%speed = 0.7_wp
       scene%profile%hurst = 0.7_wp
       scene%profile%seed = 123456789012_i8
       scene%profile%rolloff_wavelength = 0.5_wp
@@ -206,6 +212,10 @@ contains
       same_scene = a%geometry == b%geometry .and. a%title == b%title .and. a%period == b%period &
          & .and. a%n == b%n .and. a%thickness == b%thickness .and. a%young == b%young &
          & .and. a%poisson == b%poisson .and. a%friction == b%friction .and. (a%companion .eqv. b%companion) &
+         & .and. a%material%model == b%material%model .and. a%material%form == b%material%form &
+         & .and. a%material%e0 == b%material%e0 .and. a%material%e_inf == b%material%e_inf &
+         & .and. a%material%tau == b%material%tau .and. a%material%equilibrium == b%material%equilibrium &
+         & .and. a%speed == b%speed .and. a%material%terms() == b%material%terms() .and. same_terms(a, b) &
          & .and. a%profile%kind == b%profile%kind .and. a%profile%hurst == b%profile%hurst &
          & .and. a%profile%seed == b%profile%seed .and. a%profile%rolloff_wavelength == b%profile%rolloff_wavelength &
          & .and. a%profile%short_wavelength == b%profile%short_wavelength &
@@ -220,6 +230,13 @@ contains
          & .and. (a%overwrite .eqv. b%overwrite) .and. (a%solver%precondition .eqv. b%solver%precondition) &
          & .and. (a%stress .eqv. b%stress) .and. a%gap_bins == b%gap_bins
    end function same_scene
+
+   logical function same_terms(a, b)
+      type(scene_type), intent(in) :: a, b
+      same_terms = a%material%terms() == b%material%terms()
+      if (same_terms .and. a%material%terms() > 0) same_terms = all(a%material%times == b%material%times) &
+         & .and. all(a%material%values == b%material%values)
+   end function same_terms
 
    subroutine test_check_output()
       type(error_type), allocatable :: error
