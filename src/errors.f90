@@ -4,9 +4,11 @@
 !> Codes follow the executable's exit codes: 2 = bad input, 3 = not converged (used as a
 !> status, not an error), 4 = I/O failure, 5 = internal/numerical failure.
 module lc_errors
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use lc_kinds, only: wp
    implicit none (type, external)
    private
-   public :: error_type, fatal_error, input_error
+   public :: error_type, fatal_error, input_error, positive_finite
    public :: code_input, code_not_converged, code_io, code_internal
 
    integer, parameter :: code_input = 2
@@ -40,4 +42,10 @@ contains
       call fatal_error(error, '&' // group // ': ' // variable // ' = ' // value // ' is not allowed; allowed: ' &
          & // allowed, code_input)
    end subroutine input_error
+
+   !> True for a finite x > 0 (the common input check; false for NaN and Inf).
+   pure logical function positive_finite(x)
+      real(wp), intent(in) :: x
+      positive_finite = ieee_is_finite(x) .and. x > 0.0_wp
+   end function positive_finite
 end module lc_errors

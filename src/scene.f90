@@ -9,7 +9,7 @@
 module lc_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, input_error
+   use lc_errors, only: error_type, input_error, positive_finite
    use lc_strings, only: to_string
    use lc_greens_viscoelastic, only: material_law, check_material, static_modulus
    implicit none (type, external)
@@ -122,13 +122,13 @@ contains
       associate (p => scene%profile, s => scene%solver)
          if (.not. one_of(scene%geometry, [character(len=8) :: 'line'])) then
             call input_error(error, 'scene', 'geometry', trim(scene%geometry), "'line' (areal contacts come later)")
-         else if (.not. positive(scene%period)) then
+         else if (.not. positive_finite(scene%period)) then
             call input_error(error, 'scene', 'period', to_string(scene%period), '> 0 and finite')
          else if (scene%n < 8 .or. scene%n > 2**26) then
             call input_error(error, 'scene', 'n', to_string(scene%n), '8 <= n <= 2**26')
          else if (ieee_is_nan(scene%thickness) .or. scene%thickness <= 0.0_wp) then
             call input_error(error, 'layer', 'thickness', to_string(scene%thickness), '> 0, or Inf for a half-space')
-         else if (.not. positive(scene%young)) then
+         else if (.not. positive_finite(scene%young)) then
             call input_error(error, 'layer', 'young', to_string(scene%young), '> 0 and finite')
          else if (.not. (scene%poisson > -1.0_wp .and. scene%poisson <= 0.5_wp)) then
             call input_error(error, 'layer', 'poisson', to_string(scene%poisson), '-1 < poisson <= 0.5')
@@ -154,7 +154,7 @@ contains
                call input_error(error, 'profile', 'hurst', to_string(p%hurst), '0 < hurst < 1')
             else if (p%seed < 0_i8) then
                call input_error(error, 'profile', 'seed', to_string(p%seed), '>= 0')
-            else if (p%rolloff_wavelength /= not_set .and. .not. (positive(p%rolloff_wavelength) &
+            else if (p%rolloff_wavelength /= not_set .and. .not. (positive_finite(p%rolloff_wavelength) &
                & .and. p%rolloff_wavelength <= scene%period)) then
                call input_error(error, 'profile', 'rolloff_wavelength', to_string(p%rolloff_wavelength), &
                   & '0 < rolloff_wavelength <= period')
@@ -164,13 +164,13 @@ contains
                   & '2*period/n <= short_wavelength <= period (at least two grid points per wavelength)')
             else if (p%rms_gradient /= not_set .and. p%rms_height /= not_set) then
                call input_error(error, 'profile', 'rms_gradient/rms_height', 'both given', 'at most one of them')
-            else if (p%rms_gradient /= not_set .and. .not. positive(p%rms_gradient)) then
+            else if (p%rms_gradient /= not_set .and. .not. positive_finite(p%rms_gradient)) then
                call input_error(error, 'profile', 'rms_gradient', to_string(p%rms_gradient), '> 0 and finite')
-            else if (p%rms_height /= not_set .and. .not. positive(p%rms_height)) then
+            else if (p%rms_height /= not_set .and. .not. positive_finite(p%rms_height)) then
                call input_error(error, 'profile', 'rms_height', to_string(p%rms_height), '> 0 and finite')
             end if
          case ('sinusoid')
-            if (.not. positive(p%amplitude)) then
+            if (.not. positive_finite(p%amplitude)) then
                call input_error(error, 'profile', 'amplitude', to_string(p%amplitude), '> 0 and finite')
             else if (p%mode < 1 .or. p%mode > (scene%n - 1)/2) then
                call input_error(error, 'profile', 'mode', to_string(p%mode), '1 <= mode <= (n-1)/2')
@@ -189,10 +189,10 @@ contains
             call input_error(error, 'loading', 'mean_pressure/normalised_pressure', 'both or neither given', &
                & "exactly one of them with control = 'load'")
          else if (trim(scene%control) == 'load' .and. scene%mean_pressure /= not_set &
-            & .and. .not. positive(scene%mean_pressure)) then
+            & .and. .not. positive_finite(scene%mean_pressure)) then
             call input_error(error, 'loading', 'mean_pressure', to_string(scene%mean_pressure), '> 0 and finite')
          else if (trim(scene%control) == 'load' .and. scene%normalised_pressure /= not_set &
-            & .and. .not. positive(scene%normalised_pressure)) then
+            & .and. .not. positive_finite(scene%normalised_pressure)) then
             call input_error(error, 'loading', 'normalised_pressure', to_string(scene%normalised_pressure), '> 0 and finite')
          else if (trim(scene%control) == 'load' .and. scene%penetration /= not_set) then
             call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
@@ -201,7 +201,7 @@ contains
             & (scene%mean_pressure /= not_set .or. scene%normalised_pressure /= not_set)) then
             call input_error(error, 'loading', 'mean_pressure/normalised_pressure', 'given', &
                & "neither with control = 'displacement' (the penetration fixes the load)")
-         else if (trim(scene%control) == 'displacement' .and. .not. positive(scene%penetration)) then
+         else if (trim(scene%control) == 'displacement' .and. .not. positive_finite(scene%penetration)) then
             call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
                & "> 0 and finite with control = 'displacement'")
          else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'anderson'])) then
@@ -220,10 +220,6 @@ contains
       end associate
    end subroutine check_scene
 
-   pure logical function positive(x)
-      real(wp), intent(in) :: x
-      positive = ieee_is_finite(x) .and. x > 0.0_wp
-   end function positive
 
    pure logical function one_of(word, words)
       character(len=*), intent(in) :: word

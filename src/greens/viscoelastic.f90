@@ -20,7 +20,7 @@
 module lc_greens_viscoelastic
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
-   use lc_errors, only: error_type, input_error
+   use lc_errors, only: error_type, input_error, positive_finite
    use lc_strings, only: to_string
    implicit none (type, external)
    private
@@ -134,14 +134,14 @@ contains
       select case (trim(law%model))
       case ('elastic')
       case ('sls')
-         if (.not. positive(law%e0)) then
+         if (.not. positive_finite(law%e0)) then
             call input_error(error, 'material', 'e0', to_string(law%e0), '> 0 and finite')
-         else if (.not. positive(law%e_inf)) then
+         else if (.not. positive_finite(law%e_inf)) then
             call input_error(error, 'material', 'e_inf', to_string(law%e_inf), '> 0 and finite')
          else if (law%e_inf < law%e0) then
             call input_error(error, 'material', 'e_inf', to_string(law%e_inf), &
                & '>= e0 = ' // to_string(law%e0) // ' (the glassy modulus is the larger one)')
-         else if (.not. positive(law%tau)) then
+         else if (.not. positive_finite(law%tau)) then
             call input_error(error, 'material', 'tau', to_string(law%tau), '> 0 and finite')
          end if
       case ('prony')
@@ -162,10 +162,10 @@ contains
          end if
          if (allocated(error)) return
          do i = 1, size(law%times)
-            if (.not. positive(law%times(i))) then
+            if (.not. positive_finite(law%times(i))) then
                call input_error(error, 'material', 'prony_times(' // to_string(i) // ')', to_string(law%times(i)), &
                   & '> 0 and finite')
-            else if (.not. positive(law%values(i))) then
+            else if (.not. positive_finite(law%values(i))) then
                call input_error(error, 'material', 'prony_values(' // to_string(i) // ')', to_string(law%values(i)), &
                   & '> 0 and finite (a Prony series must be positive)')
             end if
@@ -186,8 +186,4 @@ contains
       end select
    end subroutine check_material
 
-   pure logical function positive(x)
-      real(wp), intent(in) :: x
-      positive = ieee_is_finite(x) .and. x > 0.0_wp
-   end function positive
 end module lc_greens_viscoelastic

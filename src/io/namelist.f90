@@ -580,13 +580,13 @@ contains
    !> Length of the longest line of `text` (at least 1).
    pure integer function line_width(text)
       character(len=*), intent(in) :: text
-      integer :: start, stop
+      integer :: start, finish
       line_width = 1
       start = 1
       do while (start <= len(text))
-         stop = line_end(text, start)
-         line_width = max(line_width, stop - start + 1)
-         start = stop + 2
+         finish = line_end(text, start)
+         line_width = max(line_width, finish - start + 1)
+         start = finish + 2
       end do
    end function line_width
 
@@ -595,16 +595,16 @@ contains
    pure subroutine split_lines(text, lines)
       character(len=*), intent(in) :: text
       character(len=*), intent(out) :: lines(:)
-      integer :: start, stop, i
+      integer :: start, finish, i
 
       start = 1
       do i = 1, size(lines)
-         stop = min(line_end(text, start), len(text))
-         lines(i) = text(min(start, len(text) + 1):stop)
-         if (stop >= start) then
-            if (text(stop:stop) == achar(13)) lines(i) = text(start:stop - 1)
+         finish = min(line_end(text, start), len(text))
+         lines(i) = text(min(start, len(text) + 1):finish)
+         if (finish >= start) then
+            if (text(finish:finish) == achar(13)) lines(i) = text(start:finish - 1)
          end if
-         start = stop + 2
+         start = finish + 2
       end do
    end subroutine split_lines
 

@@ -22,9 +22,8 @@
 !>    i.e. r_j = sum_m s a_m cos(q_m x_j + phi_m): the c2r backward transform of
 !>    lc_fft_plans. The heights have zero mean.
 module lc_profiles_self_affine
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input, input_error
+   use lc_errors, only: error_type, fatal_error, code_input, input_error, positive_finite
    use lc_strings, only: to_string
    use lc_scene, only: not_set
    use lc_fft_plans, only: fft_plan
@@ -75,21 +74,21 @@ contains
 
       if (n < 4) then
          call input_error(error, 'scene', 'n', to_string(n), '>= 4 (at least one mode below Nyquist)')
-      else if (.not. positive(period)) then
+      else if (.not. positive_finite(period)) then
          call input_error(error, 'scene', 'period', to_string(period), '> 0 and finite')
       else if (.not. (hurst > 0.0_wp .and. hurst < 1.0_wp)) then
          call input_error(error, 'profile', 'hurst', to_string(hurst), '0 < hurst < 1')
       else if (seed < 0_i8) then
          call input_error(error, 'profile', 'seed', to_string(seed), '>= 0')
-      else if (.not. (positive(rolloff) .and. rolloff <= period)) then
+      else if (.not. (positive_finite(rolloff) .and. rolloff <= period)) then
          call input_error(error, 'profile', 'rolloff_wavelength', to_string(rolloff), '0 < rolloff_wavelength <= period')
-      else if (.not. (positive(short) .and. short <= period)) then
+      else if (.not. (positive_finite(short) .and. short <= period)) then
          call input_error(error, 'profile', 'short_wavelength', to_string(short), '0 < short_wavelength <= period')
       else if (count([rms_gradient /= not_set, rms_height /= not_set]) /= 1) then
          call input_error(error, 'profile', 'rms_gradient/rms_height', 'both or neither given', 'exactly one of them')
-      else if (rms_gradient /= not_set .and. .not. positive(rms_gradient)) then
+      else if (rms_gradient /= not_set .and. .not. positive_finite(rms_gradient)) then
          call input_error(error, 'profile', 'rms_gradient', to_string(rms_gradient), '> 0 and finite')
-      else if (rms_height /= not_set .and. .not. positive(rms_height)) then
+      else if (rms_height /= not_set .and. .not. positive_finite(rms_height)) then
          call input_error(error, 'profile', 'rms_height', to_string(rms_height), '> 0 and finite')
       end if
       if (allocated(error)) return
@@ -157,10 +156,6 @@ contains
       end do
    end subroutine sinusoid_profile
 
-   pure logical function positive(x)
-      real(wp), intent(in) :: x
-      positive = ieee_is_finite(x) .and. x > 0.0_wp
-   end function positive
 
 
 
