@@ -86,48 +86,42 @@ def panel_a(ax):
     ax.legend(fontsize=7)
 
 
+def draw(ax, stats, label, xlabel, ylabel, title, unity=True):
+    """Mean +- spread curves (one per group) on a log x axis."""
+    for group, (x, m, s, _) in stats.items():
+        ax.errorbar(x, m, yerr=s, capsize=2, lw=1, label=label.format(group))
+    if unity:
+        ax.axhline(1, color="0.5", lw=0.5)
+    ax.set_xscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7)
+    return stats
+
+
+PRESSURE = "p_m / (E* Lambda/lambda)"
+
+
 def panel_b(ax, cols):
     a = ratio_to_frictionless(cols, "contact_fraction", ("normalised_pressure", "seed"))
     fr = cols["friction"] > 0
     stats = mean_spread(cols["normalised_pressure"][fr], a[fr], cols["friction"][fr])
-    for mu, (x, m, s, _) in stats.items():
-        ax.errorbar(x, m, yerr=s, capsize=2, lw=1, label=f"mu_c = {mu:g}")
-    ax.axhline(1, color="0.5", lw=0.5)
-    ax.set_xscale("log")
-    ax.set_xlabel("p_m / (E* Lambda/lambda)")
-    ax.set_ylabel("a / a0")
-    ax.set_title("(b) h/lambda = 0.16", fontsize=9)
-    ax.legend(fontsize=7)
-    return stats
+    return draw(ax, stats, "mu_c = {:g}", PRESSURE, "a / a0", "(b) h/lambda = 0.16")
 
 
 def panel_c(ax, cols, gbar):
     fr = cols["friction"] > 0
     y = cols["delta_mu"][fr] / (cols["friction"][fr] * gbar)
     stats = mean_spread(cols["normalised_pressure"][fr], y, cols["friction"][fr])
-    for mu, (x, m, s, _) in stats.items():
-        ax.errorbar(x, m, yerr=s, capsize=2, lw=1, label=f"mu_c = {mu:g}")
-    ax.set_xscale("log")
-    ax.set_xlabel("p_m / (E* Lambda/lambda)")
-    ax.set_ylabel("Delta mu / (mu_c g_bar)")
-    ax.set_title("(c) h/lambda = 0.01", fontsize=9)
-    ax.legend(fontsize=7)
-    return stats
+    return draw(ax, stats, "mu_c = {:g}", PRESSURE, "Delta mu / (mu_c g_bar)", "(c) h/lambda = 0.01", unity=False)
 
 
 def panel_d(ax, cols):
     a = ratio_to_frictionless(cols, "contact_fraction", ("normalised_pressure", "thickness", "seed"))
     fr = cols["friction"] > 0
     stats = mean_spread(cols["thickness"][fr], a[fr], cols["normalised_pressure"][fr])
-    for p, (x, m, s, _) in stats.items():
-        ax.errorbar(x, m, yerr=s, capsize=2, lw=1, label=f"p_m/(E* Lambda/lambda) = {p:g}")
-    ax.axhline(1, color="0.5", lw=0.5)
-    ax.set_xscale("log")
-    ax.set_xlabel("h / lambda")
-    ax.set_ylabel("a / a0")
-    ax.set_title("(d) mu_c = 0.5", fontsize=9)
-    ax.legend(fontsize=7)
-    return stats
+    return draw(ax, stats, "p_m/(E* Lambda/lambda) = {:g}", "h / lambda", "a / a0", "(d) mu_c = 0.5")
 
 
 def print_table(b, c, d, robustness) -> None:

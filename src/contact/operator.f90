@@ -164,11 +164,7 @@ contains
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
-      self%fft%real_buffer = p
-      call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*(self%metric*self%inv_n)
-      call self%fft%backward()
-      w = self%fft%real_buffer
+      call apply_real(self, self%metric, p, w)
    end subroutine apply_metric
 
    !> w = G_eff p with the full (possibly complex) multiplier.
@@ -176,15 +172,11 @@ contains
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
-      if (.not. self%coupled) then
-         call self%apply_metric(p, w)
-         return
+      if (self%coupled) then
+         call apply_complex(self, self%full, p, w)
+      else
+         call apply_real(self, self%metric, p, w)
       end if
-      self%fft%real_buffer = p
-      call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*(self%full*self%inv_n)
-      call self%fft%backward()
-      w = self%fft%real_buffer
    end subroutine apply_full
 
    !> w = (G_eff - M) p, the part the outer iteration of a coupled problem carries.
@@ -192,25 +184,43 @@ contains
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
-      if (.not. self%coupled) then
+      if (self%coupled) then
+         call apply_complex(self, self%full - self%metric, p, w)
+      else
          w = 0.0_wp
-         return
       end if
-      self%fft%real_buffer = p
-      call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*((self%full - self%metric)*self%inv_n)
-      call self%fft%backward()
-      w = self%fft%real_buffer
    end subroutine apply_difference
+
    !> w = P p with the preconditioner P ~ M^-1 of the constrained CG (see `preconditioner`).
    subroutine apply_inverse_metric(self, p, w)
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
+      call apply_real(self, self%preconditioner, p, w)
+   end subroutine apply_inverse_metric
+
+   !> w = multiplier * p through the plans; the 1/n of the forward transform is folded in.
+   subroutine apply_real(self, multiplier, p, w)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), intent(in) :: multiplier(:), p(:)
+      real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
       call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*(self%preconditioner*self%inv_n)
+      self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
       call self%fft%backward()
       w = self%fft%real_buffer
-   end subroutine apply_inverse_metric
+   end subroutine apply_real
+
+   !> The same with a complex multiplier.
+   subroutine apply_complex(self, multiplier, p, w)
+      class(compliance_operator), intent(inout) :: self
+      complex(wp), intent(in) :: multiplier(:)
+      real(wp), intent(in) :: p(:)
+      real(wp), intent(out) :: w(:)
+      self%fft%real_buffer = p
+      call self%fft%forward_unscaled()
+      self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
+      call self%fft%backward()
+      w = self%fft%real_buffer
+   end subroutine apply_complex
 end module lc_contact_operator
