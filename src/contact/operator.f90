@@ -61,12 +61,15 @@ module lc_contact_operator
       logical :: viscoelastic = .false.     !< moving viscoelastic law: complex compliances
       logical :: monotone = .true.          !< Re G_eff(k) >= 0 for every mode (unique solution)
       complex(wp), allocatable :: full(:)   !< G_eff(k), only when coupled
+      !> M in real space: (M p)(x_i) = sum_j column(i - j) p_j (L/S)
+      real(wp), allocatable :: column(:)
       type(fft_plan) :: fft
    contains
       procedure :: apply_metric
       procedure :: apply_full
       procedure :: apply_difference
       procedure :: apply_inverse_metric
+      procedure :: add_column
       procedure :: wavenumber
    end type compliance_operator
 
@@ -83,6 +86,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: k, one_minus_a, one_minus_b, c
       complex(wp) :: g
+      real(wp), allocatable :: unit_load(:)
       integer :: m
       logical :: halfspace
 
@@ -150,6 +154,10 @@ contains
       ! (1/n) sum over the whole spectrum: modes 1..ceil(n/2)-1 appear twice, Nyquist once
       op%diagonal = (op%metric(1) + 2*sum(op%metric(2:op%nk)) - merge(op%metric(op%nk), 0.0_wp, &
          & mod(n, 2) == 0))/n
+      allocate (op%column(n), unit_load(n))
+      unit_load = 0.0_wp
+      unit_load(1) = 1.0_wp
+      call op%apply_metric(unit_load, op%column)
    end subroutine build_operator
 
    !> Wavenumber k = 2 pi m / period of mode index m (0..n/2).
@@ -198,6 +206,19 @@ contains
       real(wp), intent(out) :: w(:)
       call apply_real(self, self%preconditioner, p, w)
    end subroutine apply_inverse_metric
+
+   !> w = w + value M e_j: the metric's response to a point load at x_j, in one pass.
+   pure subroutine add_column(self, j, value, w)
+      class(compliance_operator), intent(in) :: self
+      integer, intent(in) :: j
+      real(wp), intent(in) :: value
+      real(wp), intent(inout) :: w(:)
+      integer :: n
+      n = self%n
+      ! column(i - j) for i = j..n is column(1..n-j+1); for i = 1..j-1 it wraps round
+      w(j:n) = w(j:n) + value*self%column(1:n - j + 1)
+      w(1:j - 1) = w(1:j - 1) + value*self%column(n - j + 2:n)
+   end subroutine add_column
 
    !> w = multiplier * p through the plans; the 1/n of the forward transform is folded in.
    subroutine apply_real(self, multiplier, p, w)
