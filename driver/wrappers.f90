@@ -63,13 +63,13 @@ subroutine py_self_affine_profile(n, period, hurst, seed, rolloff_wavelength, sh
 end subroutine py_self_affine_profile
 
 !> Solve a line contact on the given heights. control: 0 load, 1 displacement;
-!> method: 0 auto, 1 cg, 2 anderson; precondition, stress: 0/1.
+!> method: 0 auto, 1 cg, 2 anderson; precondition, coarse_start, stress: 0/1.
 !> fields(:, 1:5): pressure, gap, displacement_z, displacement_x, stress_xx (the last two
 !> zero unless stress = 1); spots(1:n_spots, 1:4): trailing and leading edges, largest
 !> sigma_xx around the spot and its offset from the trailing edge (zero unless stress = 1);
 !> scalars: in the order of layercontact.api._SCALARS.
 subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
-      & penetration, method, precondition, tol, max_iter, memory, threads, stress, model, form, e0, e_inf, tau, &
+      & penetration, method, precondition, coarse_start, tol, max_iter, memory, threads, stress, model, form, e0, e_inf, tau, &
       & equilibrium, nt, times, values, speed, fields, spots, scalars, history, stat, errmsg)
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, check_scene
@@ -77,7 +77,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    use lc_contact_solve, only: solve_line_contact
    use lc_greens_viscoelastic, only: make_material_law
    implicit none (type, external)
-   integer, intent(in) :: n, control, method, precondition, max_iter, memory, threads, stress, model, form, nt
+   integer, intent(in) :: n, control, method, precondition, coarse_start, max_iter, memory, threads, stress, model, form, nt
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
    real(8), intent(in) :: e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
    real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 4), scalars(25), history(max_iter)
@@ -104,6 +104,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    scene%solver%memory = memory
    scene%solver%threads = threads
    scene%solver%precondition = precondition == 1
+   scene%solver%coarse_start = coarse_start == 1
    call check_scene(scene, error)
    if (.not. allocated(error)) call solve_line_contact(scene, height, friction, r, error)
    if (allocated(error)) then

@@ -59,6 +59,9 @@ module lc_scene
       !> precondition the constrained CG with the stiffness 1/M (Fourier) on the contact set:
       !> one more FFT pair per iteration, 3-6x fewer iterations on fine grids (bench/iterations.py)
       logical :: precondition = .true.
+      !> start from the solution on the grid of every second point (recursively): the
+      !> contact set is then nearly known and the fine-grid iterations few
+      logical :: coarse_start = .true.
       !> FFTW threads (1 = no threading)
       integer :: threads = 1
    end type solver_settings

@@ -188,6 +188,36 @@ def test_preconditioned_and_plain_cg_agree(rough_profile, thickness, friction):
     assert a.penetration == pytest.approx(b.penetration, rel=1e-9)
 
 
+@pytest.mark.parametrize("case", ["half-space", "coupled", "thin coupled", "viscoelastic", "displacement"])
+def test_coarse_start_reaches_the_same_solution(rough_profile, case):
+    """Starting from the solution on the grids of every second point changes the path, not
+    the fixed point: the same pressure to the solver tolerance, in fewer fine-grid
+    iterations (n = 4096 has coarse levels 2048 and 1024)."""
+    pm = rough_profile.max()
+    kw = {
+        "half-space": dict(mean_pressure=pm),
+        "coupled": dict(thickness=0.16, friction=0.5, mean_pressure=pm),
+        "thin coupled": dict(thickness=0.01, friction=1.0, mean_pressure=16 * pm),
+        "viscoelastic": dict(thickness=0.16, friction=0.3, mean_pressure=pm, speed=0.1,
+                             material=lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0)),
+        "displacement": dict(thickness=0.16, poisson=0.3, penetration=0.5 * np.ptp(rough_profile)),
+    }[case]
+    a = lc.solve_line(rough_profile, coarse_start=True, tol=1e-11, **kw)
+    b = lc.solve_line(rough_profile, coarse_start=False, tol=1e-11, **kw)
+    assert a.converged and b.converged
+    assert a.iterations < b.iterations
+    assert np.abs(a.pressure - b.pressure).max() <= 1e-8 * a.pressure.max()
+    assert a.penetration == pytest.approx(b.penetration, rel=1e-9)
+
+
+def test_coarse_start_needs_an_even_grid():
+    """An odd grid has no grid of every second point: the solve is the plain one."""
+    h = lc.self_affine_profile(1025, 0.8, seed=3, short_wavelength=1 / 64)
+    a = lc.solve_line(h, mean_pressure=h.max(), coarse_start=True)
+    b = lc.solve_line(h, mean_pressure=h.max(), coarse_start=False)
+    assert a.iterations == b.iterations and np.array_equal(a.pressure, b.pressure)
+
+
 def test_threads_need_an_openmp_build(rough_profile):
     with pytest.raises(lc.LayercontactError, match="-Dopenmp=true") as err:
         lc.solve_line(rough_profile, mean_pressure=0.01, threads=2)

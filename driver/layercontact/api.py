@@ -141,6 +141,7 @@ def solve_line(
     stress: bool = True,
     method: str = "auto",
     precondition: bool = True,
+    coarse_start: bool = True,
     tol: float = 1e-10,
     max_iter: int = 100000,
     memory: int = 12,
@@ -158,7 +159,9 @@ def solve_line(
     the same load and sets ``a_over_a0`` and ``companion``. ``stress`` computes
     ``displacement_x``, ``shear`` and the surface stress ``stress_xx`` (one more FFT pair).
     ``precondition`` applies the Fourier stiffness 1/M to the residual on the contact set
-    (fewer iterations, nearly flat in the grid size; see bench/iterations.py).
+    (fewer iterations). ``coarse_start`` starts from the solution on the grid of every
+    second point, recursively down to 512 points (fine-grid iterations nearly flat in
+    the grid size; see bench/iterations.py).
     Raises :class:`LayercontactError` with the library's message for bad input. A run that
     did not reach ``tol`` returns with ``converged = False``.
     """
@@ -170,7 +173,8 @@ def solve_line(
     if method not in _METHODS:
         raise ValueError(f"method = {method!r} is not allowed; allowed: {sorted(_METHODS)}")
     settings = dict(period=period, thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
-                    penetration=penetration, stress=stress, method=method, precondition=precondition, tol=tol,
+                    penetration=penetration, stress=stress, method=method, precondition=precondition,
+                    coarse_start=coarse_start, tol=tol,
                     max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
     result = _solve_once(h, friction=friction, **settings)
     if companion:
@@ -182,7 +186,7 @@ def solve_line(
 
 
 def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure, penetration, stress, method,
-                precondition, tol, max_iter, memory, threads, material, speed) -> LineResult:
+                precondition, coarse_start, tol, max_iter, memory, threads, material, speed) -> LineResult:
     from .materials import material_codes
 
     control = "load" if mean_pressure is not None else "displacement"
@@ -191,7 +195,7 @@ def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure
         h, float(period), float(thickness), young, float(poisson), float(friction), _CONTROLS[control],
         NOT_SET if mean_pressure is None else float(mean_pressure),
         NOT_SET if penetration is None else float(penetration),
-        _METHODS[method], int(bool(precondition)), float(tol), int(max_iter), int(memory), int(threads),
+        _METHODS[method], int(bool(precondition)), int(bool(coarse_start)), float(tol), int(max_iter), int(memory), int(threads),
         int(bool(stress)), model, form, e0, e_inf, tau, eq, times, values, float(speed),
     )
     _check(stat, errmsg)

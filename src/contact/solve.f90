@@ -23,6 +23,13 @@ module lc_contact_solve
    private
    public :: solve_line_contact, scene_mean_pressure
 
+   !> The coarse-start recursion stops at grids below 2*coarsest_grid points: below that a
+   !> solve costs less than the set-up of another level.
+   integer, parameter :: coarsest_grid = 512
+   !> Tolerance of the coarse solves (or the scene's, if looser): a starting guess only
+   !> needs to be closer than the discretisation difference between the two grids.
+   real(wp), parameter :: coarse_tol = 1.0e-4_wp
+
 contains
 
    !> p_m of a load-controlled scene on profile `height` (S).
@@ -47,12 +54,10 @@ contains
       type(contact_result), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       type(compliance_operator) :: op
-      type(cg_outcome) :: cg
-      type(anderson_outcome) :: outer
-      real(wp), allocatable :: p(:), w(:), gap(:), history(:)
+      real(wp), allocatable :: p(:), w(:), gap(:)
       real(wp) :: pm, s, g_ref, lambda_max
       integer(i8) :: start, finish, rate
-      logical :: load_control, precondition
+      logical :: load_control
       integer :: n
 
       call system_clock(start, rate)
@@ -69,20 +74,11 @@ contains
             & "so the penetration does not fix the load; use control = 'load'", code_input)
          return
       end if
-      call build_operator(op, n, scene%period, scene%thickness, material_of(scene), scene%poisson, friction, &
-         & scene%speed, scene%solver%threads, error)
-      if (allocated(error)) return
-      if (op%coupled .and. trim(scene%solver%method) == 'cg') then
-         call fatal_error(error, "&solver: method = 'cg' cannot solve this scene: friction couples the normal " // &
-            & "and tangential fields and the operator is not symmetric; allowed: 'auto' or 'anderson'", code_input)
-         return
-      end if
 
       lambda_max = maxval(height)
       g_ref = maxval(height) - minval(height)
       if (g_ref <= 0.0_wp) g_ref = scene%period   ! flat punch: any length scale will do
-      allocate (p(n), w(n), gap(n), history(scene%solver%max_iter))
-      history = 0.0_wp
+      allocate (p(n), w(n), gap(n))
       if (load_control) then
          pm = scene_mean_pressure(scene, height)
          p = pm
@@ -92,28 +88,8 @@ contains
          p = 0.0_wp
          s = scene%penetration - lambda_max
       end if
-
-      precondition = scene%solver%precondition
-      if (op%coupled) then
-         call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & scene%solver%memory, precondition, p, w, gap, outer, history, error)
-         if (allocated(error)) return
-         result%converged = outer%converged
-         result%iterations = outer%cg_iterations
-         result%outer_iterations = outer%outer_iterations
-         result%fft_pairs = outer%fft_pairs
-         result%residual = outer%residual
-         result%residual_history = history(1:outer%outer_iterations)
-      else
-         call constrained_cg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & precondition, p, w, gap, cg, history)
-         result%converged = cg%converged
-         result%iterations = cg%iterations
-         result%outer_iterations = 1
-         result%fft_pairs = cg%fft_pairs
-         result%residual = cg%residual
-         result%residual_history = history(1:cg%iterations)
-      end if
+      call solve_on_grid(scene, height, friction, load_control, pm, g_ref, op, p, w, gap, s, result, error)
+      if (allocated(error)) return
 
       result%friction = friction
       result%pressure = p
@@ -127,6 +103,100 @@ contains
       result%wall_time = real(finish - start, wp)/real(rate, wp)
       call observe(scene, op, height, result)
    end subroutine solve_line_contact
+
+   !> Build the operator on the grid of `height` and solve: p is the starting guess on
+   !> entry and the solution on exit, w = G_eff p, gap; s the constant of the gap (given
+   !> under displacement control, found under load control). Sets the solver statistics
+   !> of `result`. With &solver coarse_start the guess is first replaced by the solution
+   !> on the grid of every second point (recursively down to coarsest_grid points).
+   recursive subroutine solve_on_grid(scene, height, friction, load_control, pm, g_ref, op, p, w, gap, s, &
+         & result, error)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:), friction, pm, g_ref
+      logical, intent(in) :: load_control
+      type(compliance_operator), intent(out) :: op
+      real(wp), intent(inout) :: p(:), s
+      real(wp), intent(out) :: w(:), gap(:)
+      type(contact_result), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(cg_outcome) :: cg
+      type(anderson_outcome) :: outer
+      real(wp), allocatable :: history(:)
+      integer :: n, coarse_pairs
+
+      n = size(height)
+      coarse_pairs = 0
+      if (scene%solver%coarse_start .and. mod(n, 2) == 0 .and. n >= 2*coarsest_grid) then
+         call coarse_solution(scene, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, error)
+         if (allocated(error)) return
+      end if
+      call build_operator(op, n, scene%period, scene%thickness, material_of(scene), scene%poisson, friction, &
+         & scene%speed, scene%solver%threads, error)
+      if (allocated(error)) return
+      if (op%coupled .and. trim(scene%solver%method) == 'cg') then
+         call fatal_error(error, "&solver: method = 'cg' cannot solve this scene: friction couples the normal " // &
+            & "and tangential fields and the operator is not symmetric; allowed: 'auto' or 'anderson'", code_input)
+         return
+      end if
+      allocate (history(scene%solver%max_iter))
+      history = 0.0_wp
+      if (op%coupled) then
+         call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+            & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error)
+         if (allocated(error)) return
+         result%converged = outer%converged
+         result%iterations = outer%cg_iterations
+         result%outer_iterations = outer%outer_iterations
+         result%fft_pairs = outer%fft_pairs
+         result%residual = outer%residual
+         result%residual_history = history(1:outer%outer_iterations)
+      else
+         call constrained_cg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+            & scene%solver%precondition, p, w, gap, cg, history)
+         result%converged = cg%converged
+         result%iterations = cg%iterations
+         result%outer_iterations = 1
+         result%fft_pairs = cg%fft_pairs
+         result%residual = cg%residual
+         result%residual_history = history(1:cg%iterations)
+      end if
+      result%fft_pairs = result%fft_pairs + coarse_pairs
+   end subroutine solve_on_grid
+
+   !> Replace the guess p (and s) by the solution on the grid of every second point,
+   !> interpolated linearly (which keeps p >= 0). The coarse solve needs only the accuracy
+   !> of a starting guess (coarse_tol); its FFT pairs are returned in units of pairs of
+   !> this grid (half as long each).
+   recursive subroutine coarse_solution(scene, height, friction, load_control, pm, g_ref, p, s, pairs, error)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:), friction, pm, g_ref
+      logical, intent(in) :: load_control
+      real(wp), intent(inout) :: p(:), s
+      integer, intent(out) :: pairs
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: coarse
+      type(compliance_operator) :: coarse_op
+      type(contact_result) :: coarse_result
+      real(wp), allocatable :: pc(:), wc(:), gapc(:)
+      real(wp) :: sc
+      integer :: n, nc
+
+      n = size(height)
+      nc = n/2
+      coarse = scene
+      coarse%n = nc
+      coarse%solver%tol = max(scene%solver%tol, coarse_tol)
+      allocate (pc(nc), wc(nc), gapc(nc))
+      pc = p(1:n:2)
+      sc = s
+      call solve_on_grid(coarse, height(1:n:2), friction, load_control, pm, g_ref, coarse_op, pc, wc, gapc, sc, &
+         & coarse_result, error)
+      if (allocated(error)) return
+      p(1:n:2) = pc
+      p(2:n:2) = 0.5_wp*(pc + cshift(pc, 1))
+      if (load_control) s = sc
+      pairs = (coarse_result%fft_pairs + 1)/2
+   end subroutine coarse_solution
 
    !> The observables of a solved contact, computed only as the scene asks.
    subroutine observe(scene, op, height, result)

@@ -29,7 +29,7 @@ module lc_io_namelist
       & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
       & 'amplitude, mode, file, dataset', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
-      & 'method, tol, max_iter, memory, precondition, threads', &
+      & 'method, tol, max_iter, memory, precondition, coarse_start, threads', &
       & 'file, overwrite, stress, gap_bins']
 
    character(len=*), parameter :: newline = new_line('a')
@@ -168,6 +168,7 @@ contains
             & // entry('max_iter', to_string(s%max_iter)) &
             & // entry('memory', to_string(s%memory)) &
             & // entry('precondition', logical_value(s%precondition)) &
+            & // entry('coarse_start', logical_value(s%coarse_start)) &
             & // entry('threads', to_string(s%threads)) &
             & // '/' // newline // '&output' // newline &
             & // entry('file', str_value(scene%output_file)) &
@@ -456,14 +457,15 @@ contains
       character(len=max_string) :: method
       real(wp) :: tol
       integer :: max_iter, memory, threads
-      logical :: precondition
-      namelist /solver/ method, tol, max_iter, memory, precondition, threads
+      logical :: precondition, coarse_start
+      namelist /solver/ method, tol, max_iter, memory, precondition, coarse_start, threads
 
       method = config%solver%method
       tol = config%solver%tol
       max_iter = config%solver%max_iter
       memory = config%solver%memory
       precondition = config%solver%precondition
+      coarse_start = config%solver%coarse_start
       threads = config%solver%threads
       read (lines, nml=solver, iostat=stat, iomsg=msg)
       if (stat /= 0) return
@@ -472,6 +474,7 @@ contains
       config%solver%max_iter = max_iter
       config%solver%memory = memory
       config%solver%precondition = precondition
+      config%solver%coarse_start = coarse_start
       config%solver%threads = threads
    end subroutine read_group_solver
 

@@ -228,6 +228,7 @@ contains
          & .and. a%solver%max_iter == b%solver%max_iter .and. a%solver%memory == b%solver%memory &
          & .and. a%solver%threads == b%solver%threads .and. a%output_file == b%output_file &
          & .and. (a%overwrite .eqv. b%overwrite) .and. (a%solver%precondition .eqv. b%solver%precondition) &
+         & .and. (a%solver%coarse_start .eqv. b%solver%coarse_start) &
          & .and. (a%stress .eqv. b%stress) .and. a%gap_bins == b%gap_bins
    end function same_scene
 
