@@ -51,6 +51,8 @@ module lc_contact_operator
       logical :: coupled = .false.          !< complex multiplier (not symmetric)
       real(wp), allocatable :: metric(:)    !< M(k) = |G_eff(k)|, k = 0..n/2 (L/S)
       real(wp) :: diagonal = 0.0_wp         !< real-space diagonal of the circulant M (L/S)
+      !> largest |multiplier| of M and G_eff (L/S): sets the rounding noise of w = G p
+      real(wp) :: largest = 0.0_wp
       real(wp) :: inv_n = 1.0_wp            !< 1/n, folded into the multipliers when applied
       complex(wp), allocatable :: compliance(:)   !< (1 - nu^2) J*(k V) per mode (1/S)
       !> Fourier preconditioner of the constrained CG: 1/M(k) with the material's frequency
@@ -70,6 +72,7 @@ module lc_contact_operator
       procedure :: apply_difference
       procedure :: apply_inverse_metric
       procedure :: add_column
+      procedure :: drop_uniform_mode
       procedure :: wavenumber
    end type compliance_operator
 
@@ -86,7 +89,6 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: k, one_minus_a, one_minus_b, c
       complex(wp) :: g
-      real(wp), allocatable :: unit_load(:)
       integer :: m
       logical :: halfspace
 
@@ -151,14 +153,41 @@ contains
       ! (always for elastic layers; not always for viscoelastic ones with friction).
       op%monotone = .true.
       if (op%coupled) op%monotone = all(real(op%full, wp) >= 0.0_wp)
+      call derive(op)
+   end subroutine build_operator
+
+   !> The quantities derived from the multipliers: diagonal, largest, column.
+   subroutine derive(op)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), allocatable :: unit_load(:)
+      integer :: n
+      n = op%n
       ! (1/n) sum over the whole spectrum: modes 1..ceil(n/2)-1 appear twice, Nyquist once
       op%diagonal = (op%metric(1) + 2*sum(op%metric(2:op%nk)) - merge(op%metric(op%nk), 0.0_wp, &
          & mod(n, 2) == 0))/n
-      allocate (op%column(n), unit_load(n))
+      op%largest = maxval(op%metric)
+      if (op%coupled) op%largest = max(op%largest, maxval(abs(op%full)))
+      allocate (unit_load(n))
       unit_load = 0.0_wp
       unit_load(1) = 1.0_wp
+      if (.not. allocated(op%column)) allocate (op%column(n))
       call op%apply_metric(unit_load, op%column)
-   end subroutine build_operator
+   end subroutine derive
+
+   !> Leave the uniform (k = 0) mode out of the operator and return its multiplier (h/M for
+   !> a compressible layer, L/S). Under load control the uniform mode of p is the given
+   !> p_m, so its displacement is a rigid shift that the constant s absorbs; without it w
+   !> has the size of its fluctuations, and the rounding floor of the gap does not grow
+   !> with the thickness (at h/lambda = 1e15, h p_m/M would hide every gap).
+   subroutine drop_uniform_mode(self, uniform)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), intent(out) :: uniform
+      uniform = self%metric(1)
+      self%metric(1) = 0.0_wp
+      self%preconditioner(1) = 0.0_wp
+      if (self%coupled) self%full(1) = 0.0_wp
+      call derive(self)
+   end subroutine drop_uniform_mode
 
    !> Wavenumber k = 2 pi m / period of mode index m (0..n/2).
    pure real(wp) function wavenumber(self, m)

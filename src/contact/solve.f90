@@ -122,6 +122,7 @@ contains
       type(cg_outcome) :: cg
       type(anderson_outcome) :: outer
       real(wp), allocatable :: history(:)
+      real(wp) :: uniform
       integer :: n, coarse_pairs
 
       n = size(height)
@@ -133,6 +134,8 @@ contains
       call build_operator(op, n, scene%period, scene%thickness, material_of(scene), scene%poisson, friction, &
          & scene%speed, scene%solver%threads, error)
       if (allocated(error)) return
+      uniform = 0.0_wp
+      if (load_control) call op%drop_uniform_mode(uniform)
       if (op%coupled .and. trim(scene%solver%method) == 'cg') then
          call fatal_error(error, "&solver: method = 'cg' cannot solve this scene: friction couples the normal " // &
             & "and tangential fields and the operator is not symmetric; allowed: 'auto' or 'anderson'", code_input)
@@ -161,6 +164,9 @@ contains
          result%residual_history = history(1:cg%iterations)
       end if
       result%fft_pairs = result%fft_pairs + coarse_pairs
+      ! the uniform mode's rigid shift (see drop_uniform_mode)
+      w = w + uniform*pm
+      s = s + uniform*pm
    end subroutine solve_on_grid
 
    !> Replace the guess p (and s) by the solution on the grid of every second point,
@@ -177,7 +183,7 @@ contains
       type(scene_type) :: coarse
       type(compliance_operator) :: coarse_op
       type(contact_result) :: coarse_result
-      real(wp), allocatable :: pc(:), wc(:), gapc(:)
+      real(wp), allocatable :: pc(:), wc(:), gapc(:), hc(:)
       real(wp) :: sc
       integer :: n, nc
 
@@ -187,9 +193,10 @@ contains
       coarse%n = nc
       coarse%solver%tol = max(scene%solver%tol, coarse_tol)
       allocate (pc(nc), wc(nc), gapc(nc))
+      hc = height(1:n:2)
       pc = p(1:n:2)
       sc = s
-      call solve_on_grid(coarse, height(1:n:2), friction, load_control, pm, g_ref, coarse_op, pc, wc, gapc, sc, &
+      call solve_on_grid(coarse, hc, friction, load_control, pm, g_ref, coarse_op, pc, wc, gapc, sc, &
          & coarse_result, error)
       if (allocated(error)) return
       p(1:n:2) = pc

@@ -102,7 +102,8 @@ contains
          end if
          gap = gap - s_full
          p_ref = merge(mean_pressure, sum(p)/n, load_control)
-         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref, rounding_floor(w, r))
+         outcome%residual = complementarity_residual(p, gap, p_ref, g_ref, &
+            & rounding_floor(maxval(abs(w)), maxval(abs(r)), maxval(p), op%largest))
          history(k) = outcome%residual
          if (outcome%residual <= tol) then
             outcome%converged = .true.
@@ -157,17 +158,21 @@ contains
       real(wp), allocatable :: a(:, :), rhs(:, :), sv(:), work(:)
       integer, allocatable :: iwork(:)
       real(wp) :: query(1)
-      integer :: m, ncol, rank, info, lwork, iquery(1)
+      integer :: m, ncol, ldb, rank, info, lwork, iquery(1)
 
       m = size(df, 1)
       ncol = size(df, 2)
-      allocate (a(m, ncol), rhs(m, 1), sv(ncol))
+      ! LAPACK wants the right-hand side with room for the solution: ldb >= max(m, ncol)
+      ! (more history columns than grid points on tiny grids)
+      ldb = max(m, ncol)
+      allocate (a(m, ncol), rhs(ldb, 1), sv(min(m, ncol)))
       a = df
-      rhs(:, 1) = f
-      call dgelsd(m, ncol, 1, a, m, rhs, m, sv, 1.0e-12_wp, rank, query, -1, iquery, info)
+      rhs = 0.0_wp
+      rhs(1:m, 1) = f
+      call dgelsd(m, ncol, 1, a, m, rhs, ldb, sv, 1.0e-12_wp, rank, query, -1, iquery, info)
       lwork = int(query(1))
       allocate (work(lwork), iwork(max(1, iquery(1))))
-      call dgelsd(m, ncol, 1, a, m, rhs, m, sv, 1.0e-12_wp, rank, work, lwork, iwork, info)
+      call dgelsd(m, ncol, 1, a, m, rhs, ldb, sv, 1.0e-12_wp, rank, work, lwork, iwork, info)
       if (info /= 0) then
          call fatal_error(error, 'anderson: LAPACK dgelsd failed in the mixing step', code_internal)
          return
