@@ -1,0 +1,83 @@
+"""Iteration counts of the solver across the stability grid of tests/test_extremes.py.
+
+The grid (tests/extremes_grid.py): rough, sinusoid and narrow-bump profiles, h/lambda
+1e-4 .. 1e3 and the half-space, nu in {-0.9, 0, 0.3, 0.49, 0.5}, mu_c in {0, 0.5, 1, 1.5},
+loads from one node in contact to full contact, n = 8, 9, 63, 1024 (8400 runs, ~20 s).
+Prints markdown tables of the CG iterations (summed over all inner solves) and the outer
+(Anderson) iterations of the converged runs, min / median / max, grouped by h/lambda, by
+mu_c and by the measured contact fraction, with the number of runs not converged;
+``--list`` also lists the runs that did not converge, with what stopped them.
+
+    .venv/bin/python bench/extremes.py [--list] [--sizes 63 1024]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+import extremes_grid as grid  # noqa: E402
+
+
+def stats(values) -> str:
+    if len(values) == 0:
+        return "– | – | –"
+    v = np.asarray(values)
+    return f"{v.min()} | {int(np.median(v))} | {v.max()}"
+
+
+def table(title: str, key: str, labels, rows) -> None:
+    print(f"| {title} | runs | not conv. | CG it. min | median | max | outer it. min | median | max |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for label in labels:
+        sel = [r for r in rows if r[key] == label]
+        conv = [r for r in sel if r["converged"]]
+        name = "inf" if label == np.inf else f"{label:g}" if isinstance(label, float) else label
+        print(f"| {name} | {len(sel)} | {len(sel) - len(conv)} | {stats([r['iterations'] for r in conv])} | "
+              f"{stats([r['outer'] for r in conv])} |")
+    print()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--list", action="store_true", help="list the runs that did not converge")
+    parser.add_argument("--sizes", type=int, nargs="+", default=list(grid.SIZES))
+    args = parser.parse_args()
+    rows, failures = [], []
+    start = time.perf_counter()
+    for n in args.sizes:
+        for scene in grid.scenes(n):
+            res = grid.solve(scene)
+            rows.append(dict(n=n, profile=scene["profile"], thickness=scene["thickness"], nu=scene["nu"],
+                             friction=scene["friction"], band=grid.band(res.contact_fraction),
+                             converged=res.converged, iterations=res.iterations, outer=res.outer_iterations))
+            if not res.converged:
+                failures.append((scene, res))
+    elapsed = time.perf_counter() - start
+    conv = sum(r["converged"] for r in rows)
+    print(f"{len(rows)} runs (n = {', '.join(map(str, args.sizes))}), {conv} converged, tol {grid.TOL:g}, "
+          f"max_iter {grid.MAX_ITER}, {elapsed:.0f} s; iteration counts of the converged runs; "
+          f"mu_c = 0 and the incompressible half-space are solved by CG alone (1 outer it.)")
+    print()
+    table("h/lambda", "thickness", grid.THICKNESSES, rows)
+    table("mu_c", "friction", grid.FRICTIONS, rows)
+    table("contact fraction", "band", grid.BANDS, rows)
+    per_n = ", ".join(f"n = {n}: {sum(r['converged'] for r in rows if r['n'] == n)}" for n in args.sizes)
+    print(f"converged per grid size: {per_n} (of {len(rows) // len(args.sizes)} each)")
+    if args.list:
+        print()
+        print("| n | profile | h/lambda | nu | mu_c | p_m/p_full | contact | residual | CG it. | outer | what stopped it |")
+        print("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+        for scene, res in failures:
+            print(f"| {scene['n']} | {scene['profile']} | {scene['thickness']:g} | {scene['nu']:g} | "
+                  f"{scene['friction']:g} | {scene['load_factor']:g} | {res.contact_fraction:.4f} | "
+                  f"{res.residual:.1e} | {res.iterations} | {res.outer_iterations} | {grid.diagnose(scene, res)} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,140 @@
+"""The parameter grid of the stability tests at the extremes, shared by
+tests/test_extremes.py (assertions) and bench/extremes.py (iteration table for the README).
+
+Grid: three profiles (a self-affine rough line, one cosine bump = Westergaard's sinusoid,
+a narrow Gaussian bump whose tip is Hertz-like) x h/lambda in {1e-4, 1e-3, 1e-2, 0.16, 1,
+1e3, inf} x nu in {-0.9, 0, 0.3, 0.49, 0.5} x mu_c in {0, 0.5, 1, 1.5} x five loads, on
+n = 8 (the smallest grid allowed), 9, 63 (odd) and 1024 points: 2100 runs per grid size.
+
+Loads are set relative to the full-contact pressure p_full of the scene itself: the
+pressure of full contact is p(x) = p_m + [G_eff^-1 (r - mean r)](x) (w = r + const), so
+full contact holds exactly when p_m >= p_full = -min_x [G_eff^-1 (r - mean r)](x). The
+factors p_m/p_full = 1e-6 ... 0.3 cannot give full contact and 2 must; 1e-6 touches only
+the highest point(s), i.e. one node (contact fraction 1/n ~ 0.1 % at n = 1024).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+import layercontact as lc
+
+THICKNESSES = (1e-4, 1e-3, 1e-2, 0.16, 1.0, 1e3, np.inf)
+POISSON = (-0.9, 0.0, 0.3, 0.49, 0.5)
+FRICTIONS = (0.0, 0.5, 1.0, 1.5)
+LOAD_FACTORS = (1e-6, 1e-3, 0.03, 0.3, 2.0)  # p_m / p_full
+SIZES = (8, 9, 63, 1024)
+PROFILES = ("rough", "sinusoid", "bump")
+TOL = 1e-9
+# Measured: the converged runs need at most ~2000 CG iterations (n = 1024); 10000 leaves
+# a factor 5 and bounds the cost of the runs that stall.
+MAX_ITER = 10000
+# Anderson memory: the default 12, but at most n (LAPACK dgelsd refuses a least-squares
+# problem with more columns than grid points; see test_extremes.py::test_anderson_memory_above_n).
+MEMORY = 12
+
+
+def profiles(n: int) -> dict[str, np.ndarray]:
+    """The three indenter profiles on n points of a unit period (lengths in periods)."""
+    x = np.arange(n) / n
+    return {
+        # self-affine, H = 0.8, rms gradient 0.1, shortest wavelength 4 grid steps
+        "rough": lc.self_affine_profile(n, 0.8, seed=5, short_wavelength=4 / n),
+        # one cosine bump per period: Westergaard's problem on the half-space
+        "sinusoid": 0.01 * np.cos(2 * np.pi * x),
+        # narrow bump, width 0.02 lambda, tip radius 0.04 lambda: Hertz-like at light loads
+        "bump": 0.01 * np.exp(-0.5 * ((x - 0.5) / 0.02) ** 2),
+    }
+
+
+def g_eff(n: int, thickness: float, nu: float, friction: float) -> np.ndarray:
+    """G_eff(k) (E = 1, period 1) for the modes k = 1..n/2 of numpy's rfft, convention P,
+    Nyquist made real. The uniform mode is left out: under load control it only shifts
+    the penetration."""
+    m = np.arange(1, n // 2 + 1)
+    k = 2 * np.pi * m
+    oma, _, c = lc.layer_multipliers(k * thickness, nu)
+    g = 2 * (1 - nu**2) / k * (oma - 1j * friction * c)
+    if n % 2 == 0:
+        g[-1] = g[-1].real
+    return g
+
+
+def full_contact_pressure(r: np.ndarray, thickness: float, nu: float, friction: float) -> float:
+    """Smallest mean pressure at which the whole period is in contact."""
+    rh = np.fft.rfft(r)
+    ph = np.zeros_like(rh)
+    ph[1:] = rh[1:] / g_eff(r.size, thickness, nu, friction)
+    return float(-np.fft.irfft(ph, n=r.size).min())
+
+
+def independent_residual(res: lc.LineResult, thickness: float, nu: float) -> float:
+    """The solver's stopping quantity max_j |min(p_j/p_m, g_j/(max r - min r))|,
+    recomputed from the returned pressure with numpy FFTs and without the uniform mode
+    (the penetration is the mean gap on the contact set, as in the solver)."""
+    r, p = res.height, res.pressure
+    ph = np.fft.rfft(p)
+    ph[0] = 0.0
+    ph[1:] *= g_eff(r.size, thickness, nu, res.friction)
+    gap = np.fft.irfft(ph, n=r.size) - r
+    contact = p > 0
+    gap -= gap[contact].mean()
+    return float(np.max(np.abs(np.minimum(p / res.mean_pressure, gap / np.ptp(r)))))
+
+
+def coupled(thickness: float, nu: float, friction: float) -> bool:
+    """Whether the solver takes the coupled (Anderson) path: friction on anything but an
+    incompressible half-space, whose coupling c is zero (src/contact/operator.f90)."""
+    return friction > 0 and not (np.isinf(thickness) and nu == 0.5)
+
+
+def scenes(n: int):
+    """Every scene of the grid on n points: dicts of the parameters and the profile."""
+    for name, r in profiles(n).items():
+        for thickness, nu, friction in itertools.product(THICKNESSES, POISSON, FRICTIONS):
+            p_full = full_contact_pressure(r, thickness, nu, friction)
+            for factor in LOAD_FACTORS:
+                yield dict(n=n, profile=name, heights=r, thickness=thickness, nu=nu, friction=friction,
+                           load_factor=factor, mean_pressure=factor * p_full)
+
+
+def solve(scene: dict) -> lc.LineResult:
+    return lc.solve_line(scene["heights"], thickness=scene["thickness"], poisson=scene["nu"],
+                         friction=scene["friction"], mean_pressure=scene["mean_pressure"], tol=TOL,
+                         max_iter=MAX_ITER, memory=min(MEMORY, scene["n"]))
+
+
+def band(contact_fraction: float) -> str:
+    """Contact-fraction band of a run (labels of the bench table)."""
+    if contact_fraction <= 0.005:
+        return "<= 0.5 %"
+    if contact_fraction <= 0.05:
+        return "0.5-5 %"
+    if contact_fraction <= 0.5:
+        return "5-50 %"
+    if contact_fraction < 1:
+        return "50-100 %"
+    return "full"
+
+
+BANDS = ("<= 0.5 %", "0.5-5 %", "5-50 %", "50-100 %", "full")
+
+
+def diagnose(scene: dict, res: lc.LineResult) -> str:
+    """Why a run stopped without converging, from what the result reports."""
+    p, gap = res.pressure, res.gap
+    scale = np.ptp(res.height)
+    contact = int(np.count_nonzero(p > 0))
+    overlap = int(np.count_nonzero((p == 0) & (gap < -1e-12 * scale)))
+    if res.iterations >= MAX_ITER:
+        if contact == 1 and overlap > 0:
+            return (f"CG budget spent with 1 contact node and {overlap} overlapping node(s) after "
+                    f"{res.outer_iterations} outer it.: inner CG makes no step")
+        return f"CG budget spent ({res.outer_iterations} outer it.)"
+    if coupled(scene["thickness"], scene["nu"], scene["friction"]):
+        hist = res.residual_history
+        return (f"Anderson stopped on stagnation after {res.outer_iterations} outer it. "
+                f"(best residual {hist.min():.1e} at it. {int(hist.argmin()) + 1})")
+    return "stopped early"
