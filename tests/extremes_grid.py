@@ -31,9 +31,6 @@ TOL = 1e-9
 # Measured: the converged runs need at most ~2000 CG iterations (n = 1024); 10000 leaves
 # a factor 5 and bounds the cost of the runs that stall.
 MAX_ITER = 10000
-# Anderson memory: the default 12, but at most n (LAPACK dgelsd refuses a least-squares
-# problem with more columns than grid points; see test_extremes.py::test_anderson_memory_above_n).
-MEMORY = 12
 
 
 def profiles(n: int) -> dict[str, np.ndarray]:
@@ -103,7 +100,7 @@ def scenes(n: int):
 def solve(scene: dict) -> lc.LineResult:
     return lc.solve_line(scene["heights"], thickness=scene["thickness"], poisson=scene["nu"],
                          friction=scene["friction"], mean_pressure=scene["mean_pressure"], tol=TOL,
-                         max_iter=MAX_ITER, memory=min(MEMORY, scene["n"]))
+                         max_iter=MAX_ITER)
 
 
 def band(contact_fraction: float) -> str:
