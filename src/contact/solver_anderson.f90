@@ -19,6 +19,9 @@ module lc_contact_solver_anderson
    private
    public :: anderson_coupled, anderson_outcome
 
+   !> A mixing step shorter than this (relative to max|x|) is a plateau (see below).
+   real(wp), parameter :: plateau_step = 1.0e-12_wp
+
    !> What one coupled solve did.
    type :: anderson_outcome
       logical :: converged = .false.
@@ -111,8 +114,8 @@ contains
             return
          end if
          if (outcome%cg_iterations >= max_iter) exit
-         ! Stagnation (seen only at the edge of the parameter space, e.g. h/lambda = 1e-4 with
-         ! mu_c = 10): forget the history once; if that does not help either, stop and report.
+         ! Stagnation (thin layers with friction, h/lambda <= 1e-3, where G_eff is nearly
+         ! skew): forget the history once; if that does not help either, stop and report.
          if (outcome%residual < 0.5_wp*best) then
             best = outcome%residual
             last_progress = k
@@ -145,6 +148,15 @@ contains
             do j = 1, columns
                x = x - gamma(j)*(dx(:, j) + df(:, j))
             end do
+            ! A plateau: the inner solve accepted its warm start (T(x) within inner_tol of
+            ! the previous output) and the mixing returns the x it was given; it would do so
+            ! forever. Restart it from a plain step x = T(x), whose inner problem is the
+            ! coupled one at the current p.
+            if (maxval(abs(x - x_old)) <= plateau_step*maxval(abs(x_old))) then
+               columns = 0
+               newest = 0
+               x = tx
+            end if
          end if
       end do
       s = s_full
