@@ -62,7 +62,7 @@ contains
       real(wp), intent(inout) :: history(:)
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: x(:), f(:), x_old(:), f_old(:), tx(:), dx(:, :), df(:, :), b(:), nw(:)
-      real(wp), allocatable :: gamma(:)
+      real(wp), allocatable :: gamma(:), gram(:, :), projection(:)
       type(cg_outcome) :: inner
       real(wp) :: inner_tol, p_ref, s_full, s_inner, best
       integer :: n, k, columns, newest, j, last_progress
@@ -70,7 +70,7 @@ contains
 
       n = size(p)
       allocate (x(n), f(n), x_old(n), f_old(n), tx(n), b(n), nw(n), dx(n, memory), df(n, memory))
-      allocate (gamma(memory))
+      allocate (gamma(memory), gram(memory, memory), projection(memory))
       x = p
       columns = 0
       newest = 0
@@ -136,13 +136,21 @@ contains
             dx(:, newest) = x - x_old
             df(:, newest) = f - f_old
             columns = min(columns + 1, memory)
+            ! the Gram matrix of the history, one new row and column per iteration
+            do j = 1, columns
+               gram(j, newest) = dot(df(:, j), df(:, newest))
+               gram(newest, j) = gram(j, newest)
+            end do
          end if
          x_old = x
          f_old = f
          if (columns == 0) then
             x = tx
          else
-            call least_squares(df(:, 1:columns), f, gamma(1:columns), error)
+            do j = 1, columns
+               projection(j) = dot(df(:, j), f)
+            end do
+            call least_squares(gram(1:columns, 1:columns), projection(1:columns), gamma(1:columns), error)
             if (allocated(error)) return
             x = tx
             do j = 1, columns
@@ -162,33 +170,51 @@ contains
       s = s_full
    end subroutine anderson_coupled
 
-   !> gamma = argmin || f - df gamma ||_2 (SVD-based, rank-revealing).
-   subroutine least_squares(df, f, gamma, error)
-      real(wp), intent(in) :: df(:, :), f(:)
+   !> gamma = argmin || f - DF gamma ||_2 from the normal equations: gram = DF^T DF and
+   !> projection = DF^T f. The columns are scaled to unit norm and the small system solved
+   !> by SVD (dgelsd), dropping directions below 1e-12 of the largest singular value of the
+   !> scaled Gram matrix (1e-6 of DF's: the mixing only needs a few digits of gamma). The
+   !> Gram matrix is updated by one row per iteration, so the cost is two passes over the
+   !> history per iteration instead of a dense least-squares problem of n rows (which on
+   !> top ran threaded in OpenBLAS, busy-waiting on the other core).
+   subroutine least_squares(gram, projection, gamma, error)
+      real(wp), intent(in) :: gram(:, :), projection(:)
       real(wp), intent(out) :: gamma(:)
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: a(:, :), rhs(:, :), sv(:), work(:)
+      real(wp), allocatable :: a(:, :), rhs(:, :), sv(:), work(:), scale(:)
       integer, allocatable :: iwork(:)
       real(wp) :: query(1)
-      integer :: m, ncol, ldb, rank, info, lwork, iquery(1)
+      integer :: ncol, rank, info, lwork, iquery(1), i
 
-      m = size(df, 1)
-      ncol = size(df, 2)
-      ! LAPACK wants the right-hand side with room for the solution: ldb >= max(m, ncol)
-      ! (more history columns than grid points on tiny grids)
-      ldb = max(m, ncol)
-      allocate (a(m, ncol), rhs(ldb, 1), sv(min(m, ncol)))
-      a = df
-      rhs = 0.0_wp
-      rhs(1:m, 1) = f
-      call dgelsd(m, ncol, 1, a, m, rhs, ldb, sv, 1.0e-12_wp, rank, query, -1, iquery, info)
+      ncol = size(gram, 1)
+      allocate (a(ncol, ncol), rhs(ncol, 1), sv(ncol), scale(ncol))
+      do i = 1, ncol
+         scale(i) = sqrt(gram(i, i))
+         if (.not. scale(i) > 0.0_wp) scale(i) = 1.0_wp   ! a zero column: gamma(i) = 0
+      end do
+      do i = 1, ncol
+         a(:, i) = gram(:, i)/(scale*scale(i))
+      end do
+      rhs(:, 1) = projection/scale
+      call dgelsd(ncol, ncol, 1, a, ncol, rhs, ncol, sv, 1.0e-12_wp, rank, query, -1, iquery, info)
       lwork = int(query(1))
       allocate (work(lwork), iwork(max(1, iquery(1))))
-      call dgelsd(m, ncol, 1, a, m, rhs, ldb, sv, 1.0e-12_wp, rank, work, lwork, iwork, info)
+      call dgelsd(ncol, ncol, 1, a, ncol, rhs, ncol, sv, 1.0e-12_wp, rank, work, lwork, iwork, info)
       if (info /= 0) then
          call fatal_error(error, 'anderson: LAPACK dgelsd failed in the mixing step', code_internal)
          return
       end if
-      gamma = rhs(1:ncol, 1)
+      gamma = rhs(:, 1)/scale
    end subroutine least_squares
+
+   !> a . b in one vectorised pass.
+   pure real(wp) function dot(a, b)
+      real(wp), intent(in) :: a(:), b(:)
+      integer :: j
+      dot = 0.0_wp
+      !$omp simd reduction(+:dot)
+      do j = 1, size(a)
+         dot = dot + a(j)*b(j)
+      end do
+   end function dot
 end module lc_contact_solver_anderson
