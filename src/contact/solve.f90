@@ -141,8 +141,9 @@ contains
             & "and tangential fields and the operator is not symmetric; allowed: 'auto' or 'anderson'", code_input)
          return
       end if
+      ! only the first `iterations` entries are written and read (not zeroed: the budget may
+      ! be 1e7 entries, and untouched pages cost nothing)
       allocate (history(scene%solver%max_iter))
-      history = 0.0_wp
       if (op%coupled) then
          call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error)
