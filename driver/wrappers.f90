@@ -182,6 +182,39 @@ subroutine py_check_scene_file(input, stat, errmsg)
    end if
 end subroutine py_check_scene_file
 
+!> The grid size n and tolerance tol the accuracy rule picks for a scene file with
+!> &solver target_error (runs the pilot solve; writes nothing).
+subroutine py_choose_resolution(input, n, tol, stat, errmsg)
+   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_scene, only: scene_type, not_set
+   use lc_io_namelist, only: read_scene
+   use lc_accuracy, only: choose_resolution
+   implicit none (type, external)
+   character(len=*), intent(in) :: input
+   integer, intent(out) :: n
+   real(8), intent(out) :: tol
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   type(scene_type) :: scene
+   character(len=:), allocatable :: text
+   stat = 0
+   errmsg = ''
+   n = 0
+   tol = 0
+   call read_scene(input, scene, text, error)
+   if (.not. allocated(error) .and. scene%solver%target_error == not_set) &
+      & call fatal_error(error, '&solver: target_error is not given in ' // input, code_input)
+   if (.not. allocated(error)) call choose_resolution(scene, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+      return
+   end if
+   n = scene%n
+   tol = scene%solver%tol
+end subroutine py_choose_resolution
+
 !> Surface displacement u_x and stress sigma_xx for a prescribed pressure p (no contact
 !> solve): tau = friction p on an elastic layer (thickness = Inf: half-space).
 subroutine py_surface_fields(n, p, period, thickness, young, poisson, friction, displacement_x, stress_xx, &

@@ -13,6 +13,7 @@ module lc_run
    use lc_io_hdf5, only: check_output, write_results
    use lc_profiles_profile, only: make_profile
    use lc_contact_solve, only: solve_line_contact
+   use lc_accuracy, only: choose_resolution
    use lc_version, only: version_string
    implicit none (type, external)
    private
@@ -39,6 +40,10 @@ contains
       output_file = trim(scene%output_file)
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
+      if (scene%solver%target_error /= not_set) then
+         call choose_resolution(scene, error)
+         if (allocated(error)) return
+      end if
       allocate (height(scene%n))
       call make_profile(scene, height, error)
       if (allocated(error)) return
@@ -84,6 +89,11 @@ contains
       write (unit, '(a)') 'layercontact ' // version_string // ': ' // trim(input)
       if (len_trim(scene%title) > 0) write (unit, '(2x, a)') trim(scene%title)
       write (unit, real_fmt) 'thickness h/lambda', scene%thickness/scene%period
+      if (scene%solver%target_error /= not_set) then
+         write (unit, real_fmt) 'target error', scene%solver%target_error
+         write (unit, int_fmt) 'grid points n (chosen)', scene%n
+         write (unit, real_fmt) 'tolerance tol (chosen)', scene%solver%tol
+      end if
       write (unit, real_fmt) 'Coulomb friction mu_c', result%friction
       write (unit, real_fmt) 'mean pressure p_m', result%mean_pressure, '(S)'
       write (unit, real_fmt) 'contact fraction', result%contact_fraction

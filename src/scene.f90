@@ -64,6 +64,9 @@ module lc_scene
       logical :: coarse_start = .true.
       !> FFTW threads (1 = no threading)
       integer :: threads = 1
+      !> target error of the observables: when set, &scene n and tol are chosen by the
+      !> accuracy rule (lc_accuracy)
+      real(wp) :: target_error = not_set
    end type solver_settings
 
    !> One contact problem.
@@ -219,6 +222,10 @@ contains
             call input_error(error, 'solver', 'memory', to_string(s%memory), '1 <= memory <= 100')
          else if (s%threads < 1 .or. s%threads > 1024) then
             call input_error(error, 'solver', 'threads', to_string(s%threads), '1 <= threads <= 1024')
+         else if (s%target_error /= not_set .and. .not. (s%target_error >= 1.0e-4_wp .and. &
+               & s%target_error <= 0.3_wp)) then
+            call input_error(error, 'solver', 'target_error', to_string(s%target_error), &
+               & '1e-4 <= target_error <= 0.3 (the rule was measured for 1e-3 .. 1e-1)')
          end if
       end associate
    end subroutine check_scene

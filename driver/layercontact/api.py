@@ -267,6 +267,15 @@ def check_scene_file(filename: str | os.PathLike) -> None:
     _check(stat, errmsg)
 
 
+def choose_resolution(filename: str | os.PathLike) -> tuple[int, float]:
+    """The grid size ``n`` and tolerance ``tol`` that a scene file with ``&solver
+    target_error`` will be solved with (the accuracy rule of docs/accuracy.md; runs the
+    pilot solve, writes nothing)."""
+    n, tol, stat, errmsg = _core.py_choose_resolution(os.fspath(filename))
+    _check(stat, errmsg)
+    return int(n), float(tol)
+
+
 def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult:
     """Run a namelist file exactly as the ``layercontact`` executable does (same library
     routine): the HDF5 result is written where ``&output file`` says, and read back.

@@ -323,6 +323,7 @@ contains
          call write_attr_int(loc, 'memory', s%memory, st)
          call write_attr_int(loc, 'precondition', merge(1, 0, s%precondition), st)
          call write_attr_int(loc, 'coarse_start', merge(1, 0, s%coarse_start), st)
+         call write_attr_real(loc, 'target_error', s%target_error, st)
          call write_attr_int(loc, 'threads', s%threads, st)
       end associate
       call write_attr_string(loc, 'output_file', trim(scene%output_file), st)

@@ -29,7 +29,7 @@ module lc_io_namelist
       & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
       & 'amplitude, mode, file, dataset', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
-      & 'method, tol, max_iter, memory, precondition, coarse_start, threads', &
+      & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error', &
       & 'file, overwrite, stress, gap_bins']
 
    character(len=*), parameter :: newline = new_line('a')
@@ -170,6 +170,7 @@ contains
             & // entry('precondition', logical_value(s%precondition)) &
             & // entry('coarse_start', logical_value(s%coarse_start)) &
             & // entry('threads', to_string(s%threads)) &
+            & // entry('target_error', real_value(s%target_error)) &
             & // '/' // newline // '&output' // newline &
             & // entry('file', str_value(scene%output_file)) &
             & // entry('overwrite', logical_value(scene%overwrite)) &
@@ -457,8 +458,9 @@ contains
       character(len=max_string) :: method
       real(wp) :: tol
       integer :: max_iter, memory, threads
+      real(wp) :: target_error
       logical :: precondition, coarse_start
-      namelist /solver/ method, tol, max_iter, memory, precondition, coarse_start, threads
+      namelist /solver/ method, tol, max_iter, memory, precondition, coarse_start, threads, target_error
 
       method = config%solver%method
       tol = config%solver%tol
@@ -466,6 +468,7 @@ contains
       memory = config%solver%memory
       precondition = config%solver%precondition
       coarse_start = config%solver%coarse_start
+      target_error = config%solver%target_error
       threads = config%solver%threads
       read (lines, nml=solver, iostat=stat, iomsg=msg)
       if (stat /= 0) return
@@ -475,6 +478,7 @@ contains
       config%solver%memory = memory
       config%solver%precondition = precondition
       config%solver%coarse_start = coarse_start
+      config%solver%target_error = target_error
       config%solver%threads = threads
    end subroutine read_group_solver
 

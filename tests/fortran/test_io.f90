@@ -229,6 +229,7 @@ contains
          & .and. a%solver%threads == b%solver%threads .and. a%output_file == b%output_file &
          & .and. (a%overwrite .eqv. b%overwrite) .and. (a%solver%precondition .eqv. b%solver%precondition) &
          & .and. (a%solver%coarse_start .eqv. b%solver%coarse_start) &
+         & .and. a%solver%target_error == b%solver%target_error &
          & .and. (a%stress .eqv. b%stress) .and. a%gap_bins == b%gap_bins
    end function same_scene
 
