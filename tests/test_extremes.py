@@ -8,24 +8,25 @@ and 1024: 2100 runs per n, 8400 in all (~12 s alone on 2 cores, ~20 s with other
 The measured contact fraction spans one node (1/1024 ~ 0.1 %) to full contact for every
 profile.
 
-Measured (tol 1e-9, max_iter 10000): converged 2096 of 2100 at n = 8, 2092 at n = 9, 2074
-at n = 63, 2081 at n = 1024 (8343 of 8400). All the others are coupled scenes (mu_c > 0) on
-thin layers (h/lambda <= 1e-3) where the operator is nearly skew (|mu_c c|/(1-A) ~ 1.5 mu_c/(kh)
-at the fundamental): the outer Anderson iteration stops on stagnation (with memory = 60
-instead of 12 those at n = 1024 converge). `.venv/bin/python bench/extremes.py --list`
-prints them; its tables of iteration counts are in the README.
+Measured (tol 1e-9, max_iter 10000): converged 2097 of 2100 at n = 8, 2093 at n = 9, 2092
+at n = 63, 2100 at n = 1024 (8382 of 8400). All the others are coupled scenes (mu_c > 0) on
+thin incompressible layers (h/lambda <= 1e-3) where the operator is nearly skew
+(|mu_c c|/(1-A) ~ 1.5 mu_c/(kh) at the fundamental) on tiny grids: the outer Anderson
+iteration stagnates even with its history grown to 48 and stops, returning its best
+iterate. `.venv/bin/python bench/extremes.py --list` prints them; its tables of iteration
+counts are in the README.
 """
 
 import numpy as np
 import pytest
 
 import layercontact as lc
-from extremes_grid import (PROFILES, SIZES, TOL, MAX_ITER, full_contact_pressure, independent_residual,
-                           profiles, scenes, solve)
+from extremes_grid import (PROFILES, SIZES, TOL, MAX_ITER, coupled, full_contact_pressure,
+                           independent_residual, profiles, scenes, solve)
 
 # Regression guards: the measured counts (docstring) minus 5 (0.25 % of the runs), for a
 # different rounding (FFTW codelets, libm) tipping a marginal stagnation; not a target.
-CONVERGED_AT_LEAST = {8: 2091, 9: 2087, 63: 2069, 1024: 2076}
+CONVERGED_AT_LEAST = {8: 2092, 9: 2088, 63: 2087, 1024: 2095}
 RUNS_PER_SIZE = 3 * 7 * 5 * 4 * 5
 
 
@@ -44,7 +45,13 @@ def test_every_run_converges_or_says_so(n):
         assert all(np.isfinite(s) for s in scalars), where
         # the convergence flag and the residual say the same thing
         assert r.converged == (r.residual <= TOL), where
-        assert r.residual_history.size >= 1 and r.residual_history[-1] == r.residual, where
+        # the residual is that of the returned fields: the last CG iterate, or the best
+        # outer iterate of a coupled solve (the first below tol if it converged)
+        assert r.residual_history.size >= 1, where
+        if coupled(scene["thickness"], scene["nu"], scene["friction"]):
+            assert r.residual == r.residual_history.min(), where
+        else:
+            assert r.residual == r.residual_history[-1], where
         assert 1 <= r.iterations <= MAX_ITER and r.outer_iterations >= 1, where
         assert np.all(r.pressure >= 0), where
         # load control: the mean pressure is imposed by rescaling, exact to rounding (n terms)
