@@ -19,6 +19,8 @@ module lc_contact_solver_anderson
    private
    public :: anderson_coupled, anderson_outcome
 
+   !> Rows per block of the sweeps over the history (a few columns' blocks fit in L1/L2).
+   integer, parameter :: block_rows = 2048
    !> On stagnation the history grows by factors of two up to this factor of &solver memory.
    integer, parameter :: max_memory_factor = 4
    !> A mixing step shorter than this (relative to max|x|) is a plateau (see below).
@@ -130,17 +132,23 @@ contains
          ! Inner solves only need to be a little more accurate than the outer iterate.
          inner_tol = max(0.1_wp*tol, min(1.0e-4_wp, 0.01_wp*outcome%residual))
 
-         ! Anderson mixing on f = T(x) - x.
-         f = tx - x
+         ! Anderson mixing on f = T(x) - x: the new history column (one pass), the Gram
+         ! matrix's new row and the projections DF^T f (one sweep over the history), the
+         ! mixed x (another); the passes over the history are what an outer iteration costs
+         ! besides the inner solve.
          if (k > 1) then
             newest = mod(newest, depth) + 1
-            dx(:, newest) = x - x_old
-            df(:, newest) = f - f_old
             columns = min(columns + 1, depth)
-            ! the Gram matrix of the history, one new row and column per iteration
-            do j = 1, columns
-               gram(j, newest) = dot(df(:, j), df(:, newest))
-               gram(newest, j) = gram(j, newest)
+         end if
+         !$omp simd
+         do j = 1, n
+            f(j) = tx(j) - x(j)
+         end do
+         if (k > 1) then
+            !$omp simd
+            do j = 1, n
+               dx(j, newest) = x(j) - x_old(j)
+               df(j, newest) = f(j) - f_old(j)
             end do
          end if
          x_old = x
@@ -148,15 +156,11 @@ contains
          if (columns == 0) then
             x = tx
          else
-            do j = 1, columns
-               projection(j) = dot(df(:, j), f)
-            end do
+            call history_products(df(:, 1:columns), newest, f, gram(1:columns, newest), projection(1:columns))
+            gram(newest, 1:columns) = gram(1:columns, newest)
             call least_squares(gram(1:columns, 1:columns), projection(1:columns), gamma(1:columns), error)
             if (allocated(error)) return
-            x = tx
-            do j = 1, columns
-               x = x - gamma(j)*(dx(:, j) + df(:, j))
-            end do
+            call mix(tx, dx(:, 1:columns), df(:, 1:columns), gamma(1:columns), x)
             ! A plateau: the inner solve accepted its warm start (T(x) within inner_tol of
             ! the previous output) and the mixing returns the x it was given; it would do so
             ! forever. Restart it from a plain step x = T(x), whose inner problem is the
@@ -244,14 +248,47 @@ contains
       gamma = rhs(:, 1)/scale
    end subroutine least_squares
 
-   !> a . b in one vectorised pass.
-   pure real(wp) function dot(a, b)
-      real(wp), intent(in) :: a(:), b(:)
-      integer :: j
-      dot = 0.0_wp
-      !$omp simd reduction(+:dot)
-      do j = 1, size(a)
-         dot = dot + a(j)*b(j)
+   !> gram_column(j) = df(:, j) . df(:, newest) and projection(j) = df(:, j) . f for every
+   !> column j, in one sweep over df by blocks of rows (df(:, newest) and f stay in cache).
+   pure subroutine history_products(df, newest, f, gram_column, projection)
+      real(wp), intent(in) :: df(:, :), f(:)
+      integer, intent(in) :: newest
+      real(wp), intent(out) :: gram_column(:), projection(:)
+      real(wp) :: g, q
+      integer :: i, i0, i1, j, n
+      n = size(df, 1)
+      gram_column = 0.0_wp
+      projection = 0.0_wp
+      do i0 = 1, n, block_rows
+         i1 = min(n, i0 + block_rows - 1)
+         do j = 1, size(df, 2)
+            g = 0.0_wp
+            q = 0.0_wp
+            !$omp simd reduction(+:g, q)
+            do i = i0, i1
+               g = g + df(i, j)*df(i, newest)
+               q = q + df(i, j)*f(i)
+            end do
+            gram_column(j) = gram_column(j) + g
+            projection(j) = projection(j) + q
+         end do
       end do
-   end function dot
+   end subroutine history_products
+
+   !> x = tx - sum_j gamma_j (dx_j + df_j), by blocks of rows (x stays in cache).
+   pure subroutine mix(tx, dx, df, gamma, x)
+      real(wp), intent(in) :: tx(:), dx(:, :), df(:, :), gamma(:)
+      real(wp), intent(out) :: x(:)
+      integer :: i, i0, i1, j
+      do i0 = 1, size(x), block_rows
+         i1 = min(size(x), i0 + block_rows - 1)
+         x(i0:i1) = tx(i0:i1)
+         do j = 1, size(gamma)
+            !$omp simd
+            do i = i0, i1
+               x(i) = x(i) - gamma(j)*(dx(i, j) + df(i, j))
+            end do
+         end do
+      end do
+   end subroutine mix
 end module lc_contact_solver_anderson
