@@ -23,8 +23,8 @@ module lc_contact_solver_cg
    !> (bounds the drift of the update w <- w - tau M t, a few ulps per iteration).
    integer, parameter :: refresh_interval = 50
    !> Most points whose pressure changed other than along t (clipped or let in) that are
-   !> added to w column by column rather than by recomputing w = M p: one column costs a
-   !> pass over the grid, a transform pair about ten (measured at n = 4096 .. 65536)
+   !> added to w column by column rather than by recomputing w = M p: one column costs one
+   !> pass over the grid, a transform pair (log n passes, at least) several
    integer, parameter :: column_updates = 8
 
    !> What one constrained CG solve did.
@@ -197,7 +197,7 @@ contains
          end if
          tau = gt_sum/denominator
          ! update, clip at zero, and let overlapping points (p = 0, gap < 0) into the contact;
-         ! w follows p along t (exact unless a point was clipped or let in: then stale)
+         ! w follows p along t here, and the points clipped or let in below
          p_sum = 0.0_wp
          changed_count = 0.0_wp
          entered_count = 0.0_wp
@@ -243,7 +243,6 @@ contains
             end if
          end if
       end do
-
    end subroutine constrained_cg
 
    !> The state of p and w, both first scaled by load_scale: the gap, the contact mask
