@@ -1,0 +1,160 @@
+"""Peak memory of one line-contact solve per grid point, n = 2^12 .. 2^20, against the
+number of double arrays the solver holds.
+
+Every solve runs in a fresh subprocess: import layercontact, make the profile (the seed's
+Fig. 2 profile: H = 0.8, shortest wavelength lambda/128, rms gradient 0.1), read the
+resident set (VmRSS, the baseline), call ``layercontact.solve_line`` with its defaults (tol
+1e-10, stress fields, coarse start, max_iter 100000, Anderson memory 12), read
+``ru_maxrss`` (the peak). The baseline is the resident set rather than ``ru_maxrss`` after
+the profile: making the profile has a transient peak of its own (32 MiB above the resident
+set at n = 2^20, freed before the solve) which the solve's pages would otherwise hide; the
+"profile transient" column shows it, and the solve's peak is above it in every row.
+The increase over n is printed in bytes per grid point, next to the count of n-sized double
+arrays alive at the peak (see ``expected`` below); "rest" is the increase minus those
+arrays: mostly the two ``history(max_iter)`` arrays (2 x 100000 doubles = 1.6 MB whatever
+n), FFTW's plans and heap slack. A least-squares fit ``increase = fixed + slope n``
+(n >= 2^14) follows; for the coupled scenes the slope mixes grids whose Anderson history
+holds different numbers of columns (the outer iteration count grows with n).
+
+Scenes: frictionless half-space (symmetric: constrained CG), the coupled thin layer
+h/lambda = 0.16, mu_c = 0.5 (Anderson outer iteration), and a viscoelastic layer
+(StandardLinearSolid E0 = 1, E_inf = 10, tau = 1, V = 1, h/lambda = 0.16, mu_c = 0: complex
+multiplier, Anderson with the full history in use; E_inf/E0 = 100 as in bench/fft_ratio.py
+takes minutes at n = 2^20 and holds the same arrays).
+
+    .venv/bin/python bench/memory.py [--quick] [--max-exponent 20]
+
+``--quick``: n = 2^12, 2^14, 2^16 only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+SCENES = {
+    "half-space, mu_c = 0": "dict(thickness=np.inf, friction=0.0, pressure=0.3)",
+    "h/lambda = 0.16, mu_c = 0.5": "dict(thickness=0.16, friction=0.5, pressure=3.0)",
+    "viscoelastic SLS, h/lambda = 0.16, V = 1": (
+        "dict(thickness=0.16, friction=0.0, pressure=3.0, "
+        "material=lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0), speed=1.0)"),
+}
+
+CHILD = """
+import json, resource, sys, time
+import numpy as np
+import layercontact as lc
+
+def status(key):
+    with open('/proc/self/status') as f:
+        for line in f:
+            if line.startswith(key):
+                return int(line.split()[1])
+
+n = int(sys.argv[1])
+s = eval(sys.argv[2])
+h = lc.self_affine_profile(n, 0.8, seed=1, short_wavelength=1 / 128, rms_gradient=0.1)
+pm = s["pressure"] * (4 / 3) * (h.max() - h.mean())     # p_m/(E* Lambda0/lambda), E* = 4/3
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
+current = status('VmRSS:')
+t = time.perf_counter()
+r = lc.solve_line(h, thickness=s["thickness"], friction=s["friction"], mean_pressure=pm,
+                  material=s.get("material"), speed=s.get("speed", 0.0))
+t = time.perf_counter() - t
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(json.dumps(dict(base=base, current=current, peak=peak, seconds=t, iterations=r.iterations,
+                      outer=r.outer_iterations, converged=bool(r.converged))))
+"""
+
+#: n-sized double arrays alive in each phase of lc.solve_line (complex arrays of n/2 + 1
+#: modes count as one); see the module docstring of each file named.
+F2PY = 7        # driver/wrappers.f90 py_solve_line: fields(n, 5) + spots(n/2+1, 4), zero-filled by f2py
+SOLVE = 3       # src/contact/solve.f90: p, w, gap
+OPERATOR = 5    # src/contact/operator.f90: metric 1/2, preconditioner 1/2, compliance (complex) 1,
+#                 column 1; src/fft/plans.F90: real_buffer 1, spectrum (complex) 1
+FULL = 1        # operator.f90: full (complex G_eff), coupled scenes only
+CG = 4          # src/contact/solver_cg.f90: t, r, z, inside (a real 0/1 mask)
+ANDERSON = 7    # src/contact/solver_anderson.f90: x, f, x_old, f_old, tx, b, nw
+OBSERVE = 9     # src/result.f90 pressure, gap, displacement_z, displacement_x, shear, stress_xx;
+#                 src/observables/surface.f90: ph, uh, sh (complex)
+WRAP_END = 6    # py_solve_line copying the result r (6 fields) into `fields`
+PYTHON = 7      # api._solve_once: 5 field copies, shear = friction * p, height copy
+MEMORY = 12     # Anderson memory (default)
+
+
+def expected(coupled: bool, outer: int) -> tuple[int, str]:
+    """Doubles per grid point at the peak and the phase it is in. Anderson stores a
+    history column per outer iteration after the first two (k = 2 .. K-1; the last one
+    returns), at most MEMORY of them in dx and in df; the least-squares step copies the
+    columns in use plus one right-hand side while the inner CG's 4 arrays are freed."""
+    op = OPERATOR + (FULL if coupled else 0)
+    columns = min(max(outer - 2, 0), MEMORY)
+    solver = ANDERSON + 2 * columns + max(CG, columns + 1) if coupled else CG
+    phases = {
+        "solve": F2PY + SOLVE + op + solver,
+        "observables": F2PY + SOLVE + op + OBSERVE,
+        "wrapper copy-out": F2PY + WRAP_END,
+        "Python copies": F2PY + PYTHON,
+    }
+    phase = max(phases, key=phases.get)
+    return phases[phase], phase
+
+
+def measure(n: int, scene: str) -> dict:
+    done = subprocess.run([sys.executable, "-c", CHILD, str(n), scene], capture_output=True, text=True)
+    if done.returncode:
+        raise RuntimeError(done.stderr)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="n = 2^12, 2^14, 2^16 only")
+    parser.add_argument("--max-exponent", type=int, default=20)
+    args = parser.parse_args()
+    exponents = [12, 14, 16] if args.quick else list(range(12, args.max_exponent + 1))
+    start = time.perf_counter()
+    fits = []
+    print("Peak RSS (ru_maxrss) of one solve (lc.solve_line defaults, tol 1e-10) minus the resident set "
+          "after import and profile, fresh process each; 'expected' counts the n-sized double arrays alive "
+          "at the peak (8 bytes each; fixed-size arrays not included)\n")
+    print("| scene | n | baseline RSS (MiB) | profile transient (MiB) | increase (MiB) | bytes/point "
+          "| expected doubles/point (phase) | expected bytes/point | measured/expected | rest (MiB) "
+          "| CG it. | outer it. | solve (s) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name, scene in SCENES.items():
+        ns, increases = [], []
+        coupled = "friction=0.5" in scene or "material" in scene
+        for e in exponents:
+            n = 2**e
+            m = measure(n, scene)
+            if m["peak"] <= m["base"]:
+                raise RuntimeError(f"n = {n}, {name}: the solve did not exceed the profile's peak")
+            increase = (m["peak"] - m["current"]) * 1024
+            doubles, phase = expected(coupled, m["outer"])
+            ns.append(n)
+            increases.append(increase)
+            flag = "" if m["converged"] else " (not converged)"
+            transient = (m["base"] - m["current"]) / 1024
+            print(f"| {name} | 2^{e} | {m['current'] / 1024:.1f} | {transient:+.1f} | {increase / 2**20:.1f} "
+                  f"| {increase / n:.0f} | {doubles} ({phase}) | {8 * doubles} "
+                  f"| {increase / n / (8 * doubles):.2f} | {(increase - 8 * doubles * n) / 2**20:.2f} "
+                  f"| {m['iterations']} | {m['outer']}{flag} | {m['seconds']:.2f} |", flush=True)
+        large = [i for i, n in enumerate(ns) if n >= 2**14] or list(range(len(ns)))
+        slope, fixed = np.polyfit(np.array(ns)[large], np.array(increases)[large], 1)
+        fits.append((name, slope, fixed))
+    print("\nLeast-squares fit increase = fixed + slope n (n >= 2^14):\n")
+    print("| scene | slope (bytes/point) | slope (doubles/point) | fixed (MiB) |")
+    print("|---|---:|---:|---:|")
+    for name, slope, fixed in fits:
+        print(f"| {name} | {slope:.0f} | {slope / 8:.1f} | {fixed / 2**20:.2f} |")
+    print(f"\n({time.perf_counter() - start:.0f} s)")
+
+
+if __name__ == "__main__":
+    main()
