@@ -15,10 +15,11 @@ scratch in a temporary directory (deleted at the end; nothing is written in the 
   (e) as (c) with OPENBLAS_NUM_THREADS=1
   optional: (f) as (b) with OPENBLAS_NUM_THREADS=1; (g) as (e) with OMP_WAIT_POLICY=passive
 
-Why OPENBLAS_NUM_THREADS: the library's LAPACK is Debian's OpenBLAS (openblas-pthread), and
-the Anderson mixing step calls dgelsd on an n x (<= 12) matrix: OpenBLAS runs it on as
-many threads as there are cores, and its threads spin while waiting, so a single-process
-solve burns ~1.8 cores here and two worker processes put four busy threads on two cores.
+Why OPENBLAS_NUM_THREADS: the library's LAPACK is Debian's OpenBLAS (openblas-pthread).
+The Anderson mixing step used to call dgelsd on an n x (<= 12) matrix, which OpenBLAS ran
+on as many threads as there are cores, spinning while waiting (a single-process solve
+burnt ~1.8 cores, and (d) was faster than (a)). It now solves a small Gram system, and (d)
+checks that nothing threaded is left (measured: no gain).
 
 (c), (e) and (g) need a second venv built with the meson option ``openmp`` (README: &solver
 threads), e.g. ``--build-openmp`` or by hand::
@@ -32,7 +33,8 @@ Then the same run's overheads: "solver" is the sum of the ``wall_time`` every re
 holds (``/results@wall_time``: building the operator and solving, not the observables);
 "outside" is worker-seconds (wall x workers) minus that. A sample of scenes is then run
 in this process, step by step, to split the per-scene overhead (Fortran ``py_run``: namelist,
-profile, solve, observables, HDF5 write; the read-back in ``layercontact.run``; the
+profile, solve, observables, HDF5 write; the read-back in ``layercontact.run``, which the
+sweep worker skips; the
 summary columns the sweep worker reads again), and the fixed costs of the sweep command
 (writing and checking the scene files; a resumed run with every result complete).
 
@@ -238,9 +240,9 @@ def per_scene_steps(directory: Path, name: str, sample: int) -> dict[str, float]
         "- solver (/results@wall_time)": solver,
         "- profile generation (timed alone)": profile,
         "- the rest: namelist, observables, HDF5 write": run - solver - profile,
-        "read-back of the whole result in layercontact.run (discarded by the worker)": read_back,
+        "read-back of the whole result in layercontact.run (the sweep worker skips it)": read_back,
         "sweep._result_columns (opens the result again)": columns,
-        "outside the solver, total": run - solver + read_back + columns,
+        "outside the solver, total (sweep worker)": run - solver + columns,
     }
     return {key: value / len(picks) for key, value in steps.items()}
 

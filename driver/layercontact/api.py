@@ -280,6 +280,12 @@ def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult:
     """Run a namelist file exactly as the ``layercontact`` executable does (same library
     routine): the HDF5 result is written where ``&output file`` says, and read back.
     Raises :class:`LayercontactError` on bad input (nothing is written)."""
+    return read_result(run_to_file(filename, verbose))
+
+
+def run_to_file(filename: str | os.PathLike, verbose: bool = False) -> str:
+    """Run a namelist file like :func:`run`, without reading the result back; returns the
+    result file's path (for sweeps, which read only the scalars they tabulate)."""
     out, converged, stat, errmsg = _core.py_run(os.fspath(filename), 1 if verbose else 0)
     _check(stat, errmsg)
-    return read_result(out.decode().strip() if isinstance(out, bytes) else str(out).strip())
+    return out.decode().strip() if isinstance(out, bytes) else str(out).strip()

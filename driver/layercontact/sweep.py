@@ -42,7 +42,7 @@ from pathlib import Path
 import f90nml
 import numpy as np
 
-from .api import LayercontactError, check_scene_file, run
+from .api import LayercontactError, check_scene_file, run_to_file
 
 SWEEP_GROUP = "sweep"
 SUMMARY_GROUP = "summary"
@@ -383,7 +383,7 @@ def _failure(message: str) -> dict[str, object]:
 def _solve(scene_file: str, result_file: str) -> dict[str, object]:
     """Worker: run one scene file, return its result columns (or its error)."""
     try:
-        run(scene_file)
+        run_to_file(scene_file)
         return _outcome(_result_columns(Path(result_file)))
     except Exception as err:  # reported in the summary, the other scenes go on
         return _failure(f"{type(err).__name__}: {err}")
