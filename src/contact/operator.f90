@@ -74,6 +74,8 @@ module lc_contact_operator
       procedure :: apply_difference
       procedure :: apply_inverse_metric
       procedure :: add_column
+      procedure :: metric_in_buffer
+      procedure :: inverse_metric_in_buffer
       procedure :: drop_uniform_mode
       procedure :: wavenumber
    end type compliance_operator
@@ -251,17 +253,37 @@ contains
       w(1:j - 1) = w(1:j - 1) + value*self%column(n - j + 2:n)
    end subroutine add_column
 
+   !> fft%real_buffer <- M fft%real_buffer: for a solver that writes its input into the
+   !> buffer and reads the output from it (two passes over the grid fewer than apply_metric).
+   subroutine metric_in_buffer(self)
+      class(compliance_operator), intent(inout) :: self
+      call multiply_in_buffer(self, self%metric)
+   end subroutine metric_in_buffer
+
+   !> fft%real_buffer <- P fft%real_buffer with the preconditioner P (see metric_in_buffer).
+   subroutine inverse_metric_in_buffer(self)
+      class(compliance_operator), intent(inout) :: self
+      call multiply_in_buffer(self, self%preconditioner)
+   end subroutine inverse_metric_in_buffer
+
    !> w = multiplier * p through the plans; the 1/n of the forward transform is folded in.
    subroutine apply_real(self, multiplier, p, w)
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(in) :: multiplier(:), p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
+      call multiply_in_buffer(self, multiplier)
+      w = self%fft%real_buffer
+   end subroutine apply_real
+
+   !> fft%real_buffer <- multiplier * fft%real_buffer.
+   subroutine multiply_in_buffer(self, multiplier)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), intent(in) :: multiplier(:)
       call self%fft%forward_unscaled()
       self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
       call self%fft%backward()
-      w = self%fft%real_buffer
-   end subroutine apply_real
+   end subroutine multiply_in_buffer
 
    !> The same with a complex multiplier.
    subroutine apply_complex(self, multiplier, p, w)

@@ -56,7 +56,8 @@ contains
       real(wp), contiguous, intent(out) :: w(:), gap(:)
       type(cg_outcome), intent(out) :: outcome
       real(wp), intent(inout), optional :: history(:)
-      real(wp), allocatable :: t(:), r(:), z(:)
+      real(wp), allocatable :: t(:), z(:)
+      real(wp), pointer, contiguous :: buffer(:), r(:)
       !> 1 on the contact set (p > 0), 0 elsewhere: masks by multiplication keep the passes
       !> over the grid free of branches, so that they vectorise
       real(wp), allocatable :: inside(:)
@@ -70,7 +71,12 @@ contains
       ! quantities) because at large n the solver is memory-bound: whole-array expressions
       ! with masks cost a pass each, about as much as the FFTs together.
       n = size(p)
-      allocate (t(n), r(n), z(n), inside(n))
+      allocate (t(n), z(n), inside(n))
+      ! The operator's FFT buffer is written and read in place (two passes fewer per
+      ! transform than copying in and out); r = M t is the buffer's content after the
+      ! transform, and the buffer is overwritten by the next transform.
+      buffer => op%fft%real_buffer
+      r => buffer
       t = 0.0_wp
       gnorm_old = 1.0_wp
       restart = .true.
@@ -135,21 +141,21 @@ contains
          ! search direction t: the (preconditioned) residual on the contact set, conjugated
          if (preconditioned) then
             do j = 1, n
-               z(j) = gap(j)*inside(j)
+               buffer(j) = gap(j)*inside(j)
             end do
-            call op%apply_inverse_metric(z, r)
+            call op%inverse_metric_in_buffer()
             outcome%fft_pairs = outcome%fft_pairs + 1
             z_sum = 0.0_wp
             !$omp simd reduction(+:z_sum)
             do j = 1, n
-               z_sum = z_sum + r(j)*inside(j)
+               z_sum = z_sum + buffer(j)*inside(j)
             end do
             if (.not. load_control) z_sum = 0.0_wp
             z_mean = z_sum/n_contact
             gnorm = 0.0_wp
             !$omp simd reduction(+:gnorm)
             do j = 1, n
-               z(j) = (r(j) - z_mean)*inside(j)
+               z(j) = (buffer(j) - z_mean)*inside(j)
                gnorm = gnorm + gap(j)*z(j)
             end do
          end if
@@ -158,13 +164,15 @@ contains
          if (preconditioned) then
             do j = 1, n
                t(j) = (z(j) + beta*t(j))*inside(j)
+               buffer(j) = t(j)
             end do
          else
             do j = 1, n
                t(j) = (gap(j) + beta*t(j))*inside(j)
+               buffer(j) = t(j)
             end do
          end if
-         call op%apply_metric(t, r)
+         call op%metric_in_buffer()   ! r = M t
          outcome%fft_pairs = outcome%fft_pairs + 1
          ! step along t on the contact set; with load control the mean of M t over the
          ! contact set is removed (the multiplier s absorbs it):
