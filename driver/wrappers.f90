@@ -67,10 +67,12 @@ end subroutine py_self_affine_profile
 !> fields(:, 1:5): pressure, gap, displacement_z, displacement_x, stress_xx (the last two
 !> zero unless stress = 1); spots(1:n_spots, 1:4): trailing and leading edges, largest
 !> sigma_xx around the spot and its offset from the trailing edge (zero unless stress = 1);
-!> scalars: in the order of layercontact.api._SCALARS.
+!> scalars: in the order of layercontact.api._SCALARS; history(1:history_length): the last
+!> residuals of the run, at most `capacity` (an array of max_iter entries would cost more
+!> than a small solve).
 subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
       & penetration, method, precondition, coarse_start, tol, max_iter, memory, threads, stress, model, form, e0, e_inf, tau, &
-      & equilibrium, nt, times, values, speed, fields, spots, scalars, history, stat, errmsg)
+      & equilibrium, nt, times, values, speed, capacity, fields, spots, scalars, history, stat, errmsg)
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, check_scene
    use lc_result, only: contact_result
@@ -78,9 +80,10 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    use lc_greens_viscoelastic, only: make_material_law
    implicit none (type, external)
    integer, intent(in) :: n, control, method, precondition, coarse_start, max_iter, memory, threads, stress, model, form, nt
+   integer, intent(in) :: capacity
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
    real(8), intent(in) :: e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
-   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 4), scalars(25), history(max_iter)
+   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 4), scalars(25), history(capacity)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n, nt
@@ -88,6 +91,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    type(scene_type) :: scene
    type(contact_result) :: r
    character(len=12), parameter :: controls(0:1) = [character(len=12) :: 'load', 'displacement']
+   integer :: stored
    character(len=8), parameter :: methods(0:2) = [character(len=8) :: 'auto', 'cg', 'anderson']
    stat = 0
    errmsg = ''
@@ -123,12 +127,12 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    spots(1:r%n_spots, 2) = r%spot_leading
    if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 3) = r%spot_max_tension
    if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 4) = r%spot_tension_offset
-   history = 0
-   history(1:size(r%residual_history)) = r%residual_history
+   stored = min(size(r%residual_history), capacity)
+   history(1:stored) = r%residual_history(size(r%residual_history) - stored + 1:)
    scalars = [r%mean_pressure, r%penetration, r%contact_fraction, r%delta_mu, r%delta_mu_spectral, &
       & r%delta_mu_energy, r%delta_mu_profile, merge(1.0d0, 0.0d0, r%converged), real(r%iterations, 8), &
       & real(r%outer_iterations, 8), real(r%fft_pairs, 8), r%residual, r%wall_time, &
-      & real(size(r%residual_history), 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
+      & real(stored, 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
       & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), &
       & r%pressure_shift, r%summit_shift]
 end subroutine py_solve_line

@@ -21,6 +21,9 @@ _SCALARS = (
     "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
 )
 _INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
+# Residuals returned per solve (the last ones): a max_iter-long array would cost more than
+# a small solve.
+HISTORY_CAPACITY = 10000
 
 
 class LayercontactError(RuntimeError):
@@ -72,6 +75,8 @@ class LineResult:
     trailing (-x) and leading (+x) edges; ``leak_rate = <g^3>/12`` is the flow across the
     sliding direction per unit length, per unit pressure gradient, times the viscosity.
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
+    ``residual_history`` holds the residual per CG iteration (per outer iteration for a
+    coupled solve); from :func:`solve_line`, the last ``HISTORY_CAPACITY`` (10000) of them.
     """
 
     pressure: np.ndarray
@@ -197,6 +202,7 @@ def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure
         NOT_SET if penetration is None else float(penetration),
         _METHODS[method], int(bool(precondition)), int(bool(coarse_start)), float(tol), int(max_iter), int(memory), int(threads),
         int(bool(stress)), model, form, e0, e_inf, tau, eq, times, values, float(speed),
+        min(int(max_iter), HISTORY_CAPACITY),
     )
     _check(stat, errmsg)
     scalars = {name: (int(v) if name in _INTEGERS else float(v)) for name, v in zip(_SCALARS, s)}
