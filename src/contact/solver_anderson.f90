@@ -9,7 +9,8 @@
 !> does not degrade with the strength of the coupling.
 !>
 !> Convergence is judged on the complementarity residual of the full coupled problem at
-!> T's output (which is always feasible: p >= 0 and the load is exact).
+!> T's output (which is always feasible: p >= 0 and the load is exact). A run that stops
+!> without converging returns its best iterate (the smallest residual).
 module lc_contact_solver_anderson
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_internal
