@@ -26,6 +26,7 @@ where terms cancel near its zero (1/4 < nu < 1/2). `bound` evaluates this with m
 the comparisons below therefore use no tolerance that is not derived from the formulas.
 """
 
+import importlib.util
 import math
 import re
 
@@ -34,6 +35,11 @@ import pytest
 
 import layercontact as lc
 from conftest import ROOT
+
+_spec = importlib.util.spec_from_file_location("make_kernel_reference",
+                                               ROOT / "tests" / "reference" / "make_kernel_reference.py")
+_reference = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_reference)
 
 mpmath = pytest.importorskip("mpmath")
 
@@ -78,16 +84,10 @@ def lib(x, nu):
 
 def exact(x, nu, dps: int | None = 60):
     """Seed Eqs. (7)-(9) in convention P at the exact inputs, `dps` digits (None: the
-    current precision, for mpmath.diff, which raises it for its difference quotients)."""
+    current precision, for mpmath.diff, which raises it for its difference quotients);
+    the formulas of tests/reference/make_kernel_reference.py."""
     with mpmath.workdps(dps or mpmath.mp.dps):
-        x, nu = mpmath.mpf(x), mpmath.mpf(nu)
-        kappa = 3 - 4 * nu
-        d = kappa * mpmath.cosh(2 * x) + 2 * x**2 + (1 + kappa**2) / 2
-        a = (kappa * mpmath.sinh(2 * x) - 2 * x) / d
-        b = (kappa * mpmath.sinh(2 * x) + 2 * x) / d
-        cc = 4 * (1 - nu) * (2 + x**2 - 6 * nu + 4 * nu**2) / d
-        c = ((1 - 2 * nu) - cc) / (2 * (1 - nu))
-        return a, b, c
+        return _reference.coefficients(x, nu)
 
 
 def bound(x: float, nu: float):

@@ -36,7 +36,8 @@ def x_grid():
 
 
 def coefficients(x, nu):
-    """Return (1-A, 1-B, c) from Eqs. (7)-(9) in mpmath arithmetic."""
+    """Return (1-A, 1-B, c) from Eqs. (7)-(9) in mpmath arithmetic, at the current
+    mpmath precision (tests/test_kernel_branches.py uses it too)."""
     x = mpmath.mpf(x)
     nu = mpmath.mpf(nu)
     kappa = 3 - 4 * nu
