@@ -25,7 +25,7 @@ module lc_accuracy
    use lc_contact_solve, only: solve_line_contact
    implicit none (type, external)
    private
-   public :: choose_resolution, predicted_ppw
+   public :: choose_resolution
 
    !> Constants of the rule (bench/accuracy.py: RULE_SPOT, RULE_TENSION).
    real(wp), parameter :: spot_constant = 0.75_wp, tension_constant = 0.9_wp
