@@ -187,9 +187,12 @@ contains
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(out) :: uniform
       uniform = self%metric(1)
+      if (uniform == 0.0_wp) return   ! half-space, incompressible layer
       self%metric(1) = 0.0_wp
       self%preconditioner(1) = 0.0_wp
       if (self%coupled) self%full(1) = 0.0_wp
+      ! (derived afresh: subtracting uniform/n from the column would cancel catastrophically
+      ! on thick layers, where it dominates)
       call derive(self)
    end subroutine drop_uniform_mode
 
