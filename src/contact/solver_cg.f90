@@ -104,7 +104,7 @@ contains
                stale = .false.
             end if
             call evaluate_state(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, m_max, gap, inside, s, &
-               & n_contact, gnorm, outcome%residual)
+               & n_contact, gnorm, outcome%residual, buffer)
             load_scale = 1.0_wp
             if (since_fresh == 0 .or. .not. (outcome%residual <= tol .or. it > max_iter)) exit
             stale = .true.
@@ -140,9 +140,7 @@ contains
 
          ! search direction t: the (preconditioned) residual on the contact set, conjugated
          if (preconditioned) then
-            do j = 1, n
-               buffer(j) = gap(j)*inside(j)
-            end do
+            ! (evaluate_state left the gap on the contact set in the buffer)
             call op%inverse_metric_in_buffer()
             outcome%fft_pairs = outcome%fft_pairs + 1
             z_sum = 0.0_wp
@@ -253,11 +251,12 @@ contains
       end do
    end subroutine constrained_cg
 
-   !> The state of p and w, both first scaled by load_scale: the gap, the contact mask
-   !> `inside`, s (found under load control), the number of contact points, the squared gap
-   !> norm on the contact set and the complementarity residual.
+   !> The state of p and w, both first scaled by load_scale: the gap (and the gap masked to
+   !> the contact set), the contact mask `inside`, s (found under load control), the number
+   !> of contact points, the squared gap norm on the contact set and the complementarity
+   !> residual.
    subroutine evaluate_state(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, m_max, gap, inside, &
-         & s, n_contact, gnorm, residual)
+         & s, n_contact, gnorm, residual, masked_gap)
       real(wp), contiguous, intent(inout) :: p(:), w(:)
       real(wp), contiguous, intent(in) :: b(:)
       real(wp), intent(in) :: load_scale, mean_pressure, g_ref, b_max, m_max
@@ -266,6 +265,9 @@ contains
       real(wp), intent(inout) :: s
       integer, intent(out) :: n_contact
       real(wp), intent(out) :: gnorm, residual
+      !> the gap on the contact set, 0 elsewhere (the preconditioner's input, written here to
+      !> save a pass over the grid)
+      real(wp), contiguous, intent(out) :: masked_gap(:)
       real(wp) :: contact_count, gap_sum, p_sum, w_max, p_max, p_ref, pscale, g_floor, check, g, c
       integer :: j, n
 
@@ -303,6 +305,7 @@ contains
          c = abs(min(p(j)*pscale, g/g_ref))
          residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
          gnorm = gnorm + g*g*inside(j)
+         masked_gap(j) = g*inside(j)
          check = check + g
       end do
       ! a NaN or Inf gap or pressure (which max() may skip) makes a sum non-finite:
