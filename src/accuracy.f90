@@ -10,8 +10,10 @@
 !> at the trailing edge); a tolerance tol blurs the edges by ~5 tol^(2/3). Hence, with
 !> lambda_s the shortest roughness wavelength and ppw the grid points per lambda_s:
 !>    ppw = the smallest power of two >= 4 with ppw >= 0.75 (lambda_s/spot length)/eps,
-!>          and, with friction and the surface stress wanted, ppw >= (0.9/eps)^2;
-!>    tol = the largest of 1e-2, 1e-3, 1e-4, 1e-6, 1e-8 that is <= (eps/10)^1.5;
+!>          and, with friction and the surface stress wanted, ppw >= (1.2/eps)^2;
+!>    tol = the largest of 1e-2, 1e-3, 1e-4, 1e-6, 1e-8 that is <= (eps/10)^1.5 and, with
+!>          friction and the surface stress wanted, <= (eps/1.5)^3 (the tolerance blurs the
+!>          trailing edge, and the cusp turns that into ~tol^(1/3) of tension);
 !> where the mean spot length comes from a pilot solve at ppw = 8 and tol 1e-4. Checked on
 !> four scenes (frictionless half-space, h/lambda = 0.16 and 0.01 with mu_c = 0.5, a
 !> viscoelastic layer) for eps = 1e-1 .. 1e-3, on the fitted profile and on a second one.
@@ -28,7 +30,7 @@ module lc_accuracy
    public :: choose_resolution
 
    !> Constants of the rule (bench/accuracy.py: RULE_SPOT, RULE_TENSION).
-   real(wp), parameter :: spot_constant = 0.75_wp, tension_constant = 0.9_wp
+   real(wp), parameter :: spot_constant = 0.75_wp, tension_constant = 1.2_wp, tension_tol_constant = 1.5_wp
    !> The tolerances the rule was measured with.
    real(wp), parameter :: tested_tols(5) = [1.0e-2_wp, 1.0e-3_wp, 1.0e-4_wp, 1.0e-6_wp, 1.0e-8_wp]
    !> Largest grid the rule may ask for (memory ~0.1 GB; beyond, the target is refused).
@@ -48,6 +50,7 @@ contains
       real(wp) :: eps, wavelengths, spot
       integer :: ppw
       integer(kind=8) :: n
+      logical :: tension
 
       eps = scene%solver%target_error
       select case (trim(scene%profile%kind))
@@ -80,7 +83,8 @@ contains
       if (result%n_spots > 0) spot = max(spot, result%contact_length/result%n_spots)
       spot = spot*wavelengths/scene%period
 
-      ppw = predicted_ppw(eps, spot, scene%friction > 0.0_wp .and. scene%stress)
+      tension = scene%friction > 0.0_wp .and. scene%stress
+      ppw = predicted_ppw(eps, spot, tension)
       n = int(ppw, kind=8)*ceiling(wavelengths, kind=8)
       if (ppw < 0 .or. n > largest_grid) then
          call fatal_error(error, '&solver: target_error = ' // to_string(eps) // ' needs more than ' // &
@@ -90,7 +94,7 @@ contains
          return
       end if
       scene%n = grid_points(ppw, wavelengths)
-      scene%solver%tol = rule_tol(eps)
+      scene%solver%tol = rule_tol(eps, tension)
    end subroutine choose_resolution
 
    !> Points per shortest wavelength for target eps and mean spot length `spot` (in shortest
@@ -111,13 +115,18 @@ contains
       end do
    end function predicted_ppw
 
-   !> The largest tested tolerance <= (eps/10)^1.5 (the smallest if none is).
-   pure real(wp) function rule_tol(eps) result(tol)
+   !> The largest tested tolerance <= (eps/10)^1.5, and <= (eps/1.5)^3 with `tension` (the
+   !> smallest if none is).
+   pure real(wp) function rule_tol(eps, tension) result(tol)
       real(wp), intent(in) :: eps
+      logical, intent(in) :: tension
+      real(wp) :: bound
       integer :: i
+      bound = (eps/10)**1.5_wp
+      if (tension) bound = min(bound, (eps/tension_tol_constant)**3)
       tol = tested_tols(size(tested_tols))
       do i = 1, size(tested_tols)
-         if (tested_tols(i) <= (eps/10)**1.5_wp*(1 + 1.0e-9_wp)) then
+         if (tested_tols(i) <= bound*(1 + 1.0e-9_wp)) then
             tol = tested_tols(i)
             return
          end if
