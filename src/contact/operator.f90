@@ -72,7 +72,6 @@ module lc_contact_operator
       procedure :: apply_metric
       procedure :: apply_full
       procedure :: apply_difference
-      procedure :: apply_inverse_metric
       procedure :: add_column
       procedure :: metric_in_buffer
       procedure :: inverse_metric_in_buffer
@@ -234,14 +233,6 @@ contains
          w = 0.0_wp
       end if
    end subroutine apply_difference
-
-   !> w = P p with the preconditioner P ~ M^-1 of the constrained CG (see `preconditioner`).
-   subroutine apply_inverse_metric(self, p, w)
-      class(compliance_operator), intent(inout) :: self
-      real(wp), intent(in) :: p(:)
-      real(wp), intent(out) :: w(:)
-      call apply_real(self, self%preconditioner, p, w)
-   end subroutine apply_inverse_metric
 
    !> w = w + value M e_j: the metric's response to a point load at x_j, in one pass.
    pure subroutine add_column(self, j, value, w)
