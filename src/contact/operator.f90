@@ -249,10 +249,42 @@ contains
 
    !> fft%real_buffer <- M fft%real_buffer: for a solver that writes its input into the
    !> buffer and reads the output from it (two passes over the grid fewer than apply_metric).
-   subroutine metric_in_buffer(self)
+   !> energy = sum_j t_j (M t)_j for the input t, by Parseval from the spectrum (in the
+   !> multiplying pass, so without a pass over the grid).
+   subroutine metric_in_buffer(self, energy)
       class(compliance_operator), intent(inout) :: self
-      call multiply_in_buffer(self, self%metric)
+      real(wp), intent(out), optional :: energy
+      if (present(energy)) then
+         call self%fft%forward_unscaled()
+         call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, mod(self%n, 2) == 0, energy)
+         call self%fft%backward()
+      else
+         call multiply_in_buffer(self, self%metric)
+      end if
    end subroutine metric_in_buffer
+
+   !> spectrum <- spectrum * multiplier/n, and energy = (1/n) sum over the whole spectrum of
+   !> multiplier |spectrum|^2 (the modes 1..ceil(n/2)-1 of the half spectrum stand for two,
+   !> k and -k; k = 0 and, for even n, the Nyquist mode for one).
+   pure subroutine multiply_with_energy(spectrum, multiplier, inv_n, even, energy)
+      complex(wp), intent(inout) :: spectrum(:)
+      real(wp), intent(in) :: multiplier(:), inv_n
+      logical, intent(in) :: even
+      real(wp), intent(out) :: energy
+      real(wp) :: f, twice, once
+      integer :: m, nk
+      nk = size(spectrum)
+      once = multiplier(1)*inv_n*abs(spectrum(1))**2
+      if (even .and. nk > 1) once = once + multiplier(nk)*inv_n*abs(spectrum(nk))**2
+      twice = 0.0_wp
+      !$omp simd reduction(+:twice) private(f)
+      do m = 1, nk
+         f = multiplier(m)*inv_n
+         twice = twice + f*(real(spectrum(m), wp)**2 + aimag(spectrum(m))**2)
+         spectrum(m) = spectrum(m)*f
+      end do
+      energy = 2.0_wp*twice - once
+   end subroutine multiply_with_energy
 
    !> fft%real_buffer <- P fft%real_buffer with the preconditioner P (see metric_in_buffer).
    subroutine inverse_metric_in_buffer(self)

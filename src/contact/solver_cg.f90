@@ -36,6 +36,17 @@ module lc_contact_solver_cg
       real(wp) :: residual = huge(1.0_wp)
    end type cg_outcome
 
+   !> Sums over the grid that the state evaluation needs: contact points, sums of the raw
+   !> gap d = w - b and of b over the contact set, max |w|, max p, sum p.
+   type :: grid_sums
+      real(wp) :: contact = 0.0_wp
+      real(wp) :: d_contact = 0.0_wp
+      real(wp) :: b_contact = 0.0_wp
+      real(wp) :: w_max = 0.0_wp
+      real(wp) :: p_max = 0.0_wp
+      real(wp) :: p_sum = 0.0_wp
+   end type grid_sums
+
 contains
 
    !> Solve the symmetric problem with metric M. On entry p is the starting guess
@@ -56,28 +67,27 @@ contains
       real(wp), contiguous, intent(out) :: w(:), gap(:)
       type(cg_outcome), intent(out) :: outcome
       real(wp), intent(inout), optional :: history(:)
-      real(wp), allocatable :: t(:), z(:)
-      real(wp), pointer, contiguous :: buffer(:), r(:)
-      !> 1 on the contact set (p > 0), 0 elsewhere: masks by multiplication keep the passes
-      !> over the grid free of branches, so that they vectorise
-      real(wp), allocatable :: inside(:)
-      real(wp) :: gnorm, gnorm_old, tau, denominator, best, beta, b_max, m_max
-      real(wp) :: p_sum, z_sum, r_sum, rt_sum, t_sum, gt_sum, load_scale
-      integer :: it, j, n, n_contact, last_progress, since_fresh, n_changed
-      real(wp) :: trial, p_new, z_mean, g, c, changed_count, entered_count
+      real(wp), allocatable :: t(:)
+      !> the operator's FFT buffer: transform input and output, written and read in place
+      real(wp), pointer, contiguous :: buffer(:)
+      type(grid_sums) :: sums
+      real(wp) :: gnorm, gnorm_old, tau, best, beta, b_max, m_max, load_scale, p_ref, g_floor
+      real(wp) :: gt_sum, gz_sum, z_mean, t_sum, t_left, t_shift, denominator
+      integer :: it, n, n_contact, last_progress, since_fresh, n_changed
       logical :: restart, preconditioned, stale
 
-      ! The loops below are written out (one pass over the grid for each group of
-      ! quantities) because at large n the solver is memory-bound: whole-array expressions
-      ! with masks cost a pass each, about as much as the FFTs together.
+      ! The iteration works on the raw gap d = w - b (kept in `gap`) instead of w: the
+      ! update moves it with w (d <- d - tau M t), and the gap on the contact set is d - s.
+      ! An iteration is then three or four passes over the grid (state, preconditioner's
+      ! mean, direction, update) around the transforms, each streaming few arrays with
+      ! little arithmetic: at large n a pass costs about as much as one of the FFT's.
       n = size(p)
-      allocate (t(n), z(n), inside(n))
-      ! The operator's FFT buffer is written and read in place (two passes fewer per
-      ! transform than copying in and out); r = M t is the buffer's content after the
-      ! transform, and the buffer is overwritten by the next transform.
+      associate (d => gap)
+      allocate (t(n))
       buffer => op%fft%real_buffer
-      r => buffer
       t = 0.0_wp
+      t_sum = 0.0_wp
+      t_left = 0.0_wp
       gnorm_old = 1.0_wp
       restart = .true.
       p = max(p, 0.0_wp)
@@ -92,19 +102,29 @@ contains
       since_fresh = 0
       load_scale = 1.0_wp
       do it = 1, max_iter + 1
-         ! w = M p is recomputed only when p changed other than along t (a point clipped or
-         ! let in), every refresh_interval iterations, and to confirm convergence or return
-         ! at max_iter (so that the fields returned belong together); otherwise it was
-         ! updated in place (w <- w - tau M t), which saves one FFT pair per iteration.
+         ! w = M p is recomputed only when p changed other than along t (more than a few
+         ! points clipped or let in), every refresh_interval iterations, and to confirm
+         ! convergence or return at max_iter (so that the fields returned belong together);
+         ! otherwise d was updated in place (d <- d - tau M t), which saves one FFT pair
+         ! per iteration.
          do
             if (stale .or. since_fresh >= refresh_interval) then
                call op%apply_metric(p, w)
                outcome%fft_pairs = outcome%fft_pairs + 1
                since_fresh = 0
                stale = .false.
+               call fresh_state(p, w, b, load_scale, d, sums)
+               load_scale = 1.0_wp
             end if
-            call evaluate_state(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, m_max, gap, inside, s, &
-               & n_contact, gnorm, outcome%residual, buffer)
+            ! the state is evaluated after scaling p by load_scale, and d so that d + b
+            ! scales alike (in the same pass); the sums are those of the unscaled state
+            call scale_sums(sums, load_scale)
+            n_contact = nint(sums%contact)
+            if (load_control) s = sums%d_contact/max(n_contact, 1)
+            p_ref = merge(mean_pressure, sums%p_sum/n, load_control)
+            g_floor = rounding_floor(sums%w_max, b_max, sums%p_max, m_max)
+            call evaluate_state(p, d, b, load_scale, s, 1.0_wp/max(p_ref, tiny(1.0_wp)), 1.0_wp/g_ref, g_floor, &
+               & gnorm, outcome%residual, buffer)
             load_scale = 1.0_wp
             if (since_fresh == 0 .or. .not. (outcome%residual <= tol .or. it > max_iter)) exit
             stale = .true.
@@ -115,7 +135,7 @@ contains
          if (present(history)) then
             if (it <= size(history)) history(it) = outcome%residual
          end if
-         if (outcome%converged .or. it > max_iter) return
+         if (outcome%converged .or. it > max_iter) exit
          ! The Fourier preconditioner amplifies short waves; where the compliance falls
          ! steeply with k (a glassy viscoelastic layer) its directions make the contact set
          ! oscillate. If the residual has not halved in `stall_window` iterations, continue
@@ -132,69 +152,41 @@ contains
          if (n_contact == 0) then
             ! Displacement control with nothing in contact yet: load the overlapping points
             ! (the diagonal of M is the natural scale of a first step).
-            p = max(-gap, 0.0_wp)/op%diagonal
+            call let_in_overlaps(p, d, s, 1.0_wp/op%diagonal, n_changed)
             restart = .true.
             stale = .true.
             cycle
          end if
 
-         ! search direction t: the (preconditioned) residual on the contact set, conjugated
+         ! Search direction t: the (preconditioned) residual on the contact set, conjugated.
+         ! Under load control t sums to zero on the contact set (the load stays put, and
+         ! the step needs only sum t M t, which the transform gives by Parseval): the old
+         ! direction is shifted by its mean over the current set, known from the update
+         ! (the points that left the set took theirs with them).
+         t_shift = 0.0_wp
+         if (load_control .and. .not. restart) t_shift = (t_sum - t_left)/n_contact
          if (preconditioned) then
             ! (evaluate_state left the gap on the contact set in the buffer)
             call op%inverse_metric_in_buffer()
             outcome%fft_pairs = outcome%fft_pairs + 1
-            z_sum = 0.0_wp
-            !$omp simd reduction(+:z_sum)
-            do j = 1, n
-               z_sum = z_sum + buffer(j)*inside(j)
-            end do
-            if (.not. load_control) z_sum = 0.0_wp
-            z_mean = z_sum/n_contact
-            gnorm = 0.0_wp
-            !$omp simd reduction(+:gnorm)
-            do j = 1, n
-               z(j) = (buffer(j) - z_mean)*inside(j)
-               gnorm = gnorm + gap(j)*z(j)
-            end do
+            call preconditioned_products(p, d, s, buffer, gz_sum, z_mean)
+            if (.not. load_control) z_mean = 0.0_wp
+            ! sum g (z - <z>) over the set is sum g z: g sums to zero there (s is its mean)
+            gnorm = gz_sum
+         else
+            z_mean = 0.0_wp
          end if
          beta = merge(0.0_wp, gnorm/gnorm_old, restart)
          gnorm_old = gnorm
-         if (preconditioned) then
-            do j = 1, n
-               t(j) = (z(j) + beta*t(j))*inside(j)
-               buffer(j) = t(j)
-            end do
-         else
-            do j = 1, n
-               t(j) = (gap(j) + beta*t(j))*inside(j)
-               buffer(j) = t(j)
-            end do
-         end if
-         call op%metric_in_buffer()   ! r = M t
+         call new_direction(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
+         call op%metric_in_buffer(denominator)   ! buffer <- r = M t; denominator = sum t M t
          outcome%fft_pairs = outcome%fft_pairs + 1
-         ! step along t on the contact set; with load control the mean of M t over the
-         ! contact set is removed (the multiplier s absorbs it):
-         ! denominator = sum (r - <r>) t = sum r t - <r> sum t
-         r_sum = 0.0_wp
-         rt_sum = 0.0_wp
-         t_sum = 0.0_wp
-         gt_sum = 0.0_wp
-         ! (t = 0 off the contact set)
-         !$omp simd reduction(+:r_sum, rt_sum, t_sum, gt_sum)
-         do j = 1, n
-            r_sum = r_sum + r(j)*inside(j)
-            rt_sum = rt_sum + r(j)*t(j)
-            t_sum = t_sum + t(j)
-            gt_sum = gt_sum + gap(j)*t(j)
-         end do
-         denominator = rt_sum
-         if (load_control) denominator = rt_sum - r_sum/n_contact*t_sum
          if (.not. denominator > 0.0_wp) then
             ! t is (numerically) in the null space of the projected operator (e.g. a single
             ! point in contact under load control: its gap is s exactly): let the
             ! overlapping points in, as for an empty contact set, and start afresh
-            if (any(p <= 0.0_wp .and. gap < 0.0_wp)) then
-               where (p <= 0.0_wp .and. gap < 0.0_wp) p = -gap/op%diagonal
+            call let_in_overlaps(p, d, s, 1.0_wp/op%diagonal, n_changed)
+            if (n_changed > 0) then
                if (load_control) call normalise(p, mean_pressure)
                stale = .true.
             end if
@@ -202,116 +194,288 @@ contains
             cycle
          end if
          tau = gt_sum/denominator
-         ! update, clip at zero, and let overlapping points (p = 0, gap < 0) into the contact;
-         ! w follows p along t here, and the points clipped or let in below
-         p_sum = 0.0_wp
-         changed_count = 0.0_wp
-         entered_count = 0.0_wp
-         !$omp simd reduction(+:p_sum, changed_count, entered_count) private(trial, p_new, g, c)
-         do j = 1, n
-            ! t = 0 off the contact set, so p - tau t is p there
-            trial = p(j) - tau*t(j)
-            p_new = merge(trial, 0.0_wp, trial >= 0.0_wp)   ! clip (a NaN too)
-            ! let in where p = 0 and gap < 0; max(): once the contact set is solved tau is a
-            ! ratio of rounding noise and may be negative, and a negative pressure would
-            ! never be clipped again
-            g = gap(j)
-            c = merge(1.0_wp, 0.0_wp, g < 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)
-            p_new = c*max(-tau*g, 0.0_wp) + (1.0_wp - c)*p_new
-            entered_count = entered_count + c
-            w(j) = w(j) - tau*r(j)
-            ! r is free from here on: it keeps the change that is not along t
-            r(j) = p_new - trial
-            changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
-            p(j) = p_new
-            p_sum = p_sum + p_new
-         end do
-         restart = entered_count > 0.0_wp
-         n_changed = nint(changed_count)
-         ! w - tau M t is M p for p - tau t; the few points clipped or let in are added
-         ! column by column (M is circulant), more of them cost a transform
+         ! update, clip at zero, let overlapping points in; d follows p along t, and the
+         ! points clipped or let in are added column by column (M is circulant) below
+         call update(p, d, b, s, tau, t, buffer, sums, t_left, n_changed, restart)
          if (n_changed > column_updates) then
             stale = .true.
          else if (n_changed > 0) then
-            do j = 1, n
-               if (r(j) /= 0.0_wp) call op%add_column(j, r(j), w)
-            end do
+            call add_changed_columns(op, buffer, p, d, sums%d_contact)
          end if
          since_fresh = since_fresh + 1
-         ! load control: p is scaled to the load (and w alike, M being linear) in the next
-         ! pass over the grid, evaluate_state
+         ! load control: p is scaled to the load (and d alike, M being linear) before the
+         ! next evaluation (a point clipped or let in changed the load)
          if (load_control) then
-            if (p_sum > 0.0_wp) then
-               load_scale = mean_pressure*n/p_sum
+            if (sums%p_sum > 0.0_wp) then
+               load_scale = mean_pressure*n/sums%p_sum
+               ! within a few ulps of 1 it would only rescale rounding noise
+               if (abs(load_scale - 1.0_wp) <= 8*epsilon(1.0_wp)) load_scale = 1.0_wp
             else
                call normalise(p, mean_pressure)
                stale = .true.
             end if
          end if
       end do
+      ! the fields returned (w = M p was computed afresh for the last evaluation)
+      call final_fields(d, b, s, w, gap)
+      end associate
    end subroutine constrained_cg
 
-   !> The state of p and w, both first scaled by load_scale: the gap (and the gap masked to
-   !> the contact set), the contact mask `inside`, s (found under load control), the number
-   !> of contact points, the squared gap norm on the contact set and the complementarity
-   !> residual.
-   subroutine evaluate_state(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, m_max, gap, inside, &
-         & s, n_contact, gnorm, residual, masked_gap)
-      real(wp), contiguous, intent(inout) :: p(:), w(:)
-      real(wp), contiguous, intent(in) :: b(:)
-      real(wp), intent(in) :: load_scale, mean_pressure, g_ref, b_max, m_max
-      logical, intent(in) :: load_control
-      real(wp), contiguous, intent(out) :: gap(:), inside(:)
-      real(wp), intent(inout) :: s
-      integer, intent(out) :: n_contact
-      real(wp), intent(out) :: gnorm, residual
-      !> the gap on the contact set, 0 elsewhere (the preconditioner's input, written here to
-      !> save a pass over the grid)
-      real(wp), contiguous, intent(out) :: masked_gap(:)
-      real(wp) :: contact_count, gap_sum, p_sum, w_max, p_max, p_ref, pscale, g_floor, check, g, c
-      integer :: j, n
-
-      n = size(p)
-      contact_count = 0.0_wp
-      gap_sum = 0.0_wp
-      p_sum = 0.0_wp
+   !> One pass after w = M p was computed: p <- load_scale p, d = load_scale w - b, and the
+   !> sums of the state.
+   subroutine fresh_state(p, w, b, load_scale, d, sums)
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(in) :: w(:), b(:)
+      real(wp), intent(in) :: load_scale
+      real(wp), contiguous, intent(out) :: d(:)
+      type(grid_sums), intent(out) :: sums
+      real(wp) :: contact, d_contact, b_contact, w_max, p_max, p_sum, inside, pj, wj
+      integer :: j
+      contact = 0.0_wp
+      d_contact = 0.0_wp
+      b_contact = 0.0_wp
       w_max = 0.0_wp
       p_max = 0.0_wp
-      !$omp simd reduction(+:contact_count, gap_sum, p_sum) reduction(max:w_max, p_max)
-      do j = 1, n
-         p(j) = p(j)*load_scale
-         w(j) = w(j)*load_scale
-         gap(j) = w(j) - b(j)
-         w_max = max(w_max, abs(w(j)))
-         p_max = max(p_max, p(j))
-         p_sum = p_sum + p(j)
-         inside(j) = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         contact_count = contact_count + inside(j)
-         gap_sum = gap_sum + gap(j)*inside(j)
+      p_sum = 0.0_wp
+      !$omp simd reduction(+:contact, d_contact, b_contact, p_sum) reduction(max:w_max, p_max) private(inside, pj, wj)
+      do j = 1, size(p)
+         pj = p(j)*load_scale
+         wj = w(j)*load_scale
+         p(j) = pj
+         d(j) = wj - b(j)
+         inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
+         contact = contact + inside
+         d_contact = d_contact + d(j)*inside
+         b_contact = b_contact + b(j)*inside
+         w_max = max(w_max, abs(wj))
+         p_max = max(p_max, pj)
+         p_sum = p_sum + pj
       end do
-      n_contact = nint(contact_count)
-      if (load_control) s = gap_sum/max(n_contact, 1)
-      p_ref = merge(mean_pressure, p_sum/n, load_control)
-      pscale = 1.0_wp/max(p_ref, tiny(1.0_wp))
-      ! gaps below the rounding floor of w - b count as zero (see rounding_floor)
-      g_floor = rounding_floor(w_max, b_max, p_max, m_max)
+      sums = grid_sums(contact, d_contact, b_contact, w_max, p_max, p_sum)
+   end subroutine fresh_state
+
+   !> The sums of the state after p <- load_scale p, d <- load_scale d + (load_scale - 1) b.
+   pure subroutine scale_sums(sums, load_scale)
+      type(grid_sums), intent(inout) :: sums
+      real(wp), intent(in) :: load_scale
+      if (load_scale == 1.0_wp) return
+      sums%d_contact = load_scale*sums%d_contact + (load_scale - 1.0_wp)*sums%b_contact
+      sums%w_max = load_scale*sums%w_max
+      sums%p_max = load_scale*sums%p_max
+      sums%p_sum = load_scale*sums%p_sum
+   end subroutine scale_sums
+
+   !> One pass: scale p by load_scale and d so that d + b scales alike, then the
+   !> complementarity residual and the squared norm of the gap g = d - s on the contact set;
+   !> g on the contact set (0 elsewhere) goes into `masked_gap`, the preconditioner's input.
+   !> (The stores are unconditional: a store under a condition keeps the loop from being
+   !> vectorised, which costs more than the stores.)
+   subroutine evaluate_state(p, d, b, load_scale, s, p_scale, g_scale, g_floor, gnorm, residual, masked_gap)
+      real(wp), contiguous, intent(inout) :: p(:), d(:)
+      real(wp), contiguous, intent(in) :: b(:)
+      real(wp), intent(in) :: load_scale, s, p_scale, g_scale, g_floor
+      real(wp), intent(out) :: gnorm, residual
+      real(wp), contiguous, intent(inout) :: masked_gap(:)
+      real(wp) :: check, g, c, inside, pj, dj, shift
+      integer :: j
+      shift = load_scale - 1.0_wp
       residual = 0.0_wp
       gnorm = 0.0_wp
       check = 0.0_wp
-      !$omp simd reduction(max:residual) reduction(+:gnorm, check) private(g, c)
-      do j = 1, n
-         g = gap(j) - s
-         gap(j) = g
-         c = abs(min(p(j)*pscale, g/g_ref))
+      !$omp simd reduction(max:residual) reduction(+:gnorm, check) private(g, c, inside, pj, dj)
+      do j = 1, size(p)
+         pj = p(j)*load_scale
+         dj = d(j)*load_scale + shift*b(j)
+         p(j) = pj
+         d(j) = dj
+         g = dj - s
+         inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
+         c = abs(min(pj*p_scale, g*g_scale))
          residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
-         gnorm = gnorm + g*g*inside(j)
-         masked_gap(j) = g*inside(j)
-         check = check + g
+         gnorm = gnorm + g*g*inside
+         masked_gap(j) = g*inside
+         check = check + g + pj
       end do
-      ! a NaN or Inf gap or pressure (which max() may skip) makes a sum non-finite:
+      ! a NaN or Inf gap or pressure (which max() may skip) makes the sum non-finite:
       ! count it as infinitely wrong
-      if (.not. (ieee_is_finite(check) .and. ieee_is_finite(p_sum))) residual = huge(1.0_wp)
+      if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
    end subroutine evaluate_state
+
+   !> One pass over the preconditioned residual z (the buffer after the inverse metric):
+   !> gz_sum = sum g z and z_mean = <z> over the contact set.
+   subroutine preconditioned_products(p, d, s, z, gz_sum, z_mean)
+      real(wp), contiguous, intent(in) :: p(:), d(:), z(:)
+      real(wp), intent(in) :: s
+      real(wp), intent(out) :: gz_sum, z_mean
+      real(wp) :: z_sum, contact, inside
+      integer :: j
+      gz_sum = 0.0_wp
+      z_sum = 0.0_wp
+      contact = 0.0_wp
+      !$omp simd reduction(+:gz_sum, z_sum, contact) private(inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         gz_sum = gz_sum + (d(j) - s)*z(j)*inside
+         z_sum = z_sum + z(j)*inside
+         contact = contact + inside
+      end do
+      z_mean = z_sum/max(contact, 1.0_wp)
+   end subroutine preconditioned_products
+
+   !> One pass: the new direction t = (e + beta (t - t_shift)) on the contact set (0
+   !> elsewhere), with e = z - z_mean (preconditioned; z in the buffer) or the gap g; t is
+   !> also written into the buffer (the transform's input). gt_sum = sum g t, t_sum = sum t.
+   subroutine new_direction(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
+      real(wp), contiguous, intent(in) :: p(:), d(:)
+      real(wp), intent(in) :: s, z_mean, beta, t_shift
+      logical, intent(in) :: preconditioned
+      real(wp), contiguous, intent(inout) :: t(:), buffer(:)
+      real(wp), intent(out) :: gt_sum, t_sum
+      real(wp) :: g, e, tj, inside, from_z
+      integer :: j
+      gt_sum = 0.0_wp
+      t_sum = 0.0_wp
+      ! a 0/1 weight rather than a branch, which would keep the loop from being vectorised
+      ! (without the preconditioner the buffer holds the masked gap: finite)
+      from_z = merge(1.0_wp, 0.0_wp, preconditioned)
+      !$omp simd reduction(+:gt_sum, t_sum) private(g, e, tj, inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         g = d(j) - s
+         e = from_z*(buffer(j) - z_mean) + (1.0_wp - from_z)*g
+         tj = (e + beta*(t(j) - t_shift))*inside
+         t(j) = tj
+         buffer(j) = tj
+         gt_sum = gt_sum + g*tj
+         t_sum = t_sum + tj
+      end do
+   end subroutine new_direction
+
+   !> One pass: p <- p - tau t clipped at zero, overlapping points (p = 0, g < 0) let in,
+   !> d <- d - tau r (r = M t, in the buffer); r then keeps the change of p that was not
+   !> along t (nonzero at the points clipped or let in). Also the sums of the new state
+   !> (all but the maxima, which only set the rounding floor and are kept from the last
+   !> full evaluation: fewer reductions keep this loop in registers), t_left = the sum of t
+   !> over the points that left the contact set, n_changed and whether points were let in
+   !> (the next direction restarts).
+   subroutine update(p, d, b, s, tau, t, r, sums, t_left, n_changed, entered)
+      real(wp), contiguous, intent(inout) :: p(:), d(:), r(:)
+      real(wp), contiguous, intent(in) :: b(:), t(:)
+      real(wp), intent(in) :: s, tau
+      type(grid_sums), intent(inout) :: sums
+      real(wp), intent(out) :: t_left
+      integer, intent(out) :: n_changed
+      logical, intent(out) :: entered
+      real(wp) :: contact, d_contact, b_contact, p_sum, changed_count, entered_count
+      real(wp) :: trial, p_new, d_new, g, c, inside, left
+      integer :: j
+      contact = 0.0_wp
+      d_contact = 0.0_wp
+      b_contact = 0.0_wp
+      p_sum = 0.0_wp
+      changed_count = 0.0_wp
+      entered_count = 0.0_wp
+      t_left = 0.0_wp
+      !$omp simd reduction(+:contact, d_contact, b_contact, p_sum, changed_count, entered_count, t_left) &
+      !$omp& private(trial, p_new, d_new, g, c, inside, left)
+      do j = 1, size(p)
+         ! t = 0 off the contact set, so p - tau t is p there
+         trial = p(j) - tau*t(j)
+         p_new = merge(trial, 0.0_wp, trial >= 0.0_wp)   ! clip (a NaN too)
+         ! let in where p = 0 and g < 0 (g before the step); max(): once the contact set is
+         ! solved tau is a ratio of rounding noise and may be negative, and a negative
+         ! pressure would never be clipped again
+         g = d(j) - s
+         c = merge(1.0_wp, 0.0_wp, g < 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)
+         p_new = c*max(-tau*g, 0.0_wp) + (1.0_wp - c)*p_new
+         entered_count = entered_count + c
+         left = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)
+         t_left = t_left + t(j)*left
+         d_new = d(j) - tau*r(j)
+         d(j) = d_new
+         r(j) = p_new - trial
+         changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
+         p(j) = p_new
+         inside = merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
+         contact = contact + inside
+         d_contact = d_contact + d_new*inside
+         b_contact = b_contact + b(j)*inside
+         p_sum = p_sum + p_new
+      end do
+      sums%contact = contact
+      sums%d_contact = d_contact
+      sums%b_contact = b_contact
+      sums%p_sum = p_sum
+      n_changed = nint(changed_count)
+      entered = entered_count > 0.0_wp
+   end subroutine update
+
+   !> d <- d + sum_j r_j M e_j over the points j with r_j /= 0 (a pass over the grid each),
+   !> and d_contact <- d_contact + the sum of that change over the contact set (p > 0).
+   subroutine add_changed_columns(op, r, p, d, d_contact)
+      type(compliance_operator), intent(in) :: op
+      real(wp), contiguous, intent(in) :: r(:), p(:)
+      real(wp), contiguous, intent(inout) :: d(:)
+      real(wp), intent(inout) :: d_contact
+      integer :: j, n
+      n = size(r)
+      do j = 1, n
+         if (r(j) == 0.0_wp) cycle
+         ! M e_j at x_i is column(i - j): column(1..n-j+1) for i = j..n, wrapped for i < j
+         call add_on_set(r(j), op%column(1:n - j + 1), p(j:n), d(j:n), d_contact)
+         call add_on_set(r(j), op%column(n - j + 2:n), p(1:j - 1), d(1:j - 1), d_contact)
+      end do
+   end subroutine add_changed_columns
+
+   !> d <- d + value column, and total <- total + the sum of the change where p > 0.
+   pure subroutine add_on_set(value, column, p, d, total)
+      real(wp), intent(in) :: value
+      real(wp), contiguous, intent(in) :: column(:), p(:)
+      real(wp), contiguous, intent(inout) :: d(:)
+      real(wp), intent(inout) :: total
+      real(wp) :: added, v
+      integer :: i
+      added = 0.0_wp
+      !$omp simd reduction(+:added) private(v)
+      do i = 1, size(d)
+         v = value*column(i)
+         d(i) = d(i) + v
+         added = added + v*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
+      end do
+      total = total + added
+   end subroutine add_on_set
+
+   !> Load the overlapping points out of contact (p = 0, g = d - s < 0) with the pressure
+   !> -g/M_jj of a first step; n_changed: how many.
+   subroutine let_in_overlaps(p, d, s, inverse_diagonal, n_changed)
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(in) :: d(:)
+      real(wp), intent(in) :: s, inverse_diagonal
+      integer, intent(out) :: n_changed
+      real(wp) :: g
+      integer :: j
+      n_changed = 0
+      do j = 1, size(p)
+         g = d(j) - s
+         if (p(j) <= 0.0_wp .and. g < 0.0_wp) then
+            p(j) = -g*inverse_diagonal
+            n_changed = n_changed + 1
+         end if
+      end do
+   end subroutine let_in_overlaps
+
+   !> The fields returned from the raw gap d (= w - b): w = d + b, gap = d - s (in place).
+   pure subroutine final_fields(d, b, s, w, gap)
+      real(wp), contiguous, intent(in) :: d(:), b(:)
+      real(wp), intent(in) :: s
+      real(wp), contiguous, intent(out) :: w(:)
+      real(wp), contiguous, intent(inout) :: gap(:)
+      integer :: j
+      do j = 1, size(d)
+         w(j) = d(j) + b(j)
+         gap(j) = d(j) - s
+      end do
+   end subroutine final_fields
 
    !> max_j |min(p_j/p_ref, gap_j/g_ref)|: zero iff p >= 0, gap >= 0 and p gap = 0.
    !> Gaps within `g_floor` of zero count as zero: below that the gap is rounding noise of
