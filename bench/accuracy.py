@@ -54,8 +54,8 @@ tol 1e-4, 1e-6, 1e-8 with the default solver.
 Reference
 ---------
 ppw = 8192 (n = 524288) at tol 1e-10, checked against ppw = 4096: the difference is the
-reference's uncertainty ``unc`` (printed): about 1e-4 for the contact fraction, 2e-3 to
-5e-3 for the max tension of the coupled scenes, <= 4e-5 for the rest. tol 1e-12 is out of
+reference's uncertainty ``unc`` (printed): about 1e-4 for the contact fraction, <= 4e-5
+for the rest (max tension of the coupled scenes: 1e-6 to 5e-6, sub-grid). tol 1e-12 is out of
 reach on these grids for the coupled scenes: the residual stagnates near 1e-12 by
 round-off and the solve runs into the iteration budget (h/lambda = 0.01 at n = 32768:
 100000 CG iterations, 90 s, not converged), so 1e-10 is the tightest tolerance that
@@ -74,12 +74,14 @@ Observed convergence (tol 1e-8, default solver, ppw >= 8; slopes printed by the 
   min r)) <= tol admits nodes with a gap below tol (max r - min r) on the contact set,
   and the gap opens like s^(3/2) at an edge, so the edges are blurred over s ~ tol^(2/3):
   error ~ 5 tol^(2/3) (24 % at tol 1e-2, ~5 % at 1e-3, ~1 % at 1e-4, for the half-space).
-* Max tension with friction (h0.16, h0.01): order 1/2 (slope 0.54), 6-9 % at ppw 64, 2 %
-  at ppw 1024, erratic by ~1 %. The surface tension of a sliding layer peaks at the
-  trailing contact edge, where the Hilbert transform of the shear mu_c p ~ sqrt(distance)
-  has a square-root cusp; the largest grid sample misses the peak by ~ sqrt(dx) and
-  depends on where the nodes fall relative to the edge. Without friction (visco) the peak
-  is not at an edge and the error decays at second order (1e-5 by ppw 32).
+* Max tension with friction (h0.16, h0.01): order 1.5 (slopes 1.52-1.53), 4e-4 / 7e-5 at
+  ppw 64, 1e-5 at ppw 1024, erratic by a factor ~3. The surface tension of a sliding layer
+  peaks at the trailing contact edge in a square-root cusp; the library resolves it
+  sub-grid (the stress at the edge of a field without the cusps, the edge placed from the
+  gap behind it; docs/accuracy.md). The largest grid value (``max_tension_grid``, recorded
+  but not counted) misses the peak by ~ sqrt(dx): order 1/2 (slopes 0.46-0.48), 9 % at
+  ppw 64, 3 % at ppw 1024. Without friction (visco) the peak is not at an edge and the
+  error decays at second order (1e-5 by ppw 32).
 * Penetration and Delta mu (integrals of the pressure): second order (slopes 1.8-2.0),
   5e-5 to 2e-3 already at ppw 8; the pressure's square-root edges spoil the smoothness in one
   cell per edge only. a/a0 (a ratio of two contact fractions whose first-order errors
@@ -90,10 +92,9 @@ Observed convergence (tol 1e-8, default solver, ppw >= 8; slopes printed by the 
   path on a symmetric scene.
 
 Hence the accuracy rule (``rule`` below; constants fitted on seed 1, checked on seed 2):
-ppw >= 0.75 lambda_s/(eps * mean spot length) (first order), and, with friction and the
-max tension wanted, ppw >= (1.2/eps)^2 (order 1/2); tol = (eps/10)^1.5 (and (eps/1.5)^3 with the
-tension) rounded down to the
-tested values; 'auto' with the preconditioner.
+ppw >= 0.75 lambda_s/(eps * mean spot length) (first order); tol = (eps/10)^1.5 rounded
+down to the tested values; 'auto' with the preconditioner. (With the grid maximum of the
+tension, order 1/2, the rule needed ppw >= (1.2/eps)^2 and tol <= (eps/1.5)^3 on top.)
 """
 
 from __future__ import annotations

@@ -74,6 +74,9 @@ class LineResult:
     positive) are ``None`` when not asked for. ``spots`` is an ``(n_spots, 2)`` array of
     trailing (-x) and leading (+x) edges; ``leak_rate = <g^3>/12`` is the flow across the
     sliding direction per unit length, per unit pressure gradient, times the viscosity.
+    ``max_tension`` (and ``spot_max_tension`` per spot) resolve the square-root cusp of
+    ``stress_xx`` at a trailing edge sub-grid when there is friction; ``max_tension_grid``
+    (``spot_max_tension_grid``) is the largest grid value.
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
     ``residual_history`` holds the residual per CG iteration (per outer iteration for a
     coupled solve); from :func:`solve_line`, the last ``HISTORY_CAPACITY`` (10000) of them.
