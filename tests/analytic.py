@@ -65,7 +65,7 @@ def westergaard_sliding_tension(p_m, mu, Es, h0, lam):
     Im z -> inf), so H[p] = (2 p_m/s^2) sin(theta) cos(theta) in the contact, and at the
     trailing edge theta = -psi the tension is 4 mu p_m cos(psi)/s. Equivalently mu Es r'(x_e)
     with the indenter's slope there. For a -> 0 it is Johnson's 2 mu p0 (Contact Mechanics
-    §7.2) with p0 = 2 p_m/s the Hertz peak pressure."""
+    §7.1) with p0 = 2 p_m/s the Hertz peak pressure."""
     ratio = np.asarray(p_m) / westergaard_full_contact_pressure(Es, h0, lam)
     psi = np.arcsin(np.sqrt(ratio))
     return 4 * mu * p_m / np.tan(psi)

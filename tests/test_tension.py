@@ -36,7 +36,7 @@ def test_westergaard_sliding_tension_is_exact_to_subgrid_accuracy(n):
 def test_sliding_cylinder_matches_johnson():
     """Cylinder r = -(x - 1/2)^2/(2R), R = 1, on an incompressible half-space, half-width
     a = 0.02 (load pi E* a^2/(4R)), mu = 0.5: Johnson's trailing-edge tension 2 mu p0 with
-    p0 = 2P/(pi a) (Contact Mechanics §7.2). The periodic images shift it by
+    p0 = 2P/(pi a) (Contact Mechanics §7.1). The periodic images shift it by
     O((a/lambda)^2) (-3.4e-4 measured at n = 16384, -2e-3 with a = 0.05); the sub-grid
     value at n = 4096 (a = 82 dx) is within 3.7e-4, the grid maximum 5.9 % below.
     Tolerance 1e-3."""

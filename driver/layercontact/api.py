@@ -18,7 +18,8 @@ _SCALARS = (
     "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
-    "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift", "max_tension_grid",
+    "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
+    "max_tension_grid",
 )
 _INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
 # Residuals returned per solve (the last ones): a max_iter-long array would cost more than

@@ -97,7 +97,7 @@ contains
    !> two contact nodes if there are fewer than two gap nodes; sigma_xx(x_e) = Q(x_e) by cubic
    !> interpolation of Q through the four nodes around x_e. `max_tension` is the larger of
    !> that and the grid value; spots of fewer than `min_edge_nodes` nodes keep the grid
-   !> value. Error of the sub-grid value: first order, ~1e-4 at 64 points per shortest
+   !> value. Error of the sub-grid value: order 1-1.5, ~1e-4 at 64 points per shortest
    !> wavelength on rough profiles (bench/accuracy.py), against order 1/2 for the grid value.
    pure subroutine spot_tension(stress, period, trailing, leading, max_tension, offset, grid_tension, &
          & edge_field, p, gap)

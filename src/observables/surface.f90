@@ -88,7 +88,7 @@ contains
    !> and a(k), b(k) tend to the half-space constants a, b below (1-A, 1-B -> 1, c -> Dundurs'
    !> (1-2nu)/(2(1-nu)), C -> its value at the grid's shortest wave) exponentially fast in kh.
    !> Near an edge p ~ sqrt(s) inside and g' ~ sqrt(-s) outside carry the cusp of sigma_xx
-   !> (on an incompressible half-space sigma_xx = -p + mu_c E* w', Johnson §7.2); since
+   !> (on an incompressible half-space sigma_xx = -p - 2 mu_c H[p] = -p + mu_c E* w'); since
    !> w' = r' + g', Q = b r' + (a(k) - a) p + (b(k) - b) w' is as smooth as the profile
    !> and the layer's exponentially decaying corrections, so it can be interpolated to a
    !> sub-grid edge position from the grid.
