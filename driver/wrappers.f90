@@ -65,8 +65,9 @@ end subroutine py_self_affine_profile
 !> Solve a line contact on the given heights. control: 0 load, 1 displacement;
 !> method: 0 auto, 1 cg, 2 anderson; precondition, coarse_start, stress: 0/1.
 !> fields(:, 1:5): pressure, gap, displacement_z, displacement_x, stress_xx (the last two
-!> zero unless stress = 1); spots(1:n_spots, 1:4): trailing and leading edges, largest
-!> sigma_xx around the spot and its offset from the trailing edge (zero unless stress = 1);
+!> zero unless stress = 1); spots(1:n_spots, 1:5): trailing and leading edges, largest
+!> sigma_xx around the spot (sub-grid at the trailing edge with friction), its offset from
+!> the trailing edge and the largest grid value (zero unless stress = 1);
 !> scalars: in the order of layercontact.api._SCALARS; history(1:history_length): the last
 !> residuals of the run, at most `capacity` (an array of max_iter entries would cost more
 !> than a small solve).
@@ -83,7 +84,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    integer, intent(in) :: capacity
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
    real(8), intent(in) :: e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
-   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 4), scalars(25), history(capacity)
+   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 5), scalars(26), history(capacity)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n, nt
@@ -127,6 +128,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    spots(1:r%n_spots, 2) = r%spot_leading
    if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 3) = r%spot_max_tension
    if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 4) = r%spot_tension_offset
+   if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 5) = r%spot_max_tension_grid
    stored = min(size(r%residual_history), capacity)
    history(1:stored) = r%residual_history(size(r%residual_history) - stored + 1:)
    scalars = [r%mean_pressure, r%penetration, r%contact_fraction, r%delta_mu, r%delta_mu_spectral, &
@@ -134,7 +136,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
       & real(r%outer_iterations, 8), real(r%fft_pairs, 8), r%residual, r%wall_time, &
       & real(stored, 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
       & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), &
-      & r%pressure_shift, r%summit_shift]
+      & r%pressure_shift, r%summit_shift, r%max_tension_grid]
 end subroutine py_solve_line
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless

@@ -6,14 +6,14 @@
 !> penetration (relative to the profile's peak-to-valley) and the largest surface tension,
 !> against a converged reference. Measured convergence: the contact fraction is first order
 !> in the grid step (each contact edge sits within one step), relative to the mean contact
-!> spot length; the largest tension of a sliding layer is of order 1/2 (a square-root cusp
-!> at the trailing edge); a tolerance tol blurs the edges by ~5 tol^(2/3). Hence, with
-!> lambda_s the shortest roughness wavelength and ppw the grid points per lambda_s:
-!>    ppw = the smallest power of two >= 4 with ppw >= 0.75 (lambda_s/spot length)/eps,
-!>          and, with friction and the surface stress wanted, ppw >= (1.2/eps)^2;
-!>    tol = the largest of 1e-2, 1e-3, 1e-4, 1e-6, 1e-8 that is <= (eps/10)^1.5 and, with
-!>          friction and the surface stress wanted, <= (eps/1.5)^3 (the tolerance blurs the
-!>          trailing edge, and the cusp turns that into ~tol^(1/3) of tension);
+!> spot length, and it sets the grid; the largest tension of a sliding layer, resolved
+!> sub-grid at the trailing edge (lc_observables_geometry's spot_tension), converges at order
+!> 1-1.5 and stays below the contact fraction's error at the rule's settings (it needed
+!> ppw >= (1.2/eps)^2 as a grid maximum, order 1/2); a tolerance tol blurs the edges by
+!> ~5 tol^(2/3). Hence, with lambda_s the shortest roughness wavelength and ppw the grid
+!> points per lambda_s:
+!>    ppw = the smallest power of two >= 4 with ppw >= 0.75 (lambda_s/spot length)/eps;
+!>    tol = the largest of 1e-2, 1e-3, 1e-4, 1e-6, 1e-8 that is <= (eps/10)^1.5;
 !> where the mean spot length comes from a pilot solve at ppw = 8 and tol 1e-4. Checked on
 !> four scenes (frictionless half-space, h/lambda = 0.16 and 0.01 with mu_c = 0.5, a
 !> viscoelastic layer) for eps = 1e-1 .. 1e-3, on the fitted profile and on a second one.
@@ -29,8 +29,8 @@ module lc_accuracy
    private
    public :: choose_resolution
 
-   !> Constants of the rule (bench/accuracy.py: RULE_SPOT, RULE_TENSION).
-   real(wp), parameter :: spot_constant = 0.75_wp, tension_constant = 1.2_wp, tension_tol_constant = 1.5_wp
+   !> Constant of the rule (bench/accuracy.py: RULE_SPOT).
+   real(wp), parameter :: spot_constant = 0.75_wp
    !> The tolerances the rule was measured with.
    real(wp), parameter :: tested_tols(5) = [1.0e-2_wp, 1.0e-3_wp, 1.0e-4_wp, 1.0e-6_wp, 1.0e-8_wp]
    !> Largest grid the rule may ask for (memory ~0.1 GB; beyond, the target is refused).
@@ -50,7 +50,6 @@ contains
       real(wp) :: eps, wavelengths, spot
       integer :: ppw
       integer(kind=8) :: n
-      logical :: tension
 
       eps = scene%solver%target_error
       select case (trim(scene%profile%kind))
@@ -83,28 +82,25 @@ contains
       if (result%n_spots > 0) spot = max(spot, result%contact_length/result%n_spots)
       spot = spot*wavelengths/scene%period
 
-      tension = scene%friction > 0.0_wp .and. scene%stress
-      ppw = predicted_ppw(eps, spot, tension)
+      ppw = predicted_ppw(eps, spot)
       n = int(ppw, kind=8)*ceiling(wavelengths, kind=8)
       if (ppw < 0 .or. n > largest_grid) then
          call fatal_error(error, '&solver: target_error = ' // to_string(eps) // ' needs more than ' // &
-            & to_string(largest_grid) // ' grid points (the largest surface tension of a sliding layer ' // &
-            & 'converges as n^(-1/2)); allowed: a larger target_error, or &output stress = .false., ' // &
-            & 'or give &scene n and &solver tol', code_input)
+            & to_string(largest_grid) // ' grid points (' // to_string(ppw) // ' per shortest wavelength, ' // &
+            & 'for contact spots of ' // to_string(spot) // ' shortest wavelengths); allowed: a larger ' // &
+            & 'target_error, a longer short_wavelength, or give &scene n and &solver tol', code_input)
          return
       end if
       scene%n = grid_points(ppw, wavelengths)
-      scene%solver%tol = rule_tol(eps, tension)
+      scene%solver%tol = rule_tol(eps)
    end subroutine choose_resolution
 
    !> Points per shortest wavelength for target eps and mean spot length `spot` (in shortest
    !> wavelengths); -1 if beyond 2^30.
-   pure integer function predicted_ppw(eps, spot, tension) result(ppw)
+   pure integer function predicted_ppw(eps, spot) result(ppw)
       real(wp), intent(in) :: eps, spot
-      logical, intent(in) :: tension
       real(wp) :: need
       need = spot_constant/(spot*eps)
-      if (tension) need = max(need, (tension_constant/eps)**2)
       ppw = 4
       do while (ppw < need)
          if (ppw >= 2**29) then
@@ -115,15 +111,12 @@ contains
       end do
    end function predicted_ppw
 
-   !> The largest tested tolerance <= (eps/10)^1.5, and <= (eps/1.5)^3 with `tension` (the
-   !> smallest if none is).
-   pure real(wp) function rule_tol(eps, tension) result(tol)
+   !> The largest tested tolerance <= (eps/10)^1.5 (the smallest if none is).
+   pure real(wp) function rule_tol(eps) result(tol)
       real(wp), intent(in) :: eps
-      logical, intent(in) :: tension
       real(wp) :: bound
       integer :: i
       bound = (eps/10)**1.5_wp
-      if (tension) bound = min(bound, (eps/tension_tol_constant)**3)
       tol = tested_tols(size(tested_tols))
       do i = 1, size(tested_tols)
          if (tested_tols(i) <= bound*(1 + 1.0e-9_wp)) then

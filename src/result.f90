@@ -18,7 +18,10 @@ module lc_result
       real(wp), allocatable :: stress_xx(:)        !< sigma_xx at the surface (S), tension positive
       real(wp), allocatable :: spot_trailing(:)    !< trailing (-x) edge of each contact spot (L)
       real(wp), allocatable :: spot_leading(:)     !< leading (+x) edge of each contact spot (L)
-      real(wp), allocatable :: spot_max_tension(:) !< largest sigma_xx around each spot (S), with stress
+      !> largest sigma_xx around each spot (S), with stress; with friction the trailing-edge
+      !> cusp is resolved sub-grid
+      real(wp), allocatable :: spot_max_tension(:)
+      real(wp), allocatable :: spot_max_tension_grid(:) !< the largest grid value of sigma_xx around each spot (S)
       real(wp), allocatable :: spot_tension_offset(:) !< its offset from the spot's trailing edge (L)
       real(wp), allocatable :: gap_edges(:)        !< gap histogram bin edges (L)
       integer, allocatable :: gap_counts(:)        !< gap histogram counts (grid nodes)
@@ -38,7 +41,8 @@ module lc_result
       real(wp) :: contact_length = 0.0_wp     !< a = total length in contact (L)
       real(wp) :: mean_gap = 0.0_wp           !< <g> (L)
       real(wp) :: leak_rate = 0.0_wp          !< <g^3>/12 (L^3): flow across x per unit gradient and 1/viscosity
-      real(wp) :: max_tension = 0.0_wp        !< max sigma_xx (S), if stress was asked for
+      real(wp) :: max_tension = 0.0_wp        !< max sigma_xx (S), if stress was asked for (sub-grid at trailing edges)
+      real(wp) :: max_tension_grid = 0.0_wp   !< the largest grid value of sigma_xx (S)
       real(wp) :: max_tension_x = 0.0_wp      !< where it sits (L)
       real(wp) :: max_tension_offset = 0.0_wp !< its offset from the nearest spot's trailing edge (L)
       logical :: converged = .false.

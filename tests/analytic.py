@@ -51,3 +51,21 @@ def westergaard_mean_gap(p_m, Es, h0, lam):
     ratio = np.minimum(np.asarray(p_m, dtype=float) / westergaard_full_contact_pressure(Es, h0, lam), 1.0)
     ratio_log_ratio = ratio * np.log(np.where(ratio > 0, ratio, 1.0))  # P ln P -> 0 as P -> 0
     return h0 * (1 - ratio + ratio_log_ratio)
+
+
+def westergaard_sliding_tension(p_m, mu, Es, h0, lam):
+    """Largest surface tension of Westergaard's contact sliding with Coulomb friction
+    tau = mu p on an incompressible half-plane: 4 mu p_m cot(psi), psi = pi a/lam, at the
+    trailing edge.
+
+    Derivation: on an incompressible half-plane sigma_xx = -p - 2 mu H[p] at the surface
+    (H the periodic Hilbert transform; the normal problem is not changed by the shear). With
+    theta = pi x/lam and s = sin(psi), p = (2 p_m/s^2) cos(theta) sqrt(s^2 - sin^2 theta) is
+    the boundary value of (2 p_m/s^2) [cos z sqrt(sin^2 z - s^2) - sin z cos z] (bounded as
+    Im z -> inf), so H[p] = (2 p_m/s^2) sin(theta) cos(theta) in the contact, and at the
+    trailing edge theta = -psi the tension is 4 mu p_m cos(psi)/s. Equivalently mu Es r'(x_e)
+    with the indenter's slope there. For a -> 0 it is Johnson's 2 mu p0 (Contact Mechanics
+    §7.1) with p0 = 2 p_m/s the Hertz peak pressure."""
+    ratio = np.asarray(p_m) / westergaard_full_contact_pressure(Es, h0, lam)
+    psi = np.arcsin(np.sqrt(ratio))
+    return 4 * mu * p_m / np.tan(psi)

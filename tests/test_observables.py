@@ -101,6 +101,9 @@ def test_namelist_run_writes_observables(tmp_path, monkeypatch):
     np.testing.assert_allclose(res.stress_xx, ref.stress_xx, rtol=0, atol=1e-12 * np.abs(ref.stress_xx).max())
     assert res.n_spots == ref.n_spots and np.array_equal(res.spots, ref.spots)
     assert res.a_over_a0 == pytest.approx(ref.a_over_a0, rel=1e-12)
+    assert res.max_tension == pytest.approx(ref.max_tension, rel=1e-10) and res.max_tension > res.max_tension_grid
+    assert res.max_tension_grid == pytest.approx(ref.max_tension_grid, rel=1e-10)
+    np.testing.assert_allclose(res.spot_max_tension_grid, ref.spot_max_tension_grid, rtol=1e-10)
     import h5py
 
     with h5py.File(tmp_path / "r.h5") as f:
@@ -129,6 +132,7 @@ def test_spot_windows_cover_the_period_and_full_contact_has_no_trailing_edge(rou
         res = lc.solve_line(rough_profile, thickness=0.16, friction=friction,
                             mean_pressure=pm * rough_profile.max())
         assert res.n_spots > 1
-        assert res.spot_max_tension.max() == res.stress_xx.max()
+        assert res.spot_max_tension_grid.max() == res.stress_xx.max() == res.max_tension_grid
+        assert res.max_tension == res.spot_max_tension.max() >= res.max_tension_grid
     full = lc.solve_line(lc.sinusoid_profile(256, 1e-4), thickness=0.16, friction=0.5, mean_pressure=1.0)
     assert full.n_spots == 1 and np.isnan(full.spot_tension_offset[0]) and np.isnan(full.max_tension_offset)

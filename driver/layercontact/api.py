@@ -19,6 +19,7 @@ _SCALARS = (
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
     "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
+    "max_tension_grid",
 )
 _INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
 # Residuals returned per solve (the last ones): a max_iter-long array would cost more than
@@ -74,6 +75,9 @@ class LineResult:
     positive) are ``None`` when not asked for. ``spots`` is an ``(n_spots, 2)`` array of
     trailing (-x) and leading (+x) edges; ``leak_rate = <g^3>/12`` is the flow across the
     sliding direction per unit length, per unit pressure gradient, times the viscosity.
+    ``max_tension`` (and ``spot_max_tension`` per spot) resolve the square-root cusp of
+    ``stress_xx`` at a trailing edge sub-grid when there is friction; ``max_tension_grid``
+    (``spot_max_tension_grid``) is the largest grid value.
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
     ``residual_history`` holds the residual per CG iteration (per outer iteration for a
     coupled solve); from :func:`solve_line`, the last ``HISTORY_CAPACITY`` (10000) of them.
@@ -109,7 +113,9 @@ class LineResult:
     stress_xx: np.ndarray | None = field(default=None, repr=False)
     spot_max_tension: np.ndarray | None = field(default=None, repr=False)
     spot_tension_offset: np.ndarray | None = field(default=None, repr=False)
+    spot_max_tension_grid: np.ndarray | None = field(default=None, repr=False)
     max_tension: float = float("nan")
+    max_tension_grid: float = float("nan")
     max_tension_x: float = float("nan")
     max_tension_offset: float = float("nan")
     dissipated_power: float = 0.0
@@ -210,7 +216,7 @@ def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure
     scalars["converged"] = bool(scalars["converged"])
     scalars["monotone"] = bool(scalars["monotone"])
     if not stress:
-        for name in ("max_tension", "max_tension_x", "max_tension_offset"):
+        for name in ("max_tension", "max_tension_x", "max_tension_offset", "max_tension_grid"):
             scalars[name] = float("nan")
     return LineResult(
         pressure=fields[:, 0].copy(), gap=fields[:, 1].copy(), displacement_z=fields[:, 2].copy(),
@@ -219,6 +225,7 @@ def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure
         friction=float(friction), spots=spots[: scalars["n_spots"], :2].copy(), residual_history=hist[:n_hist].copy(),
         spot_max_tension=spots[: scalars["n_spots"], 2].copy() if stress else None,
         spot_tension_offset=spots[: scalars["n_spots"], 3].copy() if stress else None,
+        spot_max_tension_grid=spots[: scalars["n_spots"], 4].copy() if stress else None,
         **scalars,
     )
 
@@ -254,6 +261,8 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             stress_xx=fields.get("stress_xx"), height=f["profile/height"][()],
             spot_max_tension=base["spots/max_tension"][()] if "spots/max_tension" in base else None,
             spot_tension_offset=base["spots/max_tension_offset"][()] if "spots/max_tension_offset" in base else None,
+            spot_max_tension_grid=(base["spots/max_tension_grid"][()] if "spots/max_tension_grid" in base
+                                   else None),
             period=float(f["input"].attrs["period"]), friction=float(r["friction"]), spots=spots,
             residual_history=base["convergence/residual"][()],
             a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values,

@@ -16,7 +16,7 @@ module lc_contact_solve
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome
    use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
    use lc_observables_friction, only: interlocking_friction
-   use lc_observables_surface, only: surface_fields
+   use lc_observables_surface, only: surface_fields, edge_stress_field
    use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, &
       & spot_tension, spot_asymmetry
    implicit none (type, external)
@@ -212,7 +212,8 @@ contains
       type(compliance_operator), intent(inout) :: op
       real(wp), intent(in) :: height(:)
       type(contact_result), intent(inout) :: result
-      integer :: where_max
+      real(wp), allocatable :: edge_field(:)
+      integer :: where_max, top
 
       associate (p => result%pressure)
          call contact_spots(p, scene%period, result%n_spots, result%spot_trailing, result%spot_leading)
@@ -235,13 +236,32 @@ contains
             result%shear = result%friction*p
             call surface_fields(op, scene%thickness, scene%poisson, p, result%displacement_x, result%stress_xx)
             where_max = maxloc(result%stress_xx, dim=1)
-            result%max_tension = result%stress_xx(where_max)
+            result%max_tension_grid = result%stress_xx(where_max)
+            result%max_tension = result%max_tension_grid
             result%max_tension_x = (where_max - 1)*scene%period/size(p)
+            allocate (result%spot_max_tension(result%n_spots), result%spot_tension_offset(result%n_spots), &
+               & result%spot_max_tension_grid(result%n_spots))
+            if (result%friction > 0.0_wp) then
+               ! the trailing-edge cusp, sub-grid (a square root: the grid value is off by ~dx^(1/2))
+               allocate (edge_field(size(p)))
+               call edge_stress_field(op, scene%poisson, result%stress_xx, p, result%gap, edge_field)
+               call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
+                  & result%spot_max_tension, result%spot_tension_offset, result%spot_max_tension_grid, &
+                  & edge_field, p, result%gap)
+            else
+               call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
+                  & result%spot_max_tension, result%spot_tension_offset, result%spot_max_tension_grid)
+            end if
+            if (result%n_spots > 0) then
+               top = maxloc(result%spot_max_tension, dim=1)
+               if (result%spot_max_tension(top) > result%max_tension) then
+                  result%max_tension = result%spot_max_tension(top)
+                  result%max_tension_x = modulo(result%spot_trailing(top) + result%spot_tension_offset(top), &
+                     & scene%period)
+               end if
+            end if
             result%max_tension_offset = nearest_trailing_offset(result%max_tension_x, result%spot_trailing, &
                & result%spot_leading, scene%period)
-            allocate (result%spot_max_tension(result%n_spots), result%spot_tension_offset(result%n_spots))
-            call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
-               & result%spot_max_tension, result%spot_tension_offset)
          end if
       end associate
    end subroutine observe

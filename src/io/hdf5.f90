@@ -359,6 +359,7 @@ contains
          call write_dataset_1d(group, 'leading_edge', res%spot_leading, 'L', st)
          if (allocated(res%spot_max_tension)) then
             call write_dataset_1d(group, 'max_tension', res%spot_max_tension, 'S', st)
+            call write_dataset_1d(group, 'max_tension_grid', res%spot_max_tension_grid, 'S', st)
             call write_dataset_1d(group, 'max_tension_offset', res%spot_tension_offset, 'L', st)
          end if
          call close_group(group, st)
@@ -396,6 +397,7 @@ contains
       call write_attr_real(group, 'leak_rate', res%leak_rate, st)
       if (allocated(res%stress_xx)) then
          call write_attr_real(group, 'max_tension', res%max_tension, st)
+         call write_attr_real(group, 'max_tension_grid', res%max_tension_grid, st)
          call write_attr_real(group, 'max_tension_x', res%max_tension_x, st)
          call write_attr_real(group, 'max_tension_offset', res%max_tension_offset, st)
       end if

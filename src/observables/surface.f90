@@ -9,7 +9,10 @@
 !> u_x = mu_c p_m h/G and has sigma_xx = -(nu/(1-nu)) p_m (uniaxial strain); a half-space has
 !> no defined uniform u_x (set to zero) and sigma_xx = -p_m, the k -> 0 limit of its modes
 !> (on a frictionless half-space every mode gives sigma_xx = -p at the surface).
-!> Edge values converge slowly with the grid (like dx^(1/2)): compare interior values.
+!> Grid values next to a trailing edge converge slowly (like dx^(1/2)): sigma_xx has a
+!> square-root cusp there. `edge_stress_field` gives the smooth field that equals sigma_xx at
+!> every contact edge, from which the cusp's peak is interpolated sub-grid
+!> (lc_observables_geometry's spot_tension).
 module lc_observables_surface
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
@@ -17,7 +20,7 @@ module lc_observables_surface
    use lc_greens_layer, only: layer_coefficients
    implicit none (type, external)
    private
-   public :: surface_fields
+   public :: surface_fields, edge_stress_field
 
 contains
 
@@ -75,4 +78,42 @@ contains
       stress_xx = fft%real_buffer
       end associate
    end subroutine surface_fields
+
+   !> Q = sigma_xx - a p - b dg/dx (S): the surface stress without its two cusps, equal to
+   !> sigma_xx wherever p = 0 and dg/dx = 0, i.e. at every contact edge.
+   !>
+   !> Per mode, with C(k) = (1 - nu^2) J*(kV) and w'^ = 2 C [i sgn(k) (1-A) + c mu_c] p^,
+   !>    sigma_xx^ = a(k) p^ + b(k) w'^,   b = mu_c (1-B)/((1-A) C),
+   !>    a = -nu/(1-nu) - 2c - 2 mu_c^2 c (1-B)/(1-A),
+   !> and a(k), b(k) tend to the half-space constants a, b below (1-A, 1-B -> 1, c -> Dundurs'
+   !> (1-2nu)/(2(1-nu)), C -> its value at the grid's shortest wave) exponentially fast in kh.
+   !> Near an edge p ~ sqrt(s) inside and g' ~ sqrt(-s) outside carry the cusp of sigma_xx
+   !> (on an incompressible half-space sigma_xx = -p - 2 mu_c H[p] = -p + mu_c E* w'); since
+   !> w' = r' + g', Q = b r' + (a(k) - a) p + (b(k) - b) w' is as smooth as the profile
+   !> and the layer's exponentially decaying corrections, so it can be interpolated to a
+   !> sub-grid edge position from the grid.
+   subroutine edge_stress_field(op, poisson, stress_xx, p, gap, field)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: poisson
+      real(wp), intent(in) :: stress_xx(:), p(:), gap(:)
+      real(wp), intent(out) :: field(:)
+      real(wp) :: a, b, dundurs
+      integer :: m
+
+      associate (fft => op%fft)
+      dundurs = (1.0_wp - 2.0_wp*poisson)/(2.0_wp*(1.0_wp - poisson))
+      a = -poisson/(1.0_wp - poisson) - 2.0_wp*dundurs*(1.0_wp + op%friction**2)
+      b = op%friction/real(op%compliance(fft%nk), wp)
+      ! dg/dx spectrally (the Nyquist mode has no defined derivative: dropped)
+      fft%real_buffer = gap
+      call fft%forward()
+      fft%spectrum(1) = 0.0_wp
+      do m = 1, fft%nk - 1
+         fft%spectrum(m + 1) = cmplx(0.0_wp, op%wavenumber(m), wp)*fft%spectrum(m + 1)
+         if (2*m == fft%n) fft%spectrum(m + 1) = 0.0_wp
+      end do
+      call fft%backward()
+      field = stress_xx - a*p - b*fft%real_buffer
+      end associate
+   end subroutine edge_stress_field
 end module lc_observables_surface
