@@ -63,12 +63,13 @@ subroutine py_self_affine_profile(n, period, hurst, seed, rolloff_wavelength, sh
 end subroutine py_self_affine_profile
 
 !> Solve a line contact on the given heights. control: 0 load, 1 displacement;
-!> method: 0 auto, 1 cg, 2 anderson; precondition, coarse_start, stress: 0/1.
+!> method: 0 auto, 1 cg, 2 anderson, 3 gcr; precondition, coarse_start, stress: 0/1.
 !> fields(:, 1:5): pressure, gap, displacement_z, displacement_x, stress_xx (the last two
 !> zero unless stress = 1); spots(1:n_spots, 1:5): trailing and leading edges, largest
 !> sigma_xx around the spot (sub-grid at the trailing edge with friction), its offset from
 !> the trailing edge and the largest grid value (zero unless stress = 1);
-!> scalars: in the order of layercontact.api._SCALARS; history(1:history_length): the last
+!> scalars: in the order of layercontact.api._SCALARS (the solver that ran as its index in
+!> `solvers`); history(1:history_length): the last
 !> residuals of the run, at most `capacity` (an array of max_iter entries would cost more
 !> than a small solve).
 subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
@@ -84,7 +85,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    integer, intent(in) :: capacity
    real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
    real(8), intent(in) :: e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
-   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 5), scalars(26), history(capacity)
+   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 5), scalars(27), history(capacity)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n, nt
@@ -93,7 +94,9 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    type(contact_result) :: r
    character(len=12), parameter :: controls(0:1) = [character(len=12) :: 'load', 'displacement']
    integer :: stored
-   character(len=8), parameter :: methods(0:2) = [character(len=8) :: 'auto', 'cg', 'anderson']
+   character(len=8), parameter :: methods(0:3) = [character(len=8) :: 'auto', 'cg', 'anderson', 'gcr']
+   !> the solver that ran, as scalars(27) (layercontact.api._SOLVERS)
+   character(len=16), parameter :: solvers(4) = [character(len=16) :: 'cg', 'gcr', 'anderson', 'gcr+anderson']
    stat = 0
    errmsg = ''
    scene = scene_type(n=n, period=period, thickness=thickness, young=young, poisson=poisson, friction=friction, &
@@ -103,7 +106,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    scene%profile%file = '(array from Python)'
    scene%material = make_material_law(model, form, young, e0, e_inf, tau, equilibrium, times, values)
    scene%speed = speed
-   scene%solver%method = methods(max(0, min(2, method)))
+   scene%solver%method = methods(max(0, min(3, method)))
    scene%solver%tol = tol
    scene%solver%max_iter = max_iter
    scene%solver%memory = memory
@@ -136,7 +139,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
       & real(r%outer_iterations, 8), real(r%fft_pairs, 8), r%residual, r%wall_time, &
       & real(stored, 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
       & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), &
-      & r%pressure_shift, r%summit_shift, r%max_tension_grid]
+      & r%pressure_shift, r%summit_shift, r%max_tension_grid, real(findloc(solvers, r%solver, dim=1), 8)]
 end subroutine py_solve_line
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless

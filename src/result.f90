@@ -46,8 +46,11 @@ module lc_result
       real(wp) :: max_tension_x = 0.0_wp      !< where it sits (L)
       real(wp) :: max_tension_offset = 0.0_wp !< its offset from the nearest spot's trailing edge (L)
       logical :: converged = .false.
-      integer :: iterations = 0               !< constrained-CG iterations (all inner solves)
-      integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for a symmetric scene
+      integer :: iterations = 0               !< CG or GCR iterations (all inner CG solves for anderson)
+      integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for cg and gcr
+      !> the solver that ran: 'cg', 'gcr', 'anderson', or 'gcr+anderson' (gcr stalled and the
+      !> Anderson outer iteration went on from its best iterate)
+      character(len=16) :: solver = ''
       integer :: fft_pairs = 0                !< FFT r2c+c2r pairs spent
       real(wp) :: residual = huge(1.0_wp)     !< final dimensionless complementarity residual
       real(wp) :: wall_time = 0.0_wp          !< seconds spent in the solver

@@ -112,8 +112,10 @@ contains
          & 'the contact solution may not be unique (viscoelastic coupling with friction)'
       write (unit, real_fmt) 'interlocking friction Delta mu', result%delta_mu
       write (unit, real_fmt) 'total friction mu_c + Delta mu', result%friction + result%delta_mu
-      write (unit, int_fmt) 'CG iterations', result%iterations
-      write (unit, int_fmt) 'outer (Anderson) iterations', result%outer_iterations
+      write (unit, '(2x, a, t34, a14)') 'solver', trim(result%solver)
+      write (unit, int_fmt) 'iterations', result%iterations
+      if (index(result%solver, 'anderson') > 0) write (unit, int_fmt) 'outer (Anderson) iterations', &
+         & result%outer_iterations
       write (unit, real_fmt) 'residual', result%residual
       write (unit, '(2x, a, t34, l14)') 'converged', result%converged
       if (present(companion)) write (unit, '(2x, a, t34, l14)') 'converged, mu_c = 0', companion%converged

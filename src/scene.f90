@@ -49,7 +49,8 @@ module lc_scene
 
    !> Solver choice and stopping rule.
    type :: solver_settings
-      !> auto | cg | anderson: auto picks cg for symmetric operators, anderson otherwise
+      !> auto | cg | gcr | anderson: auto picks cg for symmetric operators, gcr otherwise
+      !> (going on with anderson if gcr stalls)
       character(len=max_string) :: method = 'auto'
       !> tolerance on the dimensionless complementarity residual
       real(wp) :: tol = 1.0e-10_wp
@@ -210,8 +211,8 @@ contains
          else if (trim(scene%control) == 'displacement' .and. .not. positive_finite(scene%penetration)) then
             call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
                & "> 0 and finite with control = 'displacement'")
-         else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'anderson'])) then
-            call input_error(error, 'solver', 'method', trim(s%method), "'auto', 'cg' or 'anderson'")
+         else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'gcr', 'anderson'])) then
+            call input_error(error, 'solver', 'method', trim(s%method), "'auto', 'cg', 'gcr' or 'anderson'")
          else if (.not. (s%tol >= 1.0e-14_wp .and. s%tol <= 1.0e-2_wp)) then
             call input_error(error, 'solver', 'tol', to_string(s%tol), '1e-14 <= tol <= 1e-2')
          else if (scene%gap_bins < 0 .or. scene%gap_bins > 100000) then

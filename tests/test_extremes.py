@@ -46,10 +46,12 @@ def test_every_run_converges_or_says_so(n):
         # the convergence flag and the residual say the same thing
         assert r.converged == (r.residual <= TOL), where
         # the residual is that of the returned fields: the last CG iterate, or the best
-        # outer iterate of a coupled solve (the first below tol if it converged)
+        # iterate of a coupled solve (the first below tol if it converged; a GCR iterate
+        # returned as its best is evaluated again with w = G p afresh, which differs from
+        # the incrementally updated w by rounding)
         assert r.residual_history.size >= 1, where
         if coupled(scene["thickness"], scene["nu"], scene["friction"]):
-            assert r.residual == r.residual_history.min(), where
+            assert r.residual == pytest.approx(r.residual_history.min(), rel=1e-9), where
         else:
             assert r.residual == r.residual_history[-1], where
         assert 1 <= r.iterations <= MAX_ITER and r.outer_iterations >= 1, where

@@ -207,8 +207,9 @@ def test_elastic_inequalities(nu):
 
 # ---------------------------------------------------------------------------------------
 # Switches of the operator built from the kernels (src/contact/operator.f90): a real
-# multiplier and constrained CG when uncoupled, a complex one and the Anderson outer
-# iteration when coupled (mu_c > 0, except the incompressible half-space, whose c = 0),
+# multiplier and constrained CG when uncoupled, a complex one and the constrained GCR (or,
+# with method 'anderson', the Anderson outer iteration) when coupled (mu_c > 0, except the
+# incompressible half-space, whose c = 0),
 # complex compliances for a moving viscoelastic law (speed > 0). Across each switch the
 # solution is continuous: a perturbation eps of the data changes p by O(eps) (the
 # solution of a monotone LCP is Lipschitz in its data) on top of the solver's tolerance.
@@ -220,18 +221,20 @@ def switch_profile():
     return lc.self_affine_profile(512, 0.8, seed=3, short_wavelength=8 / 512)
 
 
+@pytest.mark.parametrize("method", ["auto", "anderson"])
 @pytest.mark.parametrize("base, perturbed", [
     (dict(thickness=0.05, poisson=0.3, friction=0.0), dict(friction=1e-15)),
     (dict(thickness=np.inf, poisson=0.5, friction=0.8), dict(poisson=float(np.nextafter(0.5, 0.0)))),
     (dict(thickness=0.05, poisson=0.5, friction=0.3, speed=0.0), dict(speed=1e-15)),
 ], ids=["coupling mu_c 0 -> 1e-15", "coupling nu 1/2 -> 1/2 - ulp", "viscoelastic V 0 -> 1e-15"])
-def test_operator_switches_are_continuous(switch_profile, base, perturbed):
+def test_operator_switches_are_continuous(switch_profile, base, perturbed, method):
     material = lc.StandardLinearSolid(1.0, 10.0, 1.0) if "speed" in base else None
-    a = lc.solve_line(switch_profile, mean_pressure=0.05, tol=1e-12, material=material, **base)
-    b = lc.solve_line(switch_profile, mean_pressure=0.05, tol=1e-12, material=material, **{**base, **perturbed})
+    a = lc.solve_line(switch_profile, mean_pressure=0.05, tol=1e-12, material=material, method=method, **base)
+    b = lc.solve_line(switch_profile, mean_pressure=0.05, tol=1e-12, material=material, method=method,
+                      **{**base, **perturbed})
     assert a.converged and b.converged
-    # the two runs take different paths (CG alone vs CG inside the outer iteration)
-    assert (a.outer_iterations == 1) != (b.outer_iterations == 1) or "speed" in base
+    # the two runs take different paths (CG alone vs the coupled solver)
+    assert {a.solver, b.solver} == {"cg", "gcr" if method == "auto" else "anderson"} or "speed" in base
     assert np.array_equal(a.pressure > 0, b.pressure > 0)
     assert np.abs(a.pressure - b.pressure).max() <= 1e-10 * a.pressure.max()
     assert abs(a.penetration - b.penetration) <= 1e-10 * np.ptp(switch_profile)

@@ -89,7 +89,7 @@ def test_incompressible_halfspace_friction_changes_nothing(rough_profile):
     r0 = lc.solve_line(rough_profile, poisson=0.5, friction=0.0, mean_pressure=pm)
     r1 = lc.solve_line(rough_profile, poisson=0.5, friction=0.9, mean_pressure=pm)
     near = lc.solve_line(rough_profile, poisson=0.5 - 1e-9, friction=0.9, mean_pressure=pm)
-    assert r1.outer_iterations == 1 and near.outer_iterations > 1  # really the coupled path
+    assert r1.solver == "cg" and near.solver == "gcr"  # really the coupled path
     assert np.abs(near.pressure - r0.pressure).max() <= 1e-6 * r0.pressure.max()
     assert np.array_equal(r0.pressure, r1.pressure)
     assert r1.delta_mu_spectral == 0.0 and abs(r1.delta_mu) < 1e-14
@@ -132,7 +132,7 @@ def test_displacement_control_of_halfspace_is_refused(rough_profile):
 
 def test_not_converged_is_reported_honestly(rough_profile):
     res = lc.solve_line(rough_profile, thickness=0.01, friction=1.0, mean_pressure=rough_profile.max() * 16,
-                        max_iter=20)
+                        max_iter=5)
     assert not res.converged and res.residual > 1e-10
     assert np.all(np.isfinite(res.pressure))
     # the fields written for a stopped run belong together
@@ -184,7 +184,11 @@ def test_preconditioned_and_plain_cg_agree(rough_profile, thickness, friction):
     b = lc.solve_line(rough_profile, precondition=False, **kw)
     assert a.converged and b.converged
     assert a.iterations < b.iterations
-    assert np.abs(a.pressure - b.pressure).max() <= 1e-8 * a.pressure.max()
+    # A gap residual tol * ptp(profile) on the contact set allows pressure differences up to
+    # the largest stiffness, |k_max| E*/2, times that.
+    e_star = 1.0 / (1 - 0.5**2)
+    bound = 1e-11 * np.ptp(rough_profile) * e_star * np.pi * rough_profile.size / 2
+    assert np.abs(a.pressure - b.pressure).max() <= bound
     assert a.penetration == pytest.approx(b.penetration, rel=1e-9)
 
 
@@ -206,7 +210,12 @@ def test_coarse_start_reaches_the_same_solution(rough_profile, case):
     b = lc.solve_line(rough_profile, coarse_start=False, tol=1e-11, **kw)
     assert a.converged and b.converged
     assert a.iterations < b.iterations
-    assert np.abs(a.pressure - b.pressure).max() <= 1e-8 * a.pressure.max()
+    # A gap residual tol * ptp(profile) on the contact set allows pressure differences up to
+    # the largest stiffness, |k_max| E*/2 (E_inf for the glassy short waves of the
+    # viscoelastic layer), times that.
+    e_star = (10.0 if case == "viscoelastic" else 1.0) / (1 - kw.get("poisson", 0.5) ** 2)
+    bound = 1e-11 * np.ptp(rough_profile) * e_star * np.pi * rough_profile.size / 2
+    assert np.abs(a.pressure - b.pressure).max() <= bound
     assert a.penetration == pytest.approx(b.penetration, rel=1e-9)
 
 

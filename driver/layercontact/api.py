@@ -12,15 +12,17 @@ from . import _core
 
 NOT_SET = -1.0
 _CONTROLS = {"load": 0, "displacement": 1}
-_METHODS = {"auto": 0, "cg": 1, "anderson": 2}
+_METHODS = {"auto": 0, "cg": 1, "anderson": 2, "gcr": 3}
 # Order of the scalars returned by the wrapper py_solve_line (driver/wrappers.f90).
 _SCALARS = (
     "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
     "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
-    "max_tension_grid",
+    "max_tension_grid", "solver",
 )
+# The solver that ran, by the code in the scalars (driver/wrappers.f90 `solvers`).
+_SOLVERS = {1: "cg", 2: "gcr", 3: "anderson", 4: "gcr+anderson"}
 _INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
 # Residuals returned per solve (the last ones): a max_iter-long array would cost more than
 # a small solve.
@@ -79,8 +81,12 @@ class LineResult:
     ``stress_xx`` at a trailing edge sub-grid when there is friction; ``max_tension_grid``
     (``spot_max_tension_grid``) is the largest grid value.
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
-    ``residual_history`` holds the residual per CG iteration (per outer iteration for a
-    coupled solve); from :func:`solve_line`, the last ``HISTORY_CAPACITY`` (10000) of them.
+    ``solver`` names the method that ran: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled
+    scenes), ``'anderson'``, or ``'gcr+anderson'`` (GCR stalled and the Anderson outer
+    iteration went on from its best iterate). ``iterations`` counts CG or GCR iterations
+    (all inner CG iterations for Anderson). ``residual_history`` holds the residual per
+    iteration (per outer iteration for Anderson); from :func:`solve_line`, the last
+    ``HISTORY_CAPACITY`` (10000) of them.
     """
 
     pressure: np.ndarray
@@ -100,6 +106,7 @@ class LineResult:
     converged: bool
     iterations: int
     outer_iterations: int
+    solver: str
     fft_pairs: int
     residual: float
     wall_time: float
@@ -169,8 +176,10 @@ def solve_line(
     hence a unique solution) are reported. ``companion=True`` also solves the frictionless problem at
     the same load and sets ``a_over_a0`` and ``companion``. ``stress`` computes
     ``displacement_x``, ``shear`` and the surface stress ``stress_xx`` (one more FFT pair).
+    ``method``: ``'auto'`` (constrained CG for symmetric scenes, constrained GCR for coupled
+    ones, going on with Anderson if GCR stalls), ``'cg'``, ``'gcr'`` or ``'anderson'``.
     ``precondition`` applies the Fourier stiffness 1/M to the residual on the contact set
-    (fewer iterations). ``coarse_start`` starts from the solution on the grid of every
+    (fewer CG iterations). ``coarse_start`` starts from the solution on the grid of every
     second point, recursively down to 512 points (fine-grid iterations nearly flat in
     the grid size; see bench/iterations.py).
     Raises :class:`LayercontactError` with the library's message for bad input. A run that
@@ -215,6 +224,7 @@ def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure
     n_hist = int(scalars.pop("history_length"))
     scalars["converged"] = bool(scalars["converged"])
     scalars["monotone"] = bool(scalars["monotone"])
+    scalars["solver"] = _SOLVERS.get(int(scalars["solver"]), "")
     if not stress:
         for name in ("max_tension", "max_tension_x", "max_tension_offset", "max_tension_grid"):
             scalars[name] = float("nan")
@@ -251,8 +261,10 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
         fields = {k: base["fields"][k][()] for k in base["fields"]}
         spots = (np.column_stack([base["spots/trailing_edge"][()], base["spots/leading_edge"][()]])
                  if "spots" in base else np.zeros((0, 2)))
-        names = set(_SCALARS) - {"history_length"}
+        names = set(_SCALARS) - {"history_length", "solver"}
         values = {k: (int(r[k]) if k in _INTEGERS else float(r[k])) for k in names if k in r}
+        solver = r.get("solver", "")
+        values["solver"] = solver.decode() if isinstance(solver, bytes) else str(solver)
         values["converged"] = bool(r["converged"])
         values["monotone"] = bool(r.get("monotone", 1))
         return LineResult(

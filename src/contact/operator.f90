@@ -67,6 +67,11 @@ module lc_contact_operator
       complex(wp), allocatable :: full(:)   !< G_eff(k), only when coupled
       !> M in real space: (M p)(x_i) = sum_j column(i - j) p_j (L/S)
       real(wp), allocatable :: column(:)
+      !> For the constrained GCR only (prepare_gcr): 1/G_eff(k) (0 where G_eff = 0), the
+      !> real-space column of G_eff, and the real-space diagonal of 1/G_eff
+      complex(wp), allocatable :: inverse_full(:)
+      real(wp), allocatable :: full_column(:)
+      real(wp) :: inverse_diagonal = 0.0_wp
       type(fft_plan) :: fft
    contains
       procedure :: apply_metric
@@ -75,6 +80,9 @@ module lc_contact_operator
       procedure :: add_column
       procedure :: metric_in_buffer
       procedure :: inverse_metric_in_buffer
+      procedure :: prepare_gcr
+      procedure :: full_in_buffer
+      procedure :: inverse_full_in_buffer
       procedure :: drop_uniform_mode
       procedure :: wavenumber
    end type compliance_operator
@@ -291,6 +299,64 @@ contains
       class(compliance_operator), intent(inout) :: self
       call multiply_in_buffer(self, self%preconditioner)
    end subroutine inverse_metric_in_buffer
+
+   !> What the constrained GCR needs besides G_eff (built on first use, after the uniform
+   !> mode was dropped or not): its Fourier inverse, its real-space column and the
+   !> real-space diagonal of the inverse.
+   subroutine prepare_gcr(self)
+      class(compliance_operator), intent(inout) :: self
+      complex(wp), allocatable :: g(:)
+      real(wp), allocatable :: unit_load(:), inverse_column(:)
+      integer :: n
+      n = self%n
+      if (self%coupled) then
+         g = self%full
+      else
+         g = cmplx(self%metric, 0.0_wp, kind=wp)
+      end if
+      if (allocated(self%inverse_full)) deallocate (self%inverse_full)
+      allocate (self%inverse_full(self%nk), unit_load(n), inverse_column(n))
+      where (abs(g) > 0.0_wp)
+         self%inverse_full = 1.0_wp/g
+      elsewhere
+         self%inverse_full = (0.0_wp, 0.0_wp)
+      end where
+      unit_load = 0.0_wp
+      unit_load(1) = 1.0_wp
+      if (.not. allocated(self%full_column)) allocate (self%full_column(n))
+      self%fft%real_buffer = unit_load
+      call multiply_complex_in_buffer(self, g)
+      self%full_column = self%fft%real_buffer
+      self%fft%real_buffer = unit_load
+      call multiply_complex_in_buffer(self, self%inverse_full)
+      self%inverse_diagonal = self%fft%real_buffer(1)
+   end subroutine prepare_gcr
+
+   !> fft%real_buffer <- G_eff fft%real_buffer (see metric_in_buffer).
+   subroutine full_in_buffer(self)
+      class(compliance_operator), intent(inout) :: self
+      if (self%coupled) then
+         call multiply_complex_in_buffer(self, self%full)
+      else
+         call multiply_in_buffer(self, self%metric)
+      end if
+   end subroutine full_in_buffer
+
+   !> fft%real_buffer <- G_eff^-1 fft%real_buffer (0 on the modes where G_eff = 0; after
+   !> prepare_gcr).
+   subroutine inverse_full_in_buffer(self)
+      class(compliance_operator), intent(inout) :: self
+      call multiply_complex_in_buffer(self, self%inverse_full)
+   end subroutine inverse_full_in_buffer
+
+   !> fft%real_buffer <- multiplier * fft%real_buffer with a complex multiplier.
+   subroutine multiply_complex_in_buffer(self, multiplier)
+      class(compliance_operator), intent(inout) :: self
+      complex(wp), intent(in) :: multiplier(:)
+      call self%fft%forward_unscaled()
+      self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
+      call self%fft%backward()
+   end subroutine multiply_complex_in_buffer
 
    !> w = multiplier * p through the plans; the 1/n of the forward transform is folded in.
    subroutine apply_real(self, multiplier, p, w)

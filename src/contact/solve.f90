@@ -15,6 +15,7 @@ module lc_contact_solve
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome
    use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
+   use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
    use lc_observables_friction, only: interlocking_friction
    use lc_observables_surface, only: surface_fields, edge_stress_field
    use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, &
@@ -120,9 +121,10 @@ contains
       type(contact_result), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
       type(cg_outcome) :: cg
+      type(gcr_outcome) :: gcr
       type(anderson_outcome) :: outer
-      real(wp), allocatable :: history(:)
-      real(wp) :: uniform
+      real(wp), allocatable :: history(:), p_gcr(:), w_gcr(:), gap_gcr(:)
+      real(wp) :: uniform, s_gcr
       integer :: n, coarse_pairs
 
       n = size(height)
@@ -138,13 +140,51 @@ contains
       if (load_control) call op%drop_uniform_mode(uniform)
       if (op%coupled .and. trim(scene%solver%method) == 'cg') then
          call fatal_error(error, "&solver: method = 'cg' cannot solve this scene: friction couples the normal " // &
-            & "and tangential fields and the operator is not symmetric; allowed: 'auto' or 'anderson'", code_input)
+            & "and tangential fields and the operator is not symmetric; allowed: 'auto', 'gcr' or 'anderson'", code_input)
          return
       end if
       ! only the first `iterations` entries are written and read (not zeroed: the budget may
       ! be 1e7 entries, and untouched pages cost nothing)
       allocate (history(scene%solver%max_iter))
-      if (op%coupled) then
+      if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
+         ! constrained GCR; under 'auto' a solve that stalls goes on with the Anderson outer
+         ! iteration from GCR's best iterate, with the budget left
+         call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+            & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history)
+         result%converged = gcr%converged
+         result%iterations = gcr%iterations
+         result%outer_iterations = 1
+         result%fft_pairs = gcr%fft_pairs
+         result%residual = gcr%residual
+         result%residual_history = history(1:gcr%iterations)
+         result%solver = 'gcr'
+         if (.not. gcr%converged .and. trim(scene%solver%method) == 'auto' .and. &
+            & gcr%iterations < scene%solver%max_iter) then
+            ! (GCR's best iterate is kept in case the Anderson iteration ends worse)
+            p_gcr = p
+            w_gcr = w
+            gap_gcr = gap
+            s_gcr = s
+            call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
+               & scene%solver%max_iter - gcr%iterations, scene%solver%memory, scene%solver%precondition, p, w, gap, &
+               & outer, history, error)
+            if (allocated(error)) return
+            result%converged = outer%converged
+            result%iterations = result%iterations + outer%cg_iterations
+            result%outer_iterations = 1 + outer%outer_iterations
+            result%fft_pairs = result%fft_pairs + outer%fft_pairs
+            result%residual_history = [result%residual_history, history(1:outer%outer_iterations)]
+            result%solver = 'gcr+anderson'
+            if (outer%residual <= gcr%residual) then
+               result%residual = outer%residual
+            else
+               p = p_gcr
+               w = w_gcr
+               gap = gap_gcr
+               s = s_gcr
+            end if
+         end if
+      else if (op%coupled) then
          call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error)
          if (allocated(error)) return
@@ -154,6 +194,7 @@ contains
          result%fft_pairs = outer%fft_pairs
          result%residual = outer%residual
          result%residual_history = history(1:outer%outer_iterations)
+         result%solver = 'anderson'
       else
          call constrained_cg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%precondition, p, w, gap, cg, history)
@@ -163,6 +204,7 @@ contains
          result%fft_pairs = cg%fft_pairs
          result%residual = cg%residual
          result%residual_history = history(1:cg%iterations)
+         result%solver = 'cg'
       end if
       result%fft_pairs = result%fft_pairs + coarse_pairs
       ! the uniform mode's rigid shift (see drop_uniform_mode)

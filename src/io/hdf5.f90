@@ -387,6 +387,7 @@ contains
       call write_attr_int(group, 'converged', merge(1, 0, res%converged), st)
       call write_attr_int(group, 'iterations', res%iterations, st)
       call write_attr_int(group, 'outer_iterations', res%outer_iterations, st)
+      call write_attr_string(group, 'solver', trim(res%solver), st)
       call write_attr_int(group, 'fft_pairs', res%fft_pairs, st)
       call write_attr_real(group, 'residual', res%residual, st)
       call write_attr_real(group, 'wall_time', res%wall_time, st)

@@ -1,0 +1,557 @@
+!> Constrained GCR for the coupled (non-symmetric) contact problem
+!>    find p >= 0, gap = G_eff p - b - s >= 0, p gap = 0,
+!> under load control (mean(p) = p_m, s the multiplier) or displacement control (s given).
+!>
+!> GCR (Eisenstat, Elman & Schultz, SIAM J. Numer. Anal. 20 (1983) 345) is the
+!> minimal-residual Krylov method that keeps the images A d_i of its directions
+!> orthonormal; here A is G_eff restricted to the contact set (and, under load control,
+!> projected to zero sum on it, so that every step keeps the load), right-preconditioned
+!> by the Fourier inverse of G_eff masked to the set. As in Polonsky & Keer's constrained
+!> CG the set changes inside the iteration: overlapping points are let in (the history is
+!> kept, re-orthonormalised on the larger set without a transform) and negative pressures
+!> are clipped (the history is dropped). Each iteration costs two transform pairs and a few
+!> sweeps over the history. Compared with the outer fixed point of lc_contact_solver_anderson
+!> (symmetric inner solves with |G_eff|), whose rate is set by the spread of arg G_eff
+!> (thin layers with friction, lossy viscoelastic layers), the preconditioned operator
+!> here is close to the identity on a large contact set whatever arg G_eff is.
+!>
+!> The images are stored centred on the contact set under load control: a constant added
+!> to w everywhere only moves s. w is recomputed as G_eff p to confirm convergence, so the
+!> fields returned belong together. Stopping rule and residual as in lc_contact_solver_cg.
+module lc_contact_solver_gcr
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use lc_kinds, only: wp
+   use lc_contact_operator, only: compliance_operator
+   use lc_contact_solver_cg, only: rounding_floor
+   implicit none (type, external)
+   private
+   public :: constrained_gcr, gcr_outcome
+
+   !> Iterations without the residual halving after which the solve gives up (and reports
+   !> non-convergence with its best iterate; under method 'auto' the Anderson outer
+   !> iteration goes on from there). A converging solve halves the residual every one to
+   !> three iterations. Stalls happen on thin layers with strong friction and small contact
+   !> sets: G_eff restricted to the set is then nearly skew (arg G_eff near -90 degrees at
+   !> long waves) and nearly singular, and the minimal residual plateaus (measured: h/lambda
+   !> 0.01, mu_c 1, n = 256, 10 % contact: 2 of 8 seeds plateau, for 60 and 170 iterations;
+   !> a longer history or twice-orthogonalised images did not help).
+   integer, parameter :: stall_window = 25
+   !> Iterations after which w = G_eff p is recomputed (bounds the drift of the updates).
+   integer, parameter :: refresh_interval = 50
+   !> Most points clipped or let in whose change is added to w column by column.
+   integer, parameter :: column_updates = 8
+   interface
+      subroutine dpotrf(uplo, n, a, lda, info)
+         import :: wp
+         character, intent(in) :: uplo
+         integer, intent(in) :: n, lda
+         real(wp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: info
+      end subroutine dpotrf
+   end interface
+
+   !> Rows per block of the sweeps over the history.
+   integer, parameter :: block_rows = 2048
+   !> A new image whose norm falls below this fraction of its norm before the
+   !> orthogonalisation is numerically in the span of the history: restart.
+   real(wp), parameter :: breakdown = 1.0e-10_wp
+
+   !> What one constrained GCR solve did.
+   type :: gcr_outcome
+      logical :: converged = .false.
+      integer :: iterations = 0
+      integer :: fft_pairs = 0
+      real(wp) :: residual = huge(1.0_wp)
+   end type gcr_outcome
+
+contains
+
+   !> Solve the coupled problem. p: starting guess in (made feasible), solution out (the
+   !> best iterate if not converged); w = G_eff p; gap = w - b - s.
+   !> history(it) receives the residual of iteration it when present.
+   subroutine constrained_gcr(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, memory, precondition, &
+         & p, w, gap, outcome, history)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), contiguous, intent(in) :: b(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure   !< p_m (load control; ignored otherwise)
+      real(wp), intent(inout) :: s            !< in: given (displacement control); out: the multiplier
+      real(wp), intent(in) :: g_ref, tol
+      integer, intent(in) :: max_iter, memory
+      !> precondition the residual with the Fourier inverse of G_eff on the contact set
+      logical, intent(in) :: precondition
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(out) :: w(:), gap(:)
+      type(gcr_outcome), intent(out) :: outcome
+      real(wp), intent(inout), optional :: history(:)
+      real(wp), allocatable :: dirs(:, :), images(:, :), d(:), coeff(:), p_best(:)
+      real(wp), pointer, contiguous :: buffer(:)
+      real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa
+      integer :: it, n, columns, newest, n_contact, n_changed, since_fresh, last_progress
+      logical :: stale, clipped, entered
+
+      n = size(p)
+      call op%prepare_gcr()
+      ! the real-space diagonal of the preconditioner, for letting points in
+      kappa = merge(op%inverse_diagonal, 1.0_wp, precondition)
+      allocate (dirs(n, memory), images(n, memory), d(n), coeff(memory), p_best(n))
+      buffer => op%fft%real_buffer
+      p = max(p, 0.0_wp)
+      if (load_control) call normalise(p, mean_pressure)
+      b_max = maxval(abs(b))
+      columns = 0
+      newest = 0
+      stale = .true.
+      since_fresh = 0
+      best = huge(1.0_wp)
+      best_residual = huge(1.0_wp)
+      last_progress = 0
+      p_best = p
+
+      do it = 1, max_iter + 1
+         ! as in the constrained CG: w is updated in place, recomputed every
+         ! refresh_interval iterations, when many points changed, and to confirm convergence
+         do
+            if (stale .or. since_fresh >= refresh_interval) then
+               call op%apply_full(p, w)
+               outcome%fft_pairs = outcome%fft_pairs + 1
+               since_fresh = 0
+               stale = .false.
+            end if
+            call evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, n_contact, &
+               & outcome%residual, buffer)
+            if (since_fresh == 0 .or. .not. (outcome%residual <= tol .or. it > max_iter)) exit
+            stale = .true.
+         end do
+         outcome%converged = outcome%residual <= tol
+         outcome%iterations = min(it, max_iter)
+         if (present(history)) then
+            if (it <= size(history)) history(it) = outcome%residual
+         end if
+         if (outcome%residual < best_residual) then
+            best_residual = outcome%residual
+            p_best = p
+         end if
+         if (outcome%converged .or. it > max_iter) exit
+         if (outcome%residual < 0.5_wp*best) then
+            best = outcome%residual
+            last_progress = it
+         else if (it - last_progress > stall_window) then
+            exit
+         end if
+
+         if (n_contact == 0) then
+            ! displacement control with nothing in contact yet: load the overlapping points
+            call let_in_overlaps(p, gap, 1.0_wp/op%diagonal, n_changed)
+            if (n_changed == 0) exit
+            columns = 0
+            stale = .true.
+            cycle
+         end if
+
+         ! direction: the preconditioned residual on the set (evaluate left -gap there in
+         ! the buffer), projected to zero sum on the set under load control
+         if (precondition) then
+            call op%inverse_full_in_buffer()
+            outcome%fft_pairs = outcome%fft_pairs + 1
+         end if
+         call project_on_set(p, load_control, buffer, d)
+         ! its image, orthogonalised against the stored ones on the set
+         call op%full_in_buffer()
+         outcome%fft_pairs = outcome%fft_pairs + 1
+         coeff = 0.0_wp
+         if (columns > 0) then
+            call history_products(images(:, 1:columns), p, buffer, coeff(1:columns))
+            call subtract_history(dirs(:, 1:columns), images(:, 1:columns), coeff(1:columns), d, buffer)
+         end if
+         call set_norm(p, load_control, buffer, centre, norm)
+         ! (the stored images are orthonormal on the set: Pythagoras gives the norm before)
+         norm_before = sqrt(norm**2 + sum(coeff(1:columns)**2))
+         if (.not. norm_before > 0.0_wp) then
+            ! no direction on the set (e.g. one point in contact under load control: its gap
+            ! is s exactly): let the overlapping points in and start afresh
+            call let_in_overlaps(p, gap, 1.0_wp/op%diagonal, n_changed)
+            if (n_changed == 0) exit
+            if (load_control) call normalise(p, mean_pressure)
+            columns = 0
+            newest = 0
+            stale = .true.
+            cycle
+         end if
+         if (.not. norm > breakdown*norm_before) then
+            ! nothing new in this direction (or not finite): start the history afresh
+            if (columns == 0) exit
+            columns = 0
+            newest = 0
+            cycle
+         end if
+         ! the minimal-residual step: alpha = (r, u) for the unit image u; r = -gap on the set
+         call normalised_step(p, gap, centre, norm, d, buffer, alpha)
+         newest = mod(newest, memory) + 1
+         columns = min(columns + 1, memory)
+         dirs(:, newest) = d
+         images(:, newest) = buffer
+         ! the coefficient of the preconditioned residual in the step, for letting points in
+         step = alpha/norm
+         call update(p, w, gap, d, buffer, alpha, step*kappa, n_changed, clipped, entered)
+         if (n_changed > column_updates) then
+            stale = .true.
+         else if (n_changed > 0) then
+            call add_changed_columns(op%full_column, buffer, w)
+         end if
+         since_fresh = since_fresh + 1
+         if (load_control) call scale_to_load(p, w, mean_pressure, stale)
+         if (clipped) then
+            columns = 0
+            newest = 0
+         else if (entered .and. columns > 0) then
+            call reorthonormalise(p, load_control, dirs, images, columns, newest)
+         end if
+      end do
+      ! not converged: return the best iterate
+      if (.not. outcome%converged .and. best_residual < outcome%residual) then
+         p = p_best
+         call op%apply_full(p, w)
+         outcome%fft_pairs = outcome%fft_pairs + 1
+         call evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, n_contact, &
+            & outcome%residual, buffer)
+      end if
+   end subroutine constrained_gcr
+
+   !> Two passes: s (the mean of w - b over the contact set under load control), the gap
+   !> w - b - s, the complementarity residual, and -gap on the contact set (0 elsewhere) in
+   !> `masked`, the preconditioner's input.
+   subroutine evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, m_max, s, gap, n_contact, residual, &
+         & masked)
+      real(wp), contiguous, intent(in) :: p(:), w(:), b(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure, g_ref, b_max, m_max
+      real(wp), intent(inout) :: s
+      real(wp), contiguous, intent(out) :: gap(:), masked(:)
+      integer, intent(out) :: n_contact
+      real(wp), intent(out) :: residual
+      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, p_scale, g_scale, g_floor, g, c, inside, check
+      integer :: j
+      contact = 0.0_wp
+      gap_sum = 0.0_wp
+      p_sum = 0.0_wp
+      w_max = 0.0_wp
+      p_max = 0.0_wp
+      !$omp simd reduction(+:contact, gap_sum, p_sum) reduction(max:w_max, p_max) private(inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         contact = contact + inside
+         gap_sum = gap_sum + (w(j) - b(j))*inside
+         p_sum = p_sum + p(j)
+         w_max = max(w_max, abs(w(j)))
+         p_max = max(p_max, p(j))
+      end do
+      n_contact = nint(contact)
+      if (load_control) s = gap_sum/max(contact, 1.0_wp)
+      p_scale = 1.0_wp/max(merge(mean_pressure, p_sum/size(p), load_control), tiny(1.0_wp))
+      g_scale = 1.0_wp/g_ref
+      g_floor = rounding_floor(w_max, b_max, p_max, m_max)
+      residual = 0.0_wp
+      check = 0.0_wp
+      !$omp simd reduction(max:residual) reduction(+:check) private(g, c, inside)
+      do j = 1, size(p)
+         g = w(j) - b(j) - s
+         gap(j) = g
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         masked(j) = -g*inside
+         c = abs(min(p(j)*p_scale, g*g_scale))
+         residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
+         check = check + g + p(j)
+      end do
+      if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
+   end subroutine evaluate
+
+   !> d = z on the contact set, minus its mean there under load control, 0 elsewhere; z
+   !> (the buffer) is overwritten by d, the next transform's input.
+   subroutine project_on_set(p, load_control, z, d)
+      real(wp), contiguous, intent(in) :: p(:)
+      logical, intent(in) :: load_control
+      real(wp), contiguous, intent(inout) :: z(:)
+      real(wp), contiguous, intent(out) :: d(:)
+      real(wp) :: z_sum, contact, mean, inside
+      integer :: j
+      mean = 0.0_wp
+      if (load_control) then
+         z_sum = 0.0_wp
+         contact = 0.0_wp
+         !$omp simd reduction(+:z_sum, contact) private(inside)
+         do j = 1, size(p)
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            z_sum = z_sum + z(j)*inside
+            contact = contact + inside
+         end do
+         mean = z_sum/max(contact, 1.0_wp)
+      end if
+      !$omp simd private(inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         d(j) = (z(j) - mean)*inside
+         z(j) = d(j)
+      end do
+   end subroutine project_on_set
+
+   !> The mean of v over the contact set (`centre`, 0 without load control) and the norm of
+   !> v - centre on the set.
+   subroutine set_norm(p, load_control, v, centre, norm)
+      real(wp), contiguous, intent(in) :: p(:), v(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(out) :: centre, norm
+      real(wp) :: v_sum, v2_sum, contact, inside, x
+      integer :: j
+      centre = 0.0_wp
+      if (load_control) then
+         v_sum = 0.0_wp
+         contact = 0.0_wp
+         !$omp simd reduction(+:v_sum, contact) private(inside)
+         do j = 1, size(p)
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            v_sum = v_sum + v(j)*inside
+            contact = contact + inside
+         end do
+         centre = v_sum/max(contact, 1.0_wp)
+      end if
+      v2_sum = 0.0_wp
+      !$omp simd reduction(+:v2_sum) private(inside, x)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         x = (v(j) - centre)*inside
+         v2_sum = v2_sum + x*x
+      end do
+      norm = sqrt(v2_sum)
+   end subroutine set_norm
+
+   !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
+   !> (The stored images are centred on the set, so the mean of a need not be removed.)
+   pure subroutine history_products(images, p, a, coeff)
+      real(wp), intent(in) :: images(:, :), p(:), a(:)
+      real(wp), intent(out) :: coeff(:)
+      real(wp) :: c
+      integer :: i, i0, i1, k
+      coeff = 0.0_wp
+      do i0 = 1, size(a), block_rows
+         i1 = min(size(a), i0 + block_rows - 1)
+         do k = 1, size(coeff)
+            c = 0.0_wp
+            !$omp simd reduction(+:c)
+            do i = i0, i1
+               c = c + a(i)*images(i, k)*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
+            end do
+            coeff(k) = coeff(k) + c
+         end do
+      end do
+   end subroutine history_products
+
+   !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks.
+   pure subroutine subtract_history(dirs, images, coeff, d, a)
+      real(wp), intent(in) :: dirs(:, :), images(:, :), coeff(:)
+      real(wp), intent(inout) :: d(:), a(:)
+      integer :: i, i0, i1, k
+      do i0 = 1, size(a), block_rows
+         i1 = min(size(a), i0 + block_rows - 1)
+         do k = 1, size(coeff)
+            !$omp simd
+            do i = i0, i1
+               d(i) = d(i) - coeff(k)*dirs(i, k)
+               a(i) = a(i) - coeff(k)*images(i, k)
+            end do
+         end do
+      end do
+   end subroutine subtract_history
+
+   !> Centre the image a (whole grid) and scale it and d by 1/norm; alpha = (-gap, a) on
+   !> the contact set: the step along d that minimises the residual on the set.
+   subroutine normalised_step(p, gap, centre, norm, d, a, alpha)
+      real(wp), contiguous, intent(in) :: p(:), gap(:)
+      real(wp), intent(in) :: centre, norm
+      real(wp), contiguous, intent(inout) :: d(:), a(:)
+      real(wp), intent(out) :: alpha
+      real(wp) :: scale, inside
+      integer :: j
+      scale = 1.0_wp/norm
+      alpha = 0.0_wp
+      !$omp simd reduction(+:alpha) private(inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         d(j) = d(j)*scale
+         a(j) = (a(j) - centre)*scale
+         alpha = alpha - gap(j)*a(j)*inside
+      end do
+   end subroutine normalised_step
+
+   !> One pass: p <- p + alpha d and w <- w + alpha a; points out of contact with a negative
+   !> gap are let in with -let_in_scale gap (Polonsky & Keer's rule: the preconditioned step
+   !> there), negative pressures clipped. a is overwritten by the change of p that was not
+   !> along d (nonzero at the points clipped or let in), for the column updates of w.
+   subroutine update(p, w, gap, d, a, alpha, let_in_scale, n_changed, clipped, entered)
+      real(wp), contiguous, intent(inout) :: p(:), w(:), a(:)
+      real(wp), contiguous, intent(in) :: gap(:), d(:)
+      real(wp), intent(in) :: alpha, let_in_scale
+      integer, intent(out) :: n_changed
+      logical, intent(out) :: clipped, entered
+      real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count
+      integer :: j
+      clip_count = 0.0_wp
+      enter_count = 0.0_wp
+      changed_count = 0.0_wp
+      !$omp simd reduction(+:clip_count, enter_count, changed_count) private(trial, p_new, c)
+      do j = 1, size(p)
+         trial = p(j) + alpha*d(j)   ! (d = 0 off the contact set)
+         ! let in: out of contact (p = 0) and overlapping
+         c = merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp)*merge(1.0_wp, 0.0_wp, gap(j) < 0.0_wp)
+         p_new = c*max(-let_in_scale*gap(j), 0.0_wp) + (1.0_wp - c)*trial
+         enter_count = enter_count + c*merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
+         clip_count = clip_count + merge(1.0_wp, 0.0_wp, p_new < 0.0_wp)
+         p_new = merge(p_new, 0.0_wp, p_new >= 0.0_wp)   ! clip (a NaN too)
+         w(j) = w(j) + alpha*a(j)
+         a(j) = p_new - trial
+         changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
+         p(j) = p_new
+      end do
+      n_changed = nint(changed_count)
+      clipped = clip_count > 0.0_wp
+      entered = enter_count > 0.0_wp
+   end subroutine update
+
+   !> w <- w + sum_j delta_j G e_j over the points j with delta_j /= 0 (a pass each).
+   subroutine add_changed_columns(column, delta, w)
+      real(wp), contiguous, intent(in) :: column(:), delta(:)
+      real(wp), contiguous, intent(inout) :: w(:)
+      integer :: j, n
+      n = size(w)
+      do j = 1, n
+         if (delta(j) == 0.0_wp) cycle
+         ! G e_j at x_i is column(i - j): column(1..n-j+1) for i = j..n, wrapped for i < j
+         w(j:n) = w(j:n) + delta(j)*column(1:n - j + 1)
+         w(1:j - 1) = w(1:j - 1) + delta(j)*column(n - j + 2:n)
+      end do
+   end subroutine add_changed_columns
+
+   !> p and w scaled to the load (w = G p is linear in p); a vanished p is reset to uniform
+   !> (w stale then).
+   subroutine scale_to_load(p, w, mean_pressure, stale)
+      real(wp), contiguous, intent(inout) :: p(:), w(:)
+      real(wp), intent(in) :: mean_pressure
+      logical, intent(inout) :: stale
+      real(wp) :: total, factor
+      total = sum(p)
+      if (total > 0.0_wp) then
+         factor = mean_pressure*size(p)/total
+         if (abs(factor - 1.0_wp) > 8*epsilon(1.0_wp)) then
+            p = p*factor
+            w = w*factor
+         end if
+      else
+         p = mean_pressure
+         stale = .true.
+      end if
+   end subroutine scale_to_load
+
+   !> After points were let in: the stored images, centred again on the larger contact set,
+   !> are made orthonormal there again (Cholesky of their Gram matrix on the set: one sweep
+   !> for the products, one for the transform, no FFT). The columns are reordered oldest
+   !> first; if the Gram matrix is not numerically positive definite the history is dropped.
+   subroutine reorthonormalise(p, load_control, dirs, images, columns, newest)
+      real(wp), contiguous, intent(in) :: p(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(inout) :: dirs(:, :), images(:, :)
+      integer, intent(inout) :: columns, newest
+      real(wp), allocatable :: gram(:, :), sums(:), centre(:), tmp_d(:, :), tmp_a(:, :)
+      integer, allocatable :: order(:)
+      real(wp) :: contact, x
+      integer :: i, i0, i1, k, l, m, info
+
+      m = columns
+      ! oldest first
+      allocate (order(m))
+      do k = 1, m
+         order(k) = modulo(newest - m + k - 1, size(dirs, 2)) + 1
+      end do
+      allocate (gram(m, m), sums(m), centre(m))
+      gram = 0.0_wp
+      sums = 0.0_wp
+      contact = count(p > 0.0_wp)
+      do i0 = 1, size(p), block_rows
+         i1 = min(size(p), i0 + block_rows - 1)
+         do k = 1, m
+            do i = i0, i1
+               if (p(i) > 0.0_wp) sums(k) = sums(k) + images(i, order(k))
+            end do
+            do l = 1, k
+               x = 0.0_wp
+               !$omp simd reduction(+:x)
+               do i = i0, i1
+                  x = x + images(i, order(k))*images(i, order(l))*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
+               end do
+               gram(k, l) = gram(k, l) + x
+            end do
+         end do
+      end do
+      centre = 0.0_wp
+      if (load_control) centre = sums/max(contact, 1.0_wp)
+      do k = 1, m
+         do l = 1, k
+            gram(k, l) = gram(k, l) - contact*centre(k)*centre(l)
+            gram(l, k) = gram(k, l)
+         end do
+      end do
+      ! gram = L L^T; the new basis is V L^-T (column k a combination of the old 1..k)
+      call dpotrf('L', m, gram, m, info)
+      if (info /= 0) then
+         columns = 0
+         newest = 0
+         return
+      end if
+      allocate (tmp_d(size(p), m), tmp_a(size(p), m))
+      do k = 1, m
+         tmp_d(:, k) = dirs(:, order(k))
+         tmp_a(:, k) = images(:, order(k)) - centre(k)
+      end do
+      ! forward substitution: new_k = (old_k - sum_{l<k} L(k,l) new_l)/L(k,k)
+      do k = 1, m
+         do l = 1, k - 1
+            tmp_d(:, k) = tmp_d(:, k) - gram(k, l)*tmp_d(:, l)
+            tmp_a(:, k) = tmp_a(:, k) - gram(k, l)*tmp_a(:, l)
+         end do
+         tmp_d(:, k) = tmp_d(:, k)/gram(k, k)
+         tmp_a(:, k) = tmp_a(:, k)/gram(k, k)
+      end do
+      dirs(:, 1:m) = tmp_d
+      images(:, 1:m) = tmp_a
+      newest = m
+   end subroutine reorthonormalise
+
+   !> Load the overlapping points out of contact (p = 0, gap < 0) with the pressure -gap/M_jj
+   !> of a first step; n_changed: how many.
+   subroutine let_in_overlaps(p, gap, inverse_diagonal, n_changed)
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(in) :: gap(:)
+      real(wp), intent(in) :: inverse_diagonal
+      integer, intent(out) :: n_changed
+      integer :: j
+      n_changed = 0
+      do j = 1, size(p)
+         if (p(j) <= 0.0_wp .and. gap(j) < 0.0_wp) then
+            p(j) = -gap(j)*inverse_diagonal
+            n_changed = n_changed + 1
+         end if
+      end do
+   end subroutine let_in_overlaps
+
+   !> Scale p to mean p_m (uniform if p vanished altogether).
+   pure subroutine normalise(p, mean_pressure)
+      real(wp), intent(inout) :: p(:)
+      real(wp), intent(in) :: mean_pressure
+      real(wp) :: total
+      total = sum(p)
+      if (total > 0.0_wp) then
+         p = p*(mean_pressure*size(p)/total)
+      else
+         p = mean_pressure
+      end if
+   end subroutine normalise
+end module lc_contact_solver_gcr
