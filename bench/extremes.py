@@ -3,8 +3,9 @@
 The grid (tests/extremes_grid.py): rough, sinusoid and narrow-bump profiles, h/lambda
 1e-4 .. 1e3 and the half-space, nu in {-0.9, 0, 0.3, 0.49, 0.5}, mu_c in {0, 0.5, 1, 1.5},
 loads from one node in contact to full contact, n = 8, 9, 63, 1024 (8400 runs, ~20 s).
-Prints markdown tables of the CG iterations (summed over all inner solves) and the outer
-(Anderson) iterations of the converged runs, min / median / max, grouped by h/lambda, by
+Prints markdown tables of the iterations (CG, or GCR for coupled scenes, plus all inner CG
+iterations after an Anderson fallback) and the outer (Anderson) iterations of the converged
+runs (1 without the fallback), min / median / max, grouped by h/lambda, by
 mu_c and by the measured contact fraction, with the number of runs not converged;
 ``--list`` also lists the runs that did not converge, with what stopped them.
 
@@ -32,7 +33,7 @@ def stats(values) -> str:
 
 
 def table(title: str, key: str, labels, rows) -> None:
-    print(f"| {title} | runs | not conv. | CG it. min | median | max | outer it. min | median | max |")
+    print(f"| {title} | runs | not conv. | it. min | median | max | outer it. min | median | max |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for label in labels:
         sel = [r for r in rows if r[key] == label]
@@ -62,7 +63,8 @@ def main() -> None:
     conv = sum(r["converged"] for r in rows)
     print(f"{len(rows)} runs (n = {', '.join(map(str, args.sizes))}), {conv} converged, tol {grid.TOL:g}, "
           f"max_iter {grid.MAX_ITER}, {elapsed:.0f} s; iteration counts of the converged runs; "
-          f"mu_c = 0 and the incompressible half-space are solved by CG alone (1 outer it.)")
+          f"mu_c = 0 and the incompressible half-space are solved by CG, coupled scenes by GCR (1 outer it.) "
+          f"or GCR then Anderson (1 + its outer it.)")
     print()
     table("h/lambda", "thickness", grid.THICKNESSES, rows)
     table("mu_c", "friction", grid.FRICTIONS, rows)

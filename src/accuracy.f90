@@ -13,7 +13,7 @@
 !> ~5 tol^(2/3). Hence, with lambda_s the shortest roughness wavelength and ppw the grid
 !> points per lambda_s:
 !>    ppw = the smallest power of two >= 4 with ppw >= 0.75 (lambda_s/spot length)/eps;
-!>    tol = the largest of 1e-2, 1e-3, 1e-4, 1e-6, 1e-8 that is <= (eps/10)^1.5;
+!>    tol = the largest of 1e-2, 1e-3, 1e-4, 1e-6, 1e-8 that is <= (eps/12)^1.5;
 !> where the mean spot length comes from a pilot solve at ppw = 8 and tol 1e-4. Checked on
 !> four scenes (frictionless half-space, h/lambda = 0.16 and 0.01 with mu_c = 0.5, a
 !> viscoelastic layer) for eps = 1e-1 .. 1e-3, on the fitted profile and on a second one.
@@ -111,12 +111,12 @@ contains
       end do
    end function predicted_ppw
 
-   !> The largest tested tolerance <= (eps/10)^1.5 (the smallest if none is).
+   !> The largest tested tolerance <= (eps/12)^1.5 (the smallest if none is).
    pure real(wp) function rule_tol(eps) result(tol)
       real(wp), intent(in) :: eps
       real(wp) :: bound
       integer :: i
-      bound = (eps/10)**1.5_wp
+      bound = (eps/12)**1.5_wp
       tol = tested_tols(size(tested_tols))
       do i = 1, size(tested_tols)
          if (tested_tols(i) <= bound*(1 + 1.0e-9_wp)) then

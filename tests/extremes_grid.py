@@ -132,6 +132,6 @@ def diagnose(scene: dict, res: lc.LineResult) -> str:
         return f"CG budget spent ({res.outer_iterations} outer it.)"
     if coupled(scene["thickness"], scene["nu"], scene["friction"]):
         hist = res.residual_history
-        return (f"Anderson stopped on stagnation after {res.outer_iterations} outer it. "
-                f"(best residual {hist.min():.1e} at it. {int(hist.argmin()) + 1})")
+        return (f"{res.solver} stopped on stagnation after {res.iterations} it., {res.outer_iterations} outer "
+                f"(best residual {hist.min():.1e} at entry {int(hist.argmin()) + 1} of its history)")
     return "stopped early"
