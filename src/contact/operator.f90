@@ -306,7 +306,7 @@ contains
    subroutine prepare_gcr(self)
       class(compliance_operator), intent(inout) :: self
       complex(wp), allocatable :: g(:)
-      real(wp), allocatable :: unit_load(:), inverse_column(:)
+      real(wp), allocatable :: unit_load(:)
       integer :: n
       n = self%n
       if (self%coupled) then
@@ -315,7 +315,7 @@ contains
          g = cmplx(self%metric, 0.0_wp, kind=wp)
       end if
       if (allocated(self%inverse_full)) deallocate (self%inverse_full)
-      allocate (self%inverse_full(self%nk), unit_load(n), inverse_column(n))
+      allocate (self%inverse_full(self%nk), unit_load(n))
       where (abs(g) > 0.0_wp)
          self%inverse_full = 1.0_wp/g
       elsewhere
@@ -384,9 +384,7 @@ contains
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
-      call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
-      call self%fft%backward()
+      call multiply_complex_in_buffer(self, multiplier)
       w = self%fft%real_buffer
    end subroutine apply_complex
 end module lc_contact_operator

@@ -216,9 +216,10 @@ contains
             call reorthonormalise(p, load_control, dirs, images, columns, newest)
          end if
       end do
-      ! not converged: return the best iterate
-      if (.not. outcome%converged .and. best_residual < outcome%residual) then
-         p = p_best
+      ! not converged: return the best iterate, with w = G_eff p afresh (the updated w may
+      ! differ from it by a constant, see above, and by the drift of the updates)
+      if (.not. outcome%converged) then
+         if (best_residual < outcome%residual) p = p_best
          call op%apply_full(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
          call evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, n_contact, &
