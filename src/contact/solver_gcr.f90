@@ -8,8 +8,9 @@
 !> projected to zero sum on it, so that every step keeps the load), right-preconditioned
 !> by the Fourier inverse of G_eff masked to the set. As in Polonsky & Keer's constrained
 !> CG the set changes inside the iteration: overlapping points are let in (the history is
-!> kept, re-orthonormalised on the larger set without a transform) and negative pressures
-!> are clipped (the history is dropped). Each iteration costs two transform pairs and a few
+!> kept, re-orthonormalised on the larger set without a transform, and the residual
+!> projected on it once, a least-squares step that restores GCR's invariant) and negative
+!> pressures are clipped (the history is dropped). Each iteration costs two transform pairs and a few
 !> sweeps over the history. Compared with the outer fixed point of lc_contact_solver_anderson
 !> (symmetric inner solves with |G_eff|), whose rate is set by the spread of arg G_eff
 !> (thin layers with friction, lossy viscoelastic layers), the preconditioned operator
@@ -96,7 +97,8 @@ contains
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa, residual_norm2
       integer :: it, n, columns, newest, n_contact, n_changed, since_fresh, last_progress
-      logical :: stale, clipped, entered
+      logical :: stale, entered, set_changed
+      integer :: n_clipped, n_negative
 
       n = size(p)
       call op%prepare_gcr()
@@ -115,6 +117,7 @@ contains
       best_residual = huge(1.0_wp)
       last_progress = 0
       p_best = p
+      set_changed = .false.
 
       do it = 1, max_iter + 1
          ! as in the constrained CG: w is updated in place, recomputed every
@@ -155,6 +158,31 @@ contains
             columns = 0
             stale = .true.
             cycle
+         end if
+
+         if (set_changed) then
+            ! least squares in the span of the stored directions on the new set: p and w
+            ! along them by coeff = (r, u_i) (r = -gap on the set, in the buffer); pressures
+            ! it makes negative are clipped (and the history dropped then); state again
+            set_changed = .false.
+            call history_products(images(:, 1:columns), p, buffer, coeff(1:columns))
+            call subtract_history(dirs(:, 1:columns), images(:, 1:columns), -coeff(1:columns), p, w)
+            call clip_negative(p, d, n_negative)
+            if (n_negative > 0) then
+               columns = 0
+               newest = 0
+               if (n_negative > column_updates) then
+                  call op%apply_full(p, w)
+                  outcome%fft_pairs = outcome%fft_pairs + 1
+                  since_fresh = 0
+               else
+                  call add_changed_columns(op%full_column, d, w)
+               end if
+            end if
+            if (load_control) call scale_to_load(p, w, mean_pressure, stale)
+            call evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, n_contact, &
+               & outcome%residual, residual_norm2, buffer)
+            if (n_contact == 0) cycle
          end if
 
          ! direction: the preconditioned residual on the set (evaluate left -gap there in
@@ -201,7 +229,7 @@ contains
          images(:, newest) = buffer
          ! the coefficient of the preconditioned residual in the step, for letting points in
          step = alpha/norm
-         call update(p, w, gap, d, buffer, alpha, step*kappa, n_changed, clipped, entered)
+         call update(p, w, gap, d, buffer, alpha, step*kappa, n_changed, n_clipped, entered)
          if (n_changed > column_updates) then
             stale = .true.
          else if (n_changed > 0) then
@@ -209,11 +237,17 @@ contains
          end if
          since_fresh = since_fresh + 1
          if (load_control) call scale_to_load(p, w, mean_pressure, stale)
-         if (clipped .or. alpha**2 < stagnation*residual_norm2) then
+         if (n_clipped > 0 .or. alpha**2 < stagnation*residual_norm2) then
             columns = 0
             newest = 0
          else if (entered .and. columns > 0) then
+            ! points were let in: the history is kept, made orthonormal on the larger set, and
+            ! the next iteration first projects the residual on it, which restores GCR's
+            ! invariant (residual orthogonal to the stored images). (Kept across clips too,
+            ! with the clipped points taken out of the stored directions and their images
+            ! corrected column by column, it cost more than the restart: NOTES.md.)
             call reorthonormalise(p, load_control, dirs, images, columns, newest)
+            set_changed = columns > 0
          end if
       end do
       ! not converged: return the best iterate, with w = G_eff p afresh (the updated w may
@@ -399,12 +433,13 @@ contains
    !> gap are let in with -let_in_scale gap (Polonsky & Keer's rule: the preconditioned step
    !> there), negative pressures clipped. a is overwritten by the change of p that was not
    !> along d (nonzero at the points clipped or let in), for the column updates of w.
-   subroutine update(p, w, gap, d, a, alpha, let_in_scale, n_changed, clipped, entered)
+   subroutine update(p, w, gap, d, a, alpha, let_in_scale, n_changed, n_clipped, entered)
       real(wp), contiguous, intent(inout) :: p(:), w(:), a(:)
       real(wp), contiguous, intent(in) :: gap(:), d(:)
       real(wp), intent(in) :: alpha, let_in_scale
       integer, intent(out) :: n_changed
-      logical, intent(out) :: clipped, entered
+      integer, intent(out) :: n_clipped
+      logical, intent(out) :: entered
       real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count
       integer :: j
       clip_count = 0.0_wp
@@ -425,7 +460,7 @@ contains
          p(j) = p_new
       end do
       n_changed = nint(changed_count)
-      clipped = clip_count > 0.0_wp
+      n_clipped = nint(clip_count)
       entered = enter_count > 0.0_wp
    end subroutine update
 
@@ -462,6 +497,23 @@ contains
          stale = .true.
       end if
    end subroutine scale_to_load
+
+   !> p < 0 set to 0; delta = the change (0 elsewhere); n_negative: how many.
+   subroutine clip_negative(p, delta, n_negative)
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(out) :: delta(:)
+      integer, intent(out) :: n_negative
+      real(wp) :: count_negative
+      integer :: j
+      count_negative = 0.0_wp
+      !$omp simd reduction(+:count_negative)
+      do j = 1, size(p)
+         delta(j) = merge(-p(j), 0.0_wp, p(j) < 0.0_wp)
+         count_negative = count_negative + merge(1.0_wp, 0.0_wp, p(j) < 0.0_wp)
+         p(j) = p(j) + delta(j)
+      end do
+      n_negative = nint(count_negative)
+   end subroutine clip_negative
 
    !> After points were let in: the stored images, centred again on the larger contact set,
    !> are made orthonormal there again (Cholesky of their Gram matrix on the set: one sweep
