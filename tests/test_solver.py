@@ -256,3 +256,46 @@ def test_westergaard(n, ratio):
     xc = np.where(res.x > 0.5, res.x - 1, res.x)
     interior = np.abs(xc) < 0.8 * a
     assert np.abs(res.pressure - p_ref)[interior].max() <= (3e-4 if n == 1024 else 2e-6) * p_ref.max()
+
+
+@pytest.mark.parametrize("case", ["thin coupled", "viscoelastic with friction", "displacement"])
+def test_gcr_and_anderson_agree(rough_profile, case):
+    """Two different coupled solvers, the constrained GCR (method 'auto') and the Anderson
+    outer iteration around the symmetric CG, reach the same fixed point: the same pressure
+    to the bound the tolerance allows (a gap residual tol * ptp(profile) times the largest
+    stiffness |k_max| E*/2, E_inf for the glassy short waves) and the same penetration."""
+    pm = rough_profile.max()
+    kw, e_star = {
+        "thin coupled": (dict(thickness=0.01, friction=1.0, mean_pressure=16 * pm), 4 / 3),
+        "viscoelastic with friction": (dict(thickness=0.16, friction=0.3, mean_pressure=pm, speed=0.1,
+                                            material=lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0)), 40 / 3),
+        "displacement": (dict(thickness=0.16, poisson=0.3, friction=0.5, penetration=0.5 * np.ptp(rough_profile)),
+                         1 / (1 - 0.3**2)),
+    }[case]
+    a = lc.solve_line(rough_profile, tol=1e-11, stress=False, **kw)
+    b = lc.solve_line(rough_profile, tol=1e-11, stress=False, method="anderson", **kw)
+    assert a.converged and b.converged
+    assert a.solver == "gcr" and b.solver == "anderson"
+    bound = 1e-11 * np.ptp(rough_profile) * e_star * np.pi * rough_profile.size / 2
+    assert np.abs(a.pressure - b.pressure).max() <= bound
+    assert a.penetration == pytest.approx(b.penetration, rel=1e-9)
+    assert a.mean_pressure == pytest.approx(b.mean_pressure, rel=1e-9)
+
+
+def test_gcr_stall_goes_on_with_anderson():
+    """A glassy layer at a low speed (E_inf/E0 = 100, V = 4.64e-4; a scene of
+    inputs/sweeps/viscoelastic_speed.nml): the GCR alone stalls and says so; method 'auto'
+    goes on with the Anderson iteration from its best iterate and converges, to the
+    solution Anderson alone finds, in fewer transforms."""
+    h = lc.self_affine_profile(4096, 0.8, seed=1, short_wavelength=1 / 128, rms_gradient=0.1)
+    kw = dict(thickness=0.16, mean_pressure=(4 / 3) * (h.max() - h.mean()), speed=0.000464, tol=1e-8, stress=False,
+              material=lc.StandardLinearSolid(e0=1.0, e_inf=100.0, tau=1.0))
+    alone = lc.solve_line(h, method="gcr", **kw)
+    assert not alone.converged and alone.residual > 1e-8 and alone.solver == "gcr"
+    auto = lc.solve_line(h, **kw)
+    anderson = lc.solve_line(h, method="anderson", **kw)
+    assert auto.converged and auto.solver == "gcr+anderson" and auto.outer_iterations > 1
+    assert anderson.converged and auto.fft_pairs < anderson.fft_pairs
+    # tol 1e-8 on a gap scale ptp(h) with stiffness up to |k_max| E_inf*/2
+    bound = 1e-8 * np.ptp(h) * (100 / 0.75) * np.pi * h.size / 2
+    assert np.abs(auto.pressure - anderson.pressure).max() <= bound
