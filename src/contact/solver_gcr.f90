@@ -95,7 +95,7 @@ contains
       real(wp), intent(inout), optional :: history(:)
       real(wp), allocatable :: dirs(:, :), images(:, :), d(:), coeff(:), p_best(:)
       real(wp), pointer, contiguous :: buffer(:)
-      real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa, residual_norm2
+      real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa, residual_norm2, p_sum
       integer :: it, n, columns, newest, n_contact, n_changed, since_fresh, last_progress
       logical :: stale, entered, set_changed
       integer :: n_clipped, n_negative
@@ -179,7 +179,7 @@ contains
                   call add_changed_columns(op%full_column, d, w)
                end if
             end if
-            if (load_control) call scale_to_load(p, w, mean_pressure, stale)
+            if (load_control) call scale_to_load(p, w, mean_pressure, stale, sum(p))
             call evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, n_contact, &
                & outcome%residual, residual_norm2, buffer)
             if (n_contact == 0) cycle
@@ -222,21 +222,21 @@ contains
             cycle
          end if
          ! the minimal-residual step: alpha = (r, u) for the unit image u; r = -gap on the set
-         call normalised_step(p, gap, centre, norm, d, buffer, alpha)
+         ! (the normalised direction and image go straight into the history)
          newest = mod(newest, memory) + 1
          columns = min(columns + 1, memory)
-         dirs(:, newest) = d
-         images(:, newest) = buffer
+         call normalised_step(p, gap, centre, norm, d, buffer, dirs(:, newest), images(:, newest), alpha)
          ! the coefficient of the preconditioned residual in the step, for letting points in
          step = alpha/norm
-         call update(p, w, gap, d, buffer, alpha, step*kappa, n_changed, n_clipped, entered)
+         call update(p, w, gap, dirs(:, newest), images(:, newest), alpha, step*kappa, buffer, n_changed, &
+            & n_clipped, entered, p_sum)
          if (n_changed > column_updates) then
             stale = .true.
          else if (n_changed > 0) then
             call add_changed_columns(op%full_column, buffer, w)
          end if
          since_fresh = since_fresh + 1
-         if (load_control) call scale_to_load(p, w, mean_pressure, stale)
+         if (load_control) call scale_to_load(p, w, mean_pressure, stale, p_sum)
          if (n_clipped > 0 .or. alpha**2 < stagnation*residual_norm2) then
             columns = 0
             newest = 0
@@ -409,12 +409,13 @@ contains
       end do
    end subroutine subtract_history
 
-   !> Centre the image a (whole grid) and scale it and d by 1/norm; alpha = (-gap, a) on
-   !> the contact set: the step along d that minimises the residual on the set.
-   subroutine normalised_step(p, gap, centre, norm, d, a, alpha)
-      real(wp), contiguous, intent(in) :: p(:), gap(:)
+   !> The direction d scaled by 1/norm, and its image a centred (whole grid) and scaled alike,
+   !> into d_unit and a_unit; alpha = (-gap, a_unit) on the contact set: the step along
+   !> d_unit that minimises the residual on the set.
+   subroutine normalised_step(p, gap, centre, norm, d, a, d_unit, a_unit, alpha)
+      real(wp), contiguous, intent(in) :: p(:), gap(:), d(:), a(:)
       real(wp), intent(in) :: centre, norm
-      real(wp), contiguous, intent(inout) :: d(:), a(:)
+      real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
       real(wp), intent(out) :: alpha
       real(wp) :: scale, inside
       integer :: j
@@ -423,29 +424,32 @@ contains
       !$omp simd reduction(+:alpha) private(inside)
       do j = 1, size(p)
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         d(j) = d(j)*scale
-         a(j) = (a(j) - centre)*scale
-         alpha = alpha - gap(j)*a(j)*inside
+         d_unit(j) = d(j)*scale
+         a_unit(j) = (a(j) - centre)*scale
+         alpha = alpha - gap(j)*a_unit(j)*inside
       end do
    end subroutine normalised_step
 
    !> One pass: p <- p + alpha d and w <- w + alpha a; points out of contact with a negative
    !> gap are let in with -let_in_scale gap (Polonsky & Keer's rule: the preconditioned step
-   !> there), negative pressures clipped. a is overwritten by the change of p that was not
-   !> along d (nonzero at the points clipped or let in), for the column updates of w.
-   subroutine update(p, w, gap, d, a, alpha, let_in_scale, n_changed, n_clipped, entered)
-      real(wp), contiguous, intent(inout) :: p(:), w(:), a(:)
-      real(wp), contiguous, intent(in) :: gap(:), d(:)
+   !> there), negative pressures clipped. delta: the change of p that was not along d
+   !> (nonzero at the points clipped or let in), for the column updates of w; p_sum: sum p.
+   subroutine update(p, w, gap, d, a, alpha, let_in_scale, delta, n_changed, n_clipped, entered, p_sum)
+      real(wp), contiguous, intent(inout) :: p(:), w(:)
+      real(wp), contiguous, intent(in) :: gap(:), d(:), a(:)
       real(wp), intent(in) :: alpha, let_in_scale
+      real(wp), contiguous, intent(out) :: delta(:)
       integer, intent(out) :: n_changed
       integer, intent(out) :: n_clipped
       logical, intent(out) :: entered
+      real(wp), intent(out) :: p_sum
       real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count
       integer :: j
       clip_count = 0.0_wp
       enter_count = 0.0_wp
       changed_count = 0.0_wp
-      !$omp simd reduction(+:clip_count, enter_count, changed_count) private(trial, p_new, c)
+      p_sum = 0.0_wp
+      !$omp simd reduction(+:clip_count, enter_count, changed_count, p_sum) private(trial, p_new, c)
       do j = 1, size(p)
          trial = p(j) + alpha*d(j)   ! (d = 0 off the contact set)
          ! let in: out of contact (p = 0) and overlapping
@@ -455,9 +459,10 @@ contains
          clip_count = clip_count + merge(1.0_wp, 0.0_wp, p_new < 0.0_wp)
          p_new = merge(p_new, 0.0_wp, p_new >= 0.0_wp)   ! clip (a NaN too)
          w(j) = w(j) + alpha*a(j)
-         a(j) = p_new - trial
+         delta(j) = p_new - trial
          changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
          p(j) = p_new
+         p_sum = p_sum + p_new
       end do
       n_changed = nint(changed_count)
       n_clipped = nint(clip_count)
@@ -480,12 +485,12 @@ contains
 
    !> p and w scaled to the load (w = G p is linear in p); a vanished p is reset to uniform
    !> (w stale then).
-   subroutine scale_to_load(p, w, mean_pressure, stale)
+   subroutine scale_to_load(p, w, mean_pressure, stale, total)
       real(wp), contiguous, intent(inout) :: p(:), w(:)
       real(wp), intent(in) :: mean_pressure
       logical, intent(inout) :: stale
-      real(wp) :: total, factor
-      total = sum(p)
+      real(wp), intent(in) :: total   !< sum p
+      real(wp) :: factor
       if (total > 0.0_wp) then
          factor = mean_pressure*size(p)/total
          if (abs(factor - 1.0_wp) > 8*epsilon(1.0_wp)) then
