@@ -96,6 +96,7 @@ contains
       real(wp), allocatable :: dirs(:, :), images(:, :), d(:), coeff(:), p_best(:)
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa, residual_norm2, p_sum
+      real(wp) :: load_scale
       integer :: it, n, columns, newest, n_contact, n_changed, since_fresh, last_progress
       logical :: stale, entered, set_changed
       integer :: n_clipped, n_negative
@@ -118,6 +119,7 @@ contains
       last_progress = 0
       p_best = p
       set_changed = .false.
+      load_scale = 1.0_wp
 
       do it = 1, max_iter + 1
          ! as in the constrained CG: w is updated in place, recomputed every
@@ -129,8 +131,9 @@ contains
                since_fresh = 0
                stale = .false.
             end if
-            call evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, n_contact, &
-               & outcome%residual, residual_norm2, buffer)
+            call evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
+               & n_contact, outcome%residual, residual_norm2, buffer)
+            load_scale = 1.0_wp
             if (since_fresh == 0 .or. .not. (outcome%residual <= tol .or. it > max_iter)) exit
             stale = .true.
          end do
@@ -179,9 +182,10 @@ contains
                   call add_changed_columns(op%full_column, d, w)
                end if
             end if
-            if (load_control) call scale_to_load(p, w, mean_pressure, stale, sum(p))
-            call evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, n_contact, &
-               & outcome%residual, residual_norm2, buffer)
+            if (load_control) call scale_to_load(p, mean_pressure, stale, sum(p), load_scale)
+            call evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
+               & n_contact, outcome%residual, residual_norm2, buffer)
+            load_scale = 1.0_wp
             if (n_contact == 0) cycle
          end if
 
@@ -236,7 +240,8 @@ contains
             call add_changed_columns(op%full_column, buffer, w)
          end if
          since_fresh = since_fresh + 1
-         if (load_control) call scale_to_load(p, w, mean_pressure, stale, p_sum)
+         ! (p and w are scaled to the load in the next evaluation's first pass)
+         if (load_control) call scale_to_load(p, mean_pressure, stale, p_sum, load_scale)
          if (n_clipped > 0 .or. alpha**2 < stagnation*residual_norm2) then
             columns = 0
             newest = 0
@@ -256,17 +261,19 @@ contains
          if (best_residual < outcome%residual) p = p_best
          call op%apply_full(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
-         call evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, n_contact, &
-            & outcome%residual, residual_norm2, buffer)
+         call evaluate(p, w, b, 1.0_wp, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
+            & n_contact, outcome%residual, residual_norm2, buffer)
       end if
    end subroutine constrained_gcr
 
-   !> Two passes: s (the mean of w - b over the contact set under load control), the gap
-   !> w - b - s, the complementarity residual, and -gap on the contact set (0 elsewhere) in
-   !> `masked`, the preconditioner's input.
-   subroutine evaluate(p, w, b, load_control, mean_pressure, g_ref, b_max, m_max, s, gap, n_contact, residual, &
-         & norm2, masked)
-      real(wp), contiguous, intent(in) :: p(:), w(:), b(:)
+   !> Two passes: p and w scaled by load_scale, s (the mean of w - b over the contact set
+   !> under load control), the gap w - b - s, the complementarity residual, and -gap on the
+   !> contact set (0 elsewhere) in `masked`, the preconditioner's input.
+   subroutine evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, m_max, s, gap, n_contact, &
+         & residual, norm2, masked)
+      real(wp), contiguous, intent(inout) :: p(:), w(:)
+      real(wp), contiguous, intent(in) :: b(:)
+      real(wp), intent(in) :: load_scale
       logical, intent(in) :: load_control
       real(wp), intent(in) :: mean_pressure, g_ref, b_max, m_max
       real(wp), intent(inout) :: s
@@ -281,8 +288,11 @@ contains
       p_sum = 0.0_wp
       w_max = 0.0_wp
       p_max = 0.0_wp
+      ! (the stores are unconditional: a store under a condition is not vectorised)
       !$omp simd reduction(+:contact, gap_sum, p_sum) reduction(max:w_max, p_max) private(inside)
       do j = 1, size(p)
+         p(j) = p(j)*load_scale
+         w(j) = w(j)*load_scale
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
          contact = contact + inside
          gap_sum = gap_sum + (w(j) - b(j))*inside
@@ -483,20 +493,17 @@ contains
       end do
    end subroutine add_changed_columns
 
-   !> p and w scaled to the load (w = G p is linear in p); a vanished p is reset to uniform
-   !> (w stale then).
-   subroutine scale_to_load(p, w, mean_pressure, stale, total)
-      real(wp), contiguous, intent(inout) :: p(:), w(:)
+   !> The factor that scales p (and w = G p, linear in p) to the load, from sum p; a vanished
+   !> p is reset to uniform (w stale then, factor 1).
+   subroutine scale_to_load(p, mean_pressure, stale, total, factor)
+      real(wp), contiguous, intent(inout) :: p(:)
       real(wp), intent(in) :: mean_pressure
       logical, intent(inout) :: stale
       real(wp), intent(in) :: total   !< sum p
-      real(wp) :: factor
+      real(wp), intent(out) :: factor
+      factor = 1.0_wp
       if (total > 0.0_wp) then
          factor = mean_pressure*size(p)/total
-         if (abs(factor - 1.0_wp) > 8*epsilon(1.0_wp)) then
-            p = p*factor
-            w = w*factor
-         end if
       else
          p = mean_pressure
          stale = .true.
