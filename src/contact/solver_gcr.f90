@@ -31,11 +31,11 @@ module lc_contact_solver_gcr
    !> Iterations without the residual halving after which the solve gives up (and reports
    !> non-convergence with its best iterate; under method 'auto' the Anderson outer
    !> iteration goes on from there). A converging solve halves the residual every one to
-   !> three iterations. Stalls happen on thin layers with strong friction and small contact
-   !> sets: G_eff restricted to the set is then nearly skew (arg G_eff near -90 degrees at
-   !> long waves) and nearly singular, and the minimal residual plateaus (measured: h/lambda
-   !> 0.01, mu_c 1, n = 256, 10 % contact: 2 of 8 seeds plateau, for 60 and 170 iterations;
-   !> a longer history or twice-orthogonalised images did not help).
+   !> three iterations. What still stalls: glassy viscoelastic layers at low speeds, whose
+   !> fine-grid contact sets settle slowly (a clip restarts the history) and erratically
+   !> (120 of the 576 scenes of inputs/sweeps/viscoelastic_speed.nml), and a few thin
+   !> incompressible layers with strong friction on tiny grids. A window of 40 made that
+   !> sweep cost twice as many transforms (NOTES.md).
    integer, parameter :: stall_window = 25
    !> Iterations after which w = G_eff p is recomputed (bounds the drift of the updates).
    integer, parameter :: refresh_interval = 50
