@@ -183,6 +183,7 @@ contains
                end if
             end if
             if (load_control) call scale_to_load(p, mean_pressure, stale, sum(p), load_scale)
+            if (stale) cycle   ! (p vanished and was reset: w afresh first)
             call evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
                & n_contact, outcome%residual, residual_norm2, buffer)
             load_scale = 1.0_wp
