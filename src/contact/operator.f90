@@ -77,7 +77,7 @@ module lc_contact_operator
       procedure :: apply_metric
       procedure :: apply_full
       procedure :: apply_difference
-      procedure :: add_column
+      procedure :: add_full_columns
       procedure :: metric_in_buffer
       procedure :: inverse_metric_in_buffer
       procedure :: prepare_gcr
@@ -242,18 +242,21 @@ contains
       end if
    end subroutine apply_difference
 
-   !> w = w + value M e_j: the metric's response to a point load at x_j, in one pass.
-   pure subroutine add_column(self, j, value, w)
+   !> w <- w + sum_j delta_j G_eff e_j over the points j with delta_j /= 0: the response to
+   !> a few point loads, a pass over the grid each (after prepare_gcr).
+   pure subroutine add_full_columns(self, delta, w)
       class(compliance_operator), intent(in) :: self
-      integer, intent(in) :: j
-      real(wp), intent(in) :: value
+      real(wp), intent(in) :: delta(:)
       real(wp), intent(inout) :: w(:)
-      integer :: n
+      integer :: j, n
       n = self%n
-      ! column(i - j) for i = j..n is column(1..n-j+1); for i = 1..j-1 it wraps round
-      w(j:n) = w(j:n) + value*self%column(1:n - j + 1)
-      w(1:j - 1) = w(1:j - 1) + value*self%column(n - j + 2:n)
-   end subroutine add_column
+      do j = 1, n
+         if (delta(j) == 0.0_wp) cycle
+         ! column(i - j) for i = j..n is column(1..n-j+1); for i = 1..j-1 it wraps round
+         w(j:n) = w(j:n) + delta(j)*self%full_column(1:n - j + 1)
+         w(1:j - 1) = w(1:j - 1) + delta(j)*self%full_column(n - j + 2:n)
+      end do
+   end subroutine add_full_columns
 
    !> fft%real_buffer <- M fft%real_buffer: for a solver that writes its input into the
    !> buffer and reads the output from it (two passes over the grid fewer than apply_metric).

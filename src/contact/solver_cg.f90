@@ -15,7 +15,7 @@ module lc_contact_solver_cg
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private
-   public :: constrained_cg, cg_outcome, complementarity_residual, rounding_floor
+   public :: constrained_cg, cg_outcome, complementarity_residual, rounding_floor, normalise
 
    !> Iterations without the residual halving after which the preconditioner is dropped.
    integer, parameter :: stall_window = 100

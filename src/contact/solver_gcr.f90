@@ -23,7 +23,7 @@ module lc_contact_solver_gcr
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
-   use lc_contact_solver_cg, only: rounding_floor
+   use lc_contact_solver_cg, only: rounding_floor, normalise
    implicit none (type, external)
    private
    public :: constrained_gcr, gcr_outcome
@@ -179,7 +179,7 @@ contains
                   outcome%fft_pairs = outcome%fft_pairs + 1
                   since_fresh = 0
                else
-                  call add_changed_columns(op%full_column, d, w)
+                  call op%add_full_columns(d, w)
                end if
             end if
             if (load_control) call scale_to_load(p, mean_pressure, stale, sum(p), load_scale)
@@ -238,7 +238,7 @@ contains
          if (n_changed > column_updates) then
             stale = .true.
          else if (n_changed > 0) then
-            call add_changed_columns(op%full_column, buffer, w)
+            call op%add_full_columns(buffer, w)
          end if
          since_fresh = since_fresh + 1
          ! (p and w are scaled to the load in the next evaluation's first pass)
@@ -480,20 +480,6 @@ contains
       entered = enter_count > 0.0_wp
    end subroutine update
 
-   !> w <- w + sum_j delta_j G e_j over the points j with delta_j /= 0 (a pass each).
-   subroutine add_changed_columns(column, delta, w)
-      real(wp), contiguous, intent(in) :: column(:), delta(:)
-      real(wp), contiguous, intent(inout) :: w(:)
-      integer :: j, n
-      n = size(w)
-      do j = 1, n
-         if (delta(j) == 0.0_wp) cycle
-         ! G e_j at x_i is column(i - j): column(1..n-j+1) for i = j..n, wrapped for i < j
-         w(j:n) = w(j:n) + delta(j)*column(1:n - j + 1)
-         w(1:j - 1) = w(1:j - 1) + delta(j)*column(n - j + 2:n)
-      end do
-   end subroutine add_changed_columns
-
    !> The factor that scales p (and w = G p, linear in p) to the load, from sum p; a vanished
    !> p is reset to uniform (w stale then, factor 1).
    subroutine scale_to_load(p, mean_pressure, stale, total, factor)
@@ -618,17 +604,4 @@ contains
          end if
       end do
    end subroutine let_in_overlaps
-
-   !> Scale p to mean p_m (uniform if p vanished altogether).
-   pure subroutine normalise(p, mean_pressure)
-      real(wp), intent(inout) :: p(:)
-      real(wp), intent(in) :: mean_pressure
-      real(wp) :: total
-      total = sum(p)
-      if (total > 0.0_wp) then
-         p = p*(mean_pressure*size(p)/total)
-      else
-         p = mean_pressure
-      end if
-   end subroutine normalise
 end module lc_contact_solver_gcr
