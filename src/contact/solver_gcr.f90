@@ -323,6 +323,25 @@ contains
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
    end subroutine evaluate
 
+   !> The mean of v over the contact set (p > 0) under load control, 0 otherwise (one pass).
+   real(wp) function set_mean(p, load_control, v) result(mean)
+      real(wp), contiguous, intent(in) :: p(:), v(:)
+      logical, intent(in) :: load_control
+      real(wp) :: v_sum, contact, inside
+      integer :: j
+      mean = 0.0_wp
+      if (.not. load_control) return
+      v_sum = 0.0_wp
+      contact = 0.0_wp
+      !$omp simd reduction(+:v_sum, contact) private(inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         v_sum = v_sum + v(j)*inside
+         contact = contact + inside
+      end do
+      mean = v_sum/max(contact, 1.0_wp)
+   end function set_mean
+
    !> d = z on the contact set, minus its mean there under load control, 0 elsewhere; z
    !> (the buffer) is overwritten by d, the next transform's input.
    subroutine project_on_set(p, load_control, z, d)
@@ -330,20 +349,9 @@ contains
       logical, intent(in) :: load_control
       real(wp), contiguous, intent(inout) :: z(:)
       real(wp), contiguous, intent(out) :: d(:)
-      real(wp) :: z_sum, contact, mean, inside
+      real(wp) :: mean, inside
       integer :: j
-      mean = 0.0_wp
-      if (load_control) then
-         z_sum = 0.0_wp
-         contact = 0.0_wp
-         !$omp simd reduction(+:z_sum, contact) private(inside)
-         do j = 1, size(p)
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            z_sum = z_sum + z(j)*inside
-            contact = contact + inside
-         end do
-         mean = z_sum/max(contact, 1.0_wp)
-      end if
+      mean = set_mean(p, load_control, z)
       !$omp simd private(inside)
       do j = 1, size(p)
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
@@ -358,20 +366,9 @@ contains
       real(wp), contiguous, intent(in) :: p(:), v(:)
       logical, intent(in) :: load_control
       real(wp), intent(out) :: centre, norm
-      real(wp) :: v_sum, v2_sum, contact, inside, x
+      real(wp) :: v2_sum, inside, x
       integer :: j
-      centre = 0.0_wp
-      if (load_control) then
-         v_sum = 0.0_wp
-         contact = 0.0_wp
-         !$omp simd reduction(+:v_sum, contact) private(inside)
-         do j = 1, size(p)
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            v_sum = v_sum + v(j)*inside
-            contact = contact + inside
-         end do
-         centre = v_sum/max(contact, 1.0_wp)
-      end if
+      centre = set_mean(p, load_control, v)
       v2_sum = 0.0_wp
       !$omp simd reduction(+:v2_sum) private(inside, x)
       do j = 1, size(p)
