@@ -28,8 +28,11 @@ module lc_contact_solve
    !> solve costs less than the set-up of another level.
    integer, parameter :: coarsest_grid = 512
    !> Tolerance of the coarse solves (or the scene's, if looser): a starting guess only
-   !> needs to be closer than the discretisation difference between the two grids.
+   !> needs to be closer than the discretisation difference between the two grids, which
+   !> falls like 1/n (contact edges within a grid step): coarse_tol up to a fine grid of
+   !> coarse_tol_size points, coarse_tol coarse_tol_size/n beyond.
    real(wp), parameter :: coarse_tol = 1.0e-4_wp
+   integer, parameter :: coarse_tol_size = 8192
 
 contains
 
@@ -234,7 +237,7 @@ contains
       nc = n/2
       coarse = scene
       coarse%n = nc
-      coarse%solver%tol = max(scene%solver%tol, coarse_tol)
+      coarse%solver%tol = max(scene%solver%tol, coarse_tol*min(1.0_wp, real(coarse_tol_size, wp)/n))
       allocate (pc(nc), wc(nc), gapc(nc))
       hc = height(1:n:2)
       pc = p(1:n:2)
