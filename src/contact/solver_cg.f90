@@ -20,7 +20,7 @@ module lc_contact_solver_cg
    !> Iterations without the residual halving after which the preconditioner is dropped.
    integer, parameter :: stall_window = 100
    !> Iterations after which w = M p is recomputed even if it could be updated in place
-   !> (bounds the drift of the update w <- w - tau M t, a few ulps per iteration).
+   !> (bounds the drift of the update d <- d - tau M t, a few ulps per iteration).
    integer, parameter :: refresh_interval = 50
    !> Most points whose pressure changed other than along t (clipped or let in) that are
    !> added to w column by column rather than by recomputing w = M p: one column costs one
@@ -79,8 +79,9 @@ contains
       ! The iteration works on the raw gap d = w - b (kept in `gap`) instead of w: the
       ! update moves it with w (d <- d - tau M t), and the gap on the contact set is d - s.
       ! An iteration is then three or four passes over the grid (state, preconditioner's
-      ! mean, direction, update) around the transforms, each streaming few arrays with
-      ! little arithmetic: at large n a pass costs about as much as one of the FFT's.
+      ! mean, direction, update) around the transforms; each pass costs a sizeable part of a
+      ! transform (at n = 65536 they are compute-bound, not memory-bound: NOTES.md), so
+      ! every pass and every reduction saved shows.
       n = size(p)
       associate (d => gap)
       allocate (t(n))
