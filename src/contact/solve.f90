@@ -154,13 +154,8 @@ contains
          ! iteration from GCR's best iterate, with the budget left
          call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history)
-         result%converged = gcr%converged
-         result%iterations = gcr%iterations
-         result%outer_iterations = 1
-         result%fft_pairs = gcr%fft_pairs
-         result%residual = gcr%residual
-         result%residual_history = history(1:gcr%iterations)
-         result%solver = 'gcr'
+         call record_solve(result, 'gcr', gcr%converged, gcr%iterations, 1, gcr%fft_pairs, gcr%residual, &
+            & history(1:gcr%iterations))
          if (.not. gcr%converged .and. trim(scene%solver%method) == 'auto' .and. &
             & gcr%iterations < scene%solver%max_iter) then
             ! (GCR's best iterate is kept in case the Anderson iteration ends worse)
@@ -172,15 +167,10 @@ contains
                & scene%solver%max_iter - gcr%iterations, scene%solver%memory, scene%solver%precondition, p, w, gap, &
                & outer, history, error)
             if (allocated(error)) return
-            result%converged = outer%converged
-            result%iterations = result%iterations + outer%cg_iterations
-            result%outer_iterations = 1 + outer%outer_iterations
-            result%fft_pairs = result%fft_pairs + outer%fft_pairs
-            result%residual_history = [result%residual_history, history(1:outer%outer_iterations)]
-            result%solver = 'gcr+anderson'
-            if (outer%residual <= gcr%residual) then
-               result%residual = outer%residual
-            else
+            call record_solve(result, 'gcr+anderson', outer%converged, gcr%iterations + outer%cg_iterations, &
+               & 1 + outer%outer_iterations, gcr%fft_pairs + outer%fft_pairs, min(outer%residual, gcr%residual), &
+               & [result%residual_history, history(1:outer%outer_iterations)])
+            if (outer%residual > gcr%residual) then
                p = p_gcr
                w = w_gcr
                gap = gap_gcr
@@ -191,29 +181,35 @@ contains
          call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error)
          if (allocated(error)) return
-         result%converged = outer%converged
-         result%iterations = outer%cg_iterations
-         result%outer_iterations = outer%outer_iterations
-         result%fft_pairs = outer%fft_pairs
-         result%residual = outer%residual
-         result%residual_history = history(1:outer%outer_iterations)
-         result%solver = 'anderson'
+         call record_solve(result, 'anderson', outer%converged, outer%cg_iterations, outer%outer_iterations, &
+            & outer%fft_pairs, outer%residual, history(1:outer%outer_iterations))
       else
          call constrained_cg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%precondition, p, w, gap, cg, history)
-         result%converged = cg%converged
-         result%iterations = cg%iterations
-         result%outer_iterations = 1
-         result%fft_pairs = cg%fft_pairs
-         result%residual = cg%residual
-         result%residual_history = history(1:cg%iterations)
-         result%solver = 'cg'
+         call record_solve(result, 'cg', cg%converged, cg%iterations, 1, cg%fft_pairs, cg%residual, &
+            & history(1:cg%iterations))
       end if
       result%fft_pairs = result%fft_pairs + coarse_pairs
       ! the uniform mode's rigid shift (see drop_uniform_mode)
       w = w + uniform*pm
       s = s + uniform*pm
    end subroutine solve_on_grid
+
+   !> The solver statistics of `result`: which method ran and what it did.
+   pure subroutine record_solve(result, solver, converged, iterations, outer_iterations, fft_pairs, residual, history)
+      type(contact_result), intent(inout) :: result
+      character(len=*), intent(in) :: solver
+      logical, intent(in) :: converged
+      integer, intent(in) :: iterations, outer_iterations, fft_pairs
+      real(wp), intent(in) :: residual, history(:)
+      result%solver = solver
+      result%converged = converged
+      result%iterations = iterations
+      result%outer_iterations = outer_iterations
+      result%fft_pairs = fft_pairs
+      result%residual = residual
+      result%residual_history = history
+   end subroutine record_solve
 
    !> Replace the guess p (and s) by the solution on the grid of every second point,
    !> interpolated linearly (which keeps p >= 0). The coarse solve needs only the accuracy
