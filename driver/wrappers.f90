@@ -266,7 +266,6 @@ subroutine py_creep_compliance(nw, omega, model, form, young, e0, e_inf, tau, eq
    !f2py intent(hide) :: nw, nt
    type(error_type), allocatable :: error
    type(material_law) :: law
-   integer :: i
    stat = 0
    errmsg = ''
    compliance = 0
@@ -277,9 +276,7 @@ subroutine py_creep_compliance(nw, omega, model, form, young, e0, e_inf, tau, eq
       errmsg = error%message
       return
    end if
-   do i = 1, nw
-      compliance(i) = creep_compliance(law, omega(i))
-   end do
+   compliance = creep_compliance(law, omega)
 end subroutine py_creep_compliance
 
 !> Seconds per FFTW r2c + c2r pair of size n (the cost unit of the benchmarks), the best

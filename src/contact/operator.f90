@@ -120,10 +120,7 @@ contains
       ! (1 - nu^2) J*(k V) per mode: 1/E* for an elastic law. A viscoelastic law at rest is
       ! elastic with its static modulus: only a moving one needs complex compliances.
       op%viscoelastic = trim(law%model) /= 'elastic' .and. speed > 0.0_wp
-      allocate (op%compliance(op%nk))
-      do m = 0, op%nk - 1
-         op%compliance(m + 1) = (1.0_wp - poisson**2)*creep_compliance(law, op%wavenumber(m)*speed)
-      end do
+      op%compliance = (1.0_wp - poisson**2)*creep_compliance(law, [(op%wavenumber(m)*speed, m = 0, op%nk - 1)])
       if (.not. all(ieee_is_finite(real(op%compliance, wp)) .and. ieee_is_finite(aimag(op%compliance)))) then
          call fatal_error(error, '&material: speed = ' // to_string(speed) // ' gives non-finite compliances ' // &
             & '(k V tau overflows); allowed: a speed with k V tau_max well inside the floating-point range', &
@@ -156,10 +153,13 @@ contains
       end do
       allocate (op%preconditioner(op%nk))
       where (op%metric > 0.0_wp)
-         op%preconditioner = (abs(op%compliance)/abs(op%compliance(2)))**preconditioner_exponent/op%metric
+         op%preconditioner = 1.0_wp/op%metric
       elsewhere
          op%preconditioner = 0.0_wp
       end where
+      ! (an elastic law has one compliance: the factor is 1)
+      if (op%viscoelastic) op%preconditioner = op%preconditioner* &
+         & (abs(op%compliance)/abs(op%compliance(2)))**preconditioner_exponent
       ! The solution is unique when the operator is monotone, Re G_eff >= 0 on every mode
       ! (always for elastic layers; not always for viscoelastic ones with friction).
       op%monotone = .true.

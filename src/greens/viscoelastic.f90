@@ -55,13 +55,15 @@ contains
       if (allocated(self%times)) terms = size(self%times)
    end function terms
 
-   !> J*(k) of seed Eq. (14) at the sliding frequency omega = k V (1/S); omega may be any real.
-   pure complex(wp) function creep_compliance(law, omega) result(j)
+   !> J*(k) of seed Eq. (14) at the sliding frequencies omega = k V (1/S); omega may be any
+   !> real. (Whole arrays: the model is looked up once, not per mode.)
+   pure function creep_compliance(law, omega) result(j)
       type(material_law), intent(in) :: law
-      real(wp), intent(in) :: omega
+      real(wp), intent(in) :: omega(:)
+      complex(wp) :: j(size(omega))
       complex(wp), parameter :: one = (1.0_wp, 0.0_wp)
       complex(wp) :: modulus, iwt
-      integer :: i
+      integer :: i, m
 
       select case (trim(law%model))
       case ('sls')
@@ -73,12 +75,14 @@ contains
                j = j + law%values(i)/cmplx(1.0_wp, -omega*law%times(i), wp)
             end do
          else
-            modulus = law%equilibrium
-            do i = 1, size(law%times)
-               iwt = cmplx(0.0_wp, -omega*law%times(i), wp)
-               modulus = modulus + law%values(i)*iwt/(one + iwt)
+            do m = 1, size(omega)
+               modulus = law%equilibrium
+               do i = 1, size(law%times)
+                  iwt = cmplx(0.0_wp, -omega(m)*law%times(i), wp)
+                  modulus = modulus + law%values(i)*iwt/(one + iwt)
+               end do
+               j(m) = one/modulus
             end do
-            j = one/modulus
          end if
       case default
          j = 1.0_wp/law%young
@@ -110,7 +114,10 @@ contains
    !> The low-frequency (V -> 0) modulus: the elastic limit used for normalisations (S).
    pure real(wp) function static_modulus(law)
       type(material_law), intent(in) :: law
-      static_modulus = 1.0_wp/real(creep_compliance(law, 0.0_wp), wp)
+      real(wp), parameter :: zero(1) = [0.0_wp]
+      complex(wp) :: j(1)
+      j = creep_compliance(law, zero)
+      static_modulus = 1.0_wp/real(j(1), wp)
    end function static_modulus
 
    !> Validate a material law; messages name the &material variable and the allowed range.
