@@ -1,6 +1,6 @@
-"""Shared helpers for the pytest suite: an independent numpy implementation of the
-convention-P operator (numpy FFT + the kernel factors), used to check the Fortran solver's
-output against the contact conditions without going through the Fortran operator.
+"""Shared helpers for the pytest suite: the contact conditions of a result checked with the
+independent numpy operator of reference_operator.py (numpy FFT + the kernel factors), without
+going through the Fortran operator.
 
 The kernel factors themselves come from `lc.layer_multipliers`, so these checks test the
 operator assembly and the solver, not the kernels: those are tested against mpmath and the
@@ -14,32 +14,9 @@ import numpy as np
 import pytest
 
 import layercontact as lc
+from reference_operator import apply, g_eff  # noqa: F401 (shared with the tests)
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def g_eff(n: int, period: float, thickness: float, young: float, poisson: float, friction: float,
-          material=None, speed: float = 0.0):
-    """G_eff(k) for k = 0..n/2 (numpy rfft order), convention P, Nyquist made real. With a
-    viscoelastic ``material`` 1/E -> J*(k V) (seed Eq. 14)."""
-    m = np.arange(n // 2 + 1)
-    k = 2 * np.pi * m / period
-    compliance = np.full(m.size, 1 / young, dtype=complex)
-    if material is not None:
-        compliance = lc.creep_compliance(material, k * speed)
-    g = np.zeros(m.size, dtype=complex)
-    oma, _, c = lc.layer_multipliers(k[1:] * thickness, poisson)
-    g[1:] = 2 * (1 - poisson**2) * compliance[1:] / k[1:] * (oma - 1j * friction * c)
-    if n % 2 == 0:
-        g[-1] = g[-1].real  # the Nyquist mode is its own mirror image: (G(k) + G(-k))/2
-    if np.isfinite(thickness):
-        g[0] = thickness * (1 + poisson) * (1 - 2 * poisson) * compliance[0].real / (1 - poisson)
-    return g
-
-
-def apply(g: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """w = G_eff * p by numpy FFT."""
-    return np.fft.irfft(np.fft.rfft(p) * g, n=p.size)
 
 
 def contact_violation(res: lc.LineResult, thickness: float, young: float, poisson: float, material=None,
