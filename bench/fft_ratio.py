@@ -1,7 +1,10 @@
 """Cost of a solve in units of one FFTW r2c + c2r pair of the same size, and the cost of
 friction and viscoelasticity relative to the frictionless elastic solve of the same layer.
 
-    .venv/bin/python bench/fft_ratio.py [--sizes 1024 8192 65536]
+    .venv/bin/python bench/fft_ratio.py [--sizes 1024 8192 65536] [--no-marginal]
+
+A second table gives the time of one iteration without the setup and the coarse levels:
+the difference of two runs on one grid level stopped short of convergence.
 
 All ratios are measured in this run on this machine: times are the best of 5 repetitions
 of the library's own solve time (`wall_time`: operator, coarse levels and iterations; no
