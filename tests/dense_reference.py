@@ -30,7 +30,7 @@ def circulant(g: np.ndarray, n: int) -> np.ndarray:
 
 
 def solve_dense(heights: np.ndarray, g: np.ndarray, mean_pressure: float, tol: float = 1e-13,
-                max_steps: int = 300) -> tuple[np.ndarray, float, float]:
+                max_steps: int = 1000) -> tuple[np.ndarray, float, float]:
     """(p, s, residual): the pressure, the multiplier and the complementarity residual
     max_j |min(p_j/p_m, gap_j/ptp(r))| of the dense semismooth Newton solution."""
     r = np.asarray(heights, dtype=float)
