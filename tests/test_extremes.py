@@ -4,7 +4,7 @@ residual below the tolerance or says it did not, and no output is NaN or Inf.
 Grid (tests/extremes_grid.py): rough, sinusoid and narrow-bump profiles x h/lambda 1e-4 ..
 1e3 and the half-space x nu in {-0.9, 0, 0.3, 0.49, 0.5} x mu_c in {0, 0.5, 1, 1.5} x loads
 p_m/p_full = 1e-6 .. 2 (p_full: the scene's own full-contact pressure), on n = 8, 9, 63
-and 1024: 2100 runs per n, 8400 in all (~12 s alone on 2 cores, ~20 s with other jobs).
+and 1024: 2100 runs per n, 8400 in all (~5 s; the viscoelastic grid ~11 s).
 The measured contact fraction spans one node (1/1024 ~ 0.1 %) to full contact for every
 profile.
 
@@ -13,8 +13,11 @@ at n = 63, 2100 at n = 1024 (8392 of 8400). All the others are coupled scenes (m
 thin incompressible layers (h/lambda <= 1e-3) where the operator is nearly skew
 (|mu_c c|/(1-A) ~ 1.5 mu_c/(kh) at the fundamental) on tiny grids: the GCR stalls, the
 outer Anderson iteration stagnates too even with its history grown to 48 and stops,
-returning its best iterate. `.venv/bin/python bench/extremes.py --list` prints them; its tables of iteration
-counts are in the README.
+returning its best iterate. `.venv/bin/python bench/extremes.py --list` prints them; its
+tables of iteration counts are in the README.
+
+A second grid does the same for viscoelastic layers (test_viscoelastic_runs_converge_or_say_so;
+`bench/extremes.py --viscoelastic`).
 """
 
 import numpy as np
