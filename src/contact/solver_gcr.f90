@@ -33,7 +33,7 @@ module lc_contact_solver_gcr
    !> iteration goes on from there). A converging solve halves the residual every one to
    !> three iterations. What still stalls: glassy viscoelastic layers at low speeds, whose
    !> fine-grid contact sets settle slowly (a clip restarts the history) and erratically
-   !> (120 of the 576 scenes of inputs/sweeps/viscoelastic_speed.nml), and a few thin
+   !> (116 of the 576 scenes of inputs/sweeps/viscoelastic_speed.nml), and a few thin
    !> incompressible layers with strong friction on tiny grids. A window of 40 made that
    !> sweep cost twice as many transforms (NOTES.md).
    integer, parameter :: stall_window = 25
