@@ -18,7 +18,7 @@ import argparse
 import numpy as np
 
 import layercontact as lc
-from layercontact import _core
+from layercontact.native import core as _core
 
 SLS = lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0)
 # name: (settings, the scene it is compared with)
@@ -65,7 +65,7 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", default=[1024, 8192, 65536])
     parser.add_argument("--no-marginal", action="store_true", help="skip the table of the cost of one iteration")
     args = parser.parse_args()
-    print("tol 1e-8; method 'auto' (preconditioned CG or GCR) with coarse start unless said otherwise; nu = 0.5; "
+    print(f"core: {lc.BUILD} build; tol 1e-8; method 'auto' (preconditioned CG or GCR) with coarse start unless said otherwise; nu = 0.5; "
           "SLS: E0 = 1, E_inf = 10, tau = 1 (loss peak near V = 0.1 for the roughness here); times: best of 5; "
           "it.: CG or GCR iterations on the finest grid (all inner CG iterations for anderson); FFT pair: the bare "
           "FFTW r2c + c2r pair\n")

@@ -33,7 +33,7 @@ def main() -> None:
     variants = {"plain": dict(precondition=False, coarse_start=False),
                 "precond.": dict(precondition=True, coarse_start=False),
                 "precond. + coarse start": dict(precondition=True, coarse_start=True)}
-    print(f"tol = {args.tol:g}; pressure in the seed's scale p_m/(E* Lambda/lambda); nu = 0.5")
+    print(f"core: {lc.BUILD} build; tol = {args.tol:g}; pressure in the seed's scale p_m/(E* Lambda/lambda); nu = 0.5")
     print("iterations on the finest grid (CG for the half-space, GCR for the coupled scenes; after an Anderson "
           "fallback, marked +a, the GCR iterations plus all inner CG iterations); FFT pairs in units of pairs of "
           "the finest grid (coarse levels included); time in ms; 'plain': no Fourier preconditioner\n")

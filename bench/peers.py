@@ -45,7 +45,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from analytic import westergaard_half_width, westergaard_pressure  # noqa: E402
 
 import layercontact as lc  # noqa: E402
-from layercontact import _core  # noqa: E402
+from layercontact.native import core as _core  # noqa: E402
 
 INSTALL = ".venv/bin/pip install tamaas contactmechanics"
 TARGET_TOL = 1e-8  # layercontact's tolerance in the table
@@ -277,7 +277,7 @@ def available_peers():
 
 def main() -> None:
     peers = available_peers()
-    print("versions: " + ", ".join([f"layercontact {lc.__version__}"]
+    print("versions: " + ", ".join([f"layercontact {lc.__version__} ({lc.BUILD} build)"]
                                    + [f"{name} {version}" for name, (_, version) in peers.items()]))
     if "ContactMechanics" in peers:
         print(contactmechanics_kernel_check())

@@ -202,7 +202,7 @@ def per_scene_steps(directory: Path, name: str, sample: int) -> dict[str, float]
     import h5py
 
     import layercontact as lc
-    from layercontact import _core
+    from layercontact.native import core as _core
     from layercontact.sweep import _result_columns
 
     scenes = sorted((directory / "out" / "scenes").glob(f"{name}_*.nml"))

@@ -314,3 +314,15 @@ subroutine py_fft_pair_seconds(n, repeats, rounds, seconds, stat, errmsg)
       seconds = min(seconds, real(finish - start, 8)/rate/repeats)
    end do
 end subroutine py_fft_pair_seconds
+
+!> What the build and the processor offer: level = 3 if the processor runs the x86-64-v3
+!> build (AVX2, FMA), else 1; isa = the instruction set this extension was compiled for.
+subroutine py_cpu_level(level, isa)
+   use lc_cpu, only: cpu_level
+   use lc_version, only: build_isa
+   implicit none (type, external)
+   integer, intent(out) :: level
+   character(len=16), intent(out) :: isa
+   level = cpu_level()
+   isa = build_isa
+end subroutine py_cpu_level

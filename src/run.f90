@@ -14,7 +14,7 @@ module lc_run
    use lc_profiles_profile, only: make_profile
    use lc_contact_solve, only: solve_line_contact
    use lc_accuracy, only: choose_resolution
-   use lc_version, only: version_string
+   use lc_version, only: version_string, build_isa
    implicit none (type, external)
    private
    public :: run_scene_file
@@ -86,7 +86,7 @@ contains
       character(len=*), parameter :: real_fmt = '(2x, a, t34, es14.6, 1x, a)'
       character(len=*), parameter :: int_fmt = '(2x, a, t34, i14, 1x, a)'
 
-      write (unit, '(a)') 'layercontact ' // version_string // ': ' // trim(input)
+      write (unit, '(a)') 'layercontact ' // version_string // ' (' // build_isa // '): ' // trim(input)
       if (len_trim(scene%title) > 0) write (unit, '(2x, a)') trim(scene%title)
       write (unit, real_fmt) 'thickness h/lambda', scene%thickness/scene%period
       if (scene%solver%target_error /= not_set) then

@@ -86,14 +86,20 @@ def full_contact_pressure(r: np.ndarray, thickness: float, nu: float, friction: 
 def independent_residual(res: lc.LineResult, thickness: float, nu: float, material=None, speed: float = 0.0) -> float:
     """The solver's stopping quantity max_j |min(p_j/p_m, g_j/(max r - min r))|,
     recomputed from the returned pressure with numpy FFTs and without the uniform mode
-    (the penetration is the mean gap on the contact set, as in the solver)."""
+    (the penetration is the mean gap on the contact set, as in the solver). Gaps within the
+    rounding floor 256 eps max(|w|, |r|, max p max|G|) count as zero, as in the solver
+    (README, stopping rule): below it a gap is rounding noise of w - r."""
     r, p = res.height, res.pressure
+    g = g_eff(r.size, thickness, nu, res.friction, material, speed)
     ph = np.fft.rfft(p)
     ph[0] = 0.0
-    ph[1:] *= g_eff(r.size, thickness, nu, res.friction, material, speed)
-    gap = np.fft.irfft(ph, n=r.size) - r
+    ph[1:] *= g
+    w = np.fft.irfft(ph, n=r.size)
+    gap = w - r
     contact = p > 0
     gap -= gap[contact].mean()
+    floor = 256 * np.finfo(float).eps * max(np.abs(w).max(), np.ptp(r), p.max() * np.abs(g).max())
+    gap = np.where(np.abs(gap) > floor, gap, 0.0)
     return float(np.max(np.abs(np.minimum(p / res.mean_pressure, gap / np.ptp(r)))))
 
 

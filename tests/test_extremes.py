@@ -67,8 +67,9 @@ def check_run(scene: dict, r: lc.LineResult) -> None:
     assert r.monotone == scene.get("monotone", True), where
     if r.converged:
         # The stopping quantity recomputed independently (numpy FFT, kernels, no uniform
-        # mode): it differs from the solver's by rounding of w - r, ~1e-16 max|w|/g_ref,
-        # far below tol at these loads, so 2 tol is a sharp bound.
+        # mode, the same rounding floor): it differs from the solver's by rounding of
+        # w - r, ~1e-16 max|w|/g_ref, far below tol at these loads, so 2 tol is a sharp
+        # bound.
         residual = independent_residual(r, scene["thickness"], scene["nu"], scene.get("material"),
                                         scene.get("speed", 0.0))
         assert residual <= 2 * TOL, where

@@ -19,10 +19,12 @@ from .api import (
     surface_fields,
 )
 from .materials import Prony, StandardLinearSolid, creep_compliance
+from .native import BUILD
 from .profiles import load_profile, self_affine_profile, sinusoid_profile
 from .sweep import read_summary, sweep
 
 __all__ = [
+    "BUILD",
     "Prony",
     "StandardLinearSolid",
     "creep_compliance",

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from .api import LayercontactError, _check
-from . import _core
+from .native import core as _core
 
 
 def main(argv: list[str] | None = None) -> int:

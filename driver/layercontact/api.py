@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
+from .native import core as _core
 
 NOT_SET = -1.0
 _CONTROLS = {"load": 0, "displacement": 1}

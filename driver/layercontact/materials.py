@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _core
+from .native import core as _core
 
 _FORMS = {"relaxation": 0, "creep": 1}
 #: Largest number of Prony terms (the library's max_prony_terms).

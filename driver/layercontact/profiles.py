@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 
-from . import _core
+from .native import core as _core
 from .api import NOT_SET, _check
 
 

@@ -1,7 +1,7 @@
 !> HDF5 output (self-describing result file, written atomically) and profile input.
 !>
 !> Layout written by `write_results` (units: lengths L, stresses S, as in the input):
-!>   /                     attrs layercontact_version, geometry, convention, units
+!>   /                     attrs layercontact_version, layercontact_build, geometry, convention, units
 !>   /input/namelist       the namelist text; /input attrs: every parsed scene value
 !>   /profile/x, height    grid positions j*period/n and the rigid profile r(x)
 !>   /fields/pressure, gap, displacement_z
@@ -30,6 +30,7 @@ module lc_io_hdf5
    use lc_strings, only: to_string
    use lc_scene, only: scene_type, static_contact_modulus
    use lc_result, only: contact_result
+   use lc_version, only: build_isa
    implicit none (type, external)
    private
    public :: check_output, write_results, read_profile_heights
@@ -167,6 +168,7 @@ contains
       end if
       if (st%hdferr == 0) then
          call write_attr_string(file, 'layercontact_version', version, st)
+         call write_attr_string(file, 'layercontact_build', build_isa, st)
          call write_attr_string(file, 'geometry', trim(scene%geometry), st)
          call write_attr_string(file, 'convention', convention, st)
          call write_attr_string(file, 'units', units_note, st)
