@@ -1,6 +1,6 @@
-"""The compiled core in use (``core``): the x86-64-v3 build (AVX2, FMA; 6-37 % faster, bench/builds.py)
-where the processor runs it and the package has it, else the portable build
-(``portable``). The two agree to rounding, not bit for bit: set
+"""The compiled core in use (``core``): the x86-64-v3 build (AVX2, FMA; 6-37 % faster,
+bench/builds.py) where the processor runs it and the package has it, else the portable
+build (``portable``). The two agree to rounding, not bit for bit: set
 ``LAYERCONTACT_ISA=baseline`` in the environment for the portable build everywhere
 (results identical across x86-64 machines). ``BUILD`` names the instruction set of the
 core in use; result files record it (``layercontact_build``)."""
