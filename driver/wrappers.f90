@@ -78,7 +78,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, check_scene
    use lc_result, only: contact_result
-   use lc_contact_solve, only: solve_line_contact
+   use lc_contact_solve, only: solve_contact
    use lc_greens_viscoelastic, only: make_material_law
    implicit none (type, external)
    integer, intent(in) :: n, control, method, precondition, coarse_start, max_iter, memory, threads, stress, model, form, nt
@@ -114,7 +114,7 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    scene%solver%precondition = precondition == 1
    scene%solver%coarse_start = coarse_start == 1
    call check_scene(scene, error)
-   if (.not. allocated(error)) call solve_line_contact(scene, height, friction, r, error)
+   if (.not. allocated(error)) call solve_contact(scene, height, friction, r, error)
    if (allocated(error)) then
       stat = error%code
       errmsg = error%message
@@ -230,6 +230,8 @@ subroutine py_surface_fields(n, p, period, thickness, young, poisson, friction, 
       & stat, errmsg)
    use lc_errors, only: error_type
    use lc_greens_viscoelastic, only: material_law
+   use lc_grid, only: line_grid
+   use lc_greens_kernel, only: make_kernel
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_observables_surface, only: surface_fields
    implicit none (type, external)
@@ -243,13 +245,14 @@ subroutine py_surface_fields(n, p, period, thickness, young, poisson, friction, 
    type(compliance_operator) :: op
    stat = 0
    errmsg = ''
-   call build_operator(op, n, period, thickness, material_law(young=young), poisson, friction, 0d0, 1, error)
+   call build_operator(op, line_grid(n, period), make_kernel(thickness, material_law(young=young), poisson, 0d0), &
+      & friction, 1, error)
    if (allocated(error)) then
       stat = error%code
       errmsg = error%message
       return
    end if
-   call surface_fields(op, thickness, poisson, p, displacement_x, stress_xx)
+   call surface_fields(op, p, displacement_x, stress_xx)
 end subroutine py_surface_fields
 
 !> J*(k) of seed Eq. (14) at omega = k V for a material law (codes as in py_solve_line).
@@ -296,7 +299,7 @@ subroutine py_fft_pair_seconds(n, repeats, rounds, seconds, stat, errmsg)
    integer :: i, r
    stat = 0
    errmsg = ''
-   call fft%init(n, 1, error)
+   call fft%init(n, 1, 1, error)
    if (allocated(error)) then
       stat = error%code
       errmsg = error%message

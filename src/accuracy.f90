@@ -24,7 +24,7 @@ module lc_accuracy
    use lc_scene, only: scene_type, not_set
    use lc_result, only: contact_result
    use lc_profiles_profile, only: make_profile
-   use lc_contact_solve, only: solve_line_contact
+   use lc_contact_solve, only: solve_contact
    implicit none (type, external)
    private
    public :: choose_resolution
@@ -74,7 +74,7 @@ contains
       allocate (height(pilot%n))
       call make_profile(pilot, height, error)
       if (allocated(error)) return
-      call solve_line_contact(pilot, height, scene%friction, result, error)
+      call solve_contact(pilot, height, scene%friction, result, error)
       if (allocated(error)) return
       ! mean spot length in shortest wavelengths (no spot: the grid cannot resolve any,
       ! take one grid step, which asks for the finest grid the rule allows)

@@ -12,7 +12,7 @@ module lc_run
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results
    use lc_profiles_profile, only: make_profile
-   use lc_contact_solve, only: solve_line_contact
+   use lc_contact_solve, only: solve_contact
    use lc_accuracy, only: choose_resolution
    use lc_version, only: version_string, build_isa
    implicit none (type, external)
@@ -48,7 +48,7 @@ contains
       call make_profile(scene, height, error)
       if (allocated(error)) return
 
-      call solve_line_contact(scene, height, scene%friction, result, error)
+      call solve_contact(scene, height, scene%friction, result, error)
       if (allocated(error)) return
       converged = result%converged
       if (scene%companion) then
@@ -60,7 +60,7 @@ contains
             c%normalised_pressure = not_set
             c%penetration = not_set
          end associate
-         call solve_line_contact(companion_scene, height, 0.0_wp, companion, error)
+         call solve_contact(companion_scene, height, 0.0_wp, companion, error)
          if (allocated(error)) return
          converged = converged .and. companion%converged
          call write_results(output_file, scene, text, height, result, companion, version_string, error)

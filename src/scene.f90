@@ -12,10 +12,12 @@ module lc_scene
    use lc_errors, only: error_type, input_error, positive_finite
    use lc_strings, only: to_string
    use lc_greens_viscoelastic, only: material_law, check_material, static_modulus
+   use lc_grid, only: grid_type, line_grid, surface_grid
+   use lc_greens_kernel, only: layer_kernel, make_kernel
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
-      & static_contact_modulus
+      & static_contact_modulus, grid_of, kernel_of, is_areal
    public :: max_string, default_rms_gradient
 
    !> Sentinel for "not given" in optional positive quantities.
@@ -74,8 +76,11 @@ module lc_scene
    type :: scene_type
       character(len=max_string) :: geometry = 'line'
       character(len=max_string) :: title = ''
-      real(wp) :: period = 1.0_wp          !< lambda (L)
-      integer :: n = 4096                  !< grid points per period
+      real(wp) :: period = 1.0_wp          !< lambda (L), along x (the sliding direction)
+      integer :: n = 4096                  !< grid points per period along x
+      !> areal geometry: grid points and period along y (period_y not_set: = period)
+      integer :: ny = 1
+      real(wp) :: period_y = not_set
       real(wp) :: thickness = 0.16_wp      !< h (L); +Inf = half-space
       real(wp) :: young = 1.0_wp           !< E (S)
       real(wp) :: poisson = 0.5_wp         !< nu
@@ -105,6 +110,31 @@ contains
       type(scene_type), intent(in) :: scene
       is_halfspace = .not. ieee_is_finite(scene%thickness) .and. .not. ieee_is_nan(scene%thickness)
    end function is_halfspace
+
+   !> True for an areal (surface) contact.
+   pure logical function is_areal(scene)
+      type(scene_type), intent(in) :: scene
+      is_areal = trim(scene%geometry) == 'areal'
+   end function is_areal
+
+   !> The scene's grid: a line of n points, or a surface of n x ny points.
+   pure function grid_of(scene) result(grid)
+      type(scene_type), intent(in) :: scene
+      type(grid_type) :: grid
+      if (is_areal(scene)) then
+         grid = surface_grid(scene%n, scene%ny, scene%period, merge(scene%period_y, scene%period, &
+            & scene%period_y /= not_set))
+      else
+         grid = line_grid(scene%n, scene%period)
+      end if
+   end function grid_of
+
+   !> The scene's layer kernel (lc_greens_kernel).
+   pure function kernel_of(scene) result(kernel)
+      type(scene_type), intent(in) :: scene
+      type(layer_kernel) :: kernel
+      kernel = make_kernel(scene%thickness, material_of(scene), scene%poisson, scene%speed)
+   end function kernel_of
 
    !> The scene's material law (an elastic law takes &layer young).
    pure function material_of(scene) result(law)

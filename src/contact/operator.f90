@@ -1,10 +1,11 @@
-!> The compliance operator of a scene: w = G_eff * p as a Fourier multiplier.
+!> The compliance operator of a scene: w = G_eff * p as a Fourier multiplier on a grid
+!> (a line, or a surface: lc_grid), the same code for both.
 !>
-!> Convention P (DESIGN.md §1): for a mode k of p(x) = sum_k p^(k) exp(i k x),
-!>    w^(k) = 2/(E*|k|) [ (1-A) - i sgn(k) mu_c c ] p^(k),
-!> and for a viscoelastic layer sliding at speed V (seed Eq. 14) 1/E* -> (1 - nu^2) J*(k V)
-!> (lc_greens_viscoelastic),
-!> with 1-A and c from seed Eqs. (7)-(9) (lc_greens_layer), tau = mu_c p. The k = 0
+!> Convention P (docs/theory.md): for a mode q of p(x) = sum_q p^(q) exp(i q.x),
+!>    w^(q) = 2 C(q_x)/|q| [ (1-A) - i (q_x/|q|) mu_c c ] p^(q),
+!> the layer's normal response to p and to the friction traction tau_x = mu_c p
+!> (lc_greens_kernel; on a line q_x/|q| = sgn(k)), with C = 1/E* for an elastic layer and
+!> (1 - nu^2) J*(q_x V) for a viscoelastic one sliding at speed V (seed Eq. 14). The q = 0
 !> mode of a finite layer is h/M (M = E(1-nu)/((1+nu)(1-2nu)), zero for nu = 0.5); for
 !> a half-space it is set to zero (the penetration is then measured from the mean
 !> displacement).
@@ -23,8 +24,8 @@ module lc_contact_operator
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_strings, only: to_string
    use lc_fft_plans, only: fft_plan, fft_threads_available
-   use lc_greens_layer, only: layer_coefficients
-   use lc_greens_viscoelastic, only: material_law, creep_compliance
+   use lc_grid, only: grid_type
+   use lc_greens_kernel, only: layer_kernel
    implicit none (type, external)
    private
    public :: compliance_operator, build_operator
@@ -45,27 +46,31 @@ module lc_contact_operator
    !> k1, not k = 0, so that V -> 0 and V -> inf give back the elastic preconditioner.
    real(wp), parameter :: preconditioner_exponent = 0.5_wp
 
-   !> Fourier multipliers of one scene and the FFT plans to apply them.
+   !> Fourier multipliers of one scene on one grid and the FFT plans to apply them. The
+   !> solvers use it through its procedures only; multipliers are on the grid's half
+   !> spectrum (lc_grid), fields flat with x fastest.
    type :: compliance_operator
-      integer :: n = 0
-      integer :: nk = 0
-      real(wp) :: period = 1.0_wp
+      type(grid_type) :: grid
+      type(layer_kernel) :: kernel
+      integer :: n = 0                      !< grid points
+      integer :: nk = 0                     !< modes of the half spectrum
       real(wp) :: friction = 0.0_wp
       logical :: coupled = .false.          !< complex multiplier (not symmetric)
-      real(wp), allocatable :: metric(:)    !< M(k) = |G_eff(k)|, k = 0..n/2 (L/S)
+      real(wp), allocatable :: metric(:)    !< M(q) = |G_eff(q)| on the half spectrum (L/S)
       real(wp) :: diagonal = 0.0_wp         !< real-space diagonal of the circulant M (L/S)
       !> largest |multiplier| of M and G_eff (L/S): sets the rounding noise of w = G p
       real(wp) :: largest = 0.0_wp
       real(wp) :: inv_n = 1.0_wp            !< 1/n, folded into the multipliers when applied
-      complex(wp), allocatable :: compliance(:)   !< (1 - nu^2) J*(k V) per mode (1/S)
+      !> C = (1 - nu^2) J*(q_x V) per column mx = 0..nx/2 of the half spectrum (1/S)
+      complex(wp), allocatable :: compliance(:)
       !> Fourier preconditioner of the constrained CG: 1/M(k) with half the material's
       !> frequency dependence taken out (see preconditioner_exponent); 0 where M = 0 (k = 0
       !> of a half-space, or under load control)
       real(wp), allocatable :: preconditioner(:)
-      logical :: viscoelastic = .false.     !< moving viscoelastic law: complex compliances
       logical :: monotone = .true.          !< Re G_eff(k) >= 0 for every mode (unique solution)
-      complex(wp), allocatable :: full(:)   !< G_eff(k), only when coupled
-      !> M in real space: (M p)(x_i) = sum_j column(i - j) p_j (L/S)
+      complex(wp), allocatable :: full(:)   !< G_eff(q), only when coupled
+      !> M in real space: (M p)(x_i) = sum_j column(i - j) p_j, i - j taken periodically on
+      !> both axes (L/S)
       real(wp), allocatable :: column(:)
       !> For the constrained GCR only (prepare_gcr): 1/G_eff(k) (0 where G_eff = 0), the
       !> real-space column of G_eff, and the real-space diagonal of 1/G_eff
@@ -78,30 +83,32 @@ module lc_contact_operator
       procedure :: apply_full
       procedure :: apply_difference
       procedure :: add_full_columns
+      procedure :: add_metric_columns
+      procedure :: buffer
+      procedure :: column_mode
       procedure :: metric_in_buffer
       procedure :: inverse_metric_in_buffer
       procedure :: prepare_gcr
       procedure :: full_in_buffer
       procedure :: inverse_full_in_buffer
       procedure :: drop_uniform_mode
-      procedure :: wavenumber
    end type compliance_operator
 
 contains
 
-   !> Build the operator of a line contact: n points on a period, layer thickness
-   !> (+Inf = half-space), material law (elastic: law%young) and Poisson ratio, Coulomb
-   !> coefficient, sliding speed (for viscoelastic laws).
-   subroutine build_operator(op, n, period, thickness, law, poisson, friction, speed, threads, error)
+   !> Build the operator on `grid` for the layer `kernel` and Coulomb coefficient
+   !> `friction`, with `threads` FFTW threads.
+   subroutine build_operator(op, grid, kernel, friction, threads, error)
       type(compliance_operator), intent(out) :: op
-      integer, intent(in) :: n, threads
-      real(wp), intent(in) :: period, thickness, poisson, friction, speed
-      type(material_law), intent(in) :: law
+      type(grid_type), intent(in) :: grid
+      type(layer_kernel), intent(in) :: kernel
+      real(wp), intent(in) :: friction
+      integer, intent(in) :: threads
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: k, one_minus_a, one_minus_b, c
+      real(wp) :: qx, qy, q, one_minus_a, one_minus_b, c
       complex(wp) :: g
-      integer :: m
-      logical :: halfspace
+      real(wp), allocatable :: factor(:)
+      integer :: i, mx, nkx
 
       if (threads > 1 .and. .not. fft_threads_available()) then
          call fatal_error(error, '&solver: threads > 1 needs a build with FFTW threads ' // &
@@ -109,47 +116,44 @@ contains
             & code_input)
          return
       end if
-      call op%fft%init(n, threads, error)
+      call op%fft%init(grid%nx, grid%ny, threads, error)
       if (allocated(error)) return
-      op%n = n
-      op%nk = n/2 + 1
-      op%inv_n = 1.0_wp/n
-      op%period = period
+      op%grid = grid
+      op%kernel = kernel
+      op%n = grid%points()
+      op%nk = grid%modes()
+      op%inv_n = 1.0_wp/op%n
       op%friction = friction
-      halfspace = .not. ieee_is_finite(thickness)
-      ! (1 - nu^2) J*(k V) per mode: 1/E* for an elastic law. A viscoelastic law at rest is
-      ! elastic with its static modulus: only a moving one needs complex compliances.
-      op%viscoelastic = trim(law%model) /= 'elastic' .and. speed > 0.0_wp
-      op%compliance = (1.0_wp - poisson**2)*creep_compliance(law, [(op%wavenumber(m)*speed, m = 0, op%nk - 1)])
+      nkx = grid%nkx()
+      ! C per column: a viscoelastic mode sees the frequency q_x V
+      op%compliance = kernel%contact_compliance([(2.0_wp*pi*mx/grid%lx, mx = 0, nkx - 1)])
       if (.not. all(ieee_is_finite(real(op%compliance, wp)) .and. ieee_is_finite(aimag(op%compliance)))) then
-         call fatal_error(error, '&material: speed = ' // to_string(speed) // ' gives non-finite compliances ' // &
+         call fatal_error(error, '&material: speed = ' // to_string(kernel%speed) // ' gives non-finite compliances ' // &
             & '(k V tau overflows); allowed: a speed with k V tau_max well inside the floating-point range', &
             & code_input)
          return
       end if
       ! A half-space of an incompressible material has c = 0: friction changes nothing.
-      op%coupled = op%viscoelastic .or. (friction > 0.0_wp .and. .not. (halfspace .and. poisson == 0.5_wp))
+      op%coupled = kernel%viscoelastic .or. (friction > 0.0_wp .and. &
+         & .not. (kernel%halfspace .and. kernel%poisson == 0.5_wp))
 
       allocate (op%metric(op%nk))
       if (op%coupled) allocate (op%full(op%nk))
-      if (halfspace) then
-         op%metric(1) = 0.0_wp
-      else
-         ! h/M = h (1+nu)(1-2nu)/((1-nu) E) with the static compliance, exactly zero for nu = 0.5
-         op%metric(1) = thickness*(1.0_wp - 2.0_wp*poisson)/(1.0_wp - poisson)**2*real(op%compliance(1), wp)
-      end if
+      ! h/M with the static compliance (0 for a half-space)
+      op%metric(1) = kernel%normal_uniform(real(op%compliance(1), wp))
       if (op%coupled) op%full(1) = op%metric(1)
 
-      do m = 1, op%nk - 1
-         k = op%wavenumber(m)
-         ! x = +Inf (half-space) gives 1-A = 1-B = 1 and Dundurs' c
-         call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
-         g = 2.0_wp/k*op%compliance(m + 1)*cmplx(one_minus_a, -friction*c, kind=wp)
-         ! sgn(k) = +1 on the half spectrum; the Nyquist mode is its own mirror image, so its
-         ! multiplier is the mirror average (G(k) + G(-k))/2 = Re G(k)
-         if (2*m == n) g = real(g, wp)
-         op%metric(m + 1) = abs(g)
-         if (op%coupled) op%full(m + 1) = g
+      do i = 2, op%nk
+         call grid%wavevector(i, qx, qy)
+         q = hypot(qx, qy)
+         mx = mod(i - 1, nkx)
+         call kernel%factors(q, one_minus_a, one_minus_b, c)
+         g = 2.0_wp/q*op%compliance(mx + 1)*cmplx(one_minus_a, -friction*c*(qx/q), kind=wp)
+         ! A Nyquist column mode is its own mirror image (q_x = +-pi/dx), so its multiplier is
+         ! the mirror average (G(q_x, q_y) + G(-q_x, q_y))/2 = Re G
+         if (2*mx == grid%nx) g = real(g, wp)
+         op%metric(i) = abs(g)
+         if (op%coupled) op%full(i) = g
       end do
       allocate (op%preconditioner(op%nk))
       where (op%metric > 0.0_wp)
@@ -158,8 +162,12 @@ contains
          op%preconditioner = 0.0_wp
       end where
       ! (an elastic law has one compliance: the factor is 1)
-      if (op%viscoelastic) op%preconditioner = op%preconditioner* &
-         & (abs(op%compliance)/abs(op%compliance(2)))**preconditioner_exponent
+      if (kernel%viscoelastic) then
+         factor = (abs(op%compliance)/abs(op%compliance(2)))**preconditioner_exponent
+         do i = 1, op%nk
+            op%preconditioner(i) = op%preconditioner(i)*factor(mod(i - 1, nkx) + 1)
+         end do
+      end if
       ! The solution is unique when the operator is monotone, Re G_eff >= 0 on every mode
       ! (always for elastic layers; not always for viscoelastic ones with friction).
       op%monotone = .true.
@@ -171,11 +179,19 @@ contains
    subroutine derive(op)
       type(compliance_operator), intent(inout) :: op
       real(wp), allocatable :: unit_load(:)
-      integer :: n
+      integer :: n, row, nkx, first, last
       n = op%n
-      ! (1/n) sum over the whole spectrum: modes 1..ceil(n/2)-1 appear twice, Nyquist once
-      op%diagonal = (op%metric(1) + 2*sum(op%metric(2:op%nk)) - merge(op%metric(op%nk), 0.0_wp, &
-         & mod(n, 2) == 0))/n
+      nkx = op%grid%nkx()
+      ! (1/n) sum over the whole spectrum, row by row of the half spectrum: modes
+      ! 1..ceil(nx/2)-1 of a row stand for two, its mx = 0 and Nyquist modes for one
+      op%diagonal = 0.0_wp
+      do row = 1, op%grid%ny
+         first = (row - 1)*nkx + 1
+         last = row*nkx
+         op%diagonal = op%diagonal + (op%metric(first) + 2*sum(op%metric(first + 1:last)) &
+            & - merge(op%metric(last), 0.0_wp, mod(op%grid%nx, 2) == 0))
+      end do
+      op%diagonal = op%diagonal/n
       op%largest = maxval(op%metric)
       if (op%coupled) op%largest = max(op%largest, maxval(abs(op%full)))
       allocate (unit_load(n))
@@ -203,12 +219,23 @@ contains
       call derive(self)
    end subroutine drop_uniform_mode
 
-   !> Wavenumber k = 2 pi m / period of mode index m (0..n/2).
-   pure real(wp) function wavenumber(self, m)
+   !> The operator's FFT input/output buffer (n points): for the solvers that write the
+   !> input of a *_in_buffer procedure into it and read the output from it.
+   function buffer(self) result(field)
       class(compliance_operator), intent(in) :: self
-      integer, intent(in) :: m
-      wavenumber = 2.0_wp*pi*m/self%period
-   end function wavenumber
+      real(wp), pointer, contiguous :: field(:)
+      field => self%fft%real_buffer
+   end function buffer
+
+   !> Wavevector (qx, qy) (1/L) and column mx of the half-spectrum mode i.
+   pure subroutine column_mode(self, i, qx, qy, mx)
+      class(compliance_operator), intent(in) :: self
+      integer, intent(in) :: i
+      real(wp), intent(out) :: qx, qy
+      integer, intent(out) :: mx
+      call self%grid%wavevector(i, qx, qy)
+      mx = mod(i - 1, self%grid%nkx())
+   end subroutine column_mode
 
    !> w = M p with the real symmetric metric.
    subroutine apply_metric(self, p, w)
@@ -244,19 +271,77 @@ contains
 
    !> w <- w + sum_j delta_j G_eff e_j over the points j with delta_j /= 0: the response to
    !> a few point loads, a pass over the grid each (after prepare_gcr).
-   pure subroutine add_full_columns(self, delta, w)
+   subroutine add_full_columns(self, delta, w)
       class(compliance_operator), intent(in) :: self
-      real(wp), intent(in) :: delta(:)
-      real(wp), intent(inout) :: w(:)
-      integer :: j, n
-      n = self%n
-      do j = 1, n
-         if (delta(j) == 0.0_wp) cycle
-         ! column(i - j) for i = j..n is column(1..n-j+1); for i = 1..j-1 it wraps round
-         w(j:n) = w(j:n) + delta(j)*self%full_column(1:n - j + 1)
-         w(1:j - 1) = w(1:j - 1) + delta(j)*self%full_column(n - j + 2:n)
-      end do
+      real(wp), contiguous, intent(in) :: delta(:)
+      real(wp), contiguous, intent(inout) :: w(:)
+      real(wp) :: unused
+      unused = 0.0_wp
+      call add_columns(self%grid, self%full_column, delta, w, unused)
    end subroutine add_full_columns
+
+   !> d <- d + sum_j r_j M e_j over the points j with r_j /= 0 (a pass over the grid each),
+   !> and d_contact <- d_contact + the sum of that change where p > 0.
+   subroutine add_metric_columns(self, r, p, d, d_contact)
+      class(compliance_operator), intent(in) :: self
+      real(wp), contiguous, intent(in) :: r(:), p(:)
+      real(wp), contiguous, intent(inout) :: d(:)
+      real(wp), intent(inout) :: d_contact
+      call add_columns(self%grid, self%column, r, d, d_contact, p)
+   end subroutine add_metric_columns
+
+   !> d <- d + sum_j r_j column(. - j), the circulant column shifted to each point j with
+   !> r_j /= 0 (periodically along x and y), and, with p, total <- total + the sum of the
+   !> change where p > 0.
+   subroutine add_columns(grid, column, r, d, total, p)
+      type(grid_type), intent(in) :: grid
+      real(wp), contiguous, intent(in) :: column(:), r(:)
+      real(wp), contiguous, intent(inout) :: d(:)
+      real(wp), intent(inout) :: total
+      real(wp), contiguous, intent(in), optional :: p(:)
+      integer :: j, jx, jy, iy, nx, target, source
+      nx = grid%nx
+      do j = 1, size(r)
+         if (r(j) == 0.0_wp) cycle
+         jx = mod(j - 1, nx) + 1
+         jy = (j - 1)/nx
+         do iy = 0, grid%ny - 1
+            ! row iy of the response holds row iy - jy of the column, shifted by jx - 1:
+            ! column(1..nx-jx+1) for ix = jx..nx, wrapped round for ix < jx
+            target = iy*nx
+            source = modulo(iy - jy, grid%ny)*nx
+            call add_segment(r(j), column(source + 1:source + nx - jx + 1), d(target + jx:target + nx), total, &
+               & p, target + jx)
+            call add_segment(r(j), column(source + nx - jx + 2:source + nx), d(target + 1:target + jx - 1), total, &
+               & p, target + 1)
+         end do
+      end do
+   end subroutine add_columns
+
+   !> d <- d + value column, and (with p) total <- total + the sum of the change where
+   !> p(offset:) > 0.
+   pure subroutine add_segment(value, column, d, total, p, offset)
+      real(wp), intent(in) :: value
+      real(wp), contiguous, intent(in) :: column(:)
+      real(wp), contiguous, intent(inout) :: d(:)
+      real(wp), intent(inout) :: total
+      real(wp), contiguous, intent(in), optional :: p(:)
+      integer, intent(in) :: offset
+      real(wp) :: added, v
+      integer :: i
+      if (.not. present(p)) then
+         d = d + value*column
+         return
+      end if
+      added = 0.0_wp
+      !$omp simd reduction(+:added) private(v)
+      do i = 1, size(d)
+         v = value*column(i)
+         d(i) = d(i) + v
+         added = added + v*merge(1.0_wp, 0.0_wp, p(offset + i - 1) > 0.0_wp)
+      end do
+      total = total + added
+   end subroutine add_segment
 
    !> fft%real_buffer <- M fft%real_buffer: for a solver that writes its input into the
    !> buffer and reads the output from it (two passes over the grid fewer than apply_metric).
@@ -267,7 +352,8 @@ contains
       real(wp), intent(out), optional :: energy
       if (present(energy)) then
          call self%fft%forward_unscaled()
-         call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, mod(self%n, 2) == 0, energy)
+         call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, self%grid%nkx(), &
+            & mod(self%grid%nx, 2) == 0, energy)
          call self%fft%backward()
       else
          call multiply_in_buffer(self, self%metric)
@@ -275,21 +361,25 @@ contains
    end subroutine metric_in_buffer
 
    !> spectrum <- spectrum * multiplier/n, and energy = (1/n) sum over the whole spectrum of
-   !> multiplier |spectrum|^2 (the modes 1..ceil(n/2)-1 of the half spectrum stand for two,
-   !> k and -k; k = 0 and, for even n, the Nyquist mode for one).
-   pure subroutine multiply_with_energy(spectrum, multiplier, inv_n, even, energy)
+   !> multiplier |spectrum|^2 (the modes of the half spectrum stand for two, q and -q, but
+   !> those of each row's columns mx = 0 and, for even nx, mx = nx/2 for one).
+   pure subroutine multiply_with_energy(spectrum, multiplier, inv_n, nkx, even, energy)
       complex(wp), intent(inout) :: spectrum(:)
       real(wp), intent(in) :: multiplier(:), inv_n
+      integer, intent(in) :: nkx
       logical, intent(in) :: even
       real(wp), intent(out) :: energy
       real(wp) :: f, twice, once
-      integer :: m, nk
-      nk = size(spectrum)
-      once = multiplier(1)*inv_n*abs(spectrum(1))**2
-      if (even .and. nk > 1) once = once + multiplier(nk)*inv_n*abs(spectrum(nk))**2
+      integer :: m, first, last
+      once = 0.0_wp
+      do first = 1, size(spectrum), nkx
+         once = once + multiplier(first)*inv_n*abs(spectrum(first))**2
+         last = first + nkx - 1
+         if (even .and. nkx > 1) once = once + multiplier(last)*inv_n*abs(spectrum(last))**2
+      end do
       twice = 0.0_wp
       !$omp simd reduction(+:twice) private(f)
-      do m = 1, nk
+      do m = 1, size(spectrum)
          f = multiplier(m)*inv_n
          twice = twice + f*(real(spectrum(m), wp)**2 + aimag(spectrum(m))**2)
          spectrum(m) = spectrum(m)*f

@@ -1,5 +1,6 @@
-!> Solve one line-contact scene for a given Coulomb coefficient: build the operator the
-!> scene needs, pick the solver, fill a contact_result.
+!> Solve one contact scene, a line or a surface (lc_grid), for a given Coulomb
+!> coefficient: build the operator the scene needs, pick the solver, fill a
+!> contact_result.
 !>
 !> Geometry (seed Eq. 10, convention P): the indenter surface sits at r(x) - Lambda + Delta
 !> with Lambda = max r, so the highest asperity touches at Delta = 0; the gap is
@@ -10,27 +11,26 @@ module lc_contact_solve
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_strings, only: to_string
-   use lc_scene, only: scene_type, is_halfspace, not_set, material_of, static_contact_modulus
+   use lc_scene, only: scene_type, is_halfspace, not_set, static_contact_modulus, grid_of, kernel_of
    use lc_result, only: contact_result
+   use lc_grid, only: grid_type
+   use lc_greens_kernel, only: layer_kernel
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome
    use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
-   use lc_observables_friction, only: interlocking_friction
-   use lc_observables_surface, only: surface_fields, edge_stress_field
-   use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, &
-      & spot_tension, spot_asymmetry
+   use lc_observables, only: observe
    implicit none (type, external)
    private
-   public :: solve_line_contact, scene_mean_pressure
+   public :: solve_contact, scene_mean_pressure
 
-   !> The coarse-start recursion stops at grids below 2*coarsest_grid points: below that a
-   !> solve costs less than the set-up of another level.
+   !> The coarse-start recursion stops before a grid of fewer than coarsest_grid points:
+   !> below that a solve costs less than the set-up of another level.
    integer, parameter :: coarsest_grid = 512
    !> Tolerance of the coarse solves (or the scene's, if looser): a starting guess only
    !> needs to be closer than the discretisation difference between the two grids, which
-   !> falls like 1/n (contact edges within a grid step): coarse_tol up to a fine grid of
-   !> coarse_tol_size points, coarse_tol coarse_tol_size/n beyond.
+   !> falls like the grid step (contact edges within a grid step): coarse_tol up to a fine
+   !> grid of coarse_tol_size points along x, coarse_tol coarse_tol_size/nx beyond.
    real(wp), parameter :: coarse_tol = 1.0e-4_wp
    integer, parameter :: coarse_tol_size = 8192
 
@@ -49,15 +49,17 @@ contains
       end if
    end function scene_mean_pressure
 
-   !> Solve the scene on profile `height` with Coulomb coefficient `friction` (the
-   !> scene's, or 0 for the frictionless companion).
-   subroutine solve_line_contact(scene, height, friction, result, error)
+   !> Solve the scene on profile `height` (flat, x fastest: lc_grid) with Coulomb
+   !> coefficient `friction` (the scene's, or 0 for the frictionless companion).
+   subroutine solve_contact(scene, height, friction, result, error)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: height(:)
       real(wp), intent(in) :: friction
       type(contact_result), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       type(compliance_operator) :: op
+      type(grid_type) :: grid
+      type(layer_kernel) :: kernel
       real(wp), allocatable :: p(:), w(:), gap(:)
       real(wp) :: pm, s, g_ref, lambda_max
       integer(i8) :: start, finish, rate
@@ -65,10 +67,12 @@ contains
       integer :: n
 
       call system_clock(start, rate)
-      n = scene%n
+      grid = grid_of(scene)
+      kernel = kernel_of(scene)
+      n = grid%points()
       if (size(height) /= n) then
-         call fatal_error(error, 'solve: the profile has ' // to_string(size(height)) // ' heights, &scene n = ' &
-            & // to_string(n), code_input)
+         call fatal_error(error, 'solve: the profile has ' // to_string(size(height)) // ' heights, the grid ' &
+            & // to_string(grid%nx) // ' x ' // to_string(grid%ny) // ' points', code_input)
          return
       end if
       load_control = trim(scene%control) == 'load'
@@ -92,7 +96,8 @@ contains
          p = 0.0_wp
          s = scene%penetration - lambda_max
       end if
-      call solve_on_grid(scene, height, friction, load_control, pm, g_ref, op, p, w, gap, s, result, error)
+      call solve_on_grid(scene, grid, kernel, height, friction, load_control, pm, g_ref, op, p, w, gap, s, &
+         & result, error)
       if (allocated(error)) return
 
       result%friction = friction
@@ -106,16 +111,18 @@ contains
       call system_clock(finish)
       result%wall_time = real(finish - start, wp)/real(rate, wp)
       call observe(scene, op, height, result)
-   end subroutine solve_line_contact
+   end subroutine solve_contact
 
    !> Build the operator on the grid of `height` and solve: p is the starting guess on
    !> entry and the solution on exit, w = G_eff p, gap; s the constant of the gap (given
    !> under displacement control, found under load control). Sets the solver statistics
    !> of `result`. With &solver coarse_start the guess is first replaced by the solution
    !> on the grid of every second point (recursively down to coarsest_grid points).
-   recursive subroutine solve_on_grid(scene, height, friction, load_control, pm, g_ref, op, p, w, gap, s, &
-         & result, error)
+   recursive subroutine solve_on_grid(scene, grid, kernel, height, friction, load_control, pm, g_ref, op, p, w, &
+         & gap, s, result, error)
       type(scene_type), intent(in) :: scene
+      type(grid_type), intent(in) :: grid
+      type(layer_kernel), intent(in) :: kernel
       real(wp), intent(in) :: height(:), friction, pm, g_ref
       logical, intent(in) :: load_control
       type(compliance_operator), intent(out) :: op
@@ -128,16 +135,15 @@ contains
       type(anderson_outcome) :: outer
       real(wp), allocatable :: history(:), p_gcr(:), w_gcr(:), gap_gcr(:)
       real(wp) :: uniform, s_gcr
-      integer :: n, coarse_pairs
+      integer :: coarse_pairs
 
-      n = size(height)
       coarse_pairs = 0
-      if (scene%solver%coarse_start .and. mod(n, 2) == 0 .and. n >= 2*coarsest_grid) then
-         call coarse_solution(scene, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, error)
+      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid)) then
+         call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
+            & error)
          if (allocated(error)) return
       end if
-      call build_operator(op, n, scene%period, scene%thickness, material_of(scene), scene%poisson, friction, &
-         & scene%speed, scene%solver%threads, error)
+      call build_operator(op, grid, kernel, friction, scene%solver%threads, error)
       if (allocated(error)) return
       uniform = 0.0_wp
       if (load_control) call op%drop_uniform_mode(uniform)
@@ -214,97 +220,84 @@ contains
    !> Replace the guess p (and s) by the solution on the grid of every second point,
    !> interpolated linearly (which keeps p >= 0). The coarse solve needs only the accuracy
    !> of a starting guess (coarse_tol); its FFT pairs are returned in units of pairs of
-   !> this grid (half as long each).
-   recursive subroutine coarse_solution(scene, height, friction, load_control, pm, g_ref, p, s, pairs, error)
+   !> this grid (2 or 4 times as long each, on a line or a surface).
+   recursive subroutine coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, &
+         & pairs, error)
       type(scene_type), intent(in) :: scene
+      type(grid_type), intent(in) :: grid
+      type(layer_kernel), intent(in) :: kernel
       real(wp), intent(in) :: height(:), friction, pm, g_ref
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: p(:), s
       integer, intent(out) :: pairs
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: coarse
+      type(grid_type) :: coarse_grid
       type(compliance_operator) :: coarse_op
       type(contact_result) :: coarse_result
       real(wp), allocatable :: pc(:), wc(:), gapc(:), hc(:)
       real(wp) :: sc
-      integer :: n, nc
+      integer :: ratio
 
-      n = size(height)
-      nc = n/2
+      coarse_grid = grid%coarse()
       coarse = scene
-      coarse%n = nc
-      coarse%solver%tol = max(scene%solver%tol, coarse_tol*min(1.0_wp, real(coarse_tol_size, wp)/n))
-      allocate (pc(nc), wc(nc), gapc(nc))
-      hc = height(1:n:2)
-      pc = p(1:n:2)
+      coarse%solver%tol = max(scene%solver%tol, coarse_tol*min(1.0_wp, real(coarse_tol_size, wp)/grid%nx))
+      allocate (wc(coarse_grid%points()), gapc(coarse_grid%points()))
+      hc = restrict(grid, height)
+      pc = restrict(grid, p)
       sc = s
-      call solve_on_grid(coarse, hc, friction, load_control, pm, g_ref, coarse_op, pc, wc, gapc, sc, &
-         & coarse_result, error)
+      call solve_on_grid(coarse, coarse_grid, kernel, hc, friction, load_control, pm, g_ref, coarse_op, pc, wc, &
+         & gapc, sc, coarse_result, error)
       if (allocated(error)) return
-      p(1:n:2) = pc
-      p(2:n:2) = 0.5_wp*(pc + cshift(pc, 1))
+      call interpolate(grid, pc, p)
       if (load_control) s = sc
-      pairs = (coarse_result%fft_pairs + 1)/2
+      ratio = grid%points()/coarse_grid%points()
+      pairs = (coarse_result%fft_pairs + ratio - 1)/ratio
    end subroutine coarse_solution
 
-   !> The observables of a solved contact, computed only as the scene asks.
-   subroutine observe(scene, op, height, result)
-      type(scene_type), intent(in) :: scene
-      type(compliance_operator), intent(inout) :: op
-      real(wp), intent(in) :: height(:)
-      type(contact_result), intent(inout) :: result
-      real(wp), allocatable :: edge_field(:)
-      integer :: where_max, top
+   !> The values of f at every second point (along both axes of a surface).
+   pure function restrict(grid, f) result(fc)
+      type(grid_type), intent(in) :: grid
+      real(wp), intent(in) :: f(:)
+      real(wp), allocatable :: fc(:)
+      if (grid%is_line()) then
+         fc = f(1:grid%nx:2)
+      else
+         fc = reshape(reshape_grid(f, grid%nx, grid%ny, 2), [grid%points()/4])
+      end if
+   end function restrict
 
-      associate (p => result%pressure)
-         call contact_spots(p, scene%period, result%n_spots, result%spot_trailing, result%spot_leading)
-         result%contact_length = scene%period*count(p > 0.0_wp)/size(p)
-         call spot_asymmetry(p, height, scene%period, result%spot_trailing, result%spot_leading, &
-            & result%pressure_shift, result%summit_shift)
-         result%mean_gap = sum(result%gap)/size(p)
-         result%leak_rate = leak_rate(result%gap)
-         if (scene%gap_bins > 0) then
-            allocate (result%gap_edges(scene%gap_bins + 1), result%gap_counts(scene%gap_bins))
-            call gap_histogram(result%gap, result%gap_edges, result%gap_counts)
-         end if
-         if (result%mean_pressure > 0.0_wp) then
-            call interlocking_friction(op, p, result%displacement_z, height, scene%thickness, scene%poisson, &
-               & scene%speed, result%delta_mu, result%delta_mu_spectral, result%delta_mu_energy, &
-               & result%delta_mu_profile, result%dissipated_power)
-         end if
-         if (scene%stress) then
-            allocate (result%displacement_x(size(p)), result%stress_xx(size(p)))
-            result%shear = result%friction*p
-            call surface_fields(op, scene%thickness, scene%poisson, p, result%displacement_x, result%stress_xx)
-            where_max = maxloc(result%stress_xx, dim=1)
-            result%max_tension_grid = result%stress_xx(where_max)
-            result%max_tension = result%max_tension_grid
-            result%max_tension_x = (where_max - 1)*scene%period/size(p)
-            allocate (result%spot_max_tension(result%n_spots), result%spot_tension_offset(result%n_spots), &
-               & result%spot_max_tension_grid(result%n_spots))
-            if (result%friction > 0.0_wp) then
-               ! the trailing-edge cusp, sub-grid (a square root: the grid value is off by ~dx^(1/2))
-               allocate (edge_field(size(p)))
-               call edge_stress_field(op, scene%poisson, result%stress_xx, p, result%gap, edge_field)
-               call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
-                  & result%spot_max_tension, result%spot_tension_offset, result%spot_max_tension_grid, &
-                  & edge_field, p, result%gap)
-            else
-               call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
-                  & result%spot_max_tension, result%spot_tension_offset, result%spot_max_tension_grid)
-            end if
-            if (result%n_spots > 0) then
-               top = maxloc(result%spot_max_tension, dim=1)
-               if (result%spot_max_tension(top) > result%max_tension) then
-                  result%max_tension = result%spot_max_tension(top)
-                  result%max_tension_x = modulo(result%spot_trailing(top) + result%spot_tension_offset(top), &
-                     & scene%period)
-               end if
-            end if
-            result%max_tension_offset = nearest_trailing_offset(result%max_tension_x, result%spot_trailing, &
-               & result%spot_leading, scene%period)
-         end if
-      end associate
-   end subroutine observe
+   !> f(nx, ny) sampled at every `step`-th point along both axes.
+   pure function reshape_grid(f, nx, ny, step) result(fc)
+      real(wp), intent(in) :: f(nx, ny)
+      integer, intent(in) :: nx, ny, step
+      real(wp) :: fc(nx/step, ny/step)
+      fc = f(1:nx:step, 1:ny:step)
+   end function reshape_grid
+
+   !> f on this grid from fc on the grid of every second point: linear (bilinear on a
+   !> surface) interpolation, periodic.
+   pure subroutine interpolate(grid, fc, f)
+      type(grid_type), intent(in) :: grid
+      real(wp), intent(in) :: fc(:)
+      real(wp), intent(out) :: f(:)
+      integer :: n
+      if (grid%is_line()) then
+         n = grid%nx
+         f(1:n:2) = fc
+         f(2:n:2) = 0.5_wp*(fc + cshift(fc, 1))
+      else
+         call interpolate_surface(fc, f, grid%nx, grid%ny)
+      end if
+   end subroutine interpolate
+
+   pure subroutine interpolate_surface(fc, f, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: fc(nx/2, ny/2)
+      real(wp), intent(out) :: f(nx, ny)
+      f(1:nx:2, 1:ny:2) = fc
+      f(2:nx:2, 1:ny:2) = 0.5_wp*(fc + cshift(fc, 1, dim=1))
+      f(:, 2:ny:2) = 0.5_wp*(f(:, 1:ny:2) + cshift(f(:, 1:ny:2), 1, dim=2))
+   end subroutine interpolate_surface
 
 end module lc_contact_solve

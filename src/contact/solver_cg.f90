@@ -85,7 +85,7 @@ contains
       n = size(p)
       associate (d => gap)
       allocate (t(n))
-      buffer => op%fft%real_buffer
+      buffer => op%buffer()
       t = 0.0_wp
       t_sum = 0.0_wp
       t_left = 0.0_wp
@@ -201,7 +201,7 @@ contains
          if (n_changed > column_updates) then
             stale = .true.
          else if (n_changed > 0) then
-            call add_changed_columns(op, buffer, p, d, sums%d_contact)
+            call op%add_metric_columns(buffer, p, d, sums%d_contact)
          end if
          since_fresh = since_fresh + 1
          ! load control: p is scaled to the load (and d alike, M being linear) before the
@@ -410,41 +410,6 @@ contains
       n_changed = nint(changed_count)
       entered = entered_count > 0.0_wp
    end subroutine update
-
-   !> d <- d + sum_j r_j M e_j over the points j with r_j /= 0 (a pass over the grid each),
-   !> and d_contact <- d_contact + the sum of that change over the contact set (p > 0).
-   subroutine add_changed_columns(op, r, p, d, d_contact)
-      type(compliance_operator), intent(in) :: op
-      real(wp), contiguous, intent(in) :: r(:), p(:)
-      real(wp), contiguous, intent(inout) :: d(:)
-      real(wp), intent(inout) :: d_contact
-      integer :: j, n
-      n = size(r)
-      do j = 1, n
-         if (r(j) == 0.0_wp) cycle
-         ! M e_j at x_i is column(i - j): column(1..n-j+1) for i = j..n, wrapped for i < j
-         call add_on_set(r(j), op%column(1:n - j + 1), p(j:n), d(j:n), d_contact)
-         call add_on_set(r(j), op%column(n - j + 2:n), p(1:j - 1), d(1:j - 1), d_contact)
-      end do
-   end subroutine add_changed_columns
-
-   !> d <- d + value column, and total <- total + the sum of the change where p > 0.
-   pure subroutine add_on_set(value, column, p, d, total)
-      real(wp), intent(in) :: value
-      real(wp), contiguous, intent(in) :: column(:), p(:)
-      real(wp), contiguous, intent(inout) :: d(:)
-      real(wp), intent(inout) :: total
-      real(wp) :: added, v
-      integer :: i
-      added = 0.0_wp
-      !$omp simd reduction(+:added) private(v)
-      do i = 1, size(d)
-         v = value*column(i)
-         d(i) = d(i) + v
-         added = added + v*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
-      end do
-      total = total + added
-   end subroutine add_on_set
 
    !> Load the overlapping points out of contact (p = 0, g = d - s < 0) with the pressure
    !> -g/M_jj of a first step; n_changed: how many.

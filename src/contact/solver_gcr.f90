@@ -106,7 +106,7 @@ contains
       ! the real-space diagonal of the preconditioner, for letting points in
       kappa = merge(op%inverse_diagonal, 1.0_wp, precondition)
       allocate (dirs(n, memory), images(n, memory), d(n), coeff(memory), p_best(n))
-      buffer => op%fft%real_buffer
+      buffer => op%buffer()
       p = max(p, 0.0_wp)
       if (load_control) call normalise(p, mean_pressure)
       b_max = maxval(abs(b))

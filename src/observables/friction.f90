@@ -11,10 +11,10 @@
 !>                    is refined (the spectral slope of w - r is not zero at contact nodes
 !>                    next to an edge), which makes it a per-run accuracy indicator.
 !> Comparing them checks the solver and the sign conventions (DESIGN.md §3).
+!> On a surface (lc_grid) the derivatives are along the sliding direction x.
 module lc_observables_friction
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
-   use lc_greens_layer, only: layer_coefficients
    implicit none (type, external)
    private
    public :: interlocking_friction
@@ -23,25 +23,25 @@ contains
 
    !> The four routes for pressure p, displacement w and profile r, and the power dissipated
    !> in a viscoelastic layer per unit nominal area (S L/T) at sliding speed V:
+   !>    D = V sum_q q_x Im[s^* T s],  s = (mu_c p^, 0, p^),
+   !> over the whole spectrum, T the surface compliance (lc_greens_kernel); on a line
    !>    D = V sum_{k>0} 4 Im[(1-nu^2) J*(kV)] |p^(k)|^2 [(1-A) + mu_c^2 (1-B)]
    !> (the normal-tangential coupling drops out of the quadratic form). The steady power
    !> balance (work of the tractions = dissipation) reads D = V p_m (Delta mu - by_energy), so
    !> for an elastic layer Delta mu = by_energy, and for a viscoelastic one the difference is
    !> the hysteretic part.
-   subroutine interlocking_friction(op, p, w, r, thickness, poisson, speed, by_displacement, by_spectrum, &
-         & by_energy, by_profile, dissipation)
+   subroutine interlocking_friction(op, p, w, r, by_displacement, by_spectrum, by_energy, by_profile, dissipation)
       type(compliance_operator), intent(inout) :: op
-      real(wp), intent(in) :: p(:), w(:), r(:), thickness, poisson, speed
+      real(wp), intent(in) :: p(:), w(:), r(:)
       real(wp), intent(out) :: by_displacement, by_spectrum, by_energy, by_profile, dissipation
       complex(wp), allocatable :: ph(:), rh(:), wh(:)
-      real(wp) :: pm, k, one_minus_a, one_minus_b, c, im_g, power
-      complex(wp) :: uxh
-      integer :: m, nk, n
+      real(wp) :: pm, qx, qy, q, cx, cy, one_minus_a, one_minus_b, c, im_g, power, mu
+      complex(wp) :: uxh, compliance, anti
+      integer :: i, mx
 
-      n = op%n
-      nk = op%nk
-      pm = sum(p)/n
-      allocate (ph(nk), rh(nk), wh(nk))
+      pm = sum(p)/op%n
+      mu = op%friction
+      allocate (ph(op%nk), rh(op%nk), wh(op%nk))
       call spectrum_of(op, p, ph)
       call spectrum_of(op, r, rh)
       call spectrum_of(op, w, wh)
@@ -51,27 +51,34 @@ contains
       by_spectrum = 0.0_wp
       by_energy = 0.0_wp
       dissipation = 0.0_wp
-      ! Parseval on the half spectrum: <f g'> = sum_{k>0} 2 Re[conj(f^) i k g^]; the
-      ! Nyquist mode has no derivative.
-      do m = 1, nk - 1
-         if (2*m == n) cycle
-         k = op%wavenumber(m)
-         call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
-         by_displacement = by_displacement - 2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*wh(m + 1), wp)
-         by_profile = by_profile - 2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*rh(m + 1), wp)
+      ! Parseval on the half spectrum: <f g_x> = sum 2 Re[conj(f^) i q_x g^] over the modes
+      ! with 0 < mx < nx/2 (mx = 0 has no x-derivative, nor has the Nyquist column).
+      do i = 2, op%nk
+         call op%column_mode(i, qx, qy, mx)
+         if (mx == 0 .or. 2*mx == op%grid%nx) cycle
+         q = hypot(qx, qy)
+         cx = qx/q
+         cy = qy/q
+         call op%kernel%factors(q, one_minus_a, one_minus_b, c)
+         compliance = op%compliance(mx + 1)
+         anti = op%kernel%antiplane(q, compliance)
+         by_displacement = by_displacement - 2*real(conjg(ph(i))*cmplx(0.0_wp, qx, wp)*wh(i), wp)
+         by_profile = by_profile - 2*real(conjg(ph(i))*cmplx(0.0_wp, qx, wp)*rh(i), wp)
          im_g = 0.0_wp
-         if (op%coupled) im_g = aimag(op%full(m + 1))
-         power = abs(ph(m + 1))**2
-         by_spectrum = by_spectrum + 2*k*im_g*power
-         uxh = 2.0_wp/k*op%compliance(m + 1)*cmplx(op%friction*one_minus_b, c, wp)*ph(m + 1)
-         by_energy = by_energy + op%friction*2*real(conjg(ph(m + 1))*cmplx(0.0_wp, k, wp)*uxh, wp)
-         dissipation = dissipation + 4*aimag(op%compliance(m + 1))*power*(one_minus_a + op%friction**2*one_minus_b)
+         if (op%coupled) im_g = aimag(op%full(i))
+         power = abs(ph(i))**2
+         by_spectrum = by_spectrum + 2*qx*im_g*power
+         ! u_x^ = {2C/q [i c cx + mu_c (1-B) cx^2] + mu_c cy^2 tanh(qh)/(G q)} p^
+         uxh = (2.0_wp/q*compliance*cmplx(mu*one_minus_b*cx**2, c*cx, wp) + mu*cy**2*anti)*ph(i)
+         by_energy = by_energy + mu*2*real(conjg(ph(i))*cmplx(0.0_wp, qx, wp)*uxh, wp)
+         dissipation = dissipation + 2*qx*power*(2*aimag(compliance)/q*(one_minus_a + mu**2*one_minus_b*cx**2) &
+            & + mu**2*cy**2*aimag(anti))
       end do
       by_displacement = by_displacement/pm
       by_profile = by_profile/pm
       by_spectrum = by_spectrum/pm
       by_energy = by_energy/pm
-      dissipation = speed*dissipation
+      dissipation = op%kernel%speed*dissipation
    end subroutine interlocking_friction
 
    subroutine spectrum_of(op, f, fh)

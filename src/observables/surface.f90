@@ -1,4 +1,5 @@
-!> Tangential surface displacement and surface in-plane stress of a line contact.
+!> Tangential surface displacement and surface in-plane stress of a line contact (a grid
+!> with one row).
 !>
 !> Convention P (DESIGN.md §1), tau = mu_c p along +x on the layer:
 !>    u_x^(k) = 2/(E*|k|) [ i sgn(k) c p^(k) + (1-B) tau^(k) ],
@@ -14,10 +15,8 @@
 !> every contact edge, from which the cusp's peak is interpolated sub-grid
 !> (lc_observables_geometry's spot_tension).
 module lc_observables_surface
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
-   use lc_greens_layer, only: layer_coefficients
    implicit none (type, external)
    private
    public :: surface_fields, edge_stress_field
@@ -25,20 +24,19 @@ module lc_observables_surface
 contains
 
    !> u_x (L) and sigma_xx (S) at the surface for pressure p (S) and shear tau = friction p.
-   subroutine surface_fields(op, thickness, poisson, p, displacement_x, stress_xx)
+   subroutine surface_fields(op, p, displacement_x, stress_xx)
       type(compliance_operator), intent(inout) :: op
-      real(wp), intent(in) :: thickness, poisson
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: displacement_x(:), stress_xx(:)
       complex(wp), allocatable :: ph(:), uh(:), sh(:)
-      real(wp) :: k, one_minus_a, one_minus_b, c, pm, contraction, friction
+      real(wp) :: k, unused, one_minus_a, one_minus_b, c, pm, contraction, friction
       integer :: m, n
       logical :: halfspace
 
-      associate (fft => op%fft)
+      associate (fft => op%fft, thickness => op%kernel%thickness, poisson => op%kernel%poisson)
       n = fft%n
       friction = op%friction
-      halfspace = .not. ieee_is_finite(thickness)
+      halfspace = op%kernel%halfspace
       contraction = poisson/(1.0_wp - poisson)
       fft%real_buffer = p
       call fft%forward()
@@ -57,8 +55,8 @@ contains
          sh(1) = -contraction*pm
       end if
       do m = 1, fft%nk - 1
-         k = op%wavenumber(m)
-         call layer_coefficients(k*thickness, poisson, one_minus_a, one_minus_b, c)
+         call op%grid%wavevector(m + 1, k, unused)
+         call op%kernel%factors(k, one_minus_a, one_minus_b, c)
          ! (1 - nu^2) J*(kV) = 1/E* for an elastic layer; sigma_xx does not depend on it
          uh(m + 1) = 2.0_wp/k*op%compliance(m + 1)*cmplx(friction*one_minus_b, c, wp)*ph(m + 1)
          sh(m + 1) = cmplx(-contraction - 2.0_wp*c, 2.0_wp*friction*one_minus_b, wp)*ph(m + 1)
@@ -92,15 +90,14 @@ contains
    !> w' = r' + g', Q = b r' + (a(k) - a) p + (b(k) - b) w' is as smooth as the profile
    !> and the layer's exponentially decaying corrections, so it can be interpolated to a
    !> sub-grid edge position from the grid.
-   subroutine edge_stress_field(op, poisson, stress_xx, p, gap, field)
+   subroutine edge_stress_field(op, stress_xx, p, gap, field)
       type(compliance_operator), intent(inout) :: op
-      real(wp), intent(in) :: poisson
       real(wp), intent(in) :: stress_xx(:), p(:), gap(:)
       real(wp), intent(out) :: field(:)
-      real(wp) :: a, b, dundurs
+      real(wp) :: a, b, dundurs, k, unused
       integer :: m
 
-      associate (fft => op%fft)
+      associate (fft => op%fft, poisson => op%kernel%poisson)
       dundurs = (1.0_wp - 2.0_wp*poisson)/(2.0_wp*(1.0_wp - poisson))
       a = -poisson/(1.0_wp - poisson) - 2.0_wp*dundurs*(1.0_wp + op%friction**2)
       b = op%friction/real(op%compliance(fft%nk), wp)
@@ -109,7 +106,8 @@ contains
       call fft%forward()
       fft%spectrum(1) = 0.0_wp
       do m = 1, fft%nk - 1
-         fft%spectrum(m + 1) = cmplx(0.0_wp, op%wavenumber(m), wp)*fft%spectrum(m + 1)
+         call op%grid%wavevector(m + 1, k, unused)
+         fft%spectrum(m + 1) = cmplx(0.0_wp, k, wp)*fft%spectrum(m + 1)
          if (2*m == fft%n) fft%spectrum(m + 1) = 0.0_wp
       end do
       call fft%backward()

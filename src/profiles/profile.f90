@@ -88,7 +88,7 @@ contains
       rms_height = sqrt(sum((height - mean)**2)/n)
       max_height = maxval(height) - mean
 
-      call plan%init(n, 1, error)
+      call plan%init(n, 1, 1, error)
       if (allocated(error)) return
       plan%real_buffer = height
       call plan%forward()

@@ -124,7 +124,7 @@ contains
          scale = rms_height/current
       end if
 
-      call plan%init(n, 1, error)
+      call plan%init(n, 1, 1, error)
       if (allocated(error)) return
       plan%spectrum = (0.0_wp, 0.0_wp)
       do m = 1, m_max

@@ -138,7 +138,7 @@ contains
       integer :: m
 
       call self_affine_profile(n, period, hurst, 9_i8, period/m_r, period/m_s, not_set, 1.0_wp, height, error)
-      call plan%init(n, 1, error)
+      call plan%init(n, 1, 1, error)
       if (allocated(error)) then
          call report(.false., 'spectrum slope: ' // error%message)
          return

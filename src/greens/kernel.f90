@@ -1,0 +1,149 @@
+!> The layer's surface response per in-plane wavevector q: what the operator, the
+!> observables and the areal tensor are built from, in one place.
+!>
+!> Convention P (docs/theory.md): for tractions (tau_x, tau_y, p) on the surface, in the
+!> frame (l, t, z) with l = q/|q|, the (l, z) block is the plane-strain multiplier with
+!> |k| -> |q|, sgn(k) -> +1,
+!>    w^   = 2 C/|q| [ (1-A) p^     - i c tau_l^ ],
+!>    u_l^ = 2 C/|q| [ i c p^       + (1-B) tau_l^ ],
+!> and the transverse direction decouples (antiplane shear of a layer bonded to a rigid
+!> base): u_t^ = 2 C/((1-nu)|q|) tanh(|q| h) tau_t^, i.e. tanh(|q|h)/(G|q|). Here
+!> C = (1 - nu^2) J*(q_x V) is the contact compliance, 1/E* for an elastic layer; for a
+!> viscoelastic layer sliding at speed V along x a mode sees the frequency q_x V (the
+!> sliding component of q). 1-A, 1-B, c are lc_greens_layer's. At q = 0 a finite layer has
+!> the compliances h/M (normal, M the constrained modulus) and h/G (shear); a half-space
+!> has none (set to zero).
+module lc_greens_kernel
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use lc_kinds, only: wp
+   use lc_greens_layer, only: layer_coefficients
+   use lc_greens_viscoelastic, only: material_law, creep_compliance
+   implicit none (type, external)
+   private
+   public :: layer_kernel, make_kernel
+
+   !> A layer (or half-space) of one material sliding at one speed.
+   type :: layer_kernel
+      real(wp) :: thickness = 1.0_wp     !< h (L); +Inf = half-space
+      real(wp) :: poisson = 0.5_wp       !< nu, constant in time
+      real(wp) :: speed = 0.0_wp         !< V (L/T)
+      type(material_law) :: law
+      logical :: halfspace = .false.
+      !> a moving viscoelastic law: complex compliances (an elastic law, or any law at rest,
+      !> has the real compliance of its static modulus)
+      logical :: viscoelastic = .false.
+   contains
+      procedure :: contact_compliance
+      procedure :: factors
+      procedure :: normal_uniform
+      procedure :: shear_uniform
+      procedure :: antiplane
+      procedure :: tensor
+   end type layer_kernel
+
+contains
+
+   !> The kernel of a layer of thickness h (+Inf: half-space), material law, Poisson ratio
+   !> and sliding speed.
+   pure function make_kernel(thickness, law, poisson, speed) result(kernel)
+      real(wp), intent(in) :: thickness, poisson, speed
+      type(material_law), intent(in) :: law
+      type(layer_kernel) :: kernel
+      kernel%thickness = thickness
+      kernel%poisson = poisson
+      kernel%speed = speed
+      kernel%law = law
+      kernel%halfspace = .not. ieee_is_finite(thickness)
+      kernel%viscoelastic = trim(law%model) /= 'elastic' .and. speed > 0.0_wp
+   end function make_kernel
+
+   !> C = (1 - nu^2) J*(q_x V) (1/S) for the sliding wavenumbers q_x (1/L).
+   pure function contact_compliance(self, qx) result(c)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: qx(:)
+      complex(wp) :: c(size(qx))
+      c = (1.0_wp - self%poisson**2)*creep_compliance(self%law, qx*self%speed)
+   end function contact_compliance
+
+   !> 1-A, 1-B and c for |q| > 0 (1/L).
+   pure elemental subroutine factors(self, q, one_minus_a, one_minus_b, c)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: q
+      real(wp), intent(out) :: one_minus_a, one_minus_b, c
+      ! x = +Inf (half-space) gives 1-A = 1-B = 1 and Dundurs' c
+      call layer_coefficients(q*self%thickness, self%poisson, one_minus_a, one_minus_b, c)
+   end subroutine factors
+
+   !> Normal compliance of the uniform mode, h/M = h (1+nu)(1-2nu)/((1-nu) E) (L/S) with the
+   !> static compliance C0 = (1 - nu^2) J(0) given; 0 for a half-space and exactly 0 for
+   !> nu = 0.5.
+   pure real(wp) function normal_uniform(self, c0)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: c0
+      if (self%halfspace) then
+         normal_uniform = 0.0_wp
+      else
+         normal_uniform = self%thickness*(1.0_wp - 2.0_wp*self%poisson)/(1.0_wp - self%poisson)**2*c0
+      end if
+   end function normal_uniform
+
+   !> Shear compliance of the uniform mode, h/G = 2 h C0/(1 - nu) (L/S); 0 for a half-space
+   !> (whose uniform tangential displacement is not defined).
+   pure real(wp) function shear_uniform(self, c0)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: c0
+      if (self%halfspace) then
+         shear_uniform = 0.0_wp
+      else
+         shear_uniform = 2.0_wp*self%thickness*c0/(1.0_wp - self%poisson)
+      end if
+   end function shear_uniform
+
+   !> Antiplane compliance 2 C tanh(|q| h)/((1-nu)|q|) = tanh(|q|h)/(G|q|) for |q| > 0, with
+   !> the contact compliance C of the mode.
+   pure elemental complex(wp) function antiplane(self, q, c)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: q
+      complex(wp), intent(in) :: c
+      real(wp) :: t
+      t = 1.0_wp
+      if (.not. self%halfspace) t = tanh(q*self%thickness)
+      antiplane = 2.0_wp*c*t/((1.0_wp - self%poisson)*q)
+   end function antiplane
+
+   !> The 3x3 surface compliance in the (x, y, z) frame: (u_x^, u_y^, w^) = T (tau_x^, tau_y^,
+   !> p^) for the wavevector (qx, qy) (1/L); q = 0 gives the uniform mode (h/G, h/G, h/M).
+   pure function tensor(self, qx, qy) result(t)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: qx, qy
+      complex(wp) :: t(3, 3)
+      complex(wp) :: c(1), plane, anti
+      real(wp) :: q, cx, cy, one_minus_a, one_minus_b, coupling
+      t = (0.0_wp, 0.0_wp)
+      c = self%contact_compliance([qx])
+      q = hypot(qx, qy)
+      if (q == 0.0_wp) then
+         t(1, 1) = self%shear_uniform(real(c(1), wp))
+         t(2, 2) = t(1, 1)
+         t(3, 3) = self%normal_uniform(real(c(1), wp))
+         return
+      end if
+      cx = qx/q
+      cy = qy/q
+      call self%factors(q, one_minus_a, one_minus_b, coupling)
+      plane = 2.0_wp*c(1)/q
+      anti = self%antiplane(q, c(1))
+      ! u_l = plane ((1-B) tau_l + i c p), u_t = anti tau_t, w = plane ((1-A) p - i c tau_l),
+      ! with tau_l = cx tau_x + cy tau_y, tau_t = -cy tau_x + cx tau_y, u_x = cx u_l - cy u_t,
+      ! u_y = cy u_l + cx u_t
+      t(1, 1) = plane*one_minus_b*cx**2 + anti*cy**2
+      t(1, 2) = (plane*one_minus_b - anti)*cx*cy
+      t(2, 1) = t(1, 2)
+      t(2, 2) = plane*one_minus_b*cy**2 + anti*cx**2
+      t(1, 3) = plane*cmplx(0.0_wp, coupling*cx, wp)
+      t(2, 3) = plane*cmplx(0.0_wp, coupling*cy, wp)
+      t(3, 1) = -t(1, 3)
+      t(3, 2) = -t(2, 3)
+      t(3, 3) = plane*one_minus_a
+   end function tensor
+end module lc_greens_kernel

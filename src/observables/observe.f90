@@ -1,0 +1,80 @@
+!> The observables of a solved contact, from the solution and the operator's kernel,
+!> computed only as the scene asks: gap statistics and the interlocking friction on any
+!> grid; contact spots, leak rate and the surface stress of line contacts.
+module lc_observables
+   use lc_kinds, only: wp
+   use lc_scene, only: scene_type
+   use lc_result, only: contact_result
+   use lc_contact_operator, only: compliance_operator
+   use lc_observables_friction, only: interlocking_friction
+   use lc_observables_surface, only: surface_fields, edge_stress_field
+   use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, &
+      & spot_tension, spot_asymmetry
+   implicit none (type, external)
+   private
+   public :: observe
+
+contains
+
+   !> The observables of a solved contact, computed only as the scene asks.
+   subroutine observe(scene, op, height, result)
+      type(scene_type), intent(in) :: scene
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: height(:)
+      type(contact_result), intent(inout) :: result
+      real(wp), allocatable :: edge_field(:)
+      integer :: where_max, top
+
+      associate (p => result%pressure)
+         result%mean_gap = sum(result%gap)/size(p)
+         if (scene%gap_bins > 0) then
+            allocate (result%gap_edges(scene%gap_bins + 1), result%gap_counts(scene%gap_bins))
+            call gap_histogram(result%gap, result%gap_edges, result%gap_counts)
+         end if
+         if (result%mean_pressure > 0.0_wp) then
+            call interlocking_friction(op, p, result%displacement_z, height, result%delta_mu, &
+               & result%delta_mu_spectral, result%delta_mu_energy, result%delta_mu_profile, result%dissipated_power)
+         end if
+         ! the rest belongs to line contacts (contact spots along x, plane-strain stress)
+         if (.not. op%grid%is_line()) return
+         call contact_spots(p, scene%period, result%n_spots, result%spot_trailing, result%spot_leading)
+         result%contact_length = scene%period*count(p > 0.0_wp)/size(p)
+         call spot_asymmetry(p, height, scene%period, result%spot_trailing, result%spot_leading, &
+            & result%pressure_shift, result%summit_shift)
+         result%leak_rate = leak_rate(result%gap)
+         if (scene%stress) then
+            allocate (result%displacement_x(size(p)), result%stress_xx(size(p)))
+            result%shear = result%friction*p
+            call surface_fields(op, p, result%displacement_x, result%stress_xx)
+            where_max = maxloc(result%stress_xx, dim=1)
+            result%max_tension_grid = result%stress_xx(where_max)
+            result%max_tension = result%max_tension_grid
+            result%max_tension_x = (where_max - 1)*scene%period/size(p)
+            allocate (result%spot_max_tension(result%n_spots), result%spot_tension_offset(result%n_spots), &
+               & result%spot_max_tension_grid(result%n_spots))
+            if (result%friction > 0.0_wp) then
+               ! the trailing-edge cusp, sub-grid (a square root: the grid value is off by ~dx^(1/2))
+               allocate (edge_field(size(p)))
+               call edge_stress_field(op, result%stress_xx, p, result%gap, edge_field)
+               call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
+                  & result%spot_max_tension, result%spot_tension_offset, result%spot_max_tension_grid, &
+                  & edge_field, p, result%gap)
+            else
+               call spot_tension(result%stress_xx, scene%period, result%spot_trailing, result%spot_leading, &
+                  & result%spot_max_tension, result%spot_tension_offset, result%spot_max_tension_grid)
+            end if
+            if (result%n_spots > 0) then
+               top = maxloc(result%spot_max_tension, dim=1)
+               if (result%spot_max_tension(top) > result%max_tension) then
+                  result%max_tension = result%spot_max_tension(top)
+                  result%max_tension_x = modulo(result%spot_trailing(top) + result%spot_tension_offset(top), &
+                     & scene%period)
+               end if
+            end if
+            result%max_tension_offset = nearest_trailing_offset(result%max_tension_x, result%spot_trailing, &
+               & result%spot_leading, scene%period)
+         end if
+      end associate
+   end subroutine observe
+
+end module lc_observables
