@@ -62,30 +62,33 @@ subroutine py_self_affine_profile(n, period, hurst, seed, rolloff_wavelength, sh
    end if
 end subroutine py_self_affine_profile
 
-!> Solve a line contact on the given heights. control: 0 load, 1 displacement;
-!> method: 0 auto, 1 cg, 2 anderson, 3 gcr; precondition, coarse_start, stress: 0/1.
+!> Solve a contact on the given heights: a line (areal = 0; n heights) or a surface
+!> (areal = 1; n = nx*ny heights, x fastest, period_y its period along y). control: 0 load,
+!> 1 displacement; method: 0 auto, 1 cg, 2 anderson, 3 gcr; precondition, coarse_start,
+!> stress: 0/1.
 !> fields(:, 1:5): pressure, gap, displacement_z, displacement_x, stress_xx (the last two
-!> zero unless stress = 1); spots(1:n_spots, 1:5): trailing and leading edges, largest
+!> zero unless stress = 1; lines only); spots(1:n_spots, 1:5): trailing and leading edges, largest
 !> sigma_xx around the spot (sub-grid at the trailing edge with friction), its offset from
-!> the trailing edge and the largest grid value (zero unless stress = 1);
+!> the trailing edge and the largest grid value (zero unless stress = 1; lines only);
 !> scalars: in the order of layercontact.api._SCALARS (the solver that ran as its index in
 !> `solvers`); history(1:history_length): the last
 !> residuals of the run, at most `capacity` (an array of max_iter entries would cost more
 !> than a small solve).
-subroutine py_solve_line(n, height, period, thickness, young, poisson, friction, control, mean_pressure, &
-      & penetration, method, precondition, coarse_start, tol, max_iter, memory, threads, stress, model, form, e0, e_inf, tau, &
-      & equilibrium, nt, times, values, speed, capacity, fields, spots, scalars, history, stat, errmsg)
+subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, poisson, friction, control, &
+      & mean_pressure, penetration, method, precondition, coarse_start, tol, max_iter, memory, threads, stress, model, &
+      & form, e0, e_inf, tau, equilibrium, nt, times, values, speed, capacity, fields, spots, scalars, history, &
+      & stat, errmsg)
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, check_scene
    use lc_result, only: contact_result
    use lc_contact_solve, only: solve_contact
    use lc_greens_viscoelastic, only: make_material_law
    implicit none (type, external)
-   integer, intent(in) :: n, control, method, precondition, coarse_start, max_iter, memory, threads, stress, model, form, nt
-   integer, intent(in) :: capacity
-   real(8), intent(in) :: height(n), period, thickness, young, poisson, friction, mean_pressure, penetration, tol
-   real(8), intent(in) :: e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
-   real(8), intent(out) :: fields(n, 5), spots(n/2 + 1, 5), scalars(27), history(capacity)
+   integer, intent(in) :: n, nx, areal, control, method, precondition, coarse_start, max_iter, memory, threads, stress
+   integer, intent(in) :: model, form, nt, capacity
+   real(8), intent(in) :: height(n), period, period_y, thickness, young, poisson, friction, mean_pressure, penetration
+   real(8), intent(in) :: tol, e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
+   real(8), intent(out) :: fields(n, 5), spots(nx/2 + 1, 5), scalars(29), history(capacity)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n, nt
@@ -99,9 +102,10 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
    character(len=16), parameter :: solvers(4) = [character(len=16) :: 'cg', 'gcr', 'anderson', 'gcr+anderson']
    stat = 0
    errmsg = ''
-   scene = scene_type(n=n, period=period, thickness=thickness, young=young, poisson=poisson, friction=friction, &
-      & control=controls(max(0, min(1, control))), mean_pressure=mean_pressure, penetration=penetration, &
-      & stress=stress == 1, gap_bins=0)
+   scene = scene_type(n=nx, ny=n/max(nx, 1), period=period, period_y=period_y, thickness=thickness, young=young, &
+      & poisson=poisson, friction=friction, control=controls(max(0, min(1, control))), mean_pressure=mean_pressure, &
+      & penetration=penetration, stress=stress == 1 .and. areal == 0, gap_bins=0)
+   if (areal == 1) scene%geometry = 'areal'
    scene%profile%kind = 'file'
    scene%profile%file = '(array from Python)'
    scene%material = make_material_law(model, form, young, e0, e_inf, tau, equilibrium, times, values)
@@ -139,8 +143,9 @@ subroutine py_solve_line(n, height, period, thickness, young, poisson, friction,
       & real(r%outer_iterations, 8), real(r%fft_pairs, 8), r%residual, r%wall_time, &
       & real(stored, 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
       & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), &
-      & r%pressure_shift, r%summit_shift, r%max_tension_grid, real(findloc(solvers, r%solver, dim=1), 8)]
-end subroutine py_solve_line
+      & r%pressure_shift, r%summit_shift, r%max_tension_grid, real(findloc(solvers, r%solver, dim=1), 8), &
+      & r%normalised_pressure, r%normalised_thickness]
+end subroutine py_solve
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless
 !> verbose = 1). converged: 0/1.
@@ -329,3 +334,22 @@ subroutine py_cpu_level(level, isa)
    level = cpu_level()
    isa = build_isa
 end subroutine py_cpu_level
+
+!> The layer's 3x3 surface compliance (lc_greens_kernel) for the wavevectors (qx, qy):
+!> (u_x^, u_y^, w^) = tensor(i, :, :) (tau_x^, tau_y^, p^), an elastic layer of thickness
+!> h (Inf: half-space).
+subroutine py_surface_tensor(n, qx, qy, thickness, young, poisson, tensor)
+   use lc_greens_viscoelastic, only: material_law
+   use lc_greens_kernel, only: layer_kernel, make_kernel
+   implicit none (type, external)
+   integer, intent(in) :: n
+   real(8), intent(in) :: qx(n), qy(n), thickness, young, poisson
+   complex(8), intent(out) :: tensor(n, 3, 3)
+   !f2py intent(hide) :: n
+   type(layer_kernel) :: kernel
+   integer :: i
+   kernel = make_kernel(thickness, material_law(young=young), poisson, 0d0)
+   do i = 1, n
+      tensor(i, :, :) = kernel%tensor(qx(i), qy(i))
+   end do
+end subroutine py_surface_tensor

@@ -40,6 +40,10 @@ module lc_result
       integer :: n_spots = 0                  !< number of contact spots
       real(wp) :: contact_length = 0.0_wp     !< a = total length in contact (L)
       real(wp) :: mean_gap = 0.0_wp           !< <g> (L)
+      !> p_m over the seed's pressure scale (lc_contact_solve's pressure_scale; NaN for a
+      !> flat profile on a line) and h/lambda
+      real(wp) :: normalised_pressure = 0.0_wp
+      real(wp) :: normalised_thickness = 0.0_wp
       real(wp) :: leak_rate = 0.0_wp          !< <g^3>/12 (L^3): flow across x per unit gradient and 1/viscosity
       real(wp) :: max_tension = 0.0_wp        !< max sigma_xx (S), if stress was asked for (sub-grid at trailing edges)
       real(wp) :: max_tension_grid = 0.0_wp   !< the largest grid value of sigma_xx (S)

@@ -44,7 +44,7 @@ contains
          call choose_resolution(scene, error)
          if (allocated(error)) return
       end if
-      allocate (height(scene%n))
+      allocate (height(scene%n*scene%ny))
       call make_profile(scene, height, error)
       if (allocated(error)) return
 
@@ -88,6 +88,7 @@ contains
 
       write (unit, '(a)') 'layercontact ' // version_string // ' (' // build_isa // '): ' // trim(input)
       if (len_trim(scene%title) > 0) write (unit, '(2x, a)') trim(scene%title)
+      if (scene%ny > 1) write (unit, '(2x, a, t34, i6, a, i6, a)') 'areal grid nx x ny', scene%n, ' x', scene%ny
       write (unit, real_fmt) 'thickness h/lambda', scene%thickness/scene%period
       if (scene%solver%target_error /= not_set) then
          write (unit, real_fmt) 'target error', scene%solver%target_error

@@ -17,7 +17,7 @@ module lc_scene
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
-      & static_contact_modulus, grid_of, kernel_of, is_areal
+      & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale
    public :: max_string, default_rms_gradient
 
    !> Sentinel for "not given" in optional positive quantities.
@@ -30,7 +30,7 @@ module lc_scene
    !> Length of the fixed-size character components (file names, keywords).
    integer, parameter :: max_string = 512
 
-   !> Rigid indenter profile: how it is made (kind = self_affine | sinusoid | file).
+   !> Rigid indenter profile: how it is made (kind = self_affine | sinusoid | sphere | file).
    type :: profile_spec
       character(len=max_string) :: kind = 'self_affine'
       !> self_affine: Hurst exponent, seed, roll-off and shortest wavelengths (L)
@@ -41,10 +41,15 @@ module lc_scene
       !> scale: give at most one of rms_gradient (-) and rms_height (L); default rms_gradient 0.1
       real(wp) :: rms_gradient = not_set
       real(wp) :: rms_height = not_set
-      !> sinusoid r(x) = amplitude cos(2 pi mode x / period)
+      !> sinusoid r(x) = amplitude cos(2 pi mode x / period); on a surface
+      !> r(x, y) = amplitude cos(2 pi (mode x/period + mode_y y/period_y))
       real(wp) :: amplitude = not_set
       integer :: mode = 1
-      !> file: HDF5 file and dataset holding n heights (L)
+      integer :: mode_y = 0
+      !> sphere (areal): a spherical cap of this radius (L), its apex at the cell's centre
+      real(wp) :: radius = not_set
+      !> file: heights (L) from an HDF5 file (dataset below), a .npy file, or a text file
+      !> (whitespace-separated; a surface: one row of nx heights per line, ny lines)
       character(len=max_string) :: file = ''
       character(len=max_string) :: dataset = '/profile/height'
    end type profile_spec
@@ -150,6 +155,22 @@ contains
       static_contact_modulus = static_modulus(material_of(scene))/(1.0_wp - scene%poisson**2)
    end function static_contact_modulus
 
+   !> The seed's pressure scale (S): E* Lambda0/lambda for line contacts and for an areal
+   !> contact on a half-space (Lambda0 = max r - mean r, the highest summit above the mean
+   !> plane), E* h/lambda for an areal contact on a layer; E* with the static modulus,
+   !> lambda the period along x.
+   pure real(wp) function pressure_scale(scene, height)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:)
+      real(wp) :: lambda0
+      if (is_areal(scene) .and. .not. is_halfspace(scene)) then
+         pressure_scale = static_contact_modulus(scene)*scene%thickness/scene%period
+      else
+         lambda0 = maxval(height) - sum(height)/size(height)
+         pressure_scale = static_contact_modulus(scene)*lambda0/scene%period
+      end if
+   end function pressure_scale
+
    !> Validate a scene; the message names the namelist group, the variable, the value
    !> and the allowed range.
    subroutine check_scene(scene, error)
@@ -157,12 +178,23 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       associate (p => scene%profile, s => scene%solver)
-         if (.not. one_of(scene%geometry, [character(len=8) :: 'line'])) then
-            call input_error(error, 'scene', 'geometry', trim(scene%geometry), "'line' (areal contacts come later)")
+         if (.not. one_of(scene%geometry, [character(len=8) :: 'line', 'areal'])) then
+            call input_error(error, 'scene', 'geometry', trim(scene%geometry), "'line' or 'areal'")
          else if (.not. positive_finite(scene%period)) then
             call input_error(error, 'scene', 'period', to_string(scene%period), '> 0 and finite')
-         else if (scene%n < 8 .or. scene%n > 2**26) then
+         else if (.not. is_areal(scene) .and. (scene%n < 8 .or. scene%n > 2**26)) then
             call input_error(error, 'scene', 'n', to_string(scene%n), '8 <= n <= 2**26')
+         else if (.not. is_areal(scene) .and. scene%ny /= 1) then
+            call input_error(error, 'scene', 'ny', to_string(scene%ny), "1 with geometry = 'line'")
+         else if (is_areal(scene) .and. (scene%n < 4 .or. scene%n > 2**16)) then
+            call input_error(error, 'scene', 'nx (or n)', to_string(scene%n), "4 <= nx <= 65536 with geometry = 'areal'")
+         else if (is_areal(scene) .and. (scene%ny < 4 .or. scene%ny > 2**16)) then
+            call input_error(error, 'scene', 'ny (or n)', to_string(scene%ny), "4 <= ny <= 65536 with geometry = 'areal'")
+         else if (is_areal(scene) .and. int(scene%n, i8)*scene%ny > 2_i8**28) then
+            call input_error(error, 'scene', 'nx*ny', to_string(int(scene%n, i8)*scene%ny), &
+               & '<= 2**28 (16384 x 16384) grid points')
+         else if (scene%period_y /= not_set .and. .not. positive_finite(scene%period_y)) then
+            call input_error(error, 'scene', 'period_y', to_string(scene%period_y), '> 0 and finite')
          else if (ieee_is_nan(scene%thickness) .or. scene%thickness <= 0.0_wp) then
             call input_error(error, 'layer', 'thickness', to_string(scene%thickness), '> 0, or Inf for a half-space')
          else if (.not. positive_finite(scene%young)) then
@@ -173,8 +205,15 @@ contains
             call input_error(error, 'material', 'speed', to_string(scene%speed), '>= 0 and finite')
          else if (.not. (scene%friction >= 0.0_wp .and. scene%friction <= 10.0_wp)) then
             call input_error(error, 'friction', 'coefficient', to_string(scene%friction), '0 <= coefficient <= 10')
-         else if (.not. one_of(p%kind, [character(len=16) :: 'self_affine', 'sinusoid', 'file'])) then
+         else if (.not. is_areal(scene) .and. .not. one_of(p%kind, [character(len=16) :: 'self_affine', 'sinusoid', &
+            & 'file'])) then
             call input_error(error, 'profile', 'kind', trim(p%kind), "'self_affine', 'sinusoid' or 'file'")
+         else if (is_areal(scene) .and. .not. one_of(p%kind, [character(len=16) :: 'self_affine', 'sinusoid', &
+            & 'sphere', 'file'])) then
+            call input_error(error, 'profile', 'kind', trim(p%kind), "'self_affine', 'sinusoid', 'sphere' or 'file'")
+         else if (is_areal(scene) .and. scene%solver%target_error /= not_set) then
+            call input_error(error, 'solver', 'target_error', to_string(scene%solver%target_error), &
+               & "not set with geometry = 'areal' (the accuracy rule is measured for line contacts)")
          end if
          if (allocated(error)) return
          call check_material(scene%material, error)

@@ -7,6 +7,7 @@ friction traction on the layer is ``tau = +mu_c p``.
 """
 
 from .api import (
+    ArealResult,
     LayercontactError,
     LineResult,
     check_scene_file,
@@ -15,8 +16,10 @@ from .api import (
     layer_multipliers_lapack,
     read_result,
     run,
+    solve_areal,
     solve_line,
     surface_fields,
+    surface_tensor,
 )
 from .materials import Prony, StandardLinearSolid, creep_compliance
 from .native import BUILD
@@ -24,6 +27,7 @@ from .profiles import load_profile, self_affine_profile, sinusoid_profile
 from .sweep import read_summary, sweep
 
 __all__ = [
+    "ArealResult",
     "BUILD",
     "Prony",
     "StandardLinearSolid",
@@ -40,8 +44,10 @@ __all__ = [
     "run",
     "self_affine_profile",
     "sinusoid_profile",
+    "solve_areal",
     "solve_line",
     "sweep",
     "surface_fields",
+    "surface_tensor",
 ]
 __version__ = "0.1.0"

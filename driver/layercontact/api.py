@@ -13,13 +13,13 @@ from .native import core as _core
 NOT_SET = -1.0
 _CONTROLS = {"load": 0, "displacement": 1}
 _METHODS = {"auto": 0, "cg": 1, "anderson": 2, "gcr": 3}
-# Order of the scalars returned by the wrapper py_solve_line (driver/wrappers.f90).
+# Order of the scalars returned by the wrapper py_solve (driver/wrappers.f90).
 _SCALARS = (
     "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
     "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
-    "max_tension_grid", "solver",
+    "max_tension_grid", "solver", "normalised_pressure", "normalised_thickness",
 )
 # The solver that ran, by the code in the scalars (driver/wrappers.f90 `solvers`).
 _SOLVERS = {1: "cg", 2: "gcr", 3: "anderson", 4: "gcr+anderson"}
@@ -57,6 +57,21 @@ def layer_multipliers(kh, nu: float):
     if np.any(~(kh >= 0)):
         raise ValueError("kh must be >= 0 (inf allowed for the half-space)")
     return _core.py_layer_coefficients(kh, float(nu))
+
+
+def surface_tensor(qx, qy, *, thickness=np.inf, young=1.0, poisson=0.5):
+    """The layer's 3x3 surface compliance for in-plane wavevectors ``(qx, qy)`` (1/L,
+    broadcast together): ``(u_x^, u_y^, w^) = T (tau_x^, tau_y^, p^)`` in convention P,
+    shape ``broadcast.shape + (3, 3)``, complex. In the frame ``(l, t, z)`` with
+    ``l = q/|q|`` it is the plane-strain multiplier with ``|k| -> |q|`` in ``(l, z)`` and the
+    antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t``; ``q = 0`` gives the uniform mode
+    ``(h/G, h/G, h/M)`` of a layer (zero for a half-space)."""
+    qx, qy = np.broadcast_arrays(np.asarray(qx, dtype=np.float64), np.asarray(qy, dtype=np.float64))
+    if not -1.0 < poisson <= 0.5:
+        raise ValueError(f"poisson = {poisson} is not allowed; allowed: -1 < poisson <= 0.5")
+    t = _core.py_surface_tensor(np.ascontiguousarray(qx.ravel()), np.ascontiguousarray(qy.ravel()),
+                                float(thickness), float(young), float(poisson))
+    return t.reshape(qx.shape + (3, 3))
 
 
 def layer_multipliers_lapack(kh, nu: float):
@@ -129,6 +144,8 @@ class LineResult:
     monotone: bool = True
     pressure_shift: float = 0.0
     summit_shift: float = 0.0
+    normalised_pressure: float = float("nan")
+    normalised_thickness: float = float("nan")
     a_over_a0: float | None = None
     companion: "LineResult | None" = field(default=None, repr=False)
 
@@ -187,11 +204,9 @@ def solve_line(
     """
     h = np.ascontiguousarray(np.asarray(heights, dtype=np.float64))
     if h.ndim != 1:
-        raise ValueError("heights must be one-dimensional (line contact)")
+        raise ValueError("heights must be one-dimensional (line contact); use solve_areal for a surface")
     if (mean_pressure is None) == (penetration is None):
         raise ValueError("give exactly one of mean_pressure (load control) and penetration")
-    if method not in _METHODS:
-        raise ValueError(f"method = {method!r} is not allowed; allowed: {sorted(_METHODS)}")
     settings = dict(period=period, thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
                     penetration=penetration, stress=stress, method=method, precondition=precondition,
                     coarse_start=coarse_start, tol=tol,
@@ -205,14 +220,19 @@ def solve_line(
     return result
 
 
-def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure, penetration, stress, method,
-                precondition, coarse_start, tol, max_iter, memory, threads, material, speed) -> LineResult:
+def _solve_native(h, nx, areal, *, period, period_y, thickness, young, poisson, friction, mean_pressure,
+                  penetration, stress, method, precondition, coarse_start, tol, max_iter, memory, threads, material,
+                  speed):
+    """One call of the library's solve (py_solve): fields (n, 5), spots, scalars, history."""
     from .materials import material_codes
 
+    if method not in _METHODS:
+        raise ValueError(f"method = {method!r} is not allowed; allowed: {sorted(_METHODS)}")
     control = "load" if mean_pressure is not None else "displacement"
     model, form, young, e0, e_inf, tau, eq, times, values = material_codes(material, young)
-    fields, spots, s, hist, stat, errmsg = _core.py_solve_line(
-        h, float(period), float(thickness), young, float(poisson), float(friction), _CONTROLS[control],
+    fields, spots, s, hist, stat, errmsg = _core.py_solve(
+        h, int(nx), int(areal), float(period), float(period_y), float(thickness), young, float(poisson),
+        float(friction), _CONTROLS[control],
         NOT_SET if mean_pressure is None else float(mean_pressure),
         NOT_SET if penetration is None else float(penetration),
         _METHODS[method], int(bool(precondition)), int(bool(coarse_start)), float(tol), int(max_iter), int(memory), int(threads),
@@ -225,6 +245,12 @@ def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure
     scalars["converged"] = bool(scalars["converged"])
     scalars["monotone"] = bool(scalars["monotone"])
     scalars["solver"] = _SOLVERS.get(int(scalars["solver"]), "")
+    return fields, spots, scalars, hist[:n_hist].copy()
+
+
+def _solve_once(h, *, period, stress, friction, **settings) -> LineResult:
+    fields, spots, scalars, history = _solve_native(h, h.size, 0, period=period, period_y=NOT_SET, stress=stress,
+                                                    friction=friction, **settings)
     if not stress:
         for name in ("max_tension", "max_tension_x", "max_tension_offset", "max_tension_grid"):
             scalars[name] = float("nan")
@@ -232,12 +258,138 @@ def _solve_once(h, *, period, thickness, young, poisson, friction, mean_pressure
         pressure=fields[:, 0].copy(), gap=fields[:, 1].copy(), displacement_z=fields[:, 2].copy(),
         displacement_x=fields[:, 3].copy() if stress else None, shear=friction * fields[:, 0] if stress else None,
         stress_xx=fields[:, 4].copy() if stress else None, height=h.copy(), period=float(period),
-        friction=float(friction), spots=spots[: scalars["n_spots"], :2].copy(), residual_history=hist[:n_hist].copy(),
+        friction=float(friction), spots=spots[: scalars["n_spots"], :2].copy(), residual_history=history,
         spot_max_tension=spots[: scalars["n_spots"], 2].copy() if stress else None,
         spot_tension_offset=spots[: scalars["n_spots"], 3].copy() if stress else None,
         spot_max_tension_grid=spots[: scalars["n_spots"], 4].copy() if stress else None,
         **scalars,
     )
+
+
+# What an areal result keeps of the library's scalars (the others describe line contacts).
+_AREAL_SCALARS = (
+    "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
+    "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
+    "mean_gap", "dissipated_power", "monotone", "solver", "normalised_pressure", "normalised_thickness",
+)
+
+
+@dataclass
+class ArealResult:
+    """A solved areal contact. Units are those of the inputs: lengths L, pressures S.
+
+    Fields are ``(ny, nx)`` arrays on the grid ``x = j period_x/nx`` (axis 1, the sliding
+    direction), ``y = i period_y/ny`` (axis 0); ``gap = w - (r - Lambda + Delta)``.
+    ``delta_mu`` is the interlocking (or, on a viscoelastic layer, hysteretic) friction
+    ``-<p dw/dx>/p_m`` from the displacement, ``delta_mu_spectral`` the same from the Fourier
+    multiplier, ``delta_mu_profile = -<p dr/dx>/p_m`` from the rigid surface (equal to the
+    others to the discretisation error), ``delta_mu_energy = mu_c <p du_x/dx>/p_m``.
+    ``normalised_pressure`` is ``p_m/(E* h/period_x)`` on a layer and ``p_m/(E* Lambda0/period_x)``
+    on a half-space (``Lambda0`` the highest summit above the mean plane). The solver
+    statistics are those of :class:`LineResult`.
+    """
+
+    pressure: np.ndarray
+    gap: np.ndarray
+    displacement_z: np.ndarray
+    height: np.ndarray
+    period: tuple[float, float]
+    friction: float
+    mean_pressure: float
+    penetration: float
+    contact_fraction: float
+    mean_gap: float
+    delta_mu: float
+    delta_mu_spectral: float
+    delta_mu_energy: float
+    delta_mu_profile: float
+    converged: bool
+    iterations: int
+    outer_iterations: int
+    solver: str
+    fft_pairs: int
+    residual: float
+    wall_time: float
+    residual_history: np.ndarray = field(repr=False)
+    dissipated_power: float = 0.0
+    monotone: bool = True
+    normalised_pressure: float = float("nan")
+    normalised_thickness: float = float("nan")
+    a_over_a0: float | None = None
+    companion: "ArealResult | None" = field(default=None, repr=False)
+
+    @property
+    def total_friction(self) -> float:
+        """mu_c + Delta mu: the macroscopic friction coefficient."""
+        return self.friction + self.delta_mu
+
+    @property
+    def x(self) -> np.ndarray:
+        """Grid positions along the sliding direction (L), axis 1 of the fields."""
+        return np.arange(self.pressure.shape[1]) * (self.period[0] / self.pressure.shape[1])
+
+    @property
+    def y(self) -> np.ndarray:
+        """Grid positions across it (L), axis 0 of the fields."""
+        return np.arange(self.pressure.shape[0]) * (self.period[1] / self.pressure.shape[0])
+
+
+def solve_areal(
+    heights,
+    *,
+    period=1.0,
+    thickness: float = np.inf,
+    young: float = 1.0,
+    poisson: float = 0.5,
+    friction: float = 0.0,
+    mean_pressure: float | None = None,
+    penetration: float | None = None,
+    material=None,
+    speed: float = 0.0,
+    companion: bool = False,
+    method: str = "auto",
+    precondition: bool = True,
+    coarse_start: bool = True,
+    tol: float = 1e-10,
+    max_iter: int = 100000,
+    memory: int = 12,
+    threads: int = 1,
+) -> ArealResult:
+    """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
+    a uniform periodic grid, axis 1 = x = the sliding direction) on a layer of
+    ``thickness`` (``inf``: half-space) bonded to a rigid base, with Coulomb friction
+    ``tau_x = friction * p``. ``period`` is one length or a pair ``(period_x, period_y)``.
+    Every other keyword means what it means for :func:`solve_line`; the surface stress is
+    not computed for areal contacts.
+    """
+    h = np.asarray(heights, dtype=np.float64)
+    if h.ndim != 2:
+        raise ValueError(f"heights must be a (ny, nx) array for an areal contact; got shape {h.shape}")
+    if (mean_pressure is None) == (penetration is None):
+        raise ValueError("give exactly one of mean_pressure (load control) and penetration")
+    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    ny, nx = h.shape
+    flat = np.ascontiguousarray(h).ravel()
+    settings = dict(thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
+                    penetration=penetration, method=method, precondition=precondition, coarse_start=coarse_start,
+                    tol=tol, max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
+
+    def once(mu):
+        fields, _, scalars, history = _solve_native(flat, nx, 1, period=lx, period_y=ly, stress=False, friction=mu,
+                                                    **settings)
+        kept = {name: scalars[name] for name in _AREAL_SCALARS}
+        return ArealResult(
+            pressure=fields[:, 0].reshape(ny, nx).copy(), gap=fields[:, 1].reshape(ny, nx).copy(),
+            displacement_z=fields[:, 2].reshape(ny, nx).copy(), height=h.copy(), period=(lx, ly),
+            friction=float(mu), residual_history=history, **kept)
+
+    result = once(friction)
+    if companion:
+        if mean_pressure is None:
+            raise ValueError("companion=True compares at the same load: give mean_pressure")
+        result.companion = once(0.0)
+        result.a_over_a0 = result.contact_fraction / result.companion.contact_fraction
+    return result
 
 
 def surface_fields(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson=0.5, friction=0.0):
@@ -251,9 +403,10 @@ def surface_fields(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson
     return ux, sxx
 
 
-def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResult:
-    """Read a result file written by the executable or :func:`run`; the frictionless
-    companion run stored in it (if any) becomes ``result.companion``."""
+def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResult | ArealResult:
+    """Read a result file written by the executable or :func:`run` (a :class:`LineResult`,
+    or an :class:`ArealResult` for an areal scene); the frictionless companion run stored
+    in it (if any) becomes ``result.companion``."""
     import h5py
 
     def one(f, base) -> LineResult:
@@ -280,10 +433,30 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values,
         )
 
+    def one_areal(f, base) -> ArealResult:
+        r = dict(base["results"].attrs)
+        values = {k: (int(r[k]) if k in _INTEGERS else float(r[k])) for k in _AREAL_SCALARS
+                  if k in r and k not in ("solver",)}
+        solver = r.get("solver", "")
+        values["solver"] = solver.decode() if isinstance(solver, bytes) else str(solver)
+        values["converged"] = bool(r["converged"])
+        values["monotone"] = bool(r.get("monotone", 1))
+        attrs = f["input"].attrs
+        lx = float(attrs["period"])
+        ly = float(attrs["period_y"]) if float(attrs["period_y"]) > 0 else lx
+        return ArealResult(
+            pressure=base["fields/pressure"][()], gap=base["fields/gap"][()],
+            displacement_z=base["fields/displacement_z"][()], height=f["profile/height"][()], period=(lx, ly),
+            friction=float(r["friction"]), residual_history=base["convergence/residual"][()],
+            a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values)
+
     with h5py.File(filename, "r") as f:
-        result = one(f, f)
+        geometry = f.attrs.get("geometry", b"line")
+        geometry = geometry.decode() if isinstance(geometry, bytes) else str(geometry)
+        reader = one_areal if geometry == "areal" else one
+        result = reader(f, f)
         if companion and "companion" in f:
-            result.companion = one(f, f["companion"])
+            result.companion = reader(f, f["companion"])
         return result
 
 
@@ -303,7 +476,7 @@ def choose_resolution(filename: str | os.PathLike) -> tuple[int, float]:
     return int(n), float(tol)
 
 
-def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult:
+def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult | ArealResult:
     """Run a namelist file exactly as the ``layercontact`` executable does (same library
     routine): the HDF5 result is written where ``&output file`` says, and read back.
     Raises :class:`LayercontactError` on bad input (nothing is written)."""

@@ -11,7 +11,7 @@ module lc_contact_solve
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_strings, only: to_string
-   use lc_scene, only: scene_type, is_halfspace, not_set, static_contact_modulus, grid_of, kernel_of
+   use lc_scene, only: scene_type, is_halfspace, not_set, grid_of, kernel_of, pressure_scale
    use lc_result, only: contact_result
    use lc_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
@@ -36,16 +36,15 @@ module lc_contact_solve
 
 contains
 
-   !> p_m of a load-controlled scene on profile `height` (S).
+   !> p_m of a load-controlled scene on profile `height` (S): the given one, or the
+   !> normalised pressure times its scale (pressure_scale).
    pure real(wp) function scene_mean_pressure(scene, height) result(pm)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: height(:)
-      real(wp) :: lambda0
       if (scene%mean_pressure /= not_set) then
          pm = scene%mean_pressure
       else
-         lambda0 = maxval(height) - sum(height)/size(height)
-         pm = scene%normalised_pressure*static_contact_modulus(scene)*lambda0/scene%period
+         pm = scene%normalised_pressure*pressure_scale(scene, height)
       end if
    end function scene_mean_pressure
 

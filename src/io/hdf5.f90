@@ -14,10 +14,10 @@
 !> `error_type` messages naming the file and the object instead.
 module lc_io_hdf5
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_loc
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use hdf5, only: hid_t, hsize_t, size_t, h5kind_to_type, H5_INTEGER_KIND, h5open_f, h5close_f, h5eset_auto_f, &
       & h5fcreate_f, h5fopen_f, h5fclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5F_CLOSE_STRONG_F, &
-      & h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, &
+      & h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, H5P_DATASET_CREATE_F, h5pset_chunk_f, &
+      & h5pset_deflate_f, &
       & h5gcreate_f, h5gclose_f, h5iget_name_f, &
       & h5screate_f, h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
       & h5sget_simple_extent_dims_f, H5S_SCALAR_F, &
@@ -28,7 +28,7 @@ module lc_io_hdf5
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
    use lc_strings, only: to_string
-   use lc_scene, only: scene_type, static_contact_modulus
+   use lc_scene, only: scene_type, is_areal
    use lc_result, only: contact_result
    use lc_version, only: build_isa
    implicit none (type, external)
@@ -179,8 +179,13 @@ contains
          call close_group(group, st)
 
          call create_group(file, 'profile', group, st)
-         call write_dataset_1d(group, 'x', [(j*scene%period/n, j=0, n - 1)], 'L', st)
-         call write_dataset_1d(group, 'height', height, 'L', st)
+         call write_dataset_1d(group, 'x', [(j*scene%period/scene%n, j=0, scene%n - 1)], 'L', st)
+         if (is_areal(scene)) then
+            associate (ly => merge(scene%period_y, scene%period, scene%period_y > 0.0_wp))
+               call write_dataset_1d(group, 'y', [(j*ly/scene%ny, j=0, scene%ny - 1)], 'L', st)
+            end associate
+         end if
+         call write_field(group, 'height', height, 'L', scene, st)
          call close_group(group, st)
 
          if (present(companion)) then
@@ -281,6 +286,8 @@ contains
       call write_attr_string(loc, 'title', trim(scene%title), st)
       call write_attr_real(loc, 'period', scene%period, st)
       call write_attr_int(loc, 'n', scene%n, st)
+      call write_attr_int(loc, 'ny', scene%ny, st)
+      call write_attr_real(loc, 'period_y', scene%period_y, st)
       call write_attr_real(loc, 'thickness', scene%thickness, st)
       call write_attr_real(loc, 'young', scene%young, st)
       call write_attr_real(loc, 'poisson', scene%poisson, st)
@@ -342,12 +349,11 @@ contains
       !> contact area relative to the frictionless companion's
       real(wp), intent(in), optional :: a_over_a0
       integer(hid_t) :: group
-      real(wp) :: e_star, lambda_max
 
       call create_group(loc, 'fields', group, st)
-      call write_dataset_1d(group, 'pressure', res%pressure, 'S', st)
-      call write_dataset_1d(group, 'gap', res%gap, 'L', st)
-      call write_dataset_1d(group, 'displacement_z', res%displacement_z, 'L', st)
+      call write_field(group, 'pressure', res%pressure, 'S', scene, st)
+      call write_field(group, 'gap', res%gap, 'L', scene, st)
+      call write_field(group, 'displacement_z', res%displacement_z, 'L', scene, st)
       if (allocated(res%stress_xx)) then
          call write_dataset_1d(group, 'displacement_x', res%displacement_x, 'L', st)
          call write_dataset_1d(group, 'shear', res%shear, 'S', st)
@@ -404,16 +410,8 @@ contains
          call write_attr_real(group, 'max_tension_x', res%max_tension_x, st)
          call write_attr_real(group, 'max_tension_offset', res%max_tension_offset, st)
       end if
-      ! the seed's scales: Lambda = highest asperity above the mean plane (as the input's
-      ! normalised_pressure), p_m normalised by E* Lambda / lambda, thickness by lambda
-      e_star = static_contact_modulus(scene)
-      lambda_max = maxval(height) - sum(height)/size(height)
-      if (lambda_max > 0.0_wp) then
-         call write_attr_real(group, 'normalised_pressure', res%mean_pressure / (e_star*lambda_max/scene%period), st)
-      else
-         call write_attr_real(group, 'normalised_pressure', ieee_value(1.0_wp, ieee_quiet_nan), st)
-      end if
-      call write_attr_real(group, 'normalised_thickness', scene%thickness / scene%period, st)
+      call write_attr_real(group, 'normalised_pressure', res%normalised_pressure, st)
+      call write_attr_real(group, 'normalised_thickness', res%normalised_thickness, st)
       if (present(a_over_a0)) call write_attr_real(group, 'a_over_a0', a_over_a0, st)
       call close_group(group, st)
 
@@ -576,6 +574,46 @@ contains
       end if
       if (st%hdferr /= 0 .and. .not. allocated(st%object)) call failed(loc, name, st)
    end subroutine write_dataset_1d
+
+   !> A field on the scene's grid: a 1D dataset of a line, or a 2D dataset of a surface
+   !> (shape [ny, nx] as C and h5py see it, x fastest), chunked by whole rows and
+   !> compressed (deflate): a gap field of a partial contact holds many zeros.
+   subroutine write_field(loc, name, values, units, scene, st)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      real(wp), intent(in) :: values(:)
+      character(len=*), intent(in) :: units
+      type(scene_type), intent(in) :: scene
+      type(h5_status), intent(inout) :: st
+      integer(hid_t) :: space, dset, dcpl
+      integer(hsize_t) :: dims(2), chunk(2)
+      integer :: ignore
+      if (.not. is_areal(scene)) then
+         call write_dataset_1d(loc, name, values, units, st)
+         return
+      end if
+      if (st%hdferr /= 0) return
+      dims = [int(scene%n, hsize_t), int(scene%ny, hsize_t)]
+      ! rows of about 2**16 values a chunk (512 KiB)
+      chunk = [dims(1), max(1_hsize_t, min(dims(2), 65536_hsize_t/dims(1)))]
+      call h5screate_simple_f(2, dims, space, st%hdferr)
+      if (st%hdferr == 0) then
+         call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, st%hdferr)
+         if (st%hdferr == 0) call h5pset_chunk_f(dcpl, 2, chunk, st%hdferr)
+         if (st%hdferr == 0) call h5pset_deflate_f(dcpl, 4, st%hdferr)
+         if (st%hdferr == 0) then
+            call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, st%hdferr, dcpl_id=dcpl)
+            if (st%hdferr == 0) then
+               call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, st%hdferr)
+               if (st%hdferr == 0) call write_attr_string(dset, 'units', units, st)
+               call h5dclose_f(dset, ignore)
+            end if
+            call h5pclose_f(dcpl, ignore)
+         end if
+         call h5sclose_f(space, ignore)
+      end if
+      if (st%hdferr /= 0 .and. .not. allocated(st%object)) call failed(loc, name, st)
+   end subroutine write_field
 
    !> A fixed-length, null-terminated string type for `length` characters.
    subroutine string_type(length, stype, hdferr)

@@ -22,12 +22,12 @@ module lc_io_namelist
       & 'scene', 'layer', 'material', 'friction', 'profile', 'loading', 'solver', 'output']
    !> Variables allowed in each group, in the order of `group_names` (for messages).
    character(len=*), parameter :: group_variables(n_groups) = [character(len=128) :: &
-      & 'geometry, title, period, n', &
+      & 'geometry, title, period, n, period_x, period_y, nx, ny', &
       & 'thickness, young, poisson', &
       & 'model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, prony_values, prony_file', &
       & 'coefficient, companion', &
       & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
-      & 'amplitude, mode, file, dataset', &
+      & 'amplitude, mode, mode_y, radius, file, dataset', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
       & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error', &
       & 'file, overwrite, stress, gap_bins']
@@ -36,6 +36,10 @@ module lc_io_namelist
    !> Marks array entries a namelist did not set (any real a user could type is a value,
    !> so that a wrong sign is reported rather than taken for "not given").
    real(wp), parameter :: unset_entry = -huge(1.0_wp)
+   !> The same for grid sizes.
+   integer, parameter :: unset_count = -huge(1)
+   !> Grid points per side of an areal scene that gives no n, nx or ny.
+   integer, parameter :: default_areal_n = 256
 
    !> Where one group sits in the text: characters first..last, starting on `line`.
    type :: group_span
@@ -129,6 +133,8 @@ contains
             & // entry('title', str_value(scene%title)) &
             & // entry('period', real_value(scene%period)) &
             & // entry('n', to_string(scene%n)) &
+            & // entry('ny', to_string(scene%ny)) &
+            & // entry('period_y', real_value(scene%period_y)) &
             & // '/' // newline // '&layer' // newline &
             & // entry('thickness', real_value(scene%thickness)) &
             & // entry('young', real_value(scene%young)) &
@@ -155,6 +161,8 @@ contains
             & // entry('rms_height', real_value(p%rms_height)) &
             & // entry('amplitude', real_value(p%amplitude)) &
             & // entry('mode', to_string(p%mode)) &
+            & // entry('mode_y', to_string(p%mode_y)) &
+            & // entry('radius', real_value(p%radius)) &
             & // entry('file', str_value(p%file)) &
             & // entry('dataset', str_value(p%dataset)) &
             & // '/' // newline // '&loading' // newline &
@@ -226,20 +234,29 @@ contains
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
       character(len=max_string) :: geometry, title
-      real(wp) :: period
-      integer :: n
-      namelist /scene/ geometry, title, period, n
+      real(wp) :: period, period_x, period_y
+      integer :: n, nx, ny
+      namelist /scene/ geometry, title, period, n, period_x, period_y, nx, ny
 
       geometry = config%geometry
       title = config%title
       period = config%period
-      n = config%n
+      n = unset_count
+      ! areal grids: n (nx = ny = n) or nx and ny; period (= period_x) and period_y
+      ! (default: the same); unset_count marks what the file does not give
+      nx = unset_count
+      ny = unset_count
+      period_x = not_set
+      period_y = config%period_y
       read (lines, nml=scene, iostat=stat, iomsg=msg)
       if (stat /= 0) return
       config%geometry = geometry
       config%title = title
-      config%period = period
-      config%n = n
+      config%period = merge(period_x, period, period_x /= not_set)
+      config%period_y = period_y
+      if (n == unset_count) n = merge(default_areal_n, config%n, trim(geometry) == 'areal')
+      config%n = merge(nx, n, nx /= unset_count)
+      config%ny = merge(ny, merge(n, 1, trim(geometry) == 'areal'), ny /= unset_count)
    end subroutine read_group_scene
 
    subroutine read_group_layer(lines, config, stat, msg)
@@ -395,11 +412,11 @@ contains
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
       character(len=max_string) :: kind, file, dataset
-      real(wp) :: hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, amplitude
+      real(wp) :: hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, amplitude, radius
       integer(i8) :: seed
-      integer :: mode
+      integer :: mode, mode_y
       namelist /profile/ kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
-         & rms_height, amplitude, mode, file, dataset
+         & rms_height, amplitude, mode, mode_y, radius, file, dataset
 
       associate (p => config%profile)
          kind = p%kind
@@ -411,6 +428,8 @@ contains
          rms_height = p%rms_height
          amplitude = p%amplitude
          mode = p%mode
+         mode_y = p%mode_y
+         radius = p%radius
          file = p%file
          dataset = p%dataset
          read (lines, nml=profile, iostat=stat, iomsg=msg)
@@ -424,6 +443,8 @@ contains
          p%rms_height = rms_height
          p%amplitude = amplitude
          p%mode = mode
+         p%mode_y = mode_y
+         p%radius = radius
          p%file = file
          p%dataset = dataset
       end associate

@@ -3,7 +3,8 @@
 !> grid; contact spots, leak rate and the surface stress of line contacts.
 module lc_observables
    use lc_kinds, only: wp
-   use lc_scene, only: scene_type
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+   use lc_scene, only: scene_type, pressure_scale
    use lc_result, only: contact_result
    use lc_contact_operator, only: compliance_operator
    use lc_observables_friction, only: interlocking_friction
@@ -23,10 +24,15 @@ contains
       real(wp), intent(in) :: height(:)
       type(contact_result), intent(inout) :: result
       real(wp), allocatable :: edge_field(:)
+      real(wp) :: scale
       integer :: where_max, top
 
       associate (p => result%pressure)
          result%mean_gap = sum(result%gap)/size(p)
+         scale = pressure_scale(scene, height)
+         result%normalised_pressure = ieee_value(1.0_wp, ieee_quiet_nan)
+         if (scale > 0.0_wp) result%normalised_pressure = result%mean_pressure/scale
+         result%normalised_thickness = scene%thickness/scene%period
          if (scene%gap_bins > 0) then
             allocate (result%gap_edges(scene%gap_bins + 1), result%gap_counts(scene%gap_bins))
             call gap_histogram(result%gap, result%gap_edges, result%gap_counts)
