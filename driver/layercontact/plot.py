@@ -6,8 +6,9 @@ import os
 
 
 def plot_result(h5file: str | os.PathLike, png: str | os.PathLike) -> None:
-    """The seed's Fig. 2(a) view: the rigid profile and the deformed layer surface (with
-    the frictionless companion when the file has one), and the contact pressure."""
+    """The seed's Fig. 2(a) view of a line contact: the rigid profile and the deformed
+    layer surface (with the frictionless companion when the file has one), and the contact
+    pressure; for an areal contact, the pressure and gap maps."""
     import h5py
     import matplotlib
 
@@ -15,6 +16,10 @@ def plot_result(h5file: str | os.PathLike, png: str | os.PathLike) -> None:
     import matplotlib.pyplot as plt
 
     with h5py.File(h5file, "r") as f:
+        geometry = f.attrs.get("geometry", b"line")
+        if (geometry.decode() if isinstance(geometry, bytes) else str(geometry)) == "areal":
+            _plot_areal(f, png, plt)
+            return
         x = f["profile/x"][()]
         r = f["profile/height"][()]
         period = float(f["input"].attrs["period"])
@@ -38,5 +43,30 @@ def plot_result(h5file: str | os.PathLike, png: str | os.PathLike) -> None:
     bottom.set_ylabel("pressure p (S)")
     bottom.set_xlabel("x / lambda  (indenter slides along +x)")
     bottom.legend(fontsize=8)
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+
+
+def _plot_areal(f, png, plt) -> None:
+    """Pressure and gap maps of an areal result (x, the sliding direction, to the right)."""
+    import numpy as np
+
+    lx = float(f["input"].attrs["period"])
+    ly = float(f["input"].attrs["period_y"])
+    ly = ly if ly > 0 else lx
+    p = f["fields/pressure"][()]
+    g = f["fields/gap"][()]
+    attrs = dict(f["results"].attrs)
+    extent = (0.0, 1.0, 0.0, ly / lx)
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.8), constrained_layout=True)
+    shown = left.imshow(p, origin="lower", extent=extent, cmap="magma")
+    fig.colorbar(shown, ax=left, label="pressure p (S)")
+    left.set_title(f"contact fraction {attrs['contact_fraction']:.3f},  mu_c = {attrs['friction']:g}")
+    shown = right.imshow(np.where(p > 0, np.nan, g), origin="lower", extent=extent, cmap="viridis")
+    fig.colorbar(shown, ax=right, label="gap g (L); contact blank")
+    right.set_title(f"mean gap {attrs['mean_gap']:.3g},  Delta mu = {attrs['delta_mu']:.3g}")
+    for ax in (left, right):
+        ax.set_xlabel("x / lambda  (indenter slides along +x)")
+        ax.set_ylabel("y / lambda")
     fig.savefig(png, dpi=120)
     plt.close(fig)
