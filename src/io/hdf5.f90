@@ -13,7 +13,7 @@
 !> (h5open_f/h5close_f) and switches off HDF5's own error printing: failures come back as
 !> `error_type` messages naming the file and the object instead.
 module lc_io_hdf5
-   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_loc
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_loc, c_size_t
    use hdf5, only: hid_t, hsize_t, size_t, h5kind_to_type, H5_INTEGER_KIND, h5open_f, h5close_f, h5eset_auto_f, &
       & h5fcreate_f, h5fopen_f, h5fclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5F_CLOSE_STRONG_F, &
       & h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, H5P_DATASET_CREATE_F, h5pset_chunk_f, &
@@ -67,6 +67,12 @@ module lc_io_hdf5
          character(kind=c_char), intent(in) :: old(*), new(*)
       end function c_rename
       !> int remove(const char *path)
+      !> int gethostname(char *name, size_t len)
+      integer(c_int) function c_gethostname(name, length) bind(C, name='gethostname')
+         import :: c_int, c_char, c_size_t
+         character(kind=c_char), intent(out) :: name(*)
+         integer(c_size_t), value, intent(in) :: length
+      end function c_gethostname
       integer(c_int) function c_remove(path) bind(C, name='remove')
          import :: c_int, c_char
          character(kind=c_char), intent(in) :: path(*)
@@ -172,6 +178,7 @@ contains
          call write_attr_string(file, 'geometry', trim(scene%geometry), st)
          call write_attr_string(file, 'convention', convention, st)
          call write_attr_string(file, 'units', units_note, st)
+         call write_provenance(file, st)
 
          call create_group(file, 'input', group, st)
          call write_dataset_string(group, 'namelist', namelist_text, st)
@@ -614,6 +621,87 @@ contains
       end if
       if (st%hdferr /= 0 .and. .not. allocated(st%object)) call failed(loc, name, st)
    end subroutine write_field
+
+   !> Where and when the result was made: @host, @created (UTC, ISO 8601), and under Slurm
+   !> @slurm_job_id, @slurm_array_job_id, @slurm_array_task_id (as the scheduler set them).
+   subroutine write_provenance(loc, st)
+      integer(hid_t), intent(in) :: loc
+      type(h5_status), intent(inout) :: st
+      character(kind=c_char, len=256) :: host
+      character(len=8) :: date
+      character(len=10) :: time
+      character(len=5) :: zone
+      character(len=64) :: value
+      character(len=*), parameter :: slurm(3) = [character(len=19) :: 'SLURM_JOB_ID', 'SLURM_ARRAY_JOB_ID', &
+         & 'SLURM_ARRAY_TASK_ID']
+      integer :: i, length, status, minutes
+      integer :: values(8)
+
+      host = ''
+      if (c_gethostname(host, len(host, c_size_t)) /= 0) host = 'unknown'
+      length = index(host, c_null_char) - 1
+      if (length < 0) length = len_trim(host)
+      call write_attr_string(loc, 'host', host(:max(length, 0)), st)
+      call date_and_time(date, time, zone, values)
+      ! local time minus its offset from UTC (values(4), minutes)
+      minutes = values(5)*60 + values(6) - values(4)
+      call write_attr_string(loc, 'created', utc_stamp(values(1), values(2), values(3), minutes, values(7)), st)
+      do i = 1, size(slurm)
+         call get_environment_variable(trim(slurm(i)), value, length, status)
+         if (status == 0 .and. length > 0) call write_attr_string(loc, to_lower(trim(slurm(i))), trim(value), st)
+      end do
+   end subroutine write_provenance
+
+   !> 'YYYY-MM-DDThh:mm:ssZ' for a local date and the minutes since its midnight in UTC
+   !> (which may fall on the day before or after).
+   pure function utc_stamp(year, month, day, minutes, seconds) result(stamp)
+      integer, intent(in) :: year, month, day, minutes, seconds
+      character(len=20) :: stamp
+      integer :: y, m, d, t, shift
+      integer, parameter :: month_days(12) = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31]
+      y = year
+      m = month
+      d = day
+      t = minutes
+      shift = 0
+      if (t < 0) shift = -1
+      if (t >= 24*60) shift = 1
+      t = t - shift*24*60
+      d = d + shift
+      if (d < 1) then
+         m = m - 1
+         if (m < 1) then
+            m = 12
+            y = y - 1
+         end if
+         d = days_in(y, m)
+      else if (d > days_in(y, m)) then
+         d = 1
+         m = m + 1
+         if (m > 12) then
+            m = 1
+            y = y + 1
+         end if
+      end if
+      write (stamp, '(i4.4, "-", i2.2, "-", i2.2, "T", i2.2, ":", i2.2, ":", i2.2, "Z")') y, m, d, t/60, mod(t, 60), &
+         & seconds
+   contains
+      pure integer function days_in(yy, mm)
+         integer, intent(in) :: yy, mm
+         days_in = month_days(mm)
+         if (mm == 2 .and. (mod(yy, 4) == 0 .and. (mod(yy, 100) /= 0 .or. mod(yy, 400) == 0))) days_in = 29
+      end function days_in
+   end function utc_stamp
+
+   pure function to_lower(text) result(lower)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: lower
+      integer :: i
+      lower = text
+      do i = 1, len(text)
+         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') lower(i:i) = achar(iachar(text(i:i)) + 32)
+      end do
+   end function to_lower
 
    !> A fixed-length, null-terminated string type for `length` characters.
    subroutine string_type(length, stype, hdferr)
