@@ -66,18 +66,21 @@ end subroutine py_self_affine_profile
 !> (areal = 1; n = nx*ny heights, x fastest, period_y its period along y). control: 0 load,
 !> 1 displacement; method: 0 auto, 1 cg, 2 anderson, 3 gcr; precondition, coarse_start,
 !> stress: 0/1.
-!> fields(:, 1:5): pressure, gap, displacement_z, displacement_x, stress_xx (the last two
-!> zero unless stress = 1; lines only); spots(1:n_spots, 1:5): trailing and leading edges, largest
-!> sigma_xx around the spot (sub-grid at the trailing edge with friction), its offset from
-!> the trailing edge and the largest grid value (zero unless stress = 1; lines only);
+!> fields(:, 1:n_fields): pressure, gap, displacement_z, then with stress = 1 (n_fields = 5
+!> for a line, 8 for a surface) displacement_x, stress_xx (line) or displacement_x,
+!> displacement_y, stress_xx, stress_yy, stress_xy (surface);
+!> spots(1:n_spots, 1:n_columns) of a line (capacity nx/2 + 1): trailing and leading edges,
+!> largest sigma_xx around the spot (sub-grid at the trailing edge with friction), its
+!> offset from the trailing edge and the largest grid value (the last three with stress);
+!> of a surface (capacity n/2 + 1, n_columns = 2): area and perimeter of each patch;
 !> scalars: in the order of layercontact.api._SCALARS (the solver that ran as its index in
 !> `solvers`); history(1:history_length): the last
 !> residuals of the run, at most `capacity` (an array of max_iter entries would cost more
 !> than a small solve).
 subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, poisson, friction, control, &
       & mean_pressure, penetration, method, precondition, coarse_start, tol, max_iter, memory, threads, stress, model, &
-      & form, e0, e_inf, tau, equilibrium, nt, times, values, speed, capacity, fields, spots, scalars, history, &
-      & stat, errmsg)
+      & form, e0, e_inf, tau, equilibrium, nt, times, values, speed, capacity, n_fields, spot_capacity, n_columns, &
+      & fields, spots, scalars, history, stat, errmsg)
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, check_scene
    use lc_result, only: contact_result
@@ -85,10 +88,10 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
    use lc_greens_viscoelastic, only: make_material_law
    implicit none (type, external)
    integer, intent(in) :: n, nx, areal, control, method, precondition, coarse_start, max_iter, memory, threads, stress
-   integer, intent(in) :: model, form, nt, capacity
+   integer, intent(in) :: model, form, nt, capacity, n_fields, spot_capacity, n_columns
    real(8), intent(in) :: height(n), period, period_y, thickness, young, poisson, friction, mean_pressure, penetration
    real(8), intent(in) :: tol, e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
-   real(8), intent(out) :: fields(n, 5), spots(nx/2 + 1, 5), scalars(29), history(capacity)
+   real(8), intent(out) :: fields(n, n_fields), spots(spot_capacity, n_columns), scalars(33), history(capacity)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n, nt
@@ -104,7 +107,7 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
    errmsg = ''
    scene = scene_type(n=nx, ny=n/max(nx, 1), period=period, period_y=period_y, thickness=thickness, young=young, &
       & poisson=poisson, friction=friction, control=controls(max(0, min(1, control))), mean_pressure=mean_pressure, &
-      & penetration=penetration, stress=stress == 1 .and. areal == 0, gap_bins=0)
+      & penetration=penetration, stress=stress == 1, gap_bins=0)
    if (areal == 1) scene%geometry = 'areal'
    scene%profile%kind = 'file'
    scene%profile%file = '(array from Python)'
@@ -128,14 +131,30 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
    fields(:, 1) = r%pressure
    fields(:, 2) = r%gap
    fields(:, 3) = r%displacement_z
-   if (allocated(r%stress_xx)) fields(:, 4) = r%displacement_x
-   if (allocated(r%stress_xx)) fields(:, 5) = r%stress_xx
    spots = 0
-   spots(1:r%n_spots, 1) = r%spot_trailing
-   spots(1:r%n_spots, 2) = r%spot_leading
-   if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 3) = r%spot_max_tension
-   if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 4) = r%spot_tension_offset
-   if (allocated(r%spot_max_tension)) spots(1:r%n_spots, 5) = r%spot_max_tension_grid
+   if (allocated(r%patch_area)) then
+      spots(1:r%n_spots, 1) = r%patch_area
+      if (n_columns > 1) spots(1:r%n_spots, 2) = r%patch_perimeter
+   else
+      spots(1:r%n_spots, 1) = r%spot_trailing
+      spots(1:r%n_spots, 2) = r%spot_leading
+   end if
+   if (allocated(r%stress_xx) .and. n_fields >= 5) then
+      fields(:, 4) = r%displacement_x
+      if (allocated(r%stress_yy) .and. n_fields >= 8) then
+         fields(:, 5) = r%displacement_y
+         fields(:, 6) = r%stress_xx
+         fields(:, 7) = r%stress_yy
+         fields(:, 8) = r%stress_xy
+      else
+         fields(:, 5) = r%stress_xx
+      end if
+   end if
+   if (allocated(r%spot_max_tension) .and. n_columns >= 5) then
+      spots(1:r%n_spots, 3) = r%spot_max_tension
+      spots(1:r%n_spots, 4) = r%spot_tension_offset
+      spots(1:r%n_spots, 5) = r%spot_max_tension_grid
+   end if
    stored = min(size(r%residual_history), capacity)
    history(1:stored) = r%residual_history(size(r%residual_history) - stored + 1:)
    scalars = [r%mean_pressure, r%penetration, r%contact_fraction, r%delta_mu, r%delta_mu_spectral, &
@@ -144,7 +163,8 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
       & real(stored, 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
       & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), &
       & r%pressure_shift, r%summit_shift, r%max_tension_grid, real(findloc(solvers, r%solver, dim=1), 8), &
-      & r%normalised_pressure, r%normalised_thickness]
+      & r%normalised_pressure, r%normalised_thickness, r%max_tension_y, r%max_principal_stress, &
+      & r%max_principal_x, r%max_principal_y]
 end subroutine py_solve
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless
@@ -353,3 +373,97 @@ subroutine py_surface_tensor(n, qx, qy, thickness, young, poisson, tensor)
       tensor(i, :, :) = kernel%tensor(qx(i), qy(i))
    end do
 end subroutine py_surface_tensor
+
+!> A random isotropic self-affine surface (lc_profiles_surface), heights flat with x fastest
+!> (numpy height.reshape(ny, nx)). Not-given lengths and targets are passed as -1.
+subroutine py_self_affine_surface(nx, ny, lx, ly, hurst, seed, rolloff, short, rms_gradient, rms_height, height, &
+      & stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_profiles_surface, only: self_affine_surface
+   implicit none (type, external)
+   integer, intent(in) :: nx, ny
+   real(8), intent(in) :: lx, ly, hurst, rolloff, short, rms_gradient, rms_height
+   integer(8), intent(in) :: seed
+   real(8), intent(out) :: height(nx*ny)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   stat = 0
+   errmsg = ''
+   call self_affine_surface(nx, ny, lx, ly, hurst, seed, rolloff, short, rms_gradient, rms_height, height, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+   end if
+end subroutine py_self_affine_surface
+
+!> The surface of an areal scene's &profile (kind = sinusoid | sphere | file) on an
+!> nx x ny grid, made by make_profile exactly as a namelist run makes it; heights flat with
+!> x fastest. Not-given amplitude and radius are passed as -1.
+subroutine py_make_surface(profile_kind, nx, ny, lx, ly, amplitude, mode, mode_y, radius, filename, dataset, height, &
+      & stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_scene, only: scene_type
+   use lc_profiles_profile, only: make_profile
+   implicit none (type, external)
+   character(len=*), intent(in) :: profile_kind, filename, dataset
+   integer, intent(in) :: nx, ny, mode, mode_y
+   real(8), intent(in) :: lx, ly, amplitude, radius
+   real(8), intent(out) :: height(nx*ny)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   type(scene_type) :: scene
+   stat = 0
+   errmsg = ''
+   scene%geometry = 'areal'
+   scene%n = nx
+   scene%ny = ny
+   scene%period = lx
+   scene%period_y = ly
+   scene%profile%kind = profile_kind
+   scene%profile%amplitude = amplitude
+   scene%profile%mode = mode
+   scene%profile%mode_y = mode_y
+   scene%profile%radius = radius
+   scene%profile%file = filename
+   scene%profile%dataset = dataset
+   call make_profile(scene, height, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+   end if
+end subroutine py_make_surface
+
+!> In-plane displacements and surface stresses of an elastic layer (thickness Inf: half-space)
+!> under a prescribed pressure p on a surface (n = nx*ny values, x fastest) and the shear
+!> friction*p along x (no contact solve). fields(:, 1:5): u_x, u_y, sigma_xx, sigma_yy,
+!> sigma_xy.
+subroutine py_surface_stress(n, p, nx, period, period_y, thickness, young, poisson, friction, fields, stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_greens_viscoelastic, only: material_law
+   use lc_grid, only: surface_grid
+   use lc_greens_kernel, only: make_kernel
+   use lc_contact_operator, only: compliance_operator, build_operator
+   use lc_observables_stress, only: surface_stress
+   implicit none (type, external)
+   integer, intent(in) :: n, nx
+   real(8), intent(in) :: p(n), period, period_y, thickness, young, poisson, friction
+   real(8), intent(out) :: fields(n, 5)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   !f2py intent(hide) :: n
+   type(error_type), allocatable :: error
+   type(compliance_operator) :: op
+   stat = 0
+   errmsg = ''
+   fields = 0
+   call build_operator(op, surface_grid(nx, n/nx, period, period_y), &
+      & make_kernel(thickness, material_law(young=young), poisson, 0d0), friction, 1, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+      return
+   end if
+   call surface_stress(op, p, fields(:, 1), fields(:, 2), fields(:, 3), fields(:, 4), fields(:, 5))
+end subroutine py_surface_stress

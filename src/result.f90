@@ -16,6 +16,14 @@ module lc_result
       real(wp), allocatable :: displacement_x(:)   !< u_x (L), along the sliding direction
       real(wp), allocatable :: shear(:)            !< tau = mu_c p (S), on the layer along +x
       real(wp), allocatable :: stress_xx(:)        !< sigma_xx at the surface (S), tension positive
+      !> areal contacts, with &output stress: u_y (L), sigma_yy, sigma_xy (S)
+      real(wp), allocatable :: displacement_y(:)
+      real(wp), allocatable :: stress_yy(:)
+      real(wp), allocatable :: stress_xy(:)
+      !> areal contacts: the contact patches, largest first (lc_observables_patches): area (L^2)
+      !> and perimeter (L)
+      real(wp), allocatable :: patch_area(:)
+      real(wp), allocatable :: patch_perimeter(:)
       real(wp), allocatable :: spot_trailing(:)    !< trailing (-x) edge of each contact spot (L)
       real(wp), allocatable :: spot_leading(:)     !< leading (+x) edge of each contact spot (L)
       !> largest sigma_xx around each spot (S), with stress; with friction the trailing-edge
@@ -37,7 +45,12 @@ module lc_result
       real(wp) :: summit_shift = 0.0_wp       !< load-weighted spot midpoint - profile summit in it (L)
       real(wp) :: dissipated_power = 0.0_wp   !< power dissipated in a viscoelastic layer per nominal area (S L/T)
       logical :: monotone = .true.            !< Re G_eff >= 0 on every mode: the solution is unique
-      integer :: n_spots = 0                  !< number of contact spots
+      integer :: n_spots = 0                  !< number of contact spots (line) or patches (areal)
+      real(wp) :: max_tension_y = 0.0_wp      !< areal: where the largest sigma_xx sits across x (L)
+      !> areal: the largest principal surface stress (S) and where it sits (L)
+      real(wp) :: max_principal_stress = 0.0_wp
+      real(wp) :: max_principal_x = 0.0_wp
+      real(wp) :: max_principal_y = 0.0_wp
       real(wp) :: contact_length = 0.0_wp     !< a = total length in contact (L)
       real(wp) :: mean_gap = 0.0_wp           !< <g> (L)
       !> p_m over the seed's pressure scale (lc_contact_solve's pressure_scale; NaN for a

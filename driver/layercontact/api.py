@@ -19,7 +19,8 @@ _SCALARS = (
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
     "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
-    "max_tension_grid", "solver", "normalised_pressure", "normalised_thickness",
+    "max_tension_grid", "solver", "normalised_pressure", "normalised_thickness", "max_tension_y",
+    "max_principal_stress", "max_principal_x", "max_principal_y",
 )
 # The solver that ran, by the code in the scalars (driver/wrappers.f90 `solvers`).
 _SOLVERS = {1: "cg", 2: "gcr", 3: "anderson", 4: "gcr+anderson"}
@@ -230,6 +231,10 @@ def _solve_native(h, nx, areal, *, period, period_y, thickness, young, poisson, 
         raise ValueError(f"method = {method!r} is not allowed; allowed: {sorted(_METHODS)}")
     control = "load" if mean_pressure is not None else "displacement"
     model, form, young, e0, e_inf, tau, eq, times, values = material_codes(material, young)
+    # what comes back: the three solution fields, plus the in-plane ones with stress; a
+    # line's contact spots (5 columns), or a surface's patches (area, perimeter)
+    n_fields = (8 if areal else 5) if stress else 3
+    spot_capacity, n_columns = (h.size // 2 + 1, 2) if areal else (h.size // 2 + 1, 5)
     fields, spots, s, hist, stat, errmsg = _core.py_solve(
         h, int(nx), int(areal), float(period), float(period_y), float(thickness), young, float(poisson),
         float(friction), _CONTROLS[control],
@@ -237,7 +242,7 @@ def _solve_native(h, nx, areal, *, period, period_y, thickness, young, poisson, 
         NOT_SET if penetration is None else float(penetration),
         _METHODS[method], int(bool(precondition)), int(bool(coarse_start)), float(tol), int(max_iter), int(memory), int(threads),
         int(bool(stress)), model, form, e0, e_inf, tau, eq, times, values, float(speed),
-        min(int(max_iter), HISTORY_CAPACITY),
+        min(int(max_iter), HISTORY_CAPACITY), n_fields, spot_capacity, n_columns,
     )
     _check(stat, errmsg)
     scalars = {name: (int(v) if name in _INTEGERS else float(v)) for name, v in zip(_SCALARS, s)}
@@ -251,6 +256,8 @@ def _solve_native(h, nx, areal, *, period, period_y, thickness, young, poisson, 
 def _solve_once(h, *, period, stress, friction, **settings) -> LineResult:
     fields, spots, scalars, history = _solve_native(h, h.size, 0, period=period, period_y=NOT_SET, stress=stress,
                                                     friction=friction, **settings)
+    for name in _AREAL_ONLY:
+        scalars.pop(name)
     if not stress:
         for name in ("max_tension", "max_tension_x", "max_tension_offset", "max_tension_grid"):
             scalars[name] = float("nan")
@@ -266,12 +273,18 @@ def _solve_once(h, *, period, stress, friction, **settings) -> LineResult:
     )
 
 
-# What an areal result keeps of the library's scalars (the others describe line contacts).
+# What an areal result keeps of the library's scalars (the others describe line contacts),
+# and the scalars that only areal results have.
 _AREAL_SCALARS = (
     "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "mean_gap", "dissipated_power", "monotone", "solver", "normalised_pressure", "normalised_thickness",
+    "max_tension", "max_tension_x", "max_tension_y", "max_tension_offset", "max_principal_stress",
+    "max_principal_x", "max_principal_y",
 )
+_AREAL_ONLY = ("max_tension_y", "max_principal_stress", "max_principal_x", "max_principal_y")
+_STRESS_SCALARS = ("max_tension", "max_tension_x", "max_tension_y", "max_tension_offset", "max_principal_stress",
+                   "max_principal_x", "max_principal_y")
 
 
 @dataclass
@@ -285,8 +298,15 @@ class ArealResult:
     multiplier, ``delta_mu_profile = -<p dr/dx>/p_m`` from the rigid surface (equal to the
     others to the discretisation error), ``delta_mu_energy = mu_c <p du_x/dx>/p_m``.
     ``normalised_pressure`` is ``p_m/(E* h/period_x)`` on a layer and ``p_m/(E* Lambda0/period_x)``
-    on a half-space (``Lambda0`` the highest summit above the mean plane). The solver
-    statistics are those of :class:`LineResult`.
+    on a half-space (``Lambda0`` the highest summit above the mean plane). ``patches`` is an
+    ``(n_patches, 2)`` array of the contact patches' areas (L^2) and perimeters (L), largest
+    first (4-connected, periodic). With ``stress``: the in-plane surface displacements
+    ``displacement_x``, ``displacement_y`` (L) and the surface stresses ``stress_xx``,
+    ``stress_yy``, ``stress_xy`` (S, tension positive); ``max_tension`` is the largest
+    ``stress_xx``, at (``max_tension_x``, ``max_tension_y``), ``max_tension_offset`` its
+    distance along x from the trailing edge of the nearest contact on its row (negative:
+    behind it); ``max_principal_stress`` the largest principal surface stress and where it
+    sits. The solver statistics are those of :class:`LineResult`.
     """
 
     pressure: np.ndarray
@@ -315,8 +335,26 @@ class ArealResult:
     monotone: bool = True
     normalised_pressure: float = float("nan")
     normalised_thickness: float = float("nan")
+    patches: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
+    displacement_x: np.ndarray | None = field(default=None, repr=False)
+    displacement_y: np.ndarray | None = field(default=None, repr=False)
+    stress_xx: np.ndarray | None = field(default=None, repr=False)
+    stress_yy: np.ndarray | None = field(default=None, repr=False)
+    stress_xy: np.ndarray | None = field(default=None, repr=False)
+    max_tension: float = float("nan")
+    max_tension_x: float = float("nan")
+    max_tension_y: float = float("nan")
+    max_tension_offset: float = float("nan")
+    max_principal_stress: float = float("nan")
+    max_principal_x: float = float("nan")
+    max_principal_y: float = float("nan")
     a_over_a0: float | None = None
     companion: "ArealResult | None" = field(default=None, repr=False)
+
+    @property
+    def n_patches(self) -> int:
+        """Number of contact patches."""
+        return int(self.patches.shape[0])
 
     @property
     def total_friction(self) -> float:
@@ -354,13 +392,14 @@ def solve_areal(
     max_iter: int = 100000,
     memory: int = 12,
     threads: int = 1,
+    stress: bool = False,
 ) -> ArealResult:
     """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
     a uniform periodic grid, axis 1 = x = the sliding direction) on a layer of
     ``thickness`` (``inf``: half-space) bonded to a rigid base, with Coulomb friction
     ``tau_x = friction * p``. ``period`` is one length or a pair ``(period_x, period_y)``.
-    Every other keyword means what it means for :func:`solve_line`; the surface stress is
-    not computed for areal contacts.
+    ``stress=True`` also computes the in-plane displacements and the surface stress tensor
+    (five more transforms). Every other keyword means what it means for :func:`solve_line`.
     """
     h = np.asarray(heights, dtype=np.float64)
     if h.ndim != 2:
@@ -373,15 +412,23 @@ def solve_areal(
     settings = dict(thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
                     penetration=penetration, method=method, precondition=precondition, coarse_start=coarse_start,
                     tol=tol, max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
+    stress = bool(stress)
 
     def once(mu):
-        fields, _, scalars, history = _solve_native(flat, nx, 1, period=lx, period_y=ly, stress=False, friction=mu,
-                                                    **settings)
+        fields, patches, scalars, history = _solve_native(flat, nx, 1, period=lx, period_y=ly, stress=stress,
+                                                          friction=mu, **settings)
         kept = {name: scalars[name] for name in _AREAL_SCALARS}
+        if not stress:
+            kept.update({name: float("nan") for name in _STRESS_SCALARS})
+
+        def field_map(column):
+            return fields[:, column].reshape(ny, nx).copy() if column < fields.shape[1] else None
+
         return ArealResult(
-            pressure=fields[:, 0].reshape(ny, nx).copy(), gap=fields[:, 1].reshape(ny, nx).copy(),
-            displacement_z=fields[:, 2].reshape(ny, nx).copy(), height=h.copy(), period=(lx, ly),
-            friction=float(mu), residual_history=history, **kept)
+            pressure=field_map(0), gap=field_map(1), displacement_z=field_map(2), displacement_x=field_map(3),
+            displacement_y=field_map(4), stress_xx=field_map(5), stress_yy=field_map(6), stress_xy=field_map(7),
+            height=h.copy(), period=(lx, ly), friction=float(mu), residual_history=history,
+            patches=patches[: int(scalars["n_spots"])].copy(), **kept)
 
     result = once(friction)
     if companion:
@@ -401,6 +448,42 @@ def surface_fields(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson
                                                     float(poisson), float(friction))
     _check(stat, errmsg)
     return ux, sxx
+
+
+@dataclass
+class SurfaceStress:
+    """In-plane surface displacements (L) and stresses (S, tension positive) of a layer
+    under a prescribed pressure: ``(ny, nx)`` arrays for a surface; for a line,
+    ``displacement_y``, ``stress_yy`` and ``stress_xy`` are ``None``."""
+
+    displacement_x: np.ndarray
+    stress_xx: np.ndarray
+    displacement_y: np.ndarray | None = None
+    stress_yy: np.ndarray | None = None
+    stress_xy: np.ndarray | None = None
+
+
+def surface_stress(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson=0.5,
+                   friction=0.0) -> SurfaceStress:
+    """Surface displacements and stresses of an elastic layer (``thickness=np.inf``:
+    half-space) under the prescribed pressure (S; 1D for a line, ``(ny, nx)`` for a surface,
+    x = axis 1) and the shear ``friction * p`` along x, without solving a contact problem.
+    ``period`` is one length or, for a surface, a pair ``(period_x, period_y)``."""
+    p = np.asarray(pressure, dtype=np.float64)
+    if p.ndim == 1:
+        lx = float(period) if np.ndim(period) == 0 else float(period[0])
+        ux, sxx = surface_fields(p, period=lx, thickness=thickness, young=young, poisson=poisson,
+                                 friction=friction)
+        return SurfaceStress(displacement_x=ux, stress_xx=sxx)
+    if p.ndim != 2:
+        raise ValueError(f"pressure must be 1D (line) or (ny, nx) (surface); got shape {p.shape}")
+    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    ny, nx = p.shape
+    fields, stat, errmsg = _core.py_surface_stress(np.ascontiguousarray(p).ravel(), nx, lx, ly, float(thickness),
+                                                   float(young), float(poisson), float(friction))
+    _check(stat, errmsg)
+    ux, uy, sxx, syy, sxy = (fields[:, k].reshape(ny, nx).copy() for k in range(5))
+    return SurfaceStress(displacement_x=ux, stress_xx=sxx, displacement_y=uy, stress_yy=syy, stress_xy=sxy)
 
 
 def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResult | ArealResult:
@@ -444,10 +527,15 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
         attrs = f["input"].attrs
         lx = float(attrs["period"])
         ly = float(attrs["period_y"]) if float(attrs["period_y"]) > 0 else lx
+        fields = {k: base["fields"][k][()] for k in base["fields"]}
+        patches = (np.column_stack([base["patches/area"][()], base["patches/perimeter"][()]])
+                   if "patches" in base else np.zeros((0, 2)))
         return ArealResult(
-            pressure=base["fields/pressure"][()], gap=base["fields/gap"][()],
-            displacement_z=base["fields/displacement_z"][()], height=f["profile/height"][()], period=(lx, ly),
-            friction=float(r["friction"]), residual_history=base["convergence/residual"][()],
+            pressure=fields["pressure"], gap=fields["gap"], displacement_z=fields["displacement_z"],
+            displacement_x=fields.get("displacement_x"), displacement_y=fields.get("displacement_y"),
+            stress_xx=fields.get("stress_xx"), stress_yy=fields.get("stress_yy"), stress_xy=fields.get("stress_xy"),
+            height=f["profile/height"][()], period=(lx, ly), friction=float(r["friction"]), patches=patches,
+            residual_history=base["convergence/residual"][()],
             a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values)
 
     with h5py.File(filename, "r") as f:

@@ -39,6 +39,7 @@ module lc_greens_kernel
       procedure :: shear_uniform
       procedure :: antiplane
       procedure :: tensor
+      procedure :: tensor_with
    end type layer_kernel
 
 contains
@@ -117,22 +118,33 @@ contains
       class(layer_kernel), intent(in) :: self
       real(wp), intent(in) :: qx, qy
       complex(wp) :: t(3, 3)
-      complex(wp) :: c(1), plane, anti
-      real(wp) :: q, cx, cy, one_minus_a, one_minus_b, coupling
-      t = (0.0_wp, 0.0_wp)
+      complex(wp) :: c(1)
       c = self%contact_compliance([qx])
-      q = hypot(qx, qy)
-      if (q == 0.0_wp) then
+      if (hypot(qx, qy) == 0.0_wp) then
+         t = (0.0_wp, 0.0_wp)
          t(1, 1) = self%shear_uniform(real(c(1), wp))
          t(2, 2) = t(1, 1)
          t(3, 3) = self%normal_uniform(real(c(1), wp))
-         return
+      else
+         t = self%tensor_with(qx, qy, c(1))
       end if
+   end function tensor
+
+   !> The same for |q| > 0 with the mode's contact compliance C given (looked up once per
+   !> column by the caller).
+   pure function tensor_with(self, qx, qy, c) result(t)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: qx, qy
+      complex(wp), intent(in) :: c
+      complex(wp) :: t(3, 3)
+      complex(wp) :: plane, anti
+      real(wp) :: q, cx, cy, one_minus_a, one_minus_b, coupling
+      q = hypot(qx, qy)
       cx = qx/q
       cy = qy/q
       call self%factors(q, one_minus_a, one_minus_b, coupling)
-      plane = 2.0_wp*c(1)/q
-      anti = self%antiplane(q, c(1))
+      plane = 2.0_wp*c/q
+      anti = self%antiplane(q, c)
       ! u_l = plane ((1-B) tau_l + i c p), u_t = anti tau_t, w = plane ((1-A) p - i c tau_l),
       ! with tau_l = cx tau_x + cy tau_y, tau_t = -cy tau_x + cx tau_y, u_x = cx u_l - cy u_t,
       ! u_y = cy u_l + cx u_t
@@ -145,5 +157,5 @@ contains
       t(3, 1) = -t(1, 3)
       t(3, 2) = -t(2, 3)
       t(3, 3) = plane*one_minus_a
-   end function tensor
+   end function tensor_with
 end module lc_greens_kernel

@@ -362,11 +362,23 @@ contains
       call write_field(group, 'gap', res%gap, 'L', scene, st)
       call write_field(group, 'displacement_z', res%displacement_z, 'L', scene, st)
       if (allocated(res%stress_xx)) then
-         call write_dataset_1d(group, 'displacement_x', res%displacement_x, 'L', st)
-         call write_dataset_1d(group, 'shear', res%shear, 'S', st)
-         call write_dataset_1d(group, 'stress_xx', res%stress_xx, 'S', st)
+         call write_field(group, 'displacement_x', res%displacement_x, 'L', scene, st)
+         call write_field(group, 'shear', res%shear, 'S', scene, st)
+         call write_field(group, 'stress_xx', res%stress_xx, 'S', scene, st)
+      end if
+      if (allocated(res%stress_yy)) then
+         call write_field(group, 'displacement_y', res%displacement_y, 'L', scene, st)
+         call write_field(group, 'stress_yy', res%stress_yy, 'S', scene, st)
+         call write_field(group, 'stress_xy', res%stress_xy, 'S', scene, st)
       end if
       call close_group(group, st)
+
+      if (allocated(res%patch_area)) then
+         call create_group(loc, 'patches', group, st)
+         call write_dataset_1d(group, 'area', res%patch_area, 'L^2', st)
+         call write_dataset_1d(group, 'perimeter', res%patch_perimeter, 'L', st)
+         call close_group(group, st)
+      end if
 
       if (allocated(res%spot_trailing)) then
          call create_group(loc, 'spots', group, st)
@@ -416,6 +428,12 @@ contains
          call write_attr_real(group, 'max_tension_grid', res%max_tension_grid, st)
          call write_attr_real(group, 'max_tension_x', res%max_tension_x, st)
          call write_attr_real(group, 'max_tension_offset', res%max_tension_offset, st)
+         if (is_areal(scene)) then
+            call write_attr_real(group, 'max_tension_y', res%max_tension_y, st)
+            call write_attr_real(group, 'max_principal_stress', res%max_principal_stress, st)
+            call write_attr_real(group, 'max_principal_x', res%max_principal_x, st)
+            call write_attr_real(group, 'max_principal_y', res%max_principal_y, st)
+         end if
       end if
       call write_attr_real(group, 'normalised_pressure', res%normalised_pressure, st)
       call write_attr_real(group, 'normalised_thickness', res%normalised_thickness, st)

@@ -9,6 +9,8 @@ module lc_observables
    use lc_contact_operator, only: compliance_operator
    use lc_observables_friction, only: interlocking_friction
    use lc_observables_surface, only: surface_fields, edge_stress_field
+   use lc_observables_stress, only: surface_stress
+   use lc_observables_patches, only: contact_patches
    use lc_observables_geometry, only: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, &
       & spot_tension, spot_asymmetry
    implicit none (type, external)
@@ -41,8 +43,10 @@ contains
             call interlocking_friction(op, p, result%displacement_z, height, result%delta_mu, &
                & result%delta_mu_spectral, result%delta_mu_energy, result%delta_mu_profile, result%dissipated_power)
          end if
-         ! the rest belongs to line contacts (contact spots along x, plane-strain stress)
-         if (.not. op%grid%is_line()) return
+         if (.not. op%grid%is_line()) then
+            call observe_surface(scene, op, result)
+            return
+         end if
          call contact_spots(p, scene%period, result%n_spots, result%spot_trailing, result%spot_leading)
          result%contact_length = scene%period*count(p > 0.0_wp)/size(p)
          call spot_asymmetry(p, height, scene%period, result%spot_trailing, result%spot_leading, &
@@ -82,5 +86,45 @@ contains
          end if
       end associate
    end subroutine observe
+
+   !> What an areal contact adds: its patches, and with &output stress the in-plane
+   !> displacements, the surface stress tensor, the largest tension sigma_xx and the largest
+   !> principal stress with where they sit. The largest tension's offset is measured along
+   !> its row of the grid from the trailing (-x) edge of the nearest run of contact nodes
+   !> (negative: behind it), as for a line contact.
+   subroutine observe_surface(scene, op, result)
+      type(scene_type), intent(in) :: scene
+      type(compliance_operator), intent(inout) :: op
+      type(contact_result), intent(inout) :: result
+      integer, allocatable :: label(:)
+      real(wp), allocatable :: principal(:), trailing(:), leading(:)
+      integer :: where_max, nx, row, runs
+
+      associate (p => result%pressure, grid => op%grid)
+         nx = grid%nx
+         call contact_patches(grid, p, result%patch_area, result%patch_perimeter, label)
+         result%n_spots = size(result%patch_area)
+         if (.not. scene%stress) return
+         allocate (result%displacement_x(size(p)), result%displacement_y(size(p)), result%stress_xx(size(p)), &
+            & result%stress_yy(size(p)), result%stress_xy(size(p)))
+         result%shear = result%friction*p
+         call surface_stress(op, p, result%displacement_x, result%displacement_y, result%stress_xx, &
+            & result%stress_yy, result%stress_xy)
+         where_max = maxloc(result%stress_xx, dim=1)
+         result%max_tension = result%stress_xx(where_max)
+         result%max_tension_grid = result%max_tension
+         result%max_tension_x = mod(where_max - 1, nx)*grid%lx/nx
+         row = (where_max - 1)/nx
+         result%max_tension_y = row*grid%ly/grid%ny
+         call contact_spots(p(row*nx + 1:row*nx + nx), grid%lx, runs, trailing, leading)
+         result%max_tension_offset = nearest_trailing_offset(result%max_tension_x, trailing, leading, grid%lx)
+         principal = 0.5_wp*(result%stress_xx + result%stress_yy) + &
+            & sqrt((0.5_wp*(result%stress_xx - result%stress_yy))**2 + result%stress_xy**2)
+         where_max = maxloc(principal, dim=1)
+         result%max_principal_stress = principal(where_max)
+         result%max_principal_x = mod(where_max - 1, nx)*grid%lx/nx
+         result%max_principal_y = ((where_max - 1)/nx)*grid%ly/grid%ny
+      end associate
+   end subroutine observe_surface
 
 end module lc_observables
