@@ -64,7 +64,7 @@ end subroutine py_self_affine_profile
 
 !> Solve a contact on the given heights: a line (areal = 0; n heights) or a surface
 !> (areal = 1; n = nx*ny heights, x fastest, period_y its period along y). control: 0 load,
-!> 1 displacement; method: 0 auto, 1 cg, 2 anderson, 3 gcr; precondition, coarse_start,
+!> 1 displacement; method: 0 auto, 1 cg, 2 anderson, 3 gcr, 4 gfmd; precondition, coarse_start,
 !> stress: 0/1.
 !> fields(:, 1:n_fields): pressure, gap, displacement_z, then with stress = 1 (n_fields = 5
 !> for a line, 8 for a surface) displacement_x, stress_xx (line) or displacement_x,
@@ -100,9 +100,9 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
    type(contact_result) :: r
    character(len=12), parameter :: controls(0:1) = [character(len=12) :: 'load', 'displacement']
    integer :: stored
-   character(len=8), parameter :: methods(0:3) = [character(len=8) :: 'auto', 'cg', 'anderson', 'gcr']
+   character(len=8), parameter :: methods(0:4) = [character(len=8) :: 'auto', 'cg', 'anderson', 'gcr', 'gfmd']
    !> the solver that ran, as scalars(27) (layercontact.api._SOLVERS)
-   character(len=16), parameter :: solvers(4) = [character(len=16) :: 'cg', 'gcr', 'anderson', 'gcr+anderson']
+   character(len=16), parameter :: solvers(5) = [character(len=16) :: 'cg', 'gcr', 'anderson', 'gcr+anderson', 'gfmd']
    stat = 0
    errmsg = ''
    scene = scene_type(n=nx, ny=n/max(nx, 1), period=period, period_y=period_y, thickness=thickness, young=young, &
@@ -113,7 +113,7 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
    scene%profile%file = '(array from Python)'
    scene%material = make_material_law(model, form, young, e0, e_inf, tau, equilibrium, times, values)
    scene%speed = speed
-   scene%solver%method = methods(max(0, min(3, method)))
+   scene%solver%method = methods(max(0, min(4, method)))
    scene%solver%tol = tol
    scene%solver%max_iter = max_iter
    scene%solver%memory = memory

@@ -56,8 +56,8 @@ module lc_scene
 
    !> Solver choice and stopping rule.
    type :: solver_settings
-      !> auto | cg | gcr | anderson: auto picks cg for symmetric operators, gcr otherwise
-      !> (going on with anderson if gcr stalls)
+      !> auto | cg | gcr | anderson | gfmd: auto picks cg for symmetric operators, gcr
+      !> otherwise (going on with anderson if gcr stalls); gfmd: damped dynamics (FIRE)
       character(len=max_string) :: method = 'auto'
       !> tolerance on the dimensionless complementarity residual
       real(wp) :: tol = 1.0e-10_wp
@@ -230,14 +230,25 @@ contains
                call input_error(error, 'profile', 'hurst', to_string(p%hurst), '0 < hurst < 1')
             else if (p%seed < 0_i8) then
                call input_error(error, 'profile', 'seed', to_string(p%seed), '>= 0')
-            else if (p%rolloff_wavelength /= not_set .and. .not. (positive_finite(p%rolloff_wavelength) &
-               & .and. p%rolloff_wavelength <= scene%period)) then
+            else if (.not. is_areal(scene) .and. p%rolloff_wavelength /= not_set .and. &
+               & .not. (positive_finite(p%rolloff_wavelength) .and. p%rolloff_wavelength <= scene%period)) then
                call input_error(error, 'profile', 'rolloff_wavelength', to_string(p%rolloff_wavelength), &
                   & '0 < rolloff_wavelength <= period')
-            else if (p%short_wavelength /= not_set .and. .not. (p%short_wavelength >= 2*scene%period/scene%n &
-               & .and. p%short_wavelength <= scene%period)) then
+            else if (.not. is_areal(scene) .and. p%short_wavelength /= not_set .and. &
+               & .not. (p%short_wavelength >= 2*scene%period/scene%n .and. p%short_wavelength <= scene%period)) then
                call input_error(error, 'profile', 'short_wavelength', to_string(p%short_wavelength), &
                   & '2*period/n <= short_wavelength <= period (at least two grid points per wavelength)')
+            else if (is_areal(scene) .and. p%rolloff_wavelength /= not_set .and. &
+               & .not. (positive_finite(p%rolloff_wavelength) .and. p%rolloff_wavelength <= max(scene%period, &
+               & scene%period_y))) then
+               call input_error(error, 'profile', 'rolloff_wavelength', to_string(p%rolloff_wavelength), &
+                  & '0 < rolloff_wavelength <= max(period, period_y)')
+            else if (is_areal(scene) .and. p%short_wavelength /= not_set .and. &
+               & .not. (p%short_wavelength >= 2*max(scene%period/scene%n, merge(scene%period_y, scene%period, &
+               & scene%period_y /= not_set)/scene%ny) .and. p%short_wavelength <= max(scene%period, scene%period_y))) then
+               ! along both axes at least two grid points per wavelength, as on a line
+               call input_error(error, 'profile', 'short_wavelength', to_string(p%short_wavelength), &
+                  & '2*max(period/nx, period_y/ny) <= short_wavelength <= max(period, period_y)')
             else if (p%rms_gradient /= not_set .and. p%rms_height /= not_set) then
                call input_error(error, 'profile', 'rms_gradient/rms_height', 'both given', 'at most one of them')
             else if (p%rms_gradient /= not_set .and. .not. positive_finite(p%rms_gradient)) then
@@ -248,11 +259,25 @@ contains
          case ('sinusoid')
             if (.not. positive_finite(p%amplitude)) then
                call input_error(error, 'profile', 'amplitude', to_string(p%amplitude), '> 0 and finite')
-            else if (p%mode < 1 .or. p%mode > (scene%n - 1)/2) then
+            else if (.not. is_areal(scene) .and. (p%mode < 1 .or. p%mode > (scene%n - 1)/2)) then
                call input_error(error, 'profile', 'mode', to_string(p%mode), '1 <= mode <= (n-1)/2')
+            else if (is_areal(scene) .and. (p%mode < 0 .or. p%mode > (scene%n - 1)/2)) then
+               ! a surface's modes stay below the grid's Nyquist limits, as a line's
+               call input_error(error, 'profile', 'mode', to_string(p%mode), '0 <= mode <= (nx-1)/2')
+            else if (is_areal(scene) .and. abs(p%mode_y) > (scene%ny - 1)/2) then
+               call input_error(error, 'profile', 'mode_y', to_string(p%mode_y), '|mode_y| <= (ny-1)/2')
+            else if (is_areal(scene) .and. p%mode == 0 .and. p%mode_y == 0) then
+               call input_error(error, 'profile', 'mode/mode_y', '0/0', 'not both zero (a flat surface)')
+            end if
+         case ('sphere')
+            if (.not. positive_finite(p%radius)) then
+               call input_error(error, 'profile', 'radius', to_string(p%radius), '> 0 and finite')
             end if
          case ('file')
-            if (len_trim(p%file) == 0) then
+            if (len_trim(p%file) == 0 .and. is_areal(scene)) then
+               call input_error(error, 'profile', 'file', "''", &
+                  & 'the name of a file holding the heights (.h5/.hdf5, .npy or text)')
+            else if (len_trim(p%file) == 0) then
                call input_error(error, 'profile', 'file', "''", 'the name of an HDF5 file holding the heights')
             end if
          end select
@@ -280,8 +305,8 @@ contains
          else if (trim(scene%control) == 'displacement' .and. .not. positive_finite(scene%penetration)) then
             call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
                & "> 0 and finite with control = 'displacement'")
-         else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'gcr', 'anderson'])) then
-            call input_error(error, 'solver', 'method', trim(s%method), "'auto', 'cg', 'gcr' or 'anderson'")
+         else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'gcr', 'anderson', 'gfmd'])) then
+            call input_error(error, 'solver', 'method', trim(s%method), "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'")
          else if (.not. (s%tol >= 1.0e-14_wp .and. s%tol <= 1.0e-2_wp)) then
             call input_error(error, 'solver', 'tol', to_string(s%tol), '1e-14 <= tol <= 1e-2')
          else if (scene%gap_bins < 0 .or. scene%gap_bins > 100000) then

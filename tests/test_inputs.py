@@ -71,7 +71,7 @@ BAD = [
     ("&loading\n mean_pressure = 0.1\n normalised_pressure = 1.0\n/\n", "exactly one of them"),
     ("&profile\n hurst = 1.2\n/\n", "&profile: hurst"),
     ("&solver\n tol = 0.5\n/\n", "&solver: tol"),
-    ("&solver\n method = 'gmres'\n/\n", "'auto', 'cg', 'gcr' or 'anderson'"),
+    ("&solver\n method = 'gmres'\n/\n", "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"),
     ("&loading\n control = 'displacement'\n penetration = 1e-3\n/\n", "needs a finite layer"),
     ("&loading\n normalised_pressure = 1.0\n penetration = 1e-3\n/\n", "&loading: penetration"),
     ("&profile\n kind = 'sinusoid'\n amplitude = 0.1\n mode = 2000000000\n/\n", "&profile: mode"),

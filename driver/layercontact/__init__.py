@@ -19,11 +19,20 @@ from .api import (
     solve_areal,
     solve_line,
     surface_fields,
+    surface_stress,
     surface_tensor,
 )
 from .materials import Prony, StandardLinearSolid, creep_compliance
 from .native import BUILD
-from .profiles import load_profile, self_affine_profile, sinusoid_profile
+from .profiles import (
+    load_profile,
+    load_surface,
+    self_affine_profile,
+    self_affine_surface,
+    sinusoid_profile,
+    sinusoid_surface,
+    spherical_cap,
+)
 from .sweep import read_summary, sweep
 
 __all__ = [
@@ -39,15 +48,20 @@ __all__ = [
     "layer_multipliers",
     "layer_multipliers_lapack",
     "load_profile",
+    "load_surface",
     "read_result",
     "read_summary",
     "run",
     "self_affine_profile",
+    "self_affine_surface",
     "sinusoid_profile",
+    "sinusoid_surface",
     "solve_areal",
     "solve_line",
+    "spherical_cap",
     "sweep",
     "surface_fields",
+    "surface_stress",
     "surface_tensor",
 ]
 __version__ = "0.1.0"

@@ -12,7 +12,7 @@ from .native import core as _core
 
 NOT_SET = -1.0
 _CONTROLS = {"load": 0, "displacement": 1}
-_METHODS = {"auto": 0, "cg": 1, "anderson": 2, "gcr": 3}
+_METHODS = {"auto": 0, "cg": 1, "anderson": 2, "gcr": 3, "gfmd": 4}
 # Order of the scalars returned by the wrapper py_solve (driver/wrappers.f90).
 _SCALARS = (
     "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
@@ -23,7 +23,7 @@ _SCALARS = (
     "max_principal_stress", "max_principal_x", "max_principal_y",
 )
 # The solver that ran, by the code in the scalars (driver/wrappers.f90 `solvers`).
-_SOLVERS = {1: "cg", 2: "gcr", 3: "anderson", 4: "gcr+anderson"}
+_SOLVERS = {1: "cg", 2: "gcr", 3: "anderson", 4: "gcr+anderson", 5: "gfmd"}
 _INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
 # Residuals returned per solve (the last ones): a max_iter-long array would cost more than
 # a small solve.

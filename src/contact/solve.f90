@@ -19,6 +19,7 @@ module lc_contact_solve
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome
    use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
+   use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_observables, only: observe
    implicit none (type, external)
    private
@@ -133,6 +134,7 @@ contains
       type(cg_outcome) :: cg
       type(gcr_outcome) :: gcr
       type(anderson_outcome) :: outer
+      type(gfmd_outcome) :: dynamics
       real(wp), allocatable :: history(:), p_gcr(:), w_gcr(:), gap_gcr(:)
       real(wp) :: uniform, s_gcr
       integer :: coarse_pairs
@@ -155,7 +157,12 @@ contains
       ! only the first `iterations` entries are written and read (not zeroed: the budget may
       ! be 1e7 entries, and untouched pages cost nothing)
       allocate (history(scene%solver%max_iter))
-      if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
+      if (trim(scene%solver%method) == 'gfmd') then
+         call gfmd(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
+            & dynamics, history)
+         call record_solve(result, 'gfmd', dynamics%converged, dynamics%iterations, 1, dynamics%fft_pairs, &
+            & dynamics%residual, history(1:min(dynamics%iterations, size(history))))
+      else if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
          ! constrained GCR; under 'auto' a solve that stalls goes on with the Anderson outer
          ! iteration from GCR's best iterate, with the budget left
          call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &

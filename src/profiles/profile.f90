@@ -1,5 +1,8 @@
 !> The rigid indenter profile of a scene (DESIGN.md §1 "Profiles"): made from
-!> scene%profile (self_affine | sinusoid | file) on the scene's grid, and its statistics.
+!> scene%profile (self_affine | sinusoid | file; on an areal scene also sphere) on the
+!> scene's grid, and the statistics of a line profile. A line scene gets n heights
+!> (lc_profiles_self_affine), an areal scene n*ny heights, x fastest (lc_profiles_surface,
+!> lc_profiles_surface_file).
 !>
 !> Statistics of heights r_j on x_j = j*period/n, with mean r0 = sum_j r_j / n:
 !>   rms height   = sqrt(sum_j (r_j - r0)^2 / n)
@@ -12,10 +15,13 @@
 !> roundoff.
 module lc_profiles_profile
    use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, code_input
-   use lc_scene, only: scene_type, not_set, default_rms_gradient
+   use lc_errors, only: error_type, fatal_error, code_input, input_error, positive_finite
+   use lc_strings, only: to_string
+   use lc_scene, only: scene_type, not_set, default_rms_gradient, is_areal
    use lc_fft_plans, only: fft_plan
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
+   use lc_profiles_surface, only: self_affine_surface, sinusoid_surface, spherical_cap
+   use lc_profiles_surface_file, only: read_surface_heights
    use lc_io_hdf5, only: read_profile_heights
    implicit none (type, external)
    private
@@ -25,15 +31,20 @@ module lc_profiles_profile
 
 contains
 
-   !> Heights of the scene's profile on its grid, dispatching on scene%profile%kind.
+   !> Heights of the scene's profile on its grid, dispatching on the geometry and on
+   !> scene%profile%kind.
    subroutine make_profile(scene, height, error)
-      !> Scene whose %n, %period and %profile are used
+      !> Scene whose grid (%n, %ny, %period, %period_y) and %profile are used
       type(scene_type), intent(in) :: scene
-      !> Heights r(x_j) (L)
-      real(wp), intent(out) :: height(scene%n)
+      !> Heights r(x_j) of a line, or r(x, y) of a surface flat with x fastest (L)
+      real(wp), intent(out) :: height(scene%n*scene%ny)
       type(error_type), allocatable, intent(out) :: error
 
       height = 0.0_wp
+      if (is_areal(scene)) then
+         call make_surface(scene, height, error)
+         return
+      end if
       associate (p => scene%profile)
          select case (trim(p%kind))
          case ('self_affine')
@@ -55,6 +66,56 @@ contains
          end select
       end associate
    end subroutine make_profile
+
+   !> Heights of an areal scene's surface on its n x ny grid. The sinusoid's modes and the
+   !> sphere's radius are checked here too, as the surface routines cannot fail.
+   subroutine make_surface(scene, height, error)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(out) :: height(scene%n, scene%ny)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: period_y
+
+      height = 0.0_wp
+      period_y = scene%period
+      if (scene%period_y /= not_set) period_y = scene%period_y
+      associate (p => scene%profile, nx => scene%n, ny => scene%ny, lx => scene%period)
+         select case (trim(p%kind))
+         case ('self_affine')
+            if (p%rms_gradient == not_set .and. p%rms_height == not_set) then
+               call self_affine_surface(nx, ny, lx, period_y, p%hurst, p%seed, p%rolloff_wavelength, &
+                  & p%short_wavelength, default_rms_gradient, not_set, height, error)
+            else
+               call self_affine_surface(nx, ny, lx, period_y, p%hurst, p%seed, p%rolloff_wavelength, &
+                  & p%short_wavelength, p%rms_gradient, p%rms_height, height, error)
+            end if
+         case ('sinusoid')
+            if (.not. positive_finite(p%amplitude)) then
+               call input_error(error, 'profile', 'amplitude', to_string(p%amplitude), '> 0 and finite')
+            else if (p%mode < 0 .or. p%mode > (nx - 1)/2) then
+               call input_error(error, 'profile', 'mode', to_string(p%mode), &
+                  & '0 <= mode <= (nx-1)/2 = ' // to_string((nx - 1)/2))
+            else if (abs(p%mode_y) > (ny - 1)/2) then
+               call input_error(error, 'profile', 'mode_y', to_string(p%mode_y), &
+                  & '|mode_y| <= (ny-1)/2 = ' // to_string((ny - 1)/2))
+            else if (p%mode == 0 .and. p%mode_y == 0) then
+               call input_error(error, 'profile', 'mode/mode_y', '0/0', 'not both zero (a flat surface)')
+            else
+               call sinusoid_surface(nx, ny, lx, period_y, p%amplitude, p%mode, p%mode_y, height)
+            end if
+         case ('sphere')
+            if (.not. positive_finite(p%radius)) then
+               call input_error(error, 'profile', 'radius', to_string(p%radius), '> 0 and finite')
+            else
+               call spherical_cap(nx, ny, lx, period_y, p%radius, height)
+            end if
+         case ('file')
+            call read_surface_heights(trim(p%file), trim(p%dataset), nx, ny, height, error)
+         case default
+            call fatal_error(error, "&profile: kind = '" // trim(p%kind) // "' is not allowed; allowed: " // &
+               & "'self_affine', 'sinusoid', 'sphere' or 'file'", code_input)
+         end select
+      end associate
+   end subroutine make_surface
 
    !> Rms height, rms gradient and maximum height above the mean line (definitions in the
    !> module header). A plain subroutine: the gradient needs an FFT plan.

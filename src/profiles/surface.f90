@@ -35,6 +35,13 @@
 !>    zero mean. The half spectrum of lc_fft_plans (columns mx >= 0) holds a
 !>    representative with mx > 0 in row mod(my, ny); column mx = 0 holds both (0, my) and
 !>    its conjugate (0, -my), which the c2r backward transform needs there.
+!>
+!> Isotropy: second-order statistics (rms slopes along x and y, the autocorrelation) are
+!> fixed by the amplitudes alone, and on a square cell (lx = ly) the kept modes are
+!> symmetric under mx <-> my, so they are isotropic to rounding. On a rectangular cell the
+!> longest waves sit on an anisotropic lattice of modes (spacings 1/lx and 1/ly); a roll-off
+!> wavelength well below min(lx, ly) keeps them flat, where they carry little slope
+!> (tests/test_surfaces.py measures the rms slopes along x and y).
 module lc_profiles_surface
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, input_error, positive_finite
@@ -90,9 +97,9 @@ contains
       if (short_wavelength /= not_set) short = short_wavelength
 
       if (nx < 4) then
-         call input_error(error, 'scene', 'n', to_string(nx), '>= 4 (at least one mode below Nyquist)')
+         call input_error(error, 'scene', 'nx (or n)', to_string(nx), '>= 4 (at least one mode below Nyquist)')
       else if (ny < 4) then
-         call input_error(error, 'scene', 'ny', to_string(ny), '>= 4 (at least one mode below Nyquist)')
+         call input_error(error, 'scene', 'ny (or n)', to_string(ny), '>= 4 (at least one mode below Nyquist)')
       else if (.not. positive_finite(lx)) then
          call input_error(error, 'scene', 'period', to_string(lx), '> 0 and finite')
       else if (.not. positive_finite(ly)) then
@@ -123,7 +130,7 @@ contains
       if (kappa_r2 > kappa_s2) then
          ! Otherwise the modes between the two cut-offs would be both flat and cut off.
          call input_error(error, 'profile', 'rolloff_wavelength', to_string(rolloff), &
-            & '>= the shortest wavelength kept, 1/min(1/short_wavelength, ((n-1)/2)/period, ' // &
+            & '>= the shortest wavelength kept, 1/min(1/short_wavelength, ((nx-1)/2)/period, ' // &
             & '((ny-1)/2)/period_y) = ' // to_string(1.0_wp/sqrt(kappa_s2)))
          return
       end if
@@ -222,8 +229,9 @@ contains
             dx = ix*lx/nx - (nx/2)*lx/nx
             rho2 = dx**2 + dy**2
             if (rho2 < radius**2) then
-               ! sqrt(R^2 - rho^2) - R written without its cancellation near the apex
-               height(ix + 1, iy + 1) = -rho2/(radius + sqrt(radius**2 - rho2))
+               ! sqrt(R^2 - rho^2) - R written without its cancellation near the apex (and
+               ! as 0 - ..., so that the apex is +0, not -0)
+               height(ix + 1, iy + 1) = 0.0_wp - rho2/(radius + sqrt(radius**2 - rho2))
             else
                height(ix + 1, iy + 1) = -radius
             end if

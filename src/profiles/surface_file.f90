@@ -1,0 +1,463 @@
+!> Measured surfaces read from a file (&profile kind = 'file' of an areal scene): the
+!> heights of an nx x ny grid, returned as height(nx, ny), x fastest. The format follows
+!> the file name's extension:
+!>
+!> - '.h5', '.hdf5': HDF5 file, `dataset` a 2D floating-point dataset of shape [ny, nx] in
+!>   C order (what h5py writes for a numpy array height[ny, nx]; the HDF5 Fortran API
+!>   reports it as (nx, ny));
+!> - '.npy': NumPy format 1.0, 2.0 or 3.0 (the header is parsed here), dtype '<f8'
+!>   (little-endian float64), C order, shape (ny, nx);
+!> - anything else: text, ny lines of nx whitespace-separated numbers (one row y = const
+!>   per line, x growing along the line); blank lines and text after '#' are skipped, as
+!>   numpy.loadtxt does.
+!>
+!> Every height must be finite. Errors name &profile file and the value found, with code
+!> code_io when the file cannot be opened or read and code_input when its content is not
+!> what the scene needs.
+module lc_profiles_surface_file
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: iso_fortran_env, only: int8, int16, int32, iostat_end
+   use hdf5, only: hid_t, hsize_t, h5open_f, h5close_f, h5eset_auto_f, h5fopen_f, h5fclose_f, H5F_ACC_RDONLY_F, &
+      & H5F_CLOSE_STRONG_F, h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, h5dopen_f, h5dclose_f, &
+      & h5dread_f, h5dget_space_f, h5dget_type_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
+      & h5sget_simple_extent_dims_f, h5tget_class_f, h5tclose_f, H5T_NATIVE_DOUBLE, H5T_FLOAT_F
+   use lc_kinds, only: wp, i8
+   use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
+   use lc_strings, only: to_string
+   implicit none (type, external)
+   private
+   public :: read_surface_heights
+
+   !> The largest rank HDF5 allows (H5S_MAX_RANK).
+   integer, parameter :: max_rank = 32
+
+contains
+
+   !> Heights of an nx x ny surface from `filename` (format from its extension, see the
+   !> module header).
+   subroutine read_surface_heights(filename, dataset, nx, ny, height, error)
+      !> File name (&profile file)
+      character(len=*), intent(in) :: filename
+      !> Dataset inside an HDF5 file (&profile dataset), e.g. /profile/height
+      character(len=*), intent(in) :: dataset
+      !> Grid points along x and y expected
+      integer, intent(in) :: nx, ny
+      !> Heights (L)
+      real(wp), intent(out) :: height(nx, ny)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ix, iy
+
+      height = 0.0_wp
+      if (ends_with(filename, '.h5') .or. ends_with(filename, '.hdf5')) then
+         call read_hdf5(filename, dataset, nx, ny, height, error)
+      else if (ends_with(filename, '.npy')) then
+         call read_npy(filename, nx, ny, height, error)
+      else
+         call read_text(filename, nx, ny, height, error)
+      end if
+      if (allocated(error)) return
+      do iy = 1, ny
+         do ix = 1, nx
+            if (.not. ieee_is_finite(height(ix, iy))) then
+               call fatal_error(error, named(filename) // ' holds the height ' // to_string(height(ix, iy)) // &
+                  & ' at (ix, iy) = (' // to_string(ix - 1) // ', ' // to_string(iy - 1) // &
+                  & '), 0-based; allowed: finite heights', code_input)
+               return
+            end if
+         end do
+      end do
+   end subroutine read_surface_heights
+
+   !> "&profile: file = '<filename>'", the start of every message.
+   pure function named(filename) result(s)
+      character(len=*), intent(in) :: filename
+      character(len=:), allocatable :: s
+      s = "&profile: file = '" // filename // "'"
+   end function named
+
+   pure logical function ends_with(text, tail)
+      character(len=*), intent(in) :: text, tail
+      integer :: n
+      n = len_trim(text)
+      ends_with = .false.
+      if (n >= len(tail)) ends_with = lower(text(n - len(tail) + 1:n)) == tail
+   end function ends_with
+
+   pure function lower(text) result(s)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: s
+      integer :: i
+      s = text
+      do i = 1, len(s)
+         if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') s(i:i) = achar(iachar(s(i:i)) + 32)
+      end do
+   end function lower
+
+   !> "(ny, nx) = (a, b)", the shape a surface file must have, in C order.
+   pure function expected_shape(nx, ny) result(s)
+      integer, intent(in) :: nx, ny
+      character(len=:), allocatable :: s
+      s = '(ny, nx) = (' // to_string(ny) // ', ' // to_string(nx) // ')'
+   end function expected_shape
+
+   ! ---------------------------------------------------------------------------------------
+   ! HDF5
+
+   subroutine read_hdf5(filename, dataset, nx, ny, height, error)
+      character(len=*), intent(in) :: filename, dataset
+      integer, intent(in) :: nx, ny
+      real(wp), intent(out) :: height(nx, ny)
+      type(error_type), allocatable, intent(out) :: error
+      integer(hid_t) :: fapl, file, dset, space, dtype
+      integer(hsize_t) :: dims(max_rank), maxdims(max_rank)
+      integer :: hdferr, ignore, rank, class, i
+      character(len=:), allocatable :: found
+
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, ignore)
+      call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, ignore)
+      call h5pset_fclose_degree_f(fapl, H5F_CLOSE_STRONG_F, ignore)
+      reading: block
+         if (hdferr /= 0) then
+            call fatal_error(error, named(filename) // ': cannot initialise HDF5 to read it', code_internal)
+            exit reading
+         end if
+         call h5fopen_f(filename, H5F_ACC_RDONLY_F, file, hdferr, access_prp=fapl)
+         if (hdferr /= 0) then
+            call fatal_error(error, named(filename) // ' cannot be opened as HDF5; allowed: an existing, ' // &
+               & 'readable HDF5 file', code_io)
+            exit reading
+         end if
+         call h5dopen_f(file, dataset, dset, hdferr)
+         if (hdferr /= 0) then
+            call fatal_error(error, named(filename) // " has no dataset '" // dataset // "' (&profile dataset); " // &
+               & 'allowed: the path of a 2D floating-point dataset in the file', code_input)
+         else
+            call h5dget_space_f(dset, space, hdferr)
+            call h5sget_simple_extent_ndims_f(space, rank, ignore)
+            dims = 0
+            if (rank >= 1 .and. rank <= max_rank) call h5sget_simple_extent_dims_f(space, dims, maxdims, ignore)
+            call h5sclose_f(space, ignore)
+            call h5dget_type_f(dset, dtype, ignore)
+            call h5tget_class_f(dtype, class, ignore)
+            call h5tclose_f(dtype, ignore)
+            if (class /= H5T_FLOAT_F .or. rank /= 2 .or. dims(1) /= nx .or. dims(2) /= ny) then
+               ! The Fortran API lists the dimensions fastest first; print them in C order.
+               found = '('
+               do i = rank, 1, -1
+                  found = found // to_string(int(dims(i), i8))
+                  if (i > 1) found = found // ', '
+               end do
+               found = found // ')'
+               if (class /= H5T_FLOAT_F) found = found // ' of numbers that are not floating point'
+               call fatal_error(error, named(filename) // ", dataset '" // dataset // "' holds shape " // found // &
+                  & '; allowed: a 2D floating-point dataset of shape ' // expected_shape(nx, ny) // &
+                  & ' (C order, as h5py writes height[ny, nx])', code_input)
+            else
+               dims(1:2) = [integer(hsize_t) :: nx, ny]
+               call h5dread_f(dset, H5T_NATIVE_DOUBLE, height, dims(1:2), hdferr)
+               if (hdferr /= 0) call fatal_error(error, named(filename) // ": cannot read dataset '" // dataset // "'", &
+                  & code_io)
+            end if
+            call h5dclose_f(dset, ignore)
+         end if
+         call h5fclose_f(file, ignore)
+      end block reading
+      call h5pclose_f(fapl, ignore)
+      call h5close_f(ignore)
+   end subroutine read_hdf5
+
+   ! ---------------------------------------------------------------------------------------
+   ! NumPy .npy: magic '\x93NUMPY', major and minor version bytes, the header length
+   ! (2 bytes little-endian in version 1, 4 bytes in versions 2 and 3), the header (a Python
+   ! dict literal: {'descr': '<f8', 'fortran_order': False, 'shape': (ny, nx), }, padded
+   ! with spaces and a newline), then the data.
+
+   subroutine read_npy(filename, nx, ny, height, error)
+      character(len=*), intent(in) :: filename
+      integer, intent(in) :: nx, ny
+      real(wp), intent(out) :: height(nx, ny)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=6) :: magic
+      integer(int8) :: version(2)
+      integer(int16) :: length16
+      integer(int32) :: length32
+      integer :: unit, ios, header_length, data_start
+      integer(i8) :: shape(max_rank)
+      integer :: rank
+      character(len=256) :: message
+      character(len=:), allocatable :: header, descr, order, found
+
+      if (.not. little_endian()) then
+         call fatal_error(error, named(filename) // ': reading .npy files needs a little-endian machine', code_internal)
+         return
+      end if
+      open (newunit=unit, file=filename, access='stream', form='unformatted', status='old', action='read', &
+         & iostat=ios, iomsg=message)
+      if (ios /= 0) then
+         call fatal_error(error, named(filename) // ' cannot be opened (' // trim(message) // &
+            & '); allowed: an existing, readable .npy file', code_io)
+         return
+      end if
+      parsing: block
+         read (unit, iostat=ios) magic, version
+         ! the first byte is 0x93 (outside ASCII, so char, not achar)
+         if (ios /= 0 .or. magic /= char(147) // 'NUMPY') then
+            call fatal_error(error, named(filename) // ' does not start with the .npy magic string; allowed: a file ' // &
+               & 'written by numpy.save', code_input)
+            exit parsing
+         end if
+         select case (version(1))
+         case (1)
+            read (unit, iostat=ios) length16
+            header_length = int(length16)
+            ! the two bytes are unsigned
+            if (header_length < 0) header_length = header_length + 65536
+            data_start = 11 + header_length
+         case (2, 3)
+            read (unit, iostat=ios) length32
+            header_length = int(length32)
+            data_start = 13 + header_length
+         case default
+            call fatal_error(error, named(filename) // ' has .npy format version ' // to_string(int(version(1))) // &
+               & '; allowed: 1, 2 or 3', code_input)
+            exit parsing
+         end select
+         if (ios == 0 .and. header_length > 0) then
+            allocate (character(len=header_length) :: header)
+            read (unit, iostat=ios) header
+         end if
+         if (ios /= 0 .or. header_length <= 0) then
+            call fatal_error(error, named(filename) // ' has a truncated .npy header; allowed: a file written by ' // &
+               & 'numpy.save', code_input)
+            exit parsing
+         end if
+
+         descr = quoted_value(header, 'descr')
+         order = word_value(header, 'fortran_order')
+         call shape_value(header, shape, rank)
+         if (descr /= '<f8') then
+            call fatal_error(error, named(filename) // " holds dtype '" // descr // "'; allowed: '<f8' " // &
+               & "(little-endian float64: save numpy.asarray(height, dtype='<f8'))", code_input)
+         else if (order /= 'False') then
+            call fatal_error(error, named(filename) // ' holds fortran_order = ' // order // '; allowed: False ' // &
+               & '(C order: save numpy.ascontiguousarray(height))', code_input)
+         else if (rank /= 2 .or. shape(1) /= ny .or. shape(2) /= nx) then
+            if (rank < 0) then
+               found = 'that cannot be parsed'
+            else
+               found = shape_text(shape(1:rank))
+            end if
+            call fatal_error(error, named(filename) // ' holds shape ' // found // '; allowed: ' // &
+               & expected_shape(nx, ny), code_input)
+         end if
+         if (allocated(error)) exit parsing
+         read (unit, pos=data_start, iostat=ios, iomsg=message) height
+         if (ios == iostat_end) then
+            call fatal_error(error, named(filename) // ' ends before its ' // to_string(nx*ny) // ' heights; ' // &
+               & 'allowed: a complete .npy file of shape ' // expected_shape(nx, ny), code_input)
+         else if (ios /= 0) then
+            call fatal_error(error, named(filename) // ': cannot read the heights (' // trim(message) // ')', code_io)
+         end if
+      end block parsing
+      close (unit)
+   end subroutine read_npy
+
+   !> True when the least significant byte comes first (the byte order of '<f8').
+   pure logical function little_endian()
+      little_endian = all(transfer(1_int16, [0_int8, 0_int8]) == [1_int8, 0_int8])
+   end function little_endian
+
+   !> Text after `key` and the next ':' in a header, left-adjusted ('' if the key is absent).
+   pure function after_key(header, key) result(s)
+      character(len=*), intent(in) :: header, key
+      character(len=:), allocatable :: s
+      integer :: at, colon
+      s = ''
+      at = index(header, "'" // key // "'")
+      if (at == 0) at = index(header, '"' // key // '"')
+      if (at == 0) return
+      colon = index(header(at:), ':')
+      if (colon == 0) return
+      s = trim(adjustl(header(at + colon:)))
+   end function after_key
+
+   !> The quoted string value of `key` ('' if absent or unquoted).
+   pure function quoted_value(header, key) result(s)
+      character(len=*), intent(in) :: header, key
+      character(len=:), allocatable :: s, rest
+      integer :: close_quote
+      rest = after_key(header, key)
+      s = ''
+      if (len(rest) < 2) return
+      if (rest(1:1) /= "'" .and. rest(1:1) /= '"') return
+      close_quote = index(rest(2:), rest(1:1))
+      if (close_quote > 0) s = rest(2:close_quote)
+   end function quoted_value
+
+   !> The bare word value of `key` (up to ',' or '}'), e.g. True or False.
+   pure function word_value(header, key) result(s)
+      character(len=*), intent(in) :: header, key
+      character(len=:), allocatable :: s, rest
+      integer :: stop
+      rest = after_key(header, key)
+      stop = scan(rest, ',}')
+      if (stop == 0) stop = len(rest) + 1
+      s = trim(rest(1:stop - 1))
+   end function word_value
+
+   !> The shape tuple of the header; rank = -1 when it cannot be parsed.
+   pure subroutine shape_value(header, shape, rank)
+      character(len=*), intent(in) :: header
+      integer(i8), intent(out) :: shape(max_rank)
+      integer, intent(out) :: rank
+      character(len=:), allocatable :: rest, item
+      integer :: close_paren, start, comma, ios
+
+      shape = 0
+      rank = -1
+      rest = after_key(header, 'shape')
+      if (len(rest) < 2) return
+      if (rest(1:1) /= '(') return
+      close_paren = index(rest, ')')
+      if (close_paren == 0) return
+      rest = rest(2:close_paren - 1) // ','
+      rank = 0
+      start = 1
+      do while (start <= len(rest))
+         comma = index(rest(start:), ',') + start - 1
+         item = trim(adjustl(rest(start:comma - 1)))
+         start = comma + 1
+         if (len(item) == 0) cycle   ! the trailing comma of a 1-tuple
+         if (rank == max_rank .or. verify(item, '0123456789') /= 0) then
+            rank = -1
+            return
+         end if
+         rank = rank + 1
+         read (item, *, iostat=ios) shape(rank)
+         if (ios /= 0) then
+            rank = -1
+            return
+         end if
+      end do
+   end subroutine shape_value
+
+   pure function shape_text(shape) result(s)
+      integer(i8), intent(in) :: shape(:)
+      character(len=:), allocatable :: s
+      integer :: i
+      s = '('
+      do i = 1, size(shape)
+         s = s // to_string(shape(i))
+         if (i < size(shape) .or. size(shape) == 1) s = s // ','
+         if (i < size(shape)) s = s // ' '
+      end do
+      s = s // ')'
+   end function shape_text
+
+   ! ---------------------------------------------------------------------------------------
+   ! Text
+
+   subroutine read_text(filename, nx, ny, height, error)
+      character(len=*), intent(in) :: filename
+      integer, intent(in) :: nx, ny
+      real(wp), intent(out) :: height(nx, ny)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: line, token, found
+      character(len=256) :: message
+      integer :: unit, ios, line_number, rows, count, start, finish, hash
+      real(wp) :: value
+
+      open (newunit=unit, file=filename, status='old', action='read', form='formatted', iostat=ios, iomsg=message)
+      if (ios /= 0) then
+         call fatal_error(error, named(filename) // ' cannot be opened (' // trim(message) // &
+            & '); allowed: an existing, readable text file', code_io)
+         return
+      end if
+      line_number = 0
+      rows = 0
+      lines: do
+         call read_line(unit, line, ios)
+         if (ios == iostat_end) exit lines
+         if (ios /= 0) then
+            call fatal_error(error, named(filename) // ': cannot read line ' // to_string(line_number + 1), code_io)
+            exit lines
+         end if
+         line_number = line_number + 1
+         hash = index(line, '#')
+         if (hash > 0) line = line(1:hash - 1)
+         line = tabs_to_spaces(line)
+         if (len_trim(line) == 0) cycle lines
+         rows = rows + 1
+         if (rows > ny) then
+            call fatal_error(error, named(filename) // ' holds more than ny = ' // to_string(ny) // &
+               & ' lines of numbers; allowed: ny lines of nx numbers, ' // expected_shape(nx, ny), code_input)
+            exit lines
+         end if
+         count = 0
+         finish = 0
+         tokens: do
+            start = verify(line(finish + 1:), ' ') + finish
+            if (start == finish) exit tokens
+            finish = index(line(start:), ' ') + start - 2
+            if (finish < start) finish = len(line)
+            token = line(start:finish)
+            count = count + 1
+            if (count > nx) exit tokens
+            ! list-directed input would take ',', '/' and 'r*' as separators and repeats
+            ios = 1
+            if (scan(token, ",/*;'""()") == 0) read (token, *, iostat=ios) value
+            if (ios /= 0) then
+               call fatal_error(error, named(filename) // ', line ' // to_string(line_number) // ": '" // token // &
+                  & "' is not a number; allowed: whitespace-separated numbers", code_input)
+               exit lines
+            end if
+            height(count, rows) = value
+         end do tokens
+         if (count /= nx) then
+            if (count > nx) then
+               found = 'more than ' // to_string(nx)
+            else
+               found = to_string(count)
+            end if
+            call fatal_error(error, named(filename) // ', line ' // to_string(line_number) // ' holds ' // found // &
+               & ' numbers; allowed: nx = ' // to_string(nx) // ' per line, ' // expected_shape(nx, ny), code_input)
+            exit lines
+         end if
+      end do lines
+      close (unit)
+      if (.not. allocated(error) .and. rows < ny) then
+         call fatal_error(error, named(filename) // ' holds ' // to_string(rows) // ' lines of numbers; allowed: ny = ' // &
+            & to_string(ny) // ' lines of nx = ' // to_string(nx) // ' numbers, ' // expected_shape(nx, ny), code_input)
+      end if
+   end subroutine read_text
+
+   !> One whole line of a formatted file, of any length.
+   subroutine read_line(unit, line, ios)
+      integer, intent(in) :: unit
+      character(len=:), allocatable, intent(out) :: line
+      integer, intent(out) :: ios
+      character(len=4096) :: chunk
+      integer :: got
+
+      line = ''
+      do
+         read (unit, '(a)', advance='no', iostat=ios, size=got) chunk
+         line = line // chunk(1:got)
+         if (ios /= 0) exit
+      end do
+      ! the end of a record ends the line; the end of the file ends it only if it was empty
+      if (is_iostat_eor(ios)) ios = 0
+      if (ios == iostat_end .and. len(line) > 0) ios = 0
+   end subroutine read_line
+
+   pure function tabs_to_spaces(text) result(s)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: s
+      integer :: i
+      s = text
+      do i = 1, len(s)
+         if (s(i:i) == achar(9) .or. s(i:i) == achar(13)) s(i:i) = ' '
+      end do
+   end function tabs_to_spaces
+end module lc_profiles_surface_file
