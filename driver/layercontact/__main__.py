@@ -1,9 +1,27 @@
-"""Command line: ``python -m layercontact run FILE.nml [--png PICTURE]``, or
-``python -m layercontact sweep FILE.nml [--processes N] [--no-progress]``.
+"""Command line of layercontact.
 
-Runs the scene like the ``layercontact`` executable (same library routine, same HDF5
-file, same summary and exit codes) and draws the seed's Fig. 2(a) view next to the
-result file.
+    python -m layercontact run FILE.nml [--png PICTURE | --no-png]
+    python -m layercontact sweep FILE.nml [--processes N] [--no-progress] [--dry-run]
+    python -m layercontact sweep FILE.nml --slurm [--dry-run] [Slurm options]
+    python -m layercontact status DIR [--all]
+    python -m layercontact collect DIR
+
+``run`` runs a scene like the ``layercontact`` executable (same library routine, same
+HDF5 file, same summary and exit codes) and draws the seed's Fig. 2(a) view next to the
+result file. ``sweep`` runs a parameter sweep here in worker processes, or with ``--slurm``
+submits it as a Slurm job array (layercontact.submit). ``status`` and ``collect`` read a
+sweep directory (or a sweep file): where each scene stands, and the summary.
+
+Exit codes:
+    run       0 converged, 2 bad input, 3 not converged, 4 I/O failure, 5 internal failure
+    sweep     0 every scene converged, 1 some scene failed (the others ran), 2 bad sweep or
+              option (nothing ran)
+    --slurm   0 submitted, or nothing left to submit (also for --dry-run), 2 bad sweep or
+              option (nothing submitted), 4 Slurm's commands missing or the job refused
+    status    0 every scene done, 1 some scene failed, running, queued or missing, 2 not a
+              sweep (directory)
+    collect   0 every scene converged, 1 some did not or are not done (the summary is
+              written all the same), 2 not a sweep (directory)
 """
 
 from __future__ import annotations
@@ -15,26 +33,91 @@ from pathlib import Path
 from .api import LayercontactError, _check
 from .native import core as _core
 
+_BAD_SWEEP = (ValueError, LayercontactError, OSError)
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m layercontact", description=__doc__.splitlines()[0])
+
+def _parser() -> argparse.ArgumentParser:
+    from .slurm import OPTIONS
+
+    parser = argparse.ArgumentParser(
+        prog="python -m layercontact",
+        description="layercontact: run scenes and sweeps",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="Exit codes:" + __doc__.split("Exit codes:")[1],
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     run_p = sub.add_parser("run", help="run a namelist scene, write HDF5 and a PNG")
     run_p.add_argument("nml", help="namelist input file")
     run_p.add_argument("--png", help="picture to draw (default: the result file with .png)")
     run_p.add_argument("--no-png", action="store_true", help="do not draw a picture")
+
     sweep_p = sub.add_parser(
-        "sweep", help="run a parameter sweep (a scene plus &sweep); exit 1 if a scene failed, 2 bad input"
+        "sweep", help="run a parameter sweep (a scene plus &sweep) here, or submit it to Slurm with --slurm"
     )
     sweep_p.add_argument("nml", help="sweep namelist file")
     sweep_p.add_argument(
-        "--processes", type=int, help="worker processes (default: &sweep processes, or all CPUs)"
+        "--processes", type=int, help="worker processes (default: &sweep processes, or the CPUs allocated)"
     )
     sweep_p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    args = parser.parse_args(argv)
-    if args.command == "sweep":
-        return sweep_command(args.nml, args.processes, not args.no_progress)
+    sweep_p.add_argument(
+        "--dry-run",
+        action="store_true",
+        help="write and check the scenes (with --slurm also the job script, printed); run nothing",
+    )
+    sweep_p.add_argument(
+        "--slurm",
+        action="store_true",
+        help="submit the scenes that are missing or failed as a Slurm job array",
+    )
+    group = sweep_p.add_argument_group(
+        "Slurm options", "with --slurm; each overrides the &sweep variable slurm_NAME"
+    )
+    for attribute, option in OPTIONS.items():
+        repeatable = attribute in ("sbatch_lines", "setup_lines")
+        group.add_argument(
+            option.flag,
+            dest=attribute,
+            action="append" if repeatable else "store",
+            metavar="LINE" if repeatable else option.flag.lstrip("-").upper().replace("-", "_"),
+            help=option.help,
+        )
 
+    status_p = sub.add_parser(
+        "status", help="where each scene of a sweep stands: done, failed, running, queued, missing"
+    )
+    status_p.add_argument("directory", help="the sweep directory (or the sweep file)")
+    status_p.add_argument(
+        "--all", action="store_true", help="list every scene that is not done (default: 20 per state)"
+    )
+    collect_p = sub.add_parser(
+        "collect", help="write the summary (CSV and HDF5) of a sweep from its directory"
+    )
+    collect_p.add_argument("directory", help="the sweep directory (or the sweep file)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    if args.command == "sweep":
+        if args.slurm:
+            return slurm_command(args)
+        given = _slurm_values(args)
+        if given:
+            from .slurm import OPTIONS
+
+            flag = OPTIONS[next(iter(given))].flag
+            print(f"layercontact: error: {flag} applies only with --slurm", file=sys.stderr)
+            return 2
+        return sweep_command(args.nml, args.processes, not args.no_progress, args.dry_run)
+    if args.command == "status":
+        return status_command(args.directory, args.all)
+    if args.command == "collect":
+        return collect_command(args.directory)
+    return run_command(args)
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """``python -m layercontact run``: exit codes as the executable's."""
     out, converged, stat, errmsg = _core.py_run(args.nml, 1)
     try:
         _check(stat, errmsg)
@@ -54,7 +137,7 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def sweep_command(nml: str, processes: int | None, progress: bool) -> int:
+def sweep_command(nml: str, processes: int | None, progress: bool, dry_run: bool = False) -> int:
     """``python -m layercontact sweep``: run the sweep, print where the summary is and
     which scenes failed. Exit code 0 all converged, 1 some scene failed or did not
     converge (the others ran), 2 bad sweep (nothing ran)."""
@@ -62,15 +145,133 @@ def sweep_command(nml: str, processes: int | None, progress: bool) -> int:
 
     try:
         plan = read_sweep(nml)
-        rows = execute(plan, processes=processes, progress=progress)
-    except (ValueError, LayercontactError, OSError) as err:
+        rows = execute(plan, processes=processes, progress=progress, dry_run=dry_run)
+    except _BAD_SWEEP as err:
         print(f"layercontact: error: {err}", file=sys.stderr)
         return 2
+    if dry_run:
+        print(
+            f"sweep '{plan.name}': {len(rows)} scenes written to {plan.directory / 'scenes'} and checked; "
+            "nothing run (dry run)"
+        )
+        return 0
     bad = failed(rows)
     print(f"sweep '{plan.name}': {len(rows)} scenes, {len(bad)} failed")
     print(f"  {'summary':<32}{plan.summary_file('csv')}, {plan.summary_file('h5')}")
     for row in bad:
         print(f"layercontact: scene {row['scene_file']}: {row['error']}", file=sys.stderr)
+    return 1 if bad else 0
+
+
+def _slurm_values(args: argparse.Namespace) -> dict[str, object]:
+    """The Slurm options given on the command line, by attribute (numbers converted; a
+    value that is not one is left for the option's check to name)."""
+    from .slurm import INTEGER_OPTIONS, OPTIONS
+
+    values = {}
+    for attribute in OPTIONS:
+        value = getattr(args, attribute, None)
+        if value is None:
+            continue
+        if attribute in INTEGER_OPTIONS:
+            value = int(value) if value.strip().lstrip("+-").isdigit() else value
+        values[attribute] = value
+    return values
+
+
+def slurm_command(args: argparse.Namespace) -> int:
+    """``python -m layercontact sweep FILE --slurm``: submit (or with --dry-run show) the
+    job array of the scenes that are missing or failed; record the job id."""
+    from .slurm import SlurmError, resolve_options
+    from .submit import submit_sweep
+    from .sweep import read_sweep
+
+    if args.processes is not None:
+        print(
+            "layercontact: error: --processes applies to a local sweep; a Slurm sweep runs one scene at a "
+            "time per array task (--scenes-per-task, --array-limit)",
+            file=sys.stderr,
+        )
+        return 2
+    try:
+        plan = read_sweep(args.nml)
+        options = resolve_options(plan.slurm, _slurm_values(args))
+        outcome = submit_sweep(plan, options, dry_run=args.dry_run)
+    except _BAD_SWEEP as err:
+        print(f"layercontact: error: {err}", file=sys.stderr)
+        return 2
+    except SlurmError as err:
+        print(f"layercontact: error: {err}", file=sys.stderr)
+        return 4
+    states = list(outcome.states.values())
+    counts = ", ".join(
+        f"{sum(s.state == name for s in states)} {name}"
+        for name in ("done", "failed", "running", "queued", "missing")
+    )
+    print(f"sweep '{plan.name}' ({plan.directory}): {len(states)} scenes: {counts}")
+    if not outcome.scenes:
+        print(
+            "nothing to submit: every scene is done, queued or running (or failed to converge, which a rerun "
+            "would repeat)"
+        )
+        print(f"  follow it: python -m layercontact status {plan.directory}")
+        return 0
+    per = options.scenes_per_task
+    if args.dry_run:
+        print(outcome.script_text, end="")
+        print(
+            f"dry run: {len(outcome.scenes)} scenes in {outcome.tasks} array task(s) ({per} per task); "
+            f"job script {outcome.script}; nothing submitted"
+        )
+        return 0
+    first = outcome.states[outcome.scenes[0]]
+    again = (
+        ""
+        if first.state == "missing" and first.reason == "never run"
+        else f" (e.g. {first.stem}: {first.reason})"
+    )
+    print(
+        f"submitted Slurm job {outcome.submission.job_id}: {len(outcome.scenes)} scenes{again} in "
+        f"{outcome.tasks} array task(s), {per} per task; job script {outcome.script}"
+    )
+    print(f"  follow it: python -m layercontact status {plan.directory}")
+    print(f"  then:      python -m layercontact collect {plan.directory}")
+    return 0
+
+
+def status_command(directory: str, list_all: bool = False) -> int:
+    """``python -m layercontact status DIR``: 0 every scene done, 1 not (yet), 2 no sweep."""
+    from .sweep_status import report, sweep_status
+
+    try:
+        status = sweep_status(directory)
+    except _BAD_SWEEP as err:
+        print(f"layercontact: error: {err}", file=sys.stderr)
+        return 2
+    report(status, limit=None if list_all else 20)
+    return 0 if status.finished else 1
+
+
+def collect_command(directory: str) -> int:
+    """``python -m layercontact collect DIR``: write the summary; 0 every scene converged,
+    1 not, 2 no sweep."""
+    from .sweep_status import DONE, collect
+
+    try:
+        status, rows = collect(directory)
+    except _BAD_SWEEP as err:
+        print(f"layercontact: error: {err}", file=sys.stderr)
+        return 2
+    sweep = status.sweep
+    bad = [row for row in rows if row.get("error")]
+    print(f"sweep '{sweep.name}': {status.counts_line()}")
+    print(
+        f"  {'summary':<32}{sweep.directory / (sweep.name + '_summary.csv')}, "
+        f"{sweep.directory / (sweep.name + '_summary.h5')}"
+    )
+    for scene in status.states:
+        if scene.state != DONE:
+            print(f"layercontact: scene {scene.stem}: {scene.state}: {scene.reason}", file=sys.stderr)
     return 1 if bad else 0
 
 

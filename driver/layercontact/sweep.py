@@ -13,12 +13,16 @@ A sweep file holds the usual groups (``&scene &layer &material &friction &profil
        thickness = 0.16, 0.01            ! -> &layer thickness
        speed = 0.01, 0.1, 1              ! -> &material speed (viscoelastic layers)
        seed = 1, 2, 3                    ! -> &profile seed (or realisations = N: 1..N)
-       processes = 2                     ! worker processes (default: os.cpu_count())
-    /
+       processes = 2                     ! worker processes (default: the CPUs allocated)
+       slurm_time = '0:30:00'            ! slurm_*: options of a Slurm job array
+    /                                    ! (layercontact.slurm, docs/clusters.md)
 
 Layout of ``DIRECTORY``: ``scenes/NAME_XXXX.nml`` (one complete scene each),
-``results/NAME_XXXX.h5`` (written by the library, complete or absent) and
-``NAME_summary.csv`` / ``NAME_summary.h5`` (one row per scene).
+``results/NAME_XXXX.h5`` (written by the library, complete or absent), ``runs/NAME_XXXX.json``
+(the run record: host, Slurm ids, times, exit code; :mod:`layercontact.provenance`),
+``NAME_sweep.json`` (the list of scenes, read by ``status`` and ``collect``) and
+``NAME_summary.csv`` / ``NAME_summary.h5`` (one row per scene). A Slurm sweep adds
+``logs/`` (the executable's output per scene) and ``slurm/`` (job scripts and submissions).
 
 Note: ``layercontact.sweep`` is the function :func:`sweep`; this module is
 ``sys.modules['layercontact.sweep']``.
@@ -30,9 +34,11 @@ import copy
 import csv
 import io
 import itertools
+import json
 import multiprocessing
 import os
 import sys
+import time
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
@@ -42,11 +48,15 @@ from pathlib import Path
 import f90nml
 import numpy as np
 
+from . import provenance
 from .api import LayercontactError, check_scene_file, run_to_file
+from .slurm import SWEEP_VARIABLES, options_from_sweep
 
 SWEEP_GROUP = "sweep"
 SUMMARY_GROUP = "summary"
 _SETTINGS = ("name", "directory", "realisations", "processes")
+#: Format of ``NAME_sweep.json`` (raised when its meaning changes).
+PLAN_RECORD_FORMAT = 1
 _PRESSURES = ("mean_pressure", "normalised_pressure")
 
 
@@ -116,6 +126,10 @@ class SweepPlan:
         order.
     processes : int or None
         Worker processes asked for in the file.
+    slurm : dict of str to object, or None
+        The ``slurm_*`` variables of the &sweep group, checked, by
+        :class:`layercontact.slurm.SlurmOptions` attribute (see
+        :func:`layercontact.slurm.options_from_sweep`).
     """
 
     source: Path
@@ -124,6 +138,11 @@ class SweepPlan:
     base: f90nml.Namelist
     values: dict[str, list]
     processes: int | None
+    slurm: dict[str, object] | None = None
+
+    def plan_record_file(self) -> Path:
+        """``DIRECTORY/NAME_sweep.json``: the scenes, for ``status`` and ``collect``."""
+        return plan_record_file(self.directory, self.name)
 
     def summary_file(self, suffix: str) -> Path:
         """``DIRECTORY/NAME_summary.SUFFIX`` (suffix ``'csv'`` or ``'h5'``)."""
@@ -139,6 +158,11 @@ class Scene:
     scene_file: Path
     result_file: Path
     text: str
+
+    @property
+    def stem(self) -> str:
+        """``NAME_XXXX``: the name of its scene, result, run record and log files."""
+        return self.scene_file.stem
 
     def planned_row(self) -> dict[str, object]:
         """The swept values and the file names (the first columns of the summary)."""
@@ -227,16 +251,18 @@ def read_sweep(path: str | os.PathLike) -> SweepPlan:
     if SWEEP_GROUP not in nml:
         raise ValueError(f"{source}: no &sweep group (a sweep file is a scene plus a &sweep group)")
     group = nml.pop(SWEEP_GROUP)
-    unknown = [var for var in group if var not in PARAMETERS and var not in _SETTINGS]
+    known = (*PARAMETERS, *_SETTINGS, *SWEEP_VARIABLES)
+    unknown = [var for var in group if var not in known]
     if unknown:
-        allowed = ", ".join([*PARAMETERS, *_SETTINGS])
+        allowed = ", ".join(known)
         raise _sweep_error(source, unknown[0], f"unknown variable; allowed: {allowed}")
     name = _name_setting(source, "name", group.get("name", source.stem))
     if "/" in name or os.sep in name:
         raise _sweep_error(source, "name", f"{name!r} must not contain a path separator")
     directory = _name_setting(source, "directory", group.get("directory", f"out/{name}"))
     processes = _positive_int(source, "processes", group["processes"]) if "processes" in group else None
-    return SweepPlan(source, name, Path(directory), nml, _swept_values(source, group), processes)
+    slurm = options_from_sweep(source, {var: group[var] for var in SWEEP_VARIABLES if var in group})
+    return SweepPlan(source, name, Path(directory), nml, _swept_values(source, group), processes, slurm)
 
 
 # ---------------------------------------------------------------------------------------
@@ -306,9 +332,13 @@ def _atomic(path: Path) -> Iterator[Path]:
 
 
 def _write_scene(scene: Scene) -> None:
-    """Write the scene file unless it already holds the same text (keeps its mtime)."""
+    """Write the scene file unless it already holds the same text (keeps its mtime). A
+    changed scene loses its run record and log: they describe the old input."""
     if scene.scene_file.is_file() and scene.scene_file.read_text() == scene.text:
         return
+    directory = scene.scene_file.parent.parent
+    provenance.record_file(directory, scene.stem).unlink(missing_ok=True)
+    provenance.log_file(directory, scene.stem).unlink(missing_ok=True)
     with _atomic(scene.scene_file) as tmp:
         tmp.write_text(scene.text)
 
@@ -338,6 +368,34 @@ def write_scenes(plan: SweepPlan) -> list[Scene]:
     return scenes
 
 
+def plan_record_file(directory: Path, name: str) -> Path:
+    """``DIRECTORY/NAME_sweep.json``."""
+    return Path(directory) / f"{name}_sweep.json"
+
+
+def write_plan_record(plan: SweepPlan, scenes: list[Scene]) -> None:
+    """Write ``DIRECTORY/NAME_sweep.json``: the sweep's name, file and working directory
+    and, per scene, its stem, swept values and file names as a summary shows them. It
+    lets ``status`` and ``collect`` work from the directory alone (scene, result, run
+    files are found under it by stem, so the directory may be moved)."""
+    record = {
+        "format": PLAN_RECORD_FORMAT,
+        "name": plan.name,
+        "sweep_file": str(plan.source),
+        "working_directory": os.getcwd(),
+        "directory": str(plan.directory),
+        "parameters": list(plan.values),
+        "scenes": [{"stem": s.stem, "index": s.index, "values": s.values, "scene_file": str(s.scene_file),
+                    "result_file": str(s.result_file)} for s in scenes],
+    }
+    text = json.dumps(record, indent=1) + "\n"
+    path = plan.plan_record_file()
+    if path.is_file() and path.read_text(encoding="utf-8") == text:
+        return
+    with _atomic(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
 # ---------------------------------------------------------------------------------------
 # running
 
@@ -354,15 +412,27 @@ def _scalar_attributes(attrs, prefix: str = "") -> dict[str, object]:
     return out
 
 
+#: Root attributes of a result file that a summary row shows (its provenance).
+_ROOT_COLUMNS = ("layercontact_version", "layercontact_build")
+
+
 def _result_columns(result_file: Path) -> dict[str, object]:
     """Every scalar attribute of ``/results`` and of ``/companion/results``
-    (``companion_`` prefix) of a result file."""
+    (``companion_`` prefix) of a result file, the version and build that wrote it, and
+    the provenance fields of the run record where the file holds them itself (a result
+    file that records its host and Slurm ids is believed over the run record)."""
     import h5py
 
     with h5py.File(result_file, "r") as f:
         columns = _scalar_attributes(f["results"].attrs)
         if "companion/results" in f:
             columns.update(_scalar_attributes(f["companion/results"].attrs, "companion_"))
+        root = _scalar_attributes(f.attrs)
+    columns.update({name: root.get(name) for name in _ROOT_COLUMNS})
+    for name in provenance.PROVENANCE_FIELDS:
+        if name in root:  # @host and, under Slurm, @slurm_*_id (job ids as text: made integers)
+            value = root[name]
+            columns[name] = int(value) if name.startswith("slurm_") and str(value).isdigit() else value
     return columns
 
 
@@ -380,25 +450,77 @@ def _failure(message: str) -> dict[str, object]:
     return {"converged": 0, "error": message}
 
 
-def _solve(scene_file: str, result_file: str) -> dict[str, object]:
-    """Worker: run one scene file, return its result columns (or its error)."""
+def _solve(scene_file: str, result_file: str, record_file: str) -> dict[str, object]:
+    """Worker: run one scene file, return its result columns (or its error); its run
+    record says it is running, then how it ended."""
+    record = provenance.start_record(Path(scene_file).stem)
+    provenance.write_record(Path(record_file), record)
+    start = time.monotonic()
     try:
         run_to_file(scene_file)
-        return _outcome(_result_columns(Path(result_file)))
-    except Exception as err:  # reported in the summary, the other scenes go on
-        return _failure(f"{type(err).__name__}: {err}")
+        outcome = _outcome(_result_columns(Path(result_file)))
+        code = 0 if not outcome["error"] else 3
+    except LayercontactError as err:  # reported in the summary, the other scenes go on
+        outcome, code = _failure(f"{type(err).__name__}: {err}"), err.code
+    except Exception as err:  # same, for a failure outside the library (e.g. reading h5)
+        outcome, code = _failure(f"{type(err).__name__}: {err}"), 5
+    finished = provenance.finish_record(record, code, time.monotonic() - start, outcome["error"])
+    provenance.write_record(Path(record_file), finished)
+    return outcome
+
+
+def result_matches(result_file: Path, text: str) -> bool:
+    """True if ``result_file`` is a readable result made from the namelist ``text`` (a
+    killed run leaves no result file, only ``RESULT.tmp``: that is not a result)."""
+    import h5py
+
+    try:
+        with h5py.File(result_file, "r") as f:
+            stored = f["input/namelist"][()]
+    except (OSError, KeyError):
+        return False
+    return (stored.decode() if isinstance(stored, bytes) else str(stored)) == text
+
+
+def result_outcome(result_file: Path) -> dict[str, object]:
+    """The summary columns of a complete result file: its attributes and ``error``
+    (empty if it converged)."""
+    return _outcome(_result_columns(result_file))
 
 
 def _is_complete(scene: Scene) -> bool:
     """True if the scene's result file is readable and was made from the same text."""
-    import h5py
+    return result_matches(scene.result_file, scene.text)
 
+
+def _record_file(scene: Scene) -> Path:
+    """The scene's run record, ``DIRECTORY/runs/STEM.json``."""
+    return provenance.record_file(scene.scene_file.parent.parent, scene.stem)
+
+
+def allocated_cpus() -> int:
+    """The CPUs this process may use: its affinity mask (``taskset``, the cpuset a batch
+    system confines a job to), bounded inside a Slurm job by ``SLURM_CPUS_PER_TASK`` or,
+    without it, ``SLURM_CPUS_ON_NODE`` (a cluster without CPU binding leaves the mask at
+    the whole node, so the mask alone would oversubscribe the allocation).
+
+    Returns
+    -------
+    int
+        At least 1.
+    """
     try:
-        with h5py.File(scene.result_file, "r") as f:
-            stored = f["input/namelist"][()]
-    except (OSError, KeyError):
-        return False
-    return (stored.decode() if isinstance(stored, bytes) else str(stored)) == scene.text
+        cpus = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # no affinity on this platform
+        cpus = os.cpu_count() or 1
+    in_job = "SLURM_JOB_ID" in os.environ
+    for variable in ("SLURM_CPUS_PER_TASK", "SLURM_CPUS_ON_NODE"):
+        value = os.environ.get(variable, "")
+        # SLURM_CPUS_ON_NODE may be left in a login shell's environment: trust it in a job only
+        if value.isdigit() and int(value) > 0 and (variable == "SLURM_CPUS_PER_TASK" or in_job):
+            cpus = min(cpus, int(value))
+            break
+    return max(1, cpus)
 
 
 def _pool_context() -> multiprocessing.context.BaseContext:
@@ -419,7 +541,10 @@ def _run_pending(
     pool = ProcessPoolExecutor(max_workers=min(processes, len(pending)), mp_context=_pool_context(),
                                initializer=os.chdir, initargs=(os.getcwd(),))
     try:
-        futures = {pool.submit(_solve, str(s.scene_file), str(s.result_file)): s for s in pending}
+        futures = {
+            pool.submit(_solve, str(s.scene_file), str(s.result_file), str(_record_file(s))): s
+            for s in pending
+        }
         for future in as_completed(futures):
             try:
                 outcomes[futures[future].index] = future.result()
@@ -435,7 +560,7 @@ def _run_pending(
 def _resolve_processes(plan: SweepPlan, processes: int | None) -> int:
     chosen = processes if processes is not None else plan.processes
     if chosen is None:
-        return os.cpu_count() or 1
+        return allocated_cpus()
     if isinstance(chosen, bool) or not isinstance(chosen, int) or chosen < 1:
         raise ValueError(f"processes = {chosen!r} is not allowed; allowed: an integer >= 1")
     return chosen
@@ -447,6 +572,7 @@ def execute(plan: SweepPlan, processes: int | None = None, progress: bool = True
     write the summary. See :func:`sweep`."""
     workers = _resolve_processes(plan, processes)
     scenes = write_scenes(plan)
+    write_plan_record(plan, scenes)
     if dry_run:
         return [scene.planned_row() for scene in scenes]
     pending = [scene for scene in scenes if not _is_complete(scene)]
@@ -458,15 +584,24 @@ def execute(plan: SweepPlan, processes: int | None = None, progress: bool = True
 
 def _row(scene: Scene, outcomes: dict[int, dict[str, object]]) -> dict[str, object]:
     """The summary row of a scene: its planned columns, then its outcome (just run, or
-    read from its existing result file); a swept input value wins over a result
-    attribute of the same name (e.g. ``normalised_pressure``, recomputed by the library
-    to rounding)."""
+    read from its existing result file) and its provenance (run record)."""
     if scene.index in outcomes:
         outcome = outcomes[scene.index]
     else:
         outcome = _outcome(_result_columns(scene.result_file))
-    row = scene.planned_row()
+    return summary_row(scene.planned_row(), outcome, provenance.read_record(_record_file(scene)))
+
+
+def summary_row(planned: dict[str, object], outcome: dict[str, object],
+                record: dict[str, object] | None) -> dict[str, object]:
+    """One row of a summary: the planned columns (swept values, file names), the outcome
+    (result attributes, ``error``) and the provenance columns of the run record. A swept
+    input value wins over a result attribute of the same name (e.g.
+    ``normalised_pressure``, recomputed by the library to rounding)."""
+    row = dict(planned)
     row.update({key: value for key, value in outcome.items() if key not in row})
+    row.update({key: value for key, value in provenance.provenance_columns(record).items() if key not in row})
+    row["error"] = row.pop("error", "")  # last, as in the summary files
     return row
 
 
@@ -485,7 +620,8 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     path : str or os.PathLike
         The sweep file.
     processes : int, optional
-        Worker processes; default: ``&sweep processes``, else ``os.cpu_count()``.
+        Worker processes; default: ``&sweep processes``, else the CPUs allocated to this
+        process (:func:`allocated_cpus`).
     progress : bool
         Show a progress bar on stderr.
     dry_run : bool
@@ -497,7 +633,9 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     list of dict
         One row per scene: the swept values, ``scene_file``, ``result_file``, every
         scalar attribute of ``/results`` and of ``/companion/results`` (``companion_``
-        prefix) and ``error`` (empty if the scene ran and converged). A swept value is
+        prefix), the provenance (``layercontact_version``, ``layercontact_build``,
+        ``host``, ``slurm_job_id``, ``slurm_array_job_id``, ``slurm_array_task_id``,
+        ``started``, ``run_time``) and ``error`` (empty if the scene ran and converged). A swept value is
         the input value; a result attribute of the same name is not repeated. A scene
         that failed has ``converged = 0`` and its message in ``error``.
 
@@ -555,14 +693,14 @@ def _write_csv(columns: dict[str, np.ndarray], path: Path) -> None:
         writer.writerows(zip(*([_cell(v) for v in col.tolist()] for col in columns.values())))
 
 
-def _write_h5(columns: dict[str, np.ndarray], path: Path, plan: SweepPlan) -> None:
+def _write_h5(columns: dict[str, np.ndarray], path: Path, name: str, sweep_file: str) -> None:
     import h5py
 
     with _atomic(path) as tmp:
         with h5py.File(tmp, "w") as f:
             group = f.create_group(SUMMARY_GROUP, track_order=True)
-            group.attrs["name"] = plan.name
-            group.attrs["sweep_file"] = str(plan.source)
+            group.attrs["name"] = name
+            group.attrs["sweep_file"] = sweep_file
             for name, col in columns.items():
                 if col.dtype.kind == "U":
                     group.create_dataset(name, data=col.astype(object), dtype=h5py.string_dtype("utf-8"))
@@ -572,9 +710,15 @@ def _write_h5(columns: dict[str, np.ndarray], path: Path, plan: SweepPlan) -> No
 
 def write_summary(rows: list[dict[str, object]], plan: SweepPlan) -> None:
     """Write ``NAME_summary.csv`` and ``NAME_summary.h5`` of ``plan`` atomically."""
+    write_summary_files(rows, plan.directory, plan.name, str(plan.source))
+
+
+def write_summary_files(rows: list[dict[str, object]], directory: Path, name: str, sweep_file: str) -> None:
+    """Write ``DIRECTORY/NAME_summary.csv`` and ``.h5`` atomically (``sweep_file`` is
+    recorded in the HDF5 summary)."""
     columns = summary_columns(rows)
-    _write_csv(columns, plan.summary_file("csv"))
-    _write_h5(columns, plan.summary_file("h5"), plan)
+    _write_csv(columns, Path(directory) / f"{name}_summary.csv")
+    _write_h5(columns, Path(directory) / f"{name}_summary.h5", name, sweep_file)
 
 
 def _parse_column(cells: list[str]) -> np.ndarray:
