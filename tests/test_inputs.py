@@ -59,7 +59,11 @@ def test_every_input_runs_the_same_in_fortran_and_python(nml, tmp_path, monkeypa
         assert f.attrs["layercontact_version"].decode() == lc.__version__
         assert f.attrs["layercontact_build"].decode() == "x86-64"
         assert f["input/namelist"][()].decode() == nml.read_text()
-        assert f["fields/pressure"].shape == (f["input"].attrs["n"],)
+        # a line's fields hold n values; an areal scene's are (ny, nx) maps
+        grid = (f["input"].attrs["n"],)
+        if f.attrs["geometry"].decode() == "areal":
+            grid = (f["input"].attrs["ny"], f["input"].attrs["n"])
+        assert f["fields/pressure"].shape == grid
 
 
 BAD = [

@@ -22,6 +22,7 @@ from .api import (
     surface_stress,
     surface_tensor,
 )
+from .leakage import LeakageResult, reynolds_leakage
 from .materials import Prony, StandardLinearSolid, creep_compliance
 from .native import BUILD
 from .profiles import (
@@ -42,6 +43,7 @@ __all__ = [
     "StandardLinearSolid",
     "creep_compliance",
     "LayercontactError",
+    "LeakageResult",
     "LineResult",
     "check_scene_file",
     "choose_resolution",
@@ -51,6 +53,7 @@ __all__ = [
     "load_surface",
     "read_result",
     "read_summary",
+    "reynolds_leakage",
     "run",
     "self_affine_profile",
     "self_affine_surface",
