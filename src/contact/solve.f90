@@ -161,7 +161,7 @@ contains
          call gfmd(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
             & dynamics, history)
          call record_solve(result, 'gfmd', dynamics%converged, dynamics%iterations, 1, dynamics%fft_pairs, &
-            & dynamics%residual, history(1:min(dynamics%iterations, size(history))))
+            & dynamics%residual, history(1:min(dynamics%checks, size(history))))
       else if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
          ! constrained GCR; under 'auto' a solve that stalls goes on with the Anderson outer
          ! iteration from GCR's best iterate, with the budget left

@@ -1,27 +1,28 @@
 !> Green's function molecular dynamics (GFMD): damped dynamics of the surface displacement
-!> against a hard wall, with Fourier mass weighting and FIRE (Campañá and Müser, Phys.
-!> Rev. B 74, 075420; Zhou, Moseler and Müser, Phys. Rev. B 99, 144103, for the mass
-!> weighting; Bitzek, Koskinen, Gähler, Moseler and Gumbsch, Phys. Rev. Lett. 97, 170201,
-!> for FIRE).
+!> against a hard wall, with FIRE (Campañá and Müser, Phys. Rev. B 74, 075420, for GFMD;
+!> Bitzek, Koskinen, Gähler, Moseler and Gumbsch, Phys. Rev. Lett. 97, 170201, for FIRE).
 !>
-!> The surface displacement u (= w) moves under the elastic force -K u of the layer
-!> (K = 1/G_eff per mode, the stiffness of the operator: with friction the shear traction
-!> mu_c p is the external in-plane load that G_eff already contains, so the force is not
-!> the gradient of an energy) and the load; the rigid surface is a hard wall,
-!> u_j >= b_j + s, enforced by projection after each step. The pressure is the layer's
-!> reaction p = K u (+ p_m, the uniform mode, under load control); the wall carries
-!> lambda = max(p, 0) where u touches it, and the unbalanced pressure rho = p - lambda drives
-!> the motion. With the mass of each mode equal to its stiffness, every mode has the same
-!> frequency and
-!>    d2u/dt2 = -G_eff rho,
-!> integrated by FIRE's damped semi-implicit Euler steps. Under load control the wall's
-!> position s is one more degree of freedom, driven by the load it does not yet carry,
-!> sum(rho), with the mass of the contact set's local stiffness.
+!> The surface displacement u (= w) moves under the elastic force of the layer, the
+!> pressure p = K u per mode (K = 1/G_eff, the operator's stiffness; with friction the
+!> shear traction mu_c p is the in-plane load that G_eff contains, so the force is not the
+!> gradient of an energy), and the load; the rigid surface is a hard wall at a fixed
+!> position, u_j >= b_j + s, enforced by projection after each step. Under load control
+!> the uniform mode of u has no stiffness and the mean pressure p_m pushes the surface
+!> against the wall: p = K u + p_m. The wall carries lambda = max(p, 0) where u touches it;
+!> the unbalanced pressure rho = p - lambda drives the motion,
+!>    m d2u/dt2 = -rho,
+!> with one mass m for every node, the largest stiffness of a mode, so that the stiffest
+!> mode has unit frequency; FIRE's damped semi-implicit Euler steps integrate it. A mass
+!> per mode equal to its stiffness (all modes at one frequency) is not used: with the
+!> wall's projection in real space it makes FIRE's step collapse (docs/decisions).
 !>
 !> Convergence is judged, as for the other solvers, on the complementarity residual of the
-!> pressure the wall carries (p = lambda, w = G_eff p, gap = w - b - s), not on an energy;
-!> each check costs one transform pair. A step costs two.
+!> pressure the wall carries (p = lambda, w = G_eff p, gap = w - b - s), not on an energy.
+!> A step costs one transform pair, a check one more. Strongly coupled thin layers (the
+!> stiffness far from symmetric) can make the dynamics unstable: the solve then stops and
+!> reports that it did not converge.
 module lc_contact_solver_gfmd
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_cg, only: complementarity_residual, rounding_floor
@@ -34,16 +35,17 @@ module lc_contact_solver_gfmd
    integer, parameter :: fire_min_steps = 5
    real(wp), parameter :: fire_grow = 1.1_wp, fire_shrink = 0.5_wp
    real(wp), parameter :: fire_alpha0 = 0.1_wp, fire_alpha_decay = 0.99_wp
-   !> Time step and its largest value, in units of 1/omega (every mode has omega = 1): the
+   !> Time step and its largest value, in units of 1/omega_max (the stiffest mode): the
    !> semi-implicit Euler step is stable below 2.
    real(wp), parameter :: dt_start = 0.25_wp, dt_max = 1.0_wp
    !> Steps between two convergence checks (a check costs one transform pair).
-   integer, parameter :: check_interval = 5
+   integer, parameter :: check_interval = 10
 
    !> What one GFMD solve did.
    type :: gfmd_outcome
       logical :: converged = .false.
       integer :: iterations = 0      !< time steps
+      integer :: checks = 0          !< convergence checks (the entries of the history)
       integer :: fft_pairs = 0
       real(wp) :: residual = huge(1.0_wp)
    end type gfmd_outcome
@@ -53,7 +55,8 @@ contains
    !> Solve the contact problem w = G_eff p, gap = w - b - s >= 0, p >= 0, p gap = 0 (load
    !> control: mean(p) = p_m, s found; displacement control: s given). p: starting guess in,
    !> solution out (the best checked state if not converged); w = G_eff p; gap.
-   !> history(k) receives the residual of the k-th check when present.
+   !> history(k) receives the residual of the k-th check (every check_interval steps) when
+   !> present.
    subroutine gfmd(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, history)
       type(compliance_operator), intent(inout) :: op
       real(wp), contiguous, intent(in) :: b(:)
@@ -68,58 +71,48 @@ contains
       real(wp), intent(inout), optional :: history(:)
       real(wp), allocatable :: u(:), v(:), a(:), rho(:), lambda(:), p_best(:)
       real(wp), pointer, contiguous :: buffer(:)
-      real(wp) :: dt, alpha, power, v_norm, a_norm, vs, as, s_best, uniform, b_max, stiffness, residual
-      integer :: step, since_negative, checks, n, n_wall
+      real(wp) :: dt, alpha, power, v_norm, a_norm, s_best, uniform, b_max, mass, residual
+      integer :: step, since_negative, checks, n, j
 
       n = size(p)
-      call op%prepare_gcr()   ! the inverse 1/G_eff
+      call op%prepare_gcr()   ! the stiffness 1/G_eff
       buffer => op%buffer()
       allocate (u(n), v(n), a(n), rho(n), lambda(n))
       b_max = maxval(abs(b))
       uniform = merge(mean_pressure, 0.0_wp, load_control)
-      ! start from the displacement of the guess; under load control the wall touches the
-      ! highest point of the gap first (the guess then adjusts by the dynamics)
+      mass = maxval(abs(op%inverse_full))
+      ! start from the displacement of the guess; under load control the wall is placed
+      ! where it touches the highest point of the gap, and the load moves the surface
       p = max(p, 0.0_wp)
       call op%apply_full(p, u)
       if (load_control) s = minval(u - b)
       u = max(u, b + s)
       v = 0.0_wp
-      vs = 0.0_wp
       dt = dt_start
       alpha = fire_alpha0
       since_negative = 0
       checks = 0
       p_best = p
       s_best = s
-      ! the wall's mass per contact point: the local stiffness 1/diag(G_eff)
-      stiffness = 1.0_wp/max(op%diagonal, tiny(1.0_wp))
 
       do step = 1, max_iter
-         ! the layer's reaction p = K u (+ p_m) and what the wall carries
+         ! the layer's reaction p = K u (+ p_m), what the wall carries and what is left
          buffer = u
          call op%inverse_full_in_buffer()
-         lambda = 0.0_wp
-         where (u - b - s <= 0.0_wp) lambda = max(buffer + uniform, 0.0_wp)
-         rho = buffer + uniform - lambda
-         n_wall = count(u - b - s <= 0.0_wp)
-         ! accelerations: of the modes, and of the wall under load control
-         buffer = rho
-         call op%full_in_buffer()
-         a = -buffer
-         outcome%fft_pairs = outcome%fft_pairs + 2
-         as = 0.0_wp
-         if (load_control) as = sum(rho)/(stiffness*max(n_wall, 1))
-
+         outcome%fft_pairs = outcome%fft_pairs + 1
+         !$omp simd
+         do j = 1, n
+            lambda(j) = merge(max(buffer(j) + uniform, 0.0_wp), 0.0_wp, u(j) <= b(j) + s)
+            rho(j) = buffer(j) + uniform - lambda(j)
+            a(j) = -rho(j)/mass
+         end do
          ! FIRE: mix the velocity towards the force, grow the step while the power is
          ! positive, stop and shrink it when it turns negative
-         power = dot_product(v, a) + vs*as
+         power = dot_product(v, a)
          if (power > 0.0_wp) then
-            v_norm = sqrt(dot_product(v, v) + vs**2)
-            a_norm = sqrt(dot_product(a, a) + as**2)
-            if (a_norm > 0.0_wp) then
-               v = (1.0_wp - alpha)*v + alpha*v_norm/a_norm*a
-               vs = (1.0_wp - alpha)*vs + alpha*v_norm/a_norm*as
-            end if
+            v_norm = norm2(v)
+            a_norm = norm2(a)
+            if (a_norm > 0.0_wp) v = (1.0_wp - alpha)*v + (alpha*v_norm/a_norm)*a
             since_negative = since_negative + 1
             if (since_negative > fire_min_steps) then
                dt = min(dt*fire_grow, dt_max)
@@ -127,23 +120,23 @@ contains
             end if
          else
             v = 0.0_wp
-            vs = 0.0_wp
             dt = dt*fire_shrink
             alpha = fire_alpha0
             since_negative = 0
          end if
-         v = v + dt*a
-         u = u + dt*v
-         vs = vs + dt*as
-         s = s + dt*vs
-         ! the hard wall
-         where (u < b + s)
-            u = b + s
-            v = max(v, 0.0_wp)
-         end where
+         ! the step, and the hard wall
+         !$omp simd
+         do j = 1, n
+            v(j) = v(j) + dt*a(j)
+            u(j) = u(j) + dt*v(j)
+            if (u(j) < b(j) + s) then
+               u(j) = b(j) + s
+               v(j) = max(v(j), 0.0_wp)
+            end if
+         end do
          outcome%iterations = step
 
-         if (mod(step, check_interval) == 0 .or. step == max_iter) then
+         if (mod(step, check_interval) == 0 .or. step == max_iter .or. .not. ieee_is_finite(power)) then
             call check(lambda, residual)
             checks = checks + 1
             if (present(history)) then
@@ -154,10 +147,12 @@ contains
                p_best = lambda
                s_best = s
             end if
-            if (residual <= tol) exit
+            ! (a dynamics that blew up cannot recover)
+            if (residual <= tol .or. .not. ieee_is_finite(power)) exit
          end if
       end do
       outcome%converged = outcome%residual <= tol
+      outcome%checks = checks
       p = p_best
       s = s_best
       call op%apply_full(p, w)
