@@ -5,12 +5,12 @@
 !> output checked (an existing result is never overwritten unless &output overwrite) before
 !> anything is computed; the result file appears only when it is complete.
 module lc_run
-   use lc_kinds, only: wp
+   use lc_kinds, only: wp, i8
    use lc_errors, only: error_type
    use lc_scene, only: scene_type, not_set
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
-   use lc_io_hdf5, only: check_output, write_results
+   use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
    use lc_profiles_profile, only: make_profile
    use lc_contact_solve, only: solve_contact
    use lc_accuracy, only: choose_resolution
@@ -33,8 +33,13 @@ contains
       type(contact_result) :: result, companion
       character(len=:), allocatable :: text
       real(wp), allocatable :: height(:)
+      type(run_record) :: run
+      integer(i8) :: start, finish, rate
 
       converged = .false.
+      call system_clock(start, rate)
+      run%input_file = input
+      run%started = utc_now()
       call read_scene(input, scene, text, error)
       if (allocated(error)) return
       output_file = trim(scene%output_file)
@@ -63,9 +68,13 @@ contains
          call solve_contact(companion_scene, height, 0.0_wp, companion, error)
          if (allocated(error)) return
          converged = converged .and. companion%converged
-         call write_results(output_file, scene, text, height, result, companion, version_string, error)
+         call system_clock(finish)
+         run%seconds = real(finish - start, wp)/real(rate, wp)
+         call write_results(output_file, scene, text, height, result, companion, version_string, error, run)
       else
-         call write_results(output_file, scene, text, height, result, version=version_string, error=error)
+         call system_clock(finish)
+         run%seconds = real(finish - start, wp)/real(rate, wp)
+         call write_results(output_file, scene, text, height, result, version=version_string, error=error, run=run)
       end if
       if (allocated(error)) return
       if (unit >= 0) then

@@ -33,7 +33,7 @@ module lc_io_hdf5
    use lc_version, only: build_isa
    implicit none (type, external)
    private
-   public :: check_output, write_results, read_profile_heights
+   public :: check_output, write_results, read_profile_heights, run_record, utc_now
 
    character(len=*), parameter :: convention = 'P: x = sliding direction of the indenter, z into the layer, ' // &
       & 'p > 0 compressive, w = u_z > 0 indentation, tau = +mu_c p'
@@ -43,6 +43,14 @@ module lc_io_hdf5
 
    !> Sticky status of a sequence of HDF5 calls: after the first failure every helper does
    !> nothing, so a writer reads as a plain list of objects and is checked once at the end.
+   !> How a run was started, for the result's provenance (root attributes @input_file,
+   !> @started, @run_wall_time).
+   type :: run_record
+      character(len=:), allocatable :: input_file   !< the namelist file as given
+      character(len=20) :: started = ''             !< UTC, ISO 8601
+      real(wp) :: seconds = 0.0_wp                  !< from the start to the write (s)
+   end type run_record
+
    type :: h5_status
       integer :: hdferr = 0
       character(len=:), allocatable :: object   !< path of the object that failed
@@ -133,7 +141,7 @@ contains
    !> Write a complete, self-describing result file atomically: write filename.tmp (delete a
    !> stale one first), close, rename to filename. On any HDF5 failure: close, delete the
    !> .tmp, return error code_io naming file and object.
-   subroutine write_results(filename, scene, namelist_text, height, result, companion, version, error)
+   subroutine write_results(filename, scene, namelist_text, height, result, companion, version, error, run)
       character(len=*), intent(in) :: filename
       type(scene_type), intent(in) :: scene
       !> the input namelist text, echoed to /input/namelist
@@ -146,6 +154,8 @@ contains
       !> layercontact version string
       character(len=*), intent(in) :: version
       type(error_type), allocatable, intent(out) :: error
+      !> how the run was started, for the root's provenance
+      type(run_record), intent(in), optional :: run
       character(len=:), allocatable :: tmp
       type(h5_status) :: st
       integer(hid_t) :: fapl, file, group
@@ -179,6 +189,11 @@ contains
          call write_attr_string(file, 'convention', convention, st)
          call write_attr_string(file, 'units', units_note, st)
          call write_provenance(file, st)
+         if (present(run)) then
+            call write_attr_string(file, 'input_file', run%input_file, st)
+            call write_attr_string(file, 'started', run%started, st)
+            call write_attr_real(file, 'run_wall_time', run%seconds, st)
+         end if
 
          call create_group(file, 'input', group, st)
          call write_dataset_string(group, 'namelist', namelist_text, st)
@@ -641,34 +656,40 @@ contains
    end subroutine write_field
 
    !> Where and when the result was made: @host, @created (UTC, ISO 8601), and under Slurm
-   !> @slurm_job_id, @slurm_array_job_id, @slurm_array_task_id (as the scheduler set them).
+   !> @slurm_job_id, @slurm_array_job_id, @slurm_array_task_id, @slurm_cluster_name,
+   !> @slurm_restart_count (as the scheduler set them; job ids are unique per cluster, the
+   !> restart count tells a requeued task).
    subroutine write_provenance(loc, st)
       integer(hid_t), intent(in) :: loc
       type(h5_status), intent(inout) :: st
       character(kind=c_char, len=256) :: host
-      character(len=8) :: date
-      character(len=10) :: time
-      character(len=5) :: zone
       character(len=64) :: value
-      character(len=*), parameter :: slurm(3) = [character(len=19) :: 'SLURM_JOB_ID', 'SLURM_ARRAY_JOB_ID', &
-         & 'SLURM_ARRAY_TASK_ID']
-      integer :: i, length, status, minutes
-      integer :: values(8)
+      character(len=*), parameter :: slurm(5) = [character(len=19) :: 'SLURM_JOB_ID', 'SLURM_ARRAY_JOB_ID', &
+         & 'SLURM_ARRAY_TASK_ID', 'SLURM_CLUSTER_NAME', 'SLURM_RESTART_COUNT']
+      integer :: i, length, status
 
       host = ''
       if (c_gethostname(host, len(host, c_size_t)) /= 0) host = 'unknown'
       length = index(host, c_null_char) - 1
       if (length < 0) length = len_trim(host)
       call write_attr_string(loc, 'host', host(:max(length, 0)), st)
-      call date_and_time(date, time, zone, values)
-      ! local time minus its offset from UTC (values(4), minutes)
-      minutes = values(5)*60 + values(6) - values(4)
-      call write_attr_string(loc, 'created', utc_stamp(values(1), values(2), values(3), minutes, values(7)), st)
+      call write_attr_string(loc, 'created', utc_now(), st)
       do i = 1, size(slurm)
          call get_environment_variable(trim(slurm(i)), value, length, status)
          if (status == 0 .and. length > 0) call write_attr_string(loc, to_lower(trim(slurm(i))), trim(value), st)
       end do
    end subroutine write_provenance
+
+   !> The current time, 'YYYY-MM-DDThh:mm:ssZ' (UTC).
+   function utc_now() result(stamp)
+      character(len=20) :: stamp
+      character(len=8) :: date
+      character(len=10) :: time
+      character(len=5) :: zone
+      integer :: values(8)
+      call date_and_time(date, time, zone, values)
+      stamp = utc_stamp(values(1), values(2), values(3), values(5)*60 + values(6) - values(4), values(7))
+   end function utc_now
 
    !> 'YYYY-MM-DDThh:mm:ssZ' for a local date and the minutes since its midnight in UTC
    !> (which may fall on the day before or after).
