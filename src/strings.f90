@@ -1,10 +1,11 @@
-!> Numbers as text for messages: one `to_string` for every kind the code prints.
+!> Text helpers: numbers as text for messages (one `to_string` for every kind the code
+!> prints) and ASCII lower case.
 module lc_strings
    use lc_kinds, only: wp
    use, intrinsic :: iso_fortran_env, only: int32, int64
    implicit none (type, external)
    private
-   public :: to_string
+   public :: to_string, lower_case
 
    !> Shortest text of an integer; a real with 6 significant digits (es12.5).
    interface to_string
@@ -36,4 +37,14 @@ contains
       write (buffer, '(es12.5)') x
       s = trim(adjustl(buffer))
    end function real_string
+   !> The text with ASCII letters in lower case.
+   pure function lower_case(text) result(low)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: low
+      integer :: i
+      low = text
+      do i = 1, len(text)
+         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
+      end do
+   end function lower_case
 end module lc_strings

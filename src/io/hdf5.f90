@@ -27,7 +27,7 @@ module lc_io_hdf5
       & h5dcreate_f, h5dopen_f, h5dwrite_f, h5dread_f, h5dclose_f, h5dget_space_f, h5dget_type_f
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
-   use lc_strings, only: to_string
+   use lc_strings, only: to_string, lower_case
    use lc_scene, only: scene_type, is_areal
    use lc_result, only: contact_result
    use lc_version, only: build_isa
@@ -676,7 +676,7 @@ contains
       call write_attr_string(loc, 'created', utc_now(), st)
       do i = 1, size(slurm)
          call get_environment_variable(trim(slurm(i)), value, length, status)
-         if (status == 0 .and. length > 0) call write_attr_string(loc, to_lower(trim(slurm(i))), trim(value), st)
+         if (status == 0 .and. length > 0) call write_attr_string(loc, lower_case(trim(slurm(i))), trim(value), st)
       end do
    end subroutine write_provenance
 
@@ -732,15 +732,6 @@ contains
       end function days_in
    end function utc_stamp
 
-   pure function to_lower(text) result(lower)
-      character(len=*), intent(in) :: text
-      character(len=len(text)) :: lower
-      integer :: i
-      lower = text
-      do i = 1, len(text)
-         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') lower(i:i) = achar(iachar(text(i:i)) + 32)
-      end do
-   end function to_lower
 
    !> A fixed-length, null-terminated string type for `length` characters.
    subroutine string_type(length, stype, hdferr)

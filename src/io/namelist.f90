@@ -10,7 +10,7 @@ module lc_io_namelist
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input, code_io
-   use lc_strings, only: to_string
+   use lc_strings, only: to_string, lower_case
    use lc_scene, only: scene_type, check_scene, not_set, max_string
    use lc_greens_viscoelastic, only: max_prony_terms
    implicit none (type, external)
@@ -579,7 +579,7 @@ contains
                if (.not. is_name_char(text(j:j))) exit
                j = j + 1
             end do
-            name = lower(text(i + 1:j - 1))
+            name = lower_case(text(i + 1:j - 1))
             inside = .false.
             if (name /= 'end') then
                inside = .true.
@@ -661,7 +661,7 @@ contains
       line = 1
       k = index(msg, marker)
       if (k == 0) return
-      token = lower(trim(msg(k + len(marker):)))
+      token = lower_case(trim(msg(k + len(marker):)))
       if (len(token) == 0) return
       do k = 1, size(lines)
          if (is_assigned(code_of(lines(k), k == 1), token)) then
@@ -682,7 +682,7 @@ contains
       character(len=*), intent(in) :: line
       logical, intent(in) :: first
       character(len=:), allocatable :: code
-      code = lower(strip_comment(line))
+      code = lower_case(strip_comment(line))
       if (first) code = skip_group_name(code)
    end function code_of
 
@@ -853,13 +853,4 @@ contains
       end do
    end function count_char
 
-   pure function lower(word) result(low)
-      character(len=*), intent(in) :: word
-      character(len=len(word)) :: low
-      integer :: i
-      low = word
-      do i = 1, len(word)
-         if (word(i:i) >= 'A' .and. word(i:i) <= 'Z') low(i:i) = achar(iachar(word(i:i)) + 32)
-      end do
-   end function lower
 end module lc_io_namelist

@@ -30,7 +30,7 @@ module lc_profiles_self_affine
    use lc_profiles_random, only: splitmix64_uniform
    implicit none (type, external)
    private
-   public :: self_affine_profile, sinusoid_profile
+   public :: self_affine_profile, sinusoid_profile, check_roughness_scale
 
    real(wp), parameter :: pi = acos(-1.0_wp)
    !> Default shortest wavelength as a fraction of the period.
@@ -84,13 +84,9 @@ contains
          call input_error(error, 'profile', 'rolloff_wavelength', to_string(rolloff), '0 < rolloff_wavelength <= period')
       else if (.not. (positive_finite(short) .and. short <= period)) then
          call input_error(error, 'profile', 'short_wavelength', to_string(short), '0 < short_wavelength <= period')
-      else if (count([rms_gradient /= not_set, rms_height /= not_set]) /= 1) then
-         call input_error(error, 'profile', 'rms_gradient/rms_height', 'both or neither given', 'exactly one of them')
-      else if (rms_gradient /= not_set .and. .not. positive_finite(rms_gradient)) then
-         call input_error(error, 'profile', 'rms_gradient', to_string(rms_gradient), '> 0 and finite')
-      else if (rms_height /= not_set .and. .not. positive_finite(rms_height)) then
-         call input_error(error, 'profile', 'rms_height', to_string(rms_height), '> 0 and finite')
       end if
+      if (allocated(error)) return
+      call check_roughness_scale(rms_gradient, rms_height, error)
       if (allocated(error)) return
 
       m_max = (n - 1)/2
@@ -159,5 +155,19 @@ contains
 
 
 
+
+   !> Exactly one of rms_gradient (-) and rms_height (L) given, positive and finite (the
+   !> scale of a self-affine line or surface).
+   subroutine check_roughness_scale(rms_gradient, rms_height, error)
+      real(wp), intent(in) :: rms_gradient, rms_height
+      type(error_type), allocatable, intent(out) :: error
+      if (count([rms_gradient /= not_set, rms_height /= not_set]) /= 1) then
+         call input_error(error, 'profile', 'rms_gradient/rms_height', 'both or neither given', 'exactly one of them')
+      else if (rms_gradient /= not_set .and. .not. positive_finite(rms_gradient)) then
+         call input_error(error, 'profile', 'rms_gradient', to_string(rms_gradient), '> 0 and finite')
+      else if (rms_height /= not_set .and. .not. positive_finite(rms_height)) then
+         call input_error(error, 'profile', 'rms_height', to_string(rms_height), '> 0 and finite')
+      end if
+   end subroutine check_roughness_scale
 
 end module lc_profiles_self_affine

@@ -49,6 +49,7 @@ module lc_profiles_surface
    use lc_scene, only: not_set
    use lc_fft_plans, only: fft_plan
    use lc_profiles_random, only: splitmix64_uniform
+   use lc_profiles_self_affine, only: check_roughness_scale
    implicit none (type, external)
    private
    public :: self_affine_surface, sinusoid_surface, spherical_cap, surface_mode_index
@@ -114,13 +115,9 @@ contains
       else if (.not. (positive_finite(short) .and. short <= longest)) then
          call input_error(error, 'profile', 'short_wavelength', to_string(short), &
             & '0 < short_wavelength <= max(period, period_y)')
-      else if (count([rms_gradient /= not_set, rms_height /= not_set]) /= 1) then
-         call input_error(error, 'profile', 'rms_gradient/rms_height', 'both or neither given', 'exactly one of them')
-      else if (rms_gradient /= not_set .and. .not. positive_finite(rms_gradient)) then
-         call input_error(error, 'profile', 'rms_gradient', to_string(rms_gradient), '> 0 and finite')
-      else if (rms_height /= not_set .and. .not. positive_finite(rms_height)) then
-         call input_error(error, 'profile', 'rms_height', to_string(rms_height), '> 0 and finite')
       end if
+      if (allocated(error)) return
+      call check_roughness_scale(rms_gradient, rms_height, error)
       if (allocated(error)) return
 
       mx_max = (nx - 1)/2

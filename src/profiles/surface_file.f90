@@ -23,7 +23,7 @@ module lc_profiles_surface_file
       & h5sget_simple_extent_dims_f, h5tget_class_f, h5tclose_f, H5T_NATIVE_DOUBLE, H5T_FLOAT_F
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
-   use lc_strings, only: to_string
+   use lc_strings, only: to_string, lower_case
    implicit none (type, external)
    private
    public :: read_surface_heights
@@ -80,18 +80,9 @@ contains
       integer :: n
       n = len_trim(text)
       ends_with = .false.
-      if (n >= len(tail)) ends_with = lower(text(n - len(tail) + 1:n)) == tail
+      if (n >= len(tail)) ends_with = lower_case(text(n - len(tail) + 1:n)) == tail
    end function ends_with
 
-   pure function lower(text) result(s)
-      character(len=*), intent(in) :: text
-      character(len=len(text)) :: s
-      integer :: i
-      s = text
-      do i = 1, len(s)
-         if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') s(i:i) = achar(iachar(s(i:i)) + 32)
-      end do
-   end function lower
 
    !> "(ny, nx) = (a, b)", the shape a surface file must have, in C order.
    pure function expected_shape(nx, ny) result(s)
