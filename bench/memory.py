@@ -23,14 +23,29 @@ multiplier, Anderson with the full history in use; E_inf/E0 = 100 as in bench/ff
 takes minutes at n = 2^20 and holds the same arrays).
 
     .venv/bin/python bench/memory.py [--quick] [--max-exponent 20]
+    .venv/bin/python bench/memory.py --areal [--areal-sizes 1024 2048] [--big 4096]
 
 ``--quick``: n = 2^12, 2^14, 2^16 only.
+
+``--areal``: the same measurement for ``layercontact.solve_areal`` on n x n grids
+(default 1024^2 and 2048^2; about a minute): an isotropic self-affine surface
+(``bench/areal_surfaces.py``: ``layercontact.self_affine_surface`` if the package has it,
+else a numpy fallback; H = 0.8, shortest wavelength 8 points, rms gradient 0.1) on a
+frictionless incompressible half-space (p_m/E* = 0.0125, constrained CG) and on the
+coupled layer h/period = 0.16, nu = 0.5, mu_c = 0.5 (p_m/E* = 0.015, GCR), solve_areal's
+defaults (tol 1e-10, coarse start, memory 12, threads 1). The increase of the peak over
+the resident set after making the surface is printed in doubles per grid point (targets:
+<= 20 frictionless, <= 30 coupled), and the slope between the two largest sizes (the
+fixed part removed). ``--big 4096`` adds one frictionless half-space solve at 4096^2
+(time and peak; skipped if the peak predicted from the largest measured size exceeds
+~20 GiB or the memory available).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import time
@@ -105,6 +120,114 @@ def expected(coupled: bool, outer: int) -> tuple[int, str]:
     return phases[phase], phase
 
 
+AREAL_SCENES = {
+    "areal half-space, mu_c = 0": "dict(thickness=np.inf, friction=0.0, pressure=0.0125)",
+    "areal h/lambda = 0.16, mu_c = 0.5": "dict(thickness=0.16, friction=0.5, pressure=0.015)",
+}
+
+AREAL_CHILD = """
+import json, os, resource, sys, time
+import numpy as np
+sys.path.insert(0, sys.argv[3])
+import layercontact as lc
+from areal_surfaces import surface
+
+def status(key):
+    with open('/proc/self/status') as f:
+        for line in f:
+            if line.startswith(key):
+                return int(line.split()[1])
+
+n = int(sys.argv[1])
+s = eval(sys.argv[2])
+h = surface(n, short_wavelength=8 / n)
+pm = s["pressure"] * 4 / 3                                  # p_m/E*, E* = 4/3
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
+current = status('VmRSS:')
+t = time.perf_counter()
+r = lc.solve_areal(h, thickness=s["thickness"], poisson=0.5, friction=s["friction"], mean_pressure=pm)
+t = time.perf_counter() - t
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(json.dumps(dict(base=base, current=current, peak=peak, seconds=t, iterations=r.iterations,
+                      outer=r.outer_iterations, converged=bool(r.converged), solver=r.solver,
+                      library_seconds=r.wall_time, contact=r.contact_fraction)))
+"""
+
+TARGETS = {"areal half-space, mu_c = 0": 20, "areal h/lambda = 0.16, mu_c = 0.5": 30}
+GIB = 2**30
+
+
+def measure_areal(n: int, scene: str) -> dict:
+    bench = os.path.dirname(os.path.abspath(__file__))
+    done = subprocess.run([sys.executable, "-c", AREAL_CHILD, str(n), scene, bench], capture_output=True, text=True)
+    if done.returncode:
+        raise RuntimeError(done.stderr)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def available_bytes() -> int:
+    with open("/proc/meminfo") as f:
+        for line in f:
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    return 0
+
+
+def areal_main(sizes: list[int], big: int | None) -> None:
+    import layercontact as lc
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from areal_surfaces import generator_name
+
+    start = time.perf_counter()
+    print(f"layercontact {lc.__version__} ({lc.BUILD} build); surface: {generator_name()}")
+    print("Peak RSS (ru_maxrss) of one solve_areal (defaults: tol 1e-10, coarse start, threads 1) minus the resident "
+          "set after import and surface, fresh process each; doubles/point = increase / (8 n^2)\n")
+    print("| scene | n | baseline RSS (MiB) | surface transient (MiB) | increase (MiB) | doubles/point | target "
+          "| solver | it. | contact | solve (s) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|")
+    slopes, last = [], None
+    for name, scene in AREAL_SCENES.items():
+        points, increases = [], []
+        for n in sizes:
+            m = measure_areal(n, scene)
+            increase = (m["peak"] - m["current"]) * 1024
+            points.append(n * n)
+            increases.append(increase)
+            flag = "" if m["converged"] else " (not converged)"
+            print(f"| {name} | {n}^2 | {m['current'] / 1024:.1f} | {(m['base'] - m['current']) / 1024:+.1f} "
+                  f"| {increase / 2**20:.1f} | {increase / (8 * n * n):.1f} | <= {TARGETS[name]} | {m['solver']} "
+                  f"| {m['iterations']}{flag} | {m['contact']:.3f} | {m['seconds']:.2f} |", flush=True)
+            if name == "areal half-space, mu_c = 0":
+                last = (n, m)  # what --big extrapolates from
+        if len(points) > 1:
+            slope = (increases[-1] - increases[-2]) / (points[-1] - points[-2])  # bytes per point
+            slopes.append((name, slope / 8, (increases[-1] - slope * points[-1]) / 2**20))
+    if slopes:
+        print(f"\nSlope between {sizes[-2]}^2 and {sizes[-1]}^2:\n")
+        print("| scene | slope (doubles/point) | fixed (MiB) |")
+        print("|---|---:|---:|")
+        for name, slope, fixed in slopes:
+            print(f"| {name} | {slope:.1f} | {fixed:.1f} |")
+    if big:
+        n_last, m_last = last
+        per_point = (m_last["peak"] * 1024) / (n_last * n_last)  # whole peak, baseline included
+        predicted = per_point * big * big
+        limit = min(20 * GIB, available_bytes())
+        if predicted > limit:
+            print(f"\n{big}^2 frictionless half-space skipped: predicted peak {predicted / GIB:.1f} GiB > "
+                  f"{limit / GIB:.1f} GiB")
+        else:
+            m = measure_areal(big, AREAL_SCENES["areal half-space, mu_c = 0"])
+            increase = (m["peak"] - m["current"]) * 1024
+            flag = "" if m["converged"] else " (NOT converged)"
+            print(f"\n{big}^2 frictionless half-space{flag}: solve {m['seconds']:.1f} s (library {m['library_seconds']:.1f} s), "
+                  f"{m['solver']} {m['iterations']} it., contact {m['contact']:.3f}; peak RSS {m['peak'] / 2**20:.2f} GiB "
+                  f"(predicted {predicted / GIB:.2f}), increase {increase / GIB:.2f} GiB = "
+                  f"{increase / (8 * big * big):.1f} doubles/point")
+    print(f"\n({time.perf_counter() - start:.0f} s)")
+
+
 def measure(n: int, scene: str) -> dict:
     done = subprocess.run([sys.executable, "-c", CHILD, str(n), scene], capture_output=True, text=True)
     if done.returncode:
@@ -116,7 +239,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="n = 2^12, 2^14, 2^16 only")
     parser.add_argument("--max-exponent", type=int, default=20)
+    parser.add_argument("--areal", action="store_true", help="areal solves (solve_areal) instead of lines")
+    parser.add_argument("--areal-sizes", type=int, nargs="+", default=[1024, 2048])
+    parser.add_argument("--big", type=int, default=None, help="with --areal: one frictionless solve at big^2")
     args = parser.parse_args()
+    if args.areal:
+        areal_main(args.areal_sizes, args.big)
+        return
     exponents = [12, 14, 16] if args.quick else list(range(12, args.max_exponent + 1))
     start = time.perf_counter()
     fits = []
