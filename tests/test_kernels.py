@@ -1,5 +1,5 @@
 """Layer kernel factors 1-A, 1-B, c (seed Eqs. 7-9 in convention P): mpmath references,
-the independent LAPACK mode solve, the limits and the sign checks of DESIGN.md §1."""
+the independent LAPACK mode solve, the limits and the sign checks of docs/theory.md."""
 
 import numpy as np
 import pytest

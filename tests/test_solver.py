@@ -68,7 +68,7 @@ def test_rough_contact_satisfies_contact_conditions(rough_profile, thickness, fr
 
 
 def test_delta_mu_identities_in_partial_contact(rough_profile):
-    """DESIGN.md §3: -<p w'>/p_m (Eq. 11), the spectral sum and the energy route agree to
+    """-<p w'>/p_m (Eq. 11), the spectral sum and the energy route agree to
     rounding; the force balance on the rigid profile -<p r'>/p_m differs by a
     discretisation error that shrinks with the grid (measured: 2e-3 relative at n = 2048,
     below 1e-4 from n = 8192 on)."""
@@ -99,7 +99,7 @@ def test_incompressible_halfspace_friction_changes_nothing(rough_profile):
 
 
 def test_sign_check_2_thin_incompressible_layer_shifts_pressure_forward():
-    """DESIGN.md sign check 2: on a thin incompressible layer friction moves the pressure
+    """Sign check 2 of docs/theory.md: on a thin incompressible layer friction moves the pressure
     maximum ahead of the asperity (+x), the leading edge forward, and Delta mu > 0; a
     compressible half-space gives Delta mu < 0."""
     n = 2048

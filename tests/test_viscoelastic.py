@@ -86,7 +86,7 @@ def test_power_balance_and_delta_mu_routes(rough_profile, friction):
 
 
 def test_non_monotone_operator_is_reported(tmp_path):
-    """DESIGN.md §3: on a thin layer with friction, coupling times the loss compliance can
+    """on a thin layer with friction, coupling times the loss compliance can
     make Re G_eff < 0 for some modes (h/lambda = 0.05, mu_c = 0.5, k V tau ~ 1)."""
     h = lc.self_affine_profile(1024, 0.8, short_wavelength=1 / 32)
     res = lc.solve_line(h, thickness=0.05, friction=0.5, material=SLS, speed=1 / (2 * np.pi),

@@ -1,4 +1,4 @@
-"""Complex creep compliance J*(k) of steady sliding (seed Eqs. 12-15, DESIGN.md §1
+"""Complex creep compliance J*(k) of steady sliding (seed Eqs. 12-15, docs/theory.md
 "Viscoelasticity") against a direct mpmath quadrature of seed Eq. (14), plus its symmetry,
 limits, sign of the loss and the position of the loss peaks.
 
@@ -377,7 +377,7 @@ def test_sls_equals_one_term_creep_prony():
 
 def test_one_term_relaxation_prony_is_an_sls_with_retardation_time():
     """E(t) = E_r + E_1 exp(-t/tau_r) is the SLS with E0 = E_r, E_inf = E_r + E_1 and the
-    retardation time tau = tau_r E_inf/E0 (DESIGN.md: the SLS tau is a creep time):
+    retardation time tau = tau_r E_inf/E0 (the SLS tau is a creep time):
     (E_r - i x_r E_inf)/(1 - i x_r) = 1/J*_SLS with x_r = omega tau_r. Different arithmetic
     on the two sides: a few ulp, 1e-13."""
     er, e1, tr = 1.3, 7.7, 0.05

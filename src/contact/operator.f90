@@ -16,7 +16,7 @@
 !> M(k) = |G_eff(k)|: the symmetric solver works with M, the outer iteration with G - M.
 !> With this metric the linearised outer map has eigenvalues exp(i arg G_eff(k)) on the
 !> right half of the unit circle however strong the coupling or the viscoelastic loss
-!> (DESIGN.md suggests the real part Re G_eff instead, whose map has eigenvalues
+!> (the real part Re G_eff as the metric would give the eigenvalues
 !> 1 - i Im G/Re G, up to ~300 in modulus for thin incompressible layers).
 module lc_contact_operator
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite

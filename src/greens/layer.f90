@@ -1,6 +1,6 @@
 !> Fourier multipliers of an elastic layer bonded to a rigid base: `1-A`, `1-B` and `c`
 !> of Eqs. (7)-(9) of the seed paper (Menga, Carbone, Mueller, Mueser), written in the
-!> sign convention "convention P" of shared/DESIGN.md section 1:
+!> sign convention "convention P" of docs/theory.md:
 !>
 !>    w^(k)   = 2/(E*|k|) [ (1-A) p^(k)      - i sgn(k) c tau^(k) ]
 !>    u_x^(k) = 2/(E*|k|) [ i sgn(k) c p^(k) + (1-B) tau^(k)      ]

@@ -10,7 +10,7 @@
 !>                    a grid it differs by a discretisation error that vanishes as the grid
 !>                    is refined (the spectral slope of w - r is not zero at contact nodes
 !>                    next to an edge), which makes it a per-run accuracy indicator.
-!> Comparing them checks the solver and the sign conventions (DESIGN.md §3).
+!> Comparing them checks the solver and the sign conventions (docs/theory.md).
 !> On a surface (lc_grid) the derivatives are along the sliding direction x.
 module lc_observables_friction
    use lc_kinds, only: wp

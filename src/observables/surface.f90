@@ -1,7 +1,7 @@
 !> Tangential surface displacement and surface in-plane stress of a line contact (a grid
 !> with one row).
 !>
-!> Convention P (DESIGN.md §1), tau = mu_c p along +x on the layer:
+!> Convention P (docs/theory.md), tau = mu_c p along +x on the layer:
 !>    u_x^(k) = 2/(E*|k|) [ i sgn(k) c p^(k) + (1-B) tau^(k) ],
 !> with 1/E* -> (1 - nu^2) J*(kV) for a viscoelastic layer (Poisson's ratio constant),
 !> and at z = 0, from Hooke's law in plane strain with sigma_zz = -p (exact at the surface):

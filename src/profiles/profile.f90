@@ -1,4 +1,4 @@
-!> The rigid indenter profile of a scene (DESIGN.md §1 "Profiles"): made from
+!> The rigid indenter profile of a scene (docs/theory.md): made from
 !> scene%profile (self_affine | sinusoid | file; on an areal scene also sphere) on the
 !> scene's grid, and the statistics of a line profile. A line scene gets n heights
 !> (lc_profiles_self_affine), an areal scene n*ny heights, x fastest (lc_profiles_surface,

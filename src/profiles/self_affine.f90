@@ -1,4 +1,4 @@
-!> Line profiles made from a Fourier series: a random self-affine profile (DESIGN.md §1
+!> Line profiles made from a Fourier series: a random self-affine profile (docs/theory.md
 !> "Profiles": power spectrum C(q) ~ q^(-1-2H), random phases, scaled to an rms gradient
 !> or height) and a sinusoid for analytic checks.
 !>

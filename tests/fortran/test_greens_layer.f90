@@ -1,4 +1,4 @@
-!> Tests of lc_greens_layer (layer multipliers 1-A, 1-B, c of DESIGN.md convention P):
+!> Tests of lc_greens_layer (layer multipliers 1-A, 1-B, c of convention P, docs/theory.md):
 !> limits, continuity at the branch switches, closed form against the LAPACK mode solver,
 !> reciprocity and sign checks, and the mpmath table tests/data/kernel_reference.txt
 !> (path as first argument). Prints one line per check; error stop 1 on any failure.
