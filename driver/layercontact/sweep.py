@@ -600,7 +600,10 @@ def summary_row(planned: dict[str, object], outcome: dict[str, object],
     ``normalised_pressure``, recomputed by the library to rounding)."""
     row = dict(planned)
     row.update({key: value for key, value in outcome.items() if key not in row})
-    row.update({key: value for key, value in provenance.provenance_columns(record).items() if key not in row})
+    # the provenance columns in one order, whether the result file or the run record
+    # gave them (a value in the result file wins)
+    for key, value in provenance.provenance_columns(record).items():
+        row[key] = row.pop(key) if key in row else value
     row["error"] = row.pop("error", "")  # last, as in the summary files
     return row
 
