@@ -211,13 +211,13 @@ contains
          call close_group(group, st)
 
          if (present(companion)) then
-            call write_solution(file, result, scene, height, st, &
+            call write_solution(file, result, scene, st, &
                & a_over_a0=result%contact_fraction / companion%contact_fraction)
             call create_group(file, 'companion', group, st)
-            call write_solution(group, companion, scene, height, st)
+            call write_solution(group, companion, scene, st)
             call close_group(group, st)
          else
-            call write_solution(file, result, scene, height, st)
+            call write_solution(file, result, scene, st)
          end if
          call h5fclose_f(file, ignore)
       end if
@@ -362,11 +362,10 @@ contains
    end subroutine write_scene_attrs
 
    !> fields/, results (attributes) and convergence/ of one solve, under `loc`.
-   subroutine write_solution(loc, res, scene, height, st, a_over_a0)
+   subroutine write_solution(loc, res, scene, st, a_over_a0)
       integer(hid_t), intent(in) :: loc
       type(contact_result), intent(in) :: res
       type(scene_type), intent(in) :: scene
-      real(wp), intent(in) :: height(:)
       type(h5_status), intent(inout) :: st
       !> contact area relative to the frictionless companion's
       real(wp), intent(in), optional :: a_over_a0
