@@ -1,6 +1,6 @@
 !> layercontact: solve the sliding contact scene of a namelist file, write an HDF5 result.
 !>
-!>    layercontact FILE.nml
+!>    layercontact FILE.nml | --help | --version
 !>
 !> Exit codes: 0 converged; 2 bad input (nothing written); 3 not converged (results
 !> written, flagged converged = 0); 4 I/O failure; 5 internal failure; 1 usage.
@@ -8,6 +8,7 @@ program layercontact
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use lc_errors, only: error_type, code_not_converged
    use lc_run, only: run_scene_file
+   use lc_version, only: version_string, build_isa
    implicit none (type, external)
    type(error_type), allocatable :: error
    character(len=:), allocatable :: input, output_file
@@ -21,6 +22,17 @@ program layercontact
    call get_command_argument(1, length=length)
    allocate (character(len=length) :: input)
    call get_command_argument(1, input)
+   select case (input)
+   case ('--help', '-h')
+      write (output_unit, '(a)') 'usage: layercontact FILE.nml', &
+         & '  Solve the sliding contact scene of a namelist file and write its HDF5 result.', &
+         & '  Exit codes: 0 converged; 1 usage; 2 bad input (nothing written); 3 not converged', &
+         & '  (results written with converged = 0); 4 I/O failure; 5 internal failure.'
+      stop
+   case ('--version')
+      write (output_unit, '(a)') 'layercontact ' // version_string // ' (' // build_isa // ')'
+      stop
+   end select
 
    call run_scene_file(input, output_unit, output_file, converged, error)
    if (allocated(error)) then

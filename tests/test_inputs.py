@@ -143,3 +143,14 @@ def test_profile_from_hdf5_file(tmp_path):
     wrong.write_text(nml.read_text().replace("n = 512", "n = 256").replace("'r.h5'", "'w.h5'"))
     proc = run_exe(wrong, tmp_path)
     assert proc.returncode == 2 and "512" in proc.stderr and not (tmp_path / "w.h5").exists()
+
+
+def test_executable_usage_help_and_version():
+    """No argument is a usage error (exit 1, on stderr); --help and --version print and exit 0."""
+    exe = executable()
+    none = subprocess.run([exe], capture_output=True, text=True, timeout=60)
+    assert none.returncode == 1 and "usage: layercontact FILE.nml" in none.stderr
+    helped = subprocess.run([exe, "--help"], capture_output=True, text=True, timeout=60)
+    assert helped.returncode == 0 and "Exit codes: 0 converged; 1 usage; 2 bad input" in helped.stdout
+    version = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=60)
+    assert version.returncode == 0 and version.stdout.split()[:2] == ["layercontact", lc.__version__]
