@@ -154,3 +154,36 @@ def test_executable_usage_help_and_version():
     assert helped.returncode == 0 and "Exit codes: 0 converged; 1 usage; 2 bad input" in helped.stdout
     version = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=60)
     assert version.returncode == 0 and version.stdout.split()[:2] == ["layercontact", lc.__version__]
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf], ids=["nan", "inf"])
+def test_heights_that_are_not_finite_are_refused(bad, tmp_path):
+    """NaN or Inf heights, from Python or from a file, are bad input (code 2), not a run
+    with NaN fields; the executable writes nothing."""
+    line = np.cos(2 * np.pi * np.arange(64) / 64)
+    line[5] = bad
+    with pytest.raises(lc.LayercontactError, match="NaN or infinite") as err:
+        lc.solve_line(line, mean_pressure=0.1)
+    assert err.value.code == 2
+    with pytest.raises(lc.LayercontactError, match="NaN or infinite"):
+        lc.solve_areal(np.tile(line, (8, 1)), mean_pressure=0.1)
+    with h5py.File(tmp_path / "measured.h5", "w") as f:
+        f["/profile/height"] = line
+    nml = tmp_path / "scene.nml"
+    nml.write_text("&scene\n n = 64\n/\n&profile\n kind = 'file'\n file = 'measured.h5'\n/\n"
+                   "&loading\n mean_pressure = 0.1\n/\n&output\n file = 'r.h5'\n/\n")
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2 and "&profile" in proc.stderr
+    assert not (tmp_path / "r.h5").exists()
+
+
+def test_flat_profile_with_a_normalised_pressure_is_refused(tmp_path):
+    """A flat profile has no relief for the seed's line pressure scale: p_m would be 0."""
+    with h5py.File(tmp_path / "flat.h5", "w") as f:
+        f["/profile/height"] = np.zeros(64)
+    nml = tmp_path / "scene.nml"
+    nml.write_text("&scene\n n = 64\n/\n&profile\n kind = 'file'\n file = 'flat.h5'\n/\n"
+                   "&loading\n normalised_pressure = 1.0\n/\n&output\n file = 'r.h5'\n/\n")
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2 and "&loading: normalised_pressure" in proc.stderr
+    assert not (tmp_path / "r.h5").exists()

@@ -8,6 +8,7 @@
 !> p_m/(E* Lambda0/lambda), Lambda0 = max r - mean r) and finds Delta; displacement
 !> control gives Delta and finds p_m.
 module lc_contact_solve
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_strings, only: to_string
@@ -83,12 +84,24 @@ contains
          return
       end if
 
+      if (.not. all(ieee_is_finite(height))) then
+         call fatal_error(error, '&profile: the heights hold ' // to_string(count(.not. ieee_is_finite(height))) // &
+            & ' NaN or infinite values; allowed: finite heights', code_input)
+         return
+      end if
       lambda_max = maxval(height)
       g_ref = maxval(height) - minval(height)
       if (g_ref <= 0.0_wp) g_ref = scene%period   ! flat punch: any length scale will do
       allocate (p(n), w(n), gap(n))
       if (load_control) then
          pm = scene_mean_pressure(scene, height)
+         if (.not. (pm > 0.0_wp .and. ieee_is_finite(pm))) then
+            ! a flat surface has no relief to scale the seed's line pressure by
+            call fatal_error(error, '&loading: normalised_pressure = ' // to_string(scene%normalised_pressure) // &
+               & ' gives p_m = ' // to_string(pm) // ' on this profile (no summit above its mean plane); ' // &
+               & 'allowed: a profile with relief, or mean_pressure', code_input)
+            return
+         end if
          p = pm
          s = 0.0_wp
       else
