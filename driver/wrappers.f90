@@ -39,7 +39,7 @@ subroutine py_layer_coefficients_lapack(n, kh, nu, one_minus_a, one_minus_b, c, 
    end do
 end subroutine py_layer_coefficients_lapack
 
-!> Seeded self-affine line profile (lengths as given; -1 = not set).
+!> Seeded self-affine line profile (lengths as given; -huge = not set: layercontact.api.NOT_SET).
 subroutine py_self_affine_profile(n, period, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
       & rms_height, height, stat, errmsg)
    use lc_errors, only: error_type

@@ -20,8 +20,9 @@ module lc_scene
       & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale
    public :: max_string, default_rms_gradient
 
-   !> Sentinel for "not given" in optional positive quantities.
-   real(wp), parameter :: not_set = -1.0_wp
+   !> Sentinel for "not given" in optional positive quantities: a value nobody types, so
+   !> that a wrong input such as rms_gradient = -1 is reported, not taken for "not given".
+   real(wp), parameter :: not_set = -huge(1.0_wp)
    !> rms gradient of a self-affine profile when neither rms_gradient nor rms_height is given
    !> (under linear elasticity the scale only matters relative to the pressure).
    real(wp), parameter :: default_rms_gradient = 0.1_wp

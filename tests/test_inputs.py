@@ -75,6 +75,10 @@ BAD = [
     ("&loading\n mean_pressure = 0.1\n normalised_pressure = 1.0\n/\n", "exactly one of them"),
     ("&profile\n hurst = 1.2\n/\n", "&profile: hurst"),
     ("&solver\n tol = 0.5\n/\n", "&solver: tol"),
+    # a negative value is refused like any other (no number means "not given")
+    ("&profile\n rms_gradient = -1.0\n/\n", "&profile: rms_gradient"),
+    ("&loading\n mean_pressure = -1.0\n/\n", "&loading: mean_pressure"),
+    ("&profile\n short_wavelength = -1.0\n/\n", "&profile: short_wavelength"),
     ("&solver\n method = 'gmres'\n/\n", "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"),
     ("&loading\n control = 'displacement'\n penetration = 1e-3\n/\n", "needs a finite layer"),
     ("&loading\n normalised_pressure = 1.0\n penetration = 1e-3\n/\n", "&loading: penetration"),

@@ -4,13 +4,15 @@ Fortran messages become exceptions, results come back as plain dataclasses."""
 from __future__ import annotations
 
 import os
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .native import core as _core
 
-NOT_SET = -1.0
+# The library's "not given" (lc_scene's not_set): a value nobody types.
+NOT_SET = -sys.float_info.max
 _CONTROLS = {"load": 0, "displacement": 1}
 _METHODS = {"auto": 0, "cg": 1, "anderson": 2, "gcr": 3, "gfmd": 4}
 # Order of the scalars returned by the wrapper py_solve (driver/wrappers.f90).

@@ -127,7 +127,7 @@ contains
       character(len=:), allocatable, intent(out) :: text
 
       associate (p => scene%profile, s => scene%solver)
-         text = '! layercontact scene: every value as parsed (-1 = not set)' // newline &
+         text = '! layercontact scene: every value as parsed (values not given are marked ! not set)' // newline &
             & // '&scene' // newline &
             & // entry('geometry', str_value(scene%geometry)) &
             & // entry('title', str_value(scene%title)) &
