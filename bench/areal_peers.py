@@ -7,7 +7,7 @@ identical frictionless half-space problems, at equal accuracy.
     .venv/bin/python bench/areal_peers.py --sizes 2048 --peers tamaas --peer-tol tamaas=1e-8 \\
         --timeout 3600                                             # one Tamaas run at 2048^2 (~10-20 min)
 
-Problem (the one in /work/shared/REFERENCES.md): an isotropic self-affine surface, Hurst
+Problem: an isotropic self-affine surface, Hurst
 exponent 0.8, spectrum from the period down to a shortest wavelength of 8 grid points, rms
 gradient 0.1 (``layercontact.self_affine_surface``), n x n points of a
 unit square period, periodic, pressed on an incompressible elastic half-space (E = 1,

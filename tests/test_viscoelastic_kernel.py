@@ -196,7 +196,7 @@ def _assert_close(got, ref, rtol, what):
     assert abs(got.imag - ref.imag) <= rtol * abs(ref.imag), f"{what}: Im: got {got!r}, ref {ref!r}"
 
 
-# Issue requirement: relative 1e-8. The reference is good to ~1e-17 and the closed forms
+# Required: relative 1e-8. The reference is good to ~1e-17 and the closed forms
 # in double precision to a few ulp (no cancellation: every term of Re and of Im has one
 # sign), so this only leaves room: a wrong sign of i flips Im (>= 2e-3 even in |J*| on
 # this grid) and a wrong tau is an O(1) error in Im.
