@@ -111,7 +111,7 @@ def test_viscoelastic_runs_converge_or_say_so(n):
     or exist); at n = 1024, 31 of the 1152 monotone runs do not converge either: strongly
     glassy layers (E_inf/E0 >= 100) at speeds where the grid scales are glassy and the
     roughness is not, near full contact (p_m/p_full = 0.3, 60-98 % contact); GCR
-    stagnates and the Anderson iteration spends max_iter (NOTES.md, session 4)."""
+    stagnates and the Anderson iteration spends max_iter (docs/decisions/000-line-solver-measurements.md)."""
     runs = converged = monotone_failed = 0
     for scene in viscoelastic_scenes(n):
         r = solve(scene)

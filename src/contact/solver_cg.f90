@@ -80,8 +80,9 @@ contains
       ! update moves it with w (d <- d - tau M t), and the gap on the contact set is d - s.
       ! An iteration is then three or four passes over the grid (state, preconditioner's
       ! mean, direction, update) around the transforms; each pass costs a sizeable part of a
-      ! transform (at n = 65536 they are compute-bound, not memory-bound: NOTES.md), so
-      ! every pass and every reduction saved shows.
+      ! transform (at n = 65536 they are compute-bound, not memory-bound:
+      ! docs/decisions/000-line-solver-measurements.md), so every pass and every reduction
+      ! saved shows.
       n = size(p)
       associate (d => gap)
       allocate (t(n))

@@ -35,7 +35,7 @@ module lc_contact_solver_gcr
    !> fine-grid contact sets settle slowly (a clip restarts the history) and erratically
    !> (116 of the 576 scenes of inputs/sweeps/viscoelastic_speed.nml), and a few thin
    !> incompressible layers with strong friction on tiny grids. A window of 40 made that
-   !> sweep cost twice as many transforms (NOTES.md).
+   !> sweep cost twice as many transforms (docs/decisions/000-line-solver-measurements.md).
    integer, parameter :: stall_window = 25
    !> Iterations after which w = G_eff p is recomputed (bounds the drift of the updates).
    integer, parameter :: refresh_interval = 50
@@ -251,7 +251,8 @@ contains
             ! the next iteration first projects the residual on it, which restores GCR's
             ! invariant (residual orthogonal to the stored images). (Kept across clips too,
             ! with the clipped points taken out of the stored directions and their images
-            ! corrected column by column, it cost more than the restart: NOTES.md.)
+            ! corrected column by column, it cost more than the restart:
+            ! docs/decisions/000-line-solver-measurements.md.)
             call reorthonormalise(p, load_control, dirs, images, columns, newest)
             set_changed = columns > 0
          end if

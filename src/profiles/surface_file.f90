@@ -290,11 +290,11 @@ contains
    pure function word_value(header, key) result(s)
       character(len=*), intent(in) :: header, key
       character(len=:), allocatable :: s, rest
-      integer :: stop
+      integer :: word_end
       rest = after_key(header, key)
-      stop = scan(rest, ',}')
-      if (stop == 0) stop = len(rest) + 1
-      s = trim(rest(1:stop - 1))
+      word_end = scan(rest, ',}')
+      if (word_end == 0) word_end = len(rest) + 1
+      s = trim(rest(1:word_end - 1))
    end function word_value
 
    !> The shape tuple of the header; rank = -1 when it cannot be parsed.
