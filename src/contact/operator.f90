@@ -68,6 +68,9 @@ module lc_contact_operator
       !> of a half-space, or under load control)
       real(wp), allocatable :: preconditioner(:)
       logical :: monotone = .true.          !< Re G_eff(k) >= 0 for every mode (unique solution)
+      !> symmetric (not coupled) with a metric that falls with |q| over the grid's modes: the
+      !> masked Fourier inverse then preconditions the constrained CG well at every scale
+      logical :: metric_falls = .false.
       complex(wp), allocatable :: full(:)   !< G_eff(q), only when coupled
       !> M in real space: (M p)(x_i) = sum_j column(i - j) p_j, i - j taken periodically on
       !> both axes (L/S)
@@ -105,7 +108,7 @@ contains
       real(wp), intent(in) :: friction
       integer, intent(in) :: threads
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: qx, qy, q, one_minus_a, one_minus_b, c
+      real(wp) :: qx, qy, q, one_minus_a, one_minus_b, c, q_min, q_max
       complex(wp) :: g
       real(wp), allocatable :: factor(:)
       integer :: i, mx, nkx
@@ -143,9 +146,13 @@ contains
       op%metric(1) = kernel%normal_uniform(real(op%compliance(1), wp))
       if (op%coupled) op%full(1) = op%metric(1)
 
+      q_min = huge(1.0_wp)
+      q_max = 0.0_wp
       do i = 2, op%nk
          call grid%wavevector(i, qx, qy)
          q = hypot(qx, qy)
+         q_min = min(q_min, q)
+         q_max = max(q_max, q)
          mx = mod(i - 1, nkx)
          call kernel%factors(q, one_minus_a, one_minus_b, c)
          g = 2.0_wp/q*op%compliance(mx + 1)*cmplx(one_minus_a, -friction*c*(qx/q), kind=wp)
@@ -172,6 +179,8 @@ contains
       ! (always for elastic layers; not always for viscoelastic ones with friction).
       op%monotone = .true.
       if (op%coupled) op%monotone = all(real(op%full, wp) >= 0.0_wp)
+      op%metric_falls = .not. op%coupled .and. op%nk > 1
+      if (op%metric_falls) op%metric_falls = kernel%compliance_falls(q_min, q_max)
       call derive(op)
    end subroutine build_operator
 

@@ -74,7 +74,7 @@ contains
       real(wp) :: gnorm, gnorm_old, tau, best, beta, b_max, m_max, load_scale, p_ref, g_floor
       real(wp) :: gt_sum, gz_sum, z_mean, t_sum, t_left, t_shift, denominator
       integer :: it, n, n_contact, last_progress, since_fresh, n_changed
-      logical :: restart, preconditioned, stale
+      logical :: restart, preconditioned, stale, entered, safeguarded
 
       ! The iteration works on the raw gap d = w - b (kept in `gap`) instead of w: the
       ! update moves it with w (d <- d - tau M t), and the gap on the contact set is d - s.
@@ -95,6 +95,17 @@ contains
       p = max(p, 0.0_wp)
       if (load_control) call normalise(p, mean_pressure)
       preconditioned = precondition
+      ! Where the metric falls with |q| (half-space, compressible layers) its masked Fourier
+      ! inverse preconditions well at every scale; on broadband roughness points enter at
+      ! most iterations, and restarting the conjugacy at each entry would reduce CG to
+      ! steepest descent (docs/decisions/005-broadband-cg.md: 5698 -> 252 iterations on a
+      ! line of 65536 points with roughness down to 8 grid points). Elsewhere (the metric of
+      ! a coupled operator in the Anderson iteration, thin incompressible layers whose
+      ! compliance rises with |q|) the inverse is far off at the edges of the contact set:
+      ! there the iteration is safeguarded: the conjugacy restarts when points are let in,
+      ! a point clipped may enter again at once, and the preconditioner is dropped when the
+      ! iteration stalls.
+      safeguarded = .not. op%metric_falls
       best = huge(1.0_wp)
       last_progress = 0
       b_max = maxval(abs(b))
@@ -135,7 +146,8 @@ contains
          outcome%preconditioned = preconditioned
          outcome%iterations = min(it, max_iter)
          if (present(history)) then
-            if (it <= size(history)) history(it) = outcome%residual
+            ! (the evaluation after the last iteration replaces that iteration's residual)
+            if (size(history) > 0) history(min(outcome%iterations, size(history))) = outcome%residual
          end if
          if (outcome%converged .or. it > max_iter) exit
          ! The Fourier preconditioner amplifies short waves; where the compliance falls
@@ -145,7 +157,7 @@ contains
          if (outcome%residual < 0.5_wp*best) then
             best = outcome%residual
             last_progress = it
-         else if (preconditioned .and. it - last_progress > stall_window) then
+         else if (safeguarded .and. preconditioned .and. it - last_progress > stall_window) then
             preconditioned = .false.
             restart = .true.
             last_progress = it
@@ -198,7 +210,8 @@ contains
          tau = gt_sum/denominator
          ! update, clip at zero, let overlapping points in; d follows p along t, and the
          ! points clipped or let in are added column by column (M is circulant) below
-         call update(p, d, b, s, tau, t, buffer, sums, t_left, n_changed, restart)
+         call update(p, d, b, s, tau, t, buffer, safeguarded, sums, t_left, n_changed, entered)
+         restart = entered .and. safeguarded
          if (n_changed > column_updates) then
             stale = .true.
          else if (n_changed > 0) then
@@ -359,17 +372,20 @@ contains
    !> (all but the maxima, which only set the rounding floor and are kept from the last
    !> full evaluation: fewer reductions keep this loop in registers), t_left = the sum of t
    !> over the points that left the contact set, n_changed and whether points were let in
-   !> (the next direction restarts).
-   subroutine update(p, d, b, s, tau, t, r, sums, t_left, n_changed, entered)
+   !> (a safeguarded iteration restarts its conjugacy then). `reenter`: a point clipped by
+   !> this step is let in again at once if its gap is negative (the safeguarded iteration);
+   !> otherwise it stays out until the next evaluation.
+   subroutine update(p, d, b, s, tau, t, r, reenter, sums, t_left, n_changed, entered)
       real(wp), contiguous, intent(inout) :: p(:), d(:), r(:)
       real(wp), contiguous, intent(in) :: b(:), t(:)
       real(wp), intent(in) :: s, tau
+      logical, intent(in) :: reenter
       type(grid_sums), intent(inout) :: sums
       real(wp), intent(out) :: t_left
       integer, intent(out) :: n_changed
       logical, intent(out) :: entered
       real(wp) :: contact, d_contact, b_contact, p_sum, changed_count, entered_count
-      real(wp) :: trial, p_new, d_new, g, c, inside, left
+      real(wp) :: trial, p_new, d_new, g, c, inside, left, reenter_weight
       integer :: j
       contact = 0.0_wp
       d_contact = 0.0_wp
@@ -378,17 +394,20 @@ contains
       changed_count = 0.0_wp
       entered_count = 0.0_wp
       t_left = 0.0_wp
+      reenter_weight = merge(1.0_wp, 0.0_wp, reenter)
       !$omp simd reduction(+:contact, d_contact, b_contact, p_sum, changed_count, entered_count, t_left) &
       !$omp& private(trial, p_new, d_new, g, c, inside, left)
       do j = 1, size(p)
          ! t = 0 off the contact set, so p - tau t is p there
          trial = p(j) - tau*t(j)
          p_new = merge(trial, 0.0_wp, trial >= 0.0_wp)   ! clip (a NaN too)
-         ! let in where p = 0 and g < 0 (g before the step); max(): once the contact set is
+         ! let in where p = 0 and g < 0 (g before the step; p after it with `reenter`, before
+         ! it otherwise); max(): once the contact set is
          ! solved tau is a ratio of rounding noise and may be negative, and a negative
          ! pressure would never be clipped again
          g = d(j) - s
-         c = merge(1.0_wp, 0.0_wp, g < 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)
+         c = merge(1.0_wp, 0.0_wp, g < 0.0_wp)*(reenter_weight*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp) &
+            & + (1.0_wp - reenter_weight)*merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp))
          p_new = c*max(-tau*g, 0.0_wp) + (1.0_wp - c)*p_new
          entered_count = entered_count + c
          left = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)

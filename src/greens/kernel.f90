@@ -35,6 +35,7 @@ module lc_greens_kernel
    contains
       procedure :: contact_compliance
       procedure :: factors
+      procedure :: compliance_falls
       procedure :: normal_uniform
       procedure :: shear_uniform
       procedure :: antiplane
@@ -74,6 +75,32 @@ contains
       ! x = +Inf (half-space) gives 1-A = 1-B = 1 and Dundurs' c
       call layer_coefficients(q*self%thickness, self%poisson, one_minus_a, one_minus_b, c)
    end subroutine factors
+
+   !> Whether the normal compliance (1-A(|q| h))/|q| falls with |q| on [q_min, q_max] (1/L),
+   !> sampled at 64 points per decade: true for a half-space and for compressible layers
+   !> (a constant below |q| h ~ 1, then 1/|q|); false for thin, nearly incompressible
+   !> layers, whose compliance rises like (|q| h)^2 up to |q| h ~ 1.
+   pure logical function compliance_falls(self, q_min, q_max) result(falls)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: q_min, q_max
+      real(wp) :: q, previous, current, one_minus_a, one_minus_b, c
+      integer :: i, samples
+      falls = .true.
+      if (self%halfspace .or. .not. q_max > q_min) return
+      samples = max(2, ceiling(64*log10(q_max/q_min))) + 1
+      previous = huge(1.0_wp)
+      do i = 0, samples - 1
+         q = q_min*(q_max/q_min)**(real(i, wp)/(samples - 1))
+         call self%factors(q, one_minus_a, one_minus_b, c)
+         current = one_minus_a/q
+         ! (a relative margin for the rounding of 1-A where it is flat)
+         if (current > previous*(1.0_wp + 1.0e-12_wp)) then
+            falls = .false.
+            return
+         end if
+         previous = current
+      end do
+   end function compliance_falls
 
    !> Normal compliance of the uniform mode, h/M = h (1+nu)(1-2nu)/((1-nu) E) (L/S) with the
    !> static compliance C0 = (1 - nu^2) J(0) given; 0 for a half-space and exactly 0 for
