@@ -98,7 +98,7 @@ contains
       ! Where the metric falls with |q| (half-space, compressible layers) its masked Fourier
       ! inverse preconditions well at every scale; on broadband roughness points enter at
       ! most iterations, and restarting the conjugacy at each entry would reduce CG to
-      ! steepest descent (docs/decisions/005-broadband-cg.md: 5698 -> 252 iterations on a
+      ! steepest descent (docs/decisions/005-broadband-iterations.md: 5698 -> 252 iterations on a
       ! line of 65536 points with roughness down to 8 grid points). Elsewhere (the metric of
       ! a coupled operator in the Anderson iteration, thin incompressible layers whose
       ! compliance rises with |q|) the inverse is far off at the edges of the contact set:

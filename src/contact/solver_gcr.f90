@@ -30,13 +30,18 @@ module lc_contact_solver_gcr
 
    !> Iterations without the residual halving after which the solve gives up (and reports
    !> non-convergence with its best iterate; under method 'auto' the Anderson outer
-   !> iteration goes on from there). A converging solve halves the residual every one to
-   !> three iterations. What still stalls: glassy viscoelastic layers at low speeds, whose
-   !> fine-grid contact sets settle slowly (a clip restarts the history) and erratically
-   !> (116 of the 576 scenes of inputs/sweeps/viscoelastic_speed.nml), and a few thin
-   !> incompressible layers with strong friction on tiny grids. A window of 40 made that
-   !> sweep cost twice as many transforms (docs/decisions/000-line-solver-measurements.md).
-   integer, parameter :: stall_window = 25
+   !> iteration goes on from there). On a smooth surface a converging solve halves the
+   !> residual every one to three iterations; on broadband roughness (the shortest
+   !> wavelength a few grid points) the contact set settles over many iterations and the
+   !> residual halves only every 50-60 at n = 65536. What still stalls: glassy
+   !> viscoelastic layers at low speeds, whose fine-grid contact sets settle slowly (a clip
+   !> restarts the history) and erratically, and a few thin incompressible layers with
+   !> strong friction on tiny grids. Measured (docs/decisions/005-broadband-iterations.md):
+   !> a window of 25 sent the broadband coupled lines at n = 65536 to the Anderson
+   !> iteration (3198 iterations against 342) and cost inputs/sweeps/viscoelastic_speed.nml
+   !> 503k transform pairs against 341k with 200 (100: 350k; 400: 434k); the
+   !> viscoelastic extremes grid is unchanged (1236 against 1233 of 1296 converged).
+   integer, parameter :: stall_window = 200
    !> Iterations after which w = G_eff p is recomputed (bounds the drift of the updates).
    integer, parameter :: refresh_interval = 50
    !> Most points clipped or let in whose change is added to w column by column.
