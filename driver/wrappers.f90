@@ -65,7 +65,7 @@ end subroutine py_self_affine_profile
 !> Solve a contact on the given heights: a line (areal = 0; n heights) or a surface
 !> (areal = 1; n = nx*ny heights, x fastest, period_y its period along y). control: 0 load,
 !> 1 displacement; method: 0 auto, 1 cg, 2 anderson, 3 gcr, 4 gfmd; precondition, coarse_start,
-!> stress: 0/1.
+!> verbose (progress lines on standard error), stress: 0/1.
 !> fields(:, 1:n_fields): pressure, gap, displacement_z, then with stress = 1 (n_fields = 5
 !> for a line, 8 for a surface) displacement_x, stress_xx (line) or displacement_x,
 !> displacement_y, stress_xx, stress_yy, stress_xy (surface);
@@ -78,7 +78,8 @@ end subroutine py_self_affine_profile
 !> residuals of the run, at most `capacity` (an array of max_iter entries would cost more
 !> than a small solve).
 subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, poisson, friction, control, &
-      & mean_pressure, penetration, method, precondition, coarse_start, tol, max_iter, memory, threads, stress, model, &
+      & mean_pressure, penetration, method, precondition, coarse_start, verbose, tol, max_iter, memory, threads, stress, &
+      & model, &
       & form, e0, e_inf, tau, equilibrium, nt, times, values, speed, capacity, n_fields, spot_capacity, n_columns, &
       & fields, spots, scalars, history, stat, errmsg)
    use lc_errors, only: error_type
@@ -87,7 +88,8 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
    use lc_contact_solve, only: solve_contact
    use lc_greens_viscoelastic, only: make_material_law
    implicit none (type, external)
-   integer, intent(in) :: n, nx, areal, control, method, precondition, coarse_start, max_iter, memory, threads, stress
+   integer, intent(in) :: n, nx, areal, control, method, precondition, coarse_start, verbose, max_iter, memory, threads
+   integer, intent(in) :: stress
    integer, intent(in) :: model, form, nt, capacity, n_fields, spot_capacity, n_columns
    real(8), intent(in) :: height(n), period, period_y, thickness, young, poisson, friction, mean_pressure, penetration
    real(8), intent(in) :: tol, e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
@@ -120,6 +122,7 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
    scene%solver%threads = threads
    scene%solver%precondition = precondition == 1
    scene%solver%coarse_start = coarse_start == 1
+   scene%solver%verbose = verbose == 1
    call check_scene(scene, error)
    if (.not. allocated(error)) call solve_contact(scene, height, friction, r, error)
    if (allocated(error)) then

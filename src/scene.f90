@@ -73,6 +73,8 @@ module lc_scene
       logical :: coarse_start = .true.
       !> FFTW threads (1 = no threading)
       integer :: threads = 1
+      !> progress on standard error: a line per grid level and every 2 s within one
+      logical :: verbose = .false.
       !> target error of the observables: when set, &scene n and tol are chosen by the
       !> accuracy rule (lc_accuracy)
       real(wp) :: target_error = not_set

@@ -191,3 +191,27 @@ def test_flat_profile_with_a_normalised_pressure_is_refused(tmp_path):
     proc = run_exe(nml, tmp_path)
     assert proc.returncode == 2 and "&loading: normalised_pressure" in proc.stderr
     assert not (tmp_path / "r.h5").exists()
+
+
+def test_verbose_solver_reports_progress_on_stderr(tmp_path):
+    """&solver verbose = .true.: a progress line per grid level on standard error, the
+    finest with the iterations the result file records; the default is silent."""
+    text = (ROOT / "inputs" / "default.nml").read_text()
+    quiet = tmp_path / "quiet.nml"
+    quiet.write_text(text)
+    loud = tmp_path / "loud.nml"
+    loud.write_text(text.replace("&solver", "&solver\n   verbose = .true.", 1))
+    assert "verbose = .true." in loud.read_text()
+    proc = run_exe(quiet, tmp_path)
+    assert proc.returncode == 0 and proc.stderr == ""
+    (tmp_path / "out" / "default.h5").unlink()
+    proc = run_exe(loud, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    # the scene (GCR, with friction), then its frictionless companion (CG), each level by level
+    done = [line for line in proc.stderr.splitlines() if " converged in " in line]
+    with h5py.File(tmp_path / "out" / "default.h5") as f:
+        iterations = {group: int(f[group].attrs["iterations"]) for group in ("/results", "/companion/results")}
+    finest = [line for line in done if line.startswith("layercontact: n = 4096: ")]
+    assert len(finest) == 2 and len(done) == 8   # 512, 1024, 2048, 4096 (the scene's n), twice
+    assert f"gcr converged in {iterations['/results']} iterations" in finest[0]
+    assert f"cg converged in {iterations['/companion/results']} iterations" in finest[1]

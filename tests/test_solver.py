@@ -332,3 +332,32 @@ def test_dense_newton_agrees(case):
     assert np.abs(res.pressure - p).max() <= bound
     # (the Newton iterate is ~1e-20 rather than 0 out of contact: count pressures above the bound)
     assert np.count_nonzero(res.pressure > bound) == np.count_nonzero(p > bound)
+
+
+def test_progress_lines_name_every_level_and_the_final_count(capfd):
+    """progress=True: one line per grid level of the coarse start (512 .. n points), the
+    finest with the iterations and residual the result reports; silent by default."""
+    h = lc.self_affine_profile(4096, 0.8, seed=1, short_wavelength=8 / 4096, rms_gradient=0.1)
+    quiet = lc.solve_line(h, mean_pressure=0.0167, tol=1e-8)
+    assert capfd.readouterr().err == ""
+    res = lc.solve_line(h, mean_pressure=0.0167, tol=1e-8, progress=True)
+    lines = [line for line in capfd.readouterr().err.splitlines() if line.startswith("layercontact: n = ")]
+    done = [line for line in lines if " converged in " in line]
+    assert [line.split(":")[1].strip() for line in done] == [f"n = {n}" for n in (512, 1024, 2048, 4096)]
+    assert f"cg converged in {res.iterations} iterations" in done[-1]
+    assert f"residual {res.residual:.3E}" in done[-1]
+    assert f"contact fraction {res.contact_fraction:.4f}" in done[-1]
+    # printing changes nothing
+    assert res.iterations == quiet.iterations and np.array_equal(res.pressure, quiet.pressure)
+
+
+def test_broadband_line_needs_few_cg_iterations():
+    """A regression guard (not a timing): a self-affine line with roughness down to 8 grid
+    points at n = 65536 (~1000 contact spots) took 5698 CG iterations when the conjugacy
+    restarted at every point let in and the preconditioner was dropped after a stall; it
+    takes ~300 now (docs/decisions/005-broadband-iterations.md, bench/scaling.py)."""
+    n = 65536
+    h = lc.self_affine_profile(n, 0.8, seed=1, short_wavelength=8 / n, rms_gradient=0.1)
+    res = lc.solve_line(h, mean_pressure=0.0167, tol=1e-8, stress=False)
+    assert res.converged and res.solver == "cg"
+    assert res.iterations <= 600, res.iterations

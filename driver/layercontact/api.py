@@ -180,6 +180,7 @@ def solve_line(
     method: str = "auto",
     precondition: bool = True,
     coarse_start: bool = True,
+    progress: bool = False,
     tol: float = 1e-10,
     max_iter: int = 100000,
     memory: int = 12,
@@ -201,7 +202,10 @@ def solve_line(
     ``precondition`` applies the Fourier stiffness 1/M to the residual on the contact set
     (fewer CG iterations). ``coarse_start`` starts from the solution on the grid of every
     second point, recursively down to 512 points (fine-grid iterations nearly flat in
-    the grid size; see bench/iterations.py).
+    the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard
+    error for each grid level solved and every 2 s within a level (iteration, residual,
+    contact fraction, elapsed time): it comes from the compiled core, so it shows in a
+    terminal, not in a notebook cell.
     Raises :class:`LayercontactError` with the library's message for bad input. A run that
     did not reach ``tol`` returns with ``converged = False``.
     """
@@ -212,7 +216,7 @@ def solve_line(
         raise ValueError("give exactly one of mean_pressure (load control) and penetration")
     settings = dict(period=period, thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
                     penetration=penetration, stress=stress, method=method, precondition=precondition,
-                    coarse_start=coarse_start, tol=tol,
+                    coarse_start=coarse_start, progress=progress, tol=tol,
                     max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
     result = _solve_once(h, friction=friction, **settings)
     if companion:
@@ -224,7 +228,8 @@ def solve_line(
 
 
 def _solve_native(h, nx, areal, *, period, period_y, thickness, young, poisson, friction, mean_pressure,
-                  penetration, stress, method, precondition, coarse_start, tol, max_iter, memory, threads, material,
+                  penetration, stress, method, precondition, coarse_start, progress, tol, max_iter, memory, threads,
+                  material,
                   speed):
     """One call of the library's solve (py_solve): fields (n, 5), spots, scalars, history."""
     from .materials import material_codes
@@ -242,7 +247,8 @@ def _solve_native(h, nx, areal, *, period, period_y, thickness, young, poisson, 
         float(friction), _CONTROLS[control],
         NOT_SET if mean_pressure is None else float(mean_pressure),
         NOT_SET if penetration is None else float(penetration),
-        _METHODS[method], int(bool(precondition)), int(bool(coarse_start)), float(tol), int(max_iter), int(memory), int(threads),
+        _METHODS[method], int(bool(precondition)), int(bool(coarse_start)), int(bool(progress)), float(tol),
+        int(max_iter), int(memory), int(threads),
         int(bool(stress)), model, form, e0, e_inf, tau, eq, times, values, float(speed),
         min(int(max_iter), HISTORY_CAPACITY), n_fields, spot_capacity, n_columns,
     )
@@ -390,6 +396,7 @@ def solve_areal(
     method: str = "auto",
     precondition: bool = True,
     coarse_start: bool = True,
+    progress: bool = False,
     tol: float = 1e-10,
     max_iter: int = 100000,
     memory: int = 12,
@@ -413,7 +420,7 @@ def solve_areal(
     flat = np.ascontiguousarray(h).ravel()
     settings = dict(thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
                     penetration=penetration, method=method, precondition=precondition, coarse_start=coarse_start,
-                    tol=tol, max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
+                    progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
     stress = bool(stress)
 
     def once(mu):

@@ -21,6 +21,7 @@ module lc_contact_solve
    use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
+   use lc_contact_progress, only: progress_log
    use lc_observables, only: observe
    implicit none (type, external)
    private
@@ -63,11 +64,13 @@ contains
       type(layer_kernel) :: kernel
       real(wp), allocatable :: p(:), w(:), gap(:)
       real(wp) :: pm, s, g_ref, lambda_max
+      type(progress_log) :: progress
       integer(i8) :: start, finish, rate
       logical :: load_control
       integer :: n
 
       call system_clock(start, rate)
+      call progress%begin(scene%solver%verbose)
       grid = grid_of(scene)
       kernel = kernel_of(scene)
       n = grid%points()
@@ -110,7 +113,7 @@ contains
          s = scene%penetration - lambda_max
       end if
       call solve_on_grid(scene, grid, kernel, height, friction, load_control, pm, g_ref, op, p, w, gap, s, &
-         & result, error)
+         & result, progress, error)
       if (allocated(error)) return
 
       result%friction = friction
@@ -133,7 +136,7 @@ contains
    !> of `result`. With &solver coarse_start the guess is first replaced by the solution
    !> on the grid of every second point (recursively down to coarsest_grid points).
    recursive subroutine solve_on_grid(scene, grid, kernel, height, friction, load_control, pm, g_ref, op, p, w, &
-         & gap, s, result, error)
+         & gap, s, result, progress, error)
       type(scene_type), intent(in) :: scene
       type(grid_type), intent(in) :: grid
       type(layer_kernel), intent(in) :: kernel
@@ -143,6 +146,7 @@ contains
       real(wp), intent(inout) :: p(:), s
       real(wp), intent(out) :: w(:), gap(:)
       type(contact_result), intent(inout) :: result
+      type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
       type(cg_outcome) :: cg
       type(gcr_outcome) :: gcr
@@ -155,9 +159,10 @@ contains
       coarse_pairs = 0
       if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid)) then
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
-            & error)
+            & progress, error)
          if (allocated(error)) return
       end if
+      call progress%begin_level(grid%nx, grid%ny)
       call build_operator(op, grid, kernel, friction, scene%solver%threads, error)
       if (allocated(error)) return
       uniform = 0.0_wp
@@ -172,14 +177,14 @@ contains
       allocate (history(scene%solver%max_iter))
       if (trim(scene%solver%method) == 'gfmd') then
          call gfmd(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
-            & dynamics, history)
+            & dynamics, history, progress)
          call record_solve(result, 'gfmd', dynamics%converged, dynamics%iterations, 1, dynamics%fft_pairs, &
             & dynamics%residual, history(1:min(dynamics%checks, size(history))))
       else if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
          ! constrained GCR; under 'auto' a solve that stalls goes on with the Anderson outer
          ! iteration from GCR's best iterate, with the budget left
          call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history)
+            & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history, progress)
          call record_solve(result, 'gcr', gcr%converged, gcr%iterations, 1, gcr%fft_pairs, gcr%residual, &
             & history(1:gcr%iterations))
          if (.not. gcr%converged .and. trim(scene%solver%method) == 'auto' .and. &
@@ -191,7 +196,7 @@ contains
             s_gcr = s
             call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
                & scene%solver%max_iter - gcr%iterations, scene%solver%memory, scene%solver%precondition, p, w, gap, &
-               & outer, history, error)
+               & outer, history, error, progress)
             if (allocated(error)) return
             call record_solve(result, 'gcr+anderson', outer%converged, gcr%iterations + outer%cg_iterations, &
                & 1 + outer%outer_iterations, gcr%fft_pairs + outer%fft_pairs, min(outer%residual, gcr%residual), &
@@ -205,16 +210,18 @@ contains
          end if
       else if (op%coupled) then
          call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error)
+            & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error, progress)
          if (allocated(error)) return
          call record_solve(result, 'anderson', outer%converged, outer%cg_iterations, outer%outer_iterations, &
             & outer%fft_pairs, outer%residual, history(1:outer%outer_iterations))
       else
          call constrained_cg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & scene%solver%precondition, p, w, gap, cg, history)
+            & scene%solver%precondition, p, w, gap, cg, history, progress)
          call record_solve(result, 'cg', cg%converged, cg%iterations, 1, cg%fft_pairs, cg%residual, &
             & history(1:cg%iterations))
       end if
+      if (progress%enabled) call progress%level_done(result%solver, result%converged, result%iterations, &
+         & result%residual, count(p > 0.0_wp)/real(size(p), wp))
       result%fft_pairs = result%fft_pairs + coarse_pairs
       ! the uniform mode's rigid shift (see drop_uniform_mode)
       w = w + uniform*pm
@@ -242,7 +249,7 @@ contains
    !> of a starting guess (coarse_tol); its FFT pairs are returned in units of pairs of
    !> this grid (2 or 4 times as long each, on a line or a surface).
    recursive subroutine coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, &
-         & pairs, error)
+         & pairs, progress, error)
       type(scene_type), intent(in) :: scene
       type(grid_type), intent(in) :: grid
       type(layer_kernel), intent(in) :: kernel
@@ -250,6 +257,7 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: p(:), s
       integer, intent(out) :: pairs
+      type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: coarse
       type(grid_type) :: coarse_grid
@@ -267,7 +275,7 @@ contains
       pc = restrict(grid, p)
       sc = s
       call solve_on_grid(coarse, coarse_grid, kernel, hc, friction, load_control, pm, g_ref, coarse_op, pc, wc, &
-         & gapc, sc, coarse_result, error)
+         & gapc, sc, coarse_result, progress, error)
       if (allocated(error)) return
       call interpolate(grid, pc, p)
       if (load_control) s = sc

@@ -16,6 +16,7 @@ module lc_contact_solver_anderson
    use lc_errors, only: error_type, fatal_error, code_internal
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome, complementarity_residual, rounding_floor
+   use lc_contact_progress, only: progress_log
    implicit none (type, external)
    private
    public :: anderson_coupled, anderson_outcome
@@ -52,7 +53,7 @@ contains
    !> Solve the coupled problem. p: starting guess in, solution out; w = G_eff p;
    !> gap and s as in lc_contact_solver_cg. history(k) = residual after outer iteration k.
    subroutine anderson_coupled(op, r, load_control, mean_pressure, s, g_ref, tol, max_iter, memory, &
-         & precondition, p, w, gap, outcome, history, error)
+         & precondition, p, w, gap, outcome, history, error, progress)
       type(compliance_operator), intent(inout) :: op
       real(wp), intent(in) :: r(:)
       logical, intent(in) :: load_control
@@ -66,6 +67,7 @@ contains
       type(anderson_outcome), intent(out) :: outcome
       real(wp), intent(inout) :: history(:)
       type(error_type), allocatable, intent(out) :: error
+      type(progress_log), intent(inout), optional :: progress
       real(wp), allocatable :: x(:), f(:), x_old(:), f_old(:), tx(:), dx(:, :), df(:, :), b(:), nw(:), p_best(:)
       real(wp), allocatable :: gamma(:), gram(:, :), projection(:)
       type(cg_outcome) :: inner
@@ -93,8 +95,10 @@ contains
          call op%apply_difference(x, nw)
          b = r - nw
          tx = p   ! warm start from the previous output of T
+         if (present(progress)) progress%offset = outcome%cg_iterations
          call constrained_cg(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
-            & max_iter - outcome%cg_iterations, preconditioned, tx, w, gap, inner)
+            & max_iter - outcome%cg_iterations, preconditioned, tx, w, gap, inner, progress=progress)
+         if (present(progress)) progress%offset = 0
          ! once the preconditioner has stalled on this operator, do not try it again
          preconditioned = inner%preconditioned
          outcome%cg_iterations = outcome%cg_iterations + inner%iterations
@@ -104,6 +108,10 @@ contains
 
          call coupled_state(op, r, load_control, mean_pressure, s, g_ref, p, w, gap, s_full, outcome%residual)
          history(k) = outcome%residual
+         if (present(progress)) then
+            if (progress%enabled) call progress%tick(outcome%cg_iterations, outcome%residual, &
+               & count(p > 0.0_wp)/real(n, wp))
+         end if
          if (outcome%residual <= tol) then
             outcome%converged = .true.
             s = s_full

@@ -13,6 +13,7 @@ module lc_contact_solver_cg
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
+   use lc_contact_progress, only: progress_log
    implicit none (type, external)
    private
    public :: constrained_cg, cg_outcome, complementarity_residual, rounding_floor, normalise
@@ -53,7 +54,7 @@ contains
    !> (any array; it is made feasible), on exit the solution; w = M p, gap and s as above.
    !> history(1:outcome%iterations) receives the residual of each iteration when present.
    subroutine constrained_cg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, precondition, p, w, &
-         & gap, outcome, history)
+         & gap, outcome, history, progress)
       type(compliance_operator), intent(inout) :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -67,6 +68,7 @@ contains
       real(wp), contiguous, intent(out) :: w(:), gap(:)
       type(cg_outcome), intent(out) :: outcome
       real(wp), intent(inout), optional :: history(:)
+      type(progress_log), intent(inout), optional :: progress
       real(wp), allocatable :: t(:)
       !> the operator's FFT buffer: transform input and output, written and read in place
       real(wp), pointer, contiguous :: buffer(:)
@@ -149,6 +151,7 @@ contains
             ! (the evaluation after the last iteration replaces that iteration's residual)
             if (size(history) > 0) history(min(outcome%iterations, size(history))) = outcome%residual
          end if
+         if (present(progress)) call progress%tick(it, outcome%residual, sums%contact/n)
          if (outcome%converged .or. it > max_iter) exit
          ! The Fourier preconditioner amplifies short waves; where the compliance falls
          ! steeply with k (a glassy viscoelastic layer) its directions make the contact set

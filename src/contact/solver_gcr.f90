@@ -24,6 +24,7 @@ module lc_contact_solver_gcr
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_cg, only: rounding_floor, normalise
+   use lc_contact_progress, only: progress_log
    implicit none (type, external)
    private
    public :: constrained_gcr, gcr_outcome
@@ -84,7 +85,7 @@ contains
    !> best iterate if not converged); w = G_eff p; gap = w - b - s.
    !> history(it) receives the residual of iteration it when present.
    subroutine constrained_gcr(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, memory, precondition, &
-         & p, w, gap, outcome, history)
+         & p, w, gap, outcome, history, progress)
       type(compliance_operator), intent(inout) :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -98,6 +99,7 @@ contains
       real(wp), contiguous, intent(out) :: w(:), gap(:)
       type(gcr_outcome), intent(out) :: outcome
       real(wp), intent(inout), optional :: history(:)
+      type(progress_log), intent(inout), optional :: progress
       real(wp), allocatable :: dirs(:, :), images(:, :), d(:), coeff(:), p_best(:)
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa, residual_norm2, p_sum
@@ -151,6 +153,7 @@ contains
             best_residual = outcome%residual
             p_best = p
          end if
+         if (present(progress)) call progress%tick(it, outcome%residual, real(n_contact, wp)/n)
          if (outcome%converged .or. it > max_iter) exit
          if (outcome%residual < 0.5_wp*best) then
             best = outcome%residual

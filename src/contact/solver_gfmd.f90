@@ -26,6 +26,7 @@ module lc_contact_solver_gfmd
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_cg, only: complementarity_residual, rounding_floor
+   use lc_contact_progress, only: progress_log
    implicit none (type, external)
    private
    public :: gfmd, gfmd_outcome
@@ -57,7 +58,7 @@ contains
    !> solution out (the best checked state if not converged); w = G_eff p; gap.
    !> history(k) receives the residual of the k-th check (every check_interval steps) when
    !> present.
-   subroutine gfmd(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, history)
+   subroutine gfmd(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, history, progress)
       type(compliance_operator), intent(inout) :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -69,6 +70,7 @@ contains
       real(wp), contiguous, intent(out) :: w(:), gap(:)
       type(gfmd_outcome), intent(out) :: outcome
       real(wp), intent(inout), optional :: history(:)
+      type(progress_log), intent(inout), optional :: progress
       real(wp), allocatable :: u(:), v(:), a(:), rho(:), lambda(:), p_best(:)
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: dt, alpha, power, v_norm, a_norm, s_best, uniform, b_max, mass, residual
@@ -141,6 +143,9 @@ contains
             checks = checks + 1
             if (present(history)) then
                if (checks <= size(history)) history(checks) = residual
+            end if
+            if (present(progress)) then
+               if (progress%enabled) call progress%tick(step, residual, count(lambda > 0.0_wp)/real(n, wp))
             end if
             if (residual < outcome%residual) then
                outcome%residual = residual

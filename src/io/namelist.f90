@@ -29,7 +29,7 @@ module lc_io_namelist
       & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
       & 'amplitude, mode, mode_y, radius, file, dataset', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
-      & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error', &
+      & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose', &
       & 'file, overwrite, stress, gap_bins']
 
    character(len=*), parameter :: newline = new_line('a')
@@ -179,6 +179,7 @@ contains
             & // entry('coarse_start', logical_value(s%coarse_start)) &
             & // entry('threads', to_string(s%threads)) &
             & // entry('target_error', real_value(s%target_error)) &
+            & // entry('verbose', logical_value(s%verbose)) &
             & // '/' // newline // '&output' // newline &
             & // entry('file', str_value(scene%output_file)) &
             & // entry('overwrite', logical_value(scene%overwrite)) &
@@ -480,8 +481,8 @@ contains
       real(wp) :: tol
       integer :: max_iter, memory, threads
       real(wp) :: target_error
-      logical :: precondition, coarse_start
-      namelist /solver/ method, tol, max_iter, memory, precondition, coarse_start, threads, target_error
+      logical :: precondition, coarse_start, verbose
+      namelist /solver/ method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose
 
       method = config%solver%method
       tol = config%solver%tol
@@ -491,6 +492,7 @@ contains
       coarse_start = config%solver%coarse_start
       target_error = config%solver%target_error
       threads = config%solver%threads
+      verbose = config%solver%verbose
       read (lines, nml=solver, iostat=stat, iomsg=msg)
       if (stat /= 0) return
       config%solver%method = method
@@ -501,6 +503,7 @@ contains
       config%solver%coarse_start = coarse_start
       config%solver%target_error = target_error
       config%solver%threads = threads
+      config%solver%verbose = verbose
    end subroutine read_group_solver
 
    subroutine read_group_output(lines, config, stat, msg)
