@@ -96,20 +96,68 @@ def test_bad_input_is_refused_and_writes_nothing(text, message, tmp_path, monkey
     proc = run_exe(nml, tmp_path)
     assert proc.returncode == 2, proc.stderr
     assert message in proc.stderr
-    assert not (tmp_path / "bad.h5").exists() and not (tmp_path / "bad.h5.tmp").exists()
+    assert not (tmp_path / "bad.h5").exists() and not list(tmp_path.glob("*.tmp"))
     monkeypatch.chdir(tmp_path)
     with pytest.raises(lc.LayercontactError) as err:
         lc.run(nml)
     assert err.value.code == 2 and message in str(err.value)
 
 
+def scene_writing(path: Path, output: str, overwrite: bool = False, n: int = 256) -> Path:
+    path.write_text(f"&scene\n n = {n}\n/\n&loading\n normalised_pressure = 1.0\n/\n"
+                    f"&output\n file = '{output}'\n overwrite = {'.true.' if overwrite else '.false.'}\n/\n")
+    return path
+
+
 def test_existing_result_is_not_overwritten(tmp_path):
-    nml = tmp_path / "scene.nml"
-    nml.write_text("&scene\n n = 256\n/\n&loading\n normalised_pressure = 1.0\n/\n&output\n file = 'r.h5'\n/\n")
-    (tmp_path / "r.h5").write_bytes(b"precious")
+    nml = scene_writing(tmp_path / "scene.nml", "r.h5")
+    with h5py.File(tmp_path / "r.h5", "w") as f:
+        f.attrs["note"] = "precious"
+    before = (tmp_path / "r.h5").read_bytes()
     proc = run_exe(nml, tmp_path)
-    assert proc.returncode == 4 and "overwrite" in proc.stderr
-    assert (tmp_path / "r.h5").read_bytes() == b"precious"
+    assert proc.returncode == 4 and "set &output overwrite = .true." in proc.stderr
+    assert (tmp_path / "r.h5").read_bytes() == before
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+@pytest.mark.parametrize("kind", ["data", "directory", "device"])
+def test_what_is_not_a_result_file_is_never_replaced(kind, tmp_path):
+    """Even with overwrite = .true., an existing path that is not an HDF5 file (other data,
+    a directory, a device such as /dev/null) is refused with exit 4 and left as it was."""
+    target = {"data": tmp_path / "r.h5", "directory": tmp_path / "d.h5", "device": Path("/dev/null")}[kind]
+    if kind == "data":
+        target.write_bytes(b"precious")
+    elif kind == "directory":
+        target.mkdir()
+    nml = scene_writing(tmp_path / "scene.nml", str(target), overwrite=True)
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 4, proc.stderr
+    assert f"output file '{target}' exists and is not an HDF5 file" in proc.stderr
+    if kind == "data":
+        assert target.read_bytes() == b"precious"
+    elif kind == "directory":
+        assert target.is_dir() and not any(target.iterdir())
+    else:
+        assert target.is_char_device()
+    assert not list(tmp_path.glob("*.tmp")) and not list(Path("/dev").glob("null.*.tmp"))
+
+
+def test_two_runs_writing_one_file_lose_nothing(tmp_path):
+    """Two runs started together with the same output (overwrite = .false.) each write
+    their own temporary file; the first to finish places the result, the second finds it
+    there, exits 4 and replaces nothing: one complete result, no temporary file left."""
+    nml = scene_writing(tmp_path / "scene.nml", "r.h5", n=262144)
+    runs = [subprocess.Popen([executable(), str(nml)], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True) for _ in range(2)]
+    outcomes = sorted((proc.wait(timeout=600), proc.stderr.read()) for proc in runs)
+    for proc in runs:
+        proc.stdout.close()
+        proc.stderr.close()
+    assert [code for code, _ in outcomes] == [0, 4], outcomes
+    assert "was written by another run while this one computed" in outcomes[1][1]
+    with h5py.File(tmp_path / "r.h5") as f:
+        assert f["fields/pressure"].shape == (262144,) and f["results"].attrs["converged"] == 1
+    assert not list(tmp_path.glob("*.tmp"))
 
 
 def test_not_converged_exits_3_and_writes_flagged_result(tmp_path):

@@ -354,7 +354,7 @@ def test_a_killed_task_loses_only_the_scene_it_cut_short(tmp_path, monkeypatch, 
     assert [by_stem[s].state for s in ("s_0000", "s_0001", "s_0002")] == ["done", "failed", "missing"]
     assert by_stem["s_0001"].reason.startswith("killed in Slurm job 77_0 on ")
     assert "exit 143 (killed by signal 15, SIGTERM)" in by_stem["s_0001"].reason
-    assert "s_0001.h5.tmp is left from an interrupted write" in by_stem["s_0001"].reason
+    assert "s_0001.h5.tmp left from an interrupted write" in by_stem["s_0001"].reason
     assert by_stem["s_0001"].rerun and by_stem["s_0002"].rerun and not by_stem["s_0000"].rerun
 
     # SIGKILL (or a node failure) leaves the record at "running": interrupted, runs again

@@ -509,6 +509,8 @@ for scene in "${{scenes[@]}}"; do
   start_ms=$REPLY
   current=$scene
   write_record "$scene" running "" "$started" "" ""
+  # temporary result files that a killed run of this scene left (this task alone runs it)
+  rm -f "$sweep_directory/results/$scene".h5.*tmp
   # in the background, so that the trap runs at once when a signal arrives
   "$executable" "$sweep_directory/scenes/$scene.nml" >"$sweep_directory/{logs}/$scene.log" 2>&1 &
   child=$!

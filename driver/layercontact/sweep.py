@@ -450,9 +450,18 @@ def _failure(message: str) -> dict[str, object]:
     return {"converged": 0, "error": message}
 
 
+def temporary_results(results: Path, stem: str) -> list[Path]:
+    """The temporary files of a scene's result that a killed write left behind: the
+    program writes ``STEM.h5.HOST.PID.tmp`` and moves it to ``STEM.h5`` when complete."""
+    return [p for p in results.glob(f"{stem}.h5.*tmp") if p.name.endswith(".tmp")]
+
+
 def _solve(scene_file: str, result_file: str, record_file: str) -> dict[str, object]:
     """Worker: run one scene file, return its result columns (or its error); its run
-    record says it is running, then how it ended."""
+    record says it is running, then how it ended. Temporary files that a killed run of
+    the same scene left are removed first (the sweep runs each scene once at a time)."""
+    for left in temporary_results(Path(result_file).parent, Path(scene_file).stem):
+        left.unlink(missing_ok=True)
     record = provenance.start_record(Path(scene_file).stem)
     provenance.write_record(Path(record_file), record)
     start = time.monotonic()
@@ -471,7 +480,8 @@ def _solve(scene_file: str, result_file: str, record_file: str) -> dict[str, obj
 
 def result_matches(result_file: Path, text: str) -> bool:
     """True if ``result_file`` is a readable result made from the namelist ``text`` (a
-    killed run leaves no result file, only ``RESULT.tmp``: that is not a result)."""
+    killed run leaves no result file, only a temporary ``RESULT.HOST.PID.tmp``: that is
+    not a result)."""
     import h5py
 
     try:

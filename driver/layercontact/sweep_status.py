@@ -40,6 +40,7 @@ from .sweep import (
     result_matches,
     result_outcome,
     summary_row,
+    temporary_results,
     write_summary_files,
 )
 
@@ -211,12 +212,8 @@ def _exit_words(code: object) -> str:
 
 def _leftovers(directory: Path, stem: str) -> str:
     """A note on a temporary result left by a killed write, or ''."""
-    tmp = directory / "results" / f"{stem}.h5.tmp"
-    return (
-        f"; {tmp.name} is left from an interrupted write (ignored; the next run replaces it)"
-        if tmp.exists()
-        else ""
-    )
+    left = sorted(p.name for p in temporary_results(directory / "results", stem))
+    return f"; {', '.join(left)} left from an interrupted write (ignored; the next run removes it)" if left else ""
 
 
 def _state_of(ctx: _Context, stem: str) -> SceneState:

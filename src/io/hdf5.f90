@@ -15,7 +15,7 @@
 module lc_io_hdf5
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_loc, c_size_t
    use hdf5, only: hid_t, hsize_t, size_t, h5kind_to_type, H5_INTEGER_KIND, h5open_f, h5close_f, h5eset_auto_f, &
-      & h5fcreate_f, h5fopen_f, h5fclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5F_CLOSE_STRONG_F, &
+      & h5fis_hdf5_f, h5fcreate_f, h5fopen_f, h5fclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5F_CLOSE_STRONG_F, &
       & h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, H5P_DATASET_CREATE_F, h5pset_chunk_f, &
       & h5pset_deflate_f, &
       & h5gcreate_f, h5gclose_f, h5iget_name_f, &
@@ -85,6 +85,15 @@ module lc_io_hdf5
          import :: c_int, c_char
          character(kind=c_char), intent(in) :: path(*)
       end function c_remove
+      !> int link(const char *old, const char *new): fails (EEXIST) if `new` exists
+      integer(c_int) function c_link(old, new) bind(C, name='link')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: old(*), new(*)
+      end function c_link
+      !> pid_t getpid(void)
+      integer(c_int) function c_getpid() bind(C, name='getpid')
+         import :: c_int
+      end function c_getpid
    end interface
 
    !> access() modes: write and search permission on a directory
@@ -96,7 +105,9 @@ contains
 
    !> Fail early (before any computing) if the output cannot be written:
    !> existing file and not overwrite -> error code_io with the file name and the hint
-   !> "set &output overwrite = .true."; parent directory missing -> create it (mkdir -p).
+   !> "set &output overwrite = .true."; an existing file that is not an HDF5 file (a
+   !> directory, a device such as /dev/null, other data) is never replaced, overwrite or
+   !> not; parent directory missing -> create it (mkdir -p).
    subroutine check_output(filename, overwrite, error)
       !> the result file to be written
       character(len=*), intent(in) :: filename
@@ -112,6 +123,13 @@ contains
          return
       end if
       inquire (file=filename, exist=exists)
+      if (exists) then
+         if (.not. is_hdf5_file(filename)) then
+            call fatal_error(error, "output file '" // filename // "' exists and is not an HDF5 file (a " // &
+               & 'directory, a device or other data): it is not replaced; choose another name', code_io)
+            return
+         end if
+      end if
       if (exists .and. .not. overwrite) then
          call fatal_error(error, "output file '" // filename // "' exists; choose another name or " &
             & // overwrite_hint, code_io)
@@ -138,9 +156,13 @@ contains
       end if
    end subroutine check_output
 
-   !> Write a complete, self-describing result file atomically: write filename.tmp (delete a
-   !> stale one first), close, rename to filename. On any HDF5 failure: close, delete the
-   !> .tmp, return error code_io naming file and object.
+   !> Write a complete, self-describing result file atomically: write a temporary file of
+   !> this run's own (filename.HOST.PID.tmp, so that two runs never share it), close, then
+   !> move it to filename: with &output overwrite by rename (which replaces atomically),
+   !> otherwise by link + remove, which never replaces a file that another run wrote
+   !> meanwhile (on a file system without hard links: rename after checking that filename
+   !> is still absent). On any failure: delete the temporary file, return error code_io
+   !> naming file and object.
    subroutine write_results(filename, scene, namelist_text, height, result, companion, version, error, run)
       character(len=*), intent(in) :: filename
       type(scene_type), intent(in) :: scene
@@ -169,7 +191,7 @@ contains
          if (allocated(error)) return
       end if
 
-      tmp = filename // '.tmp'
+      tmp = filename // '.' // host_name() // '.' // to_string(int(c_getpid())) // '.tmp'
       call delete_file(tmp, error)
       if (allocated(error)) return
 
@@ -230,11 +252,48 @@ contains
          call fatal_error(error, "cannot write result file '" // filename // "': HDF5 failed at " // st%object, code_io)
          return
       end if
+      call move_into_place(tmp, filename, scene%overwrite, error)
+   end subroutine write_results
+
+   !> Move the complete temporary file `tmp` to `filename` (see write_results); on failure
+   !> `tmp` is deleted and the error names both.
+   subroutine move_into_place(tmp, filename, overwrite, error)
+      character(len=*), intent(in) :: tmp, filename
+      logical, intent(in) :: overwrite
+      type(error_type), allocatable, intent(out) :: error
+      logical :: exists
+      integer :: ignore
+      if (.not. overwrite) then
+         if (c_link(tmp // c_null_char, filename // c_null_char) == 0) then
+            ignore = c_remove(tmp // c_null_char)
+            return
+         end if
+         inquire (file=filename, exist=exists)
+         if (exists) then
+            ignore = c_remove(tmp // c_null_char)
+            call fatal_error(error, "output file '" // filename // "' was written by another run while this one " // &
+               & 'computed; it is kept and this result is not written; choose another name or ' // overwrite_hint, &
+               & code_io)
+            return
+         end if
+      end if
       if (c_rename(tmp // c_null_char, filename // c_null_char) /= 0) then
          ignore = c_remove(tmp // c_null_char)
          call fatal_error(error, "cannot rename '" // tmp // "' to result file '" // filename // "'", code_io)
       end if
-   end subroutine write_results
+   end subroutine move_into_place
+
+   !> Whether `filename` is an HDF5 file (false for a directory, a device, other data).
+   logical function is_hdf5_file(filename) result(yes)
+      character(len=*), intent(in) :: filename
+      integer :: hdferr, ignore
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, ignore)
+      yes = .false.
+      if (hdferr == 0) call h5fis_hdf5_f(filename, yes, hdferr)
+      if (hdferr /= 0) yes = .false.
+      call h5close_f(ignore)
+   end function is_hdf5_file
 
    !> Read n heights from an HDF5 file/dataset (1D float64 dataset of exactly n values).
    subroutine read_profile_heights(filename, dataset, n, height, error)
@@ -661,23 +720,31 @@ contains
    subroutine write_provenance(loc, st)
       integer(hid_t), intent(in) :: loc
       type(h5_status), intent(inout) :: st
-      character(kind=c_char, len=256) :: host
       character(len=64) :: value
       character(len=*), parameter :: slurm(5) = [character(len=19) :: 'SLURM_JOB_ID', 'SLURM_ARRAY_JOB_ID', &
          & 'SLURM_ARRAY_TASK_ID', 'SLURM_CLUSTER_NAME', 'SLURM_RESTART_COUNT']
       integer :: i, length, status
 
-      host = ''
-      if (c_gethostname(host, len(host, c_size_t)) /= 0) host = 'unknown'
-      length = index(host, c_null_char) - 1
-      if (length < 0) length = len_trim(host)
-      call write_attr_string(loc, 'host', host(:max(length, 0)), st)
+      call write_attr_string(loc, 'host', host_name(), st)
       call write_attr_string(loc, 'created', utc_now(), st)
       do i = 1, size(slurm)
          call get_environment_variable(trim(slurm(i)), value, length, status)
          if (status == 0 .and. length > 0) call write_attr_string(loc, lower_case(trim(slurm(i))), trim(value), st)
       end do
    end subroutine write_provenance
+
+   !> This machine's host name ('unknown' if the system does not say).
+   function host_name() result(name)
+      character(len=:), allocatable :: name
+      character(kind=c_char, len=256) :: host
+      integer :: length
+      host = ''
+      if (c_gethostname(host, len(host, c_size_t)) /= 0) host = 'unknown'
+      length = index(host, c_null_char) - 1
+      if (length < 0) length = len_trim(host)
+      name = host(:max(length, 0))
+      if (len(name) == 0) name = 'unknown'
+   end function host_name
 
    !> The current time, 'YYYY-MM-DDThh:mm:ssZ' (UTC).
    function utc_now() result(stamp)
