@@ -3,7 +3,7 @@
 !>    layercontact FILE.nml | --help | --version
 !>
 !> Exit codes: 0 converged; 2 bad input (nothing written); 3 not converged (results
-!> written, flagged converged = 0); 4 I/O failure; 5 internal failure; 1 usage.
+!> written, flagged converged = 0); 4 I/O failure; 5 not enough memory or internal failure; 1 usage.
 program layercontact
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
    use lc_errors, only: error_type, code_not_converged
@@ -27,7 +27,7 @@ program layercontact
       write (output_unit, '(a)') 'usage: layercontact FILE.nml', &
          & '  Solve the sliding contact scene of a namelist file and write its HDF5 result.', &
          & '  Exit codes: 0 converged; 1 usage; 2 bad input (nothing written); 3 not converged', &
-         & '  (results written with converged = 0); 4 I/O failure; 5 internal failure.'
+         & '  (results written with converged = 0); 4 I/O failure; 5 not enough memory or internal failure.'
       stop
    case ('--version')
       write (output_unit, '(a)') 'layercontact ' // version_string // ' (' // build_isa // ')'

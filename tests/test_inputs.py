@@ -4,6 +4,7 @@ writes nothing; an existing result is not overwritten unless the input says so."
 
 import shutil
 import subprocess
+import sys
 import sysconfig
 from pathlib import Path
 
@@ -263,3 +264,47 @@ def test_verbose_solver_reports_progress_on_stderr(tmp_path):
     assert len(finest) == 2 and len(done) == 8   # 512, 1024, 2048, 4096 (the scene's n), twice
     assert f"gcr converged in {iterations['/results']} iterations" in finest[0]
     assert f"cg converged in {iterations['/companion/results']} iterations" in finest[1]
+
+
+def limited_address_space(gib: float):
+    """A preexec_fn: the child may map at most `gib` GiB (ulimit -v)."""
+    import resource
+
+    def limit():
+        size = int(gib * 2**30)
+        resource.setrlimit(resource.RLIMIT_AS, (size, size))
+    return limit
+
+
+def test_a_grid_too_large_for_the_memory_ends_with_code_5_and_writes_nothing(tmp_path):
+    """Under ulimit -v 2 GiB an areal coupled scene of 4096^2 points (about 4.5 GiB) is
+    refused before it allocates: exit 5, a message with what it needs and which limit;
+    256^2 runs under the same limit."""
+    text = ("&scene\n geometry = 'areal'\n n = {n}\n/\n&layer\n thickness = 0.16\n/\n&friction\n coefficient = 0.5\n/\n"
+            "&loading\n normalised_pressure = 0.1\n/\n&output\n file = 'r{n}.h5'\n/\n")
+    for n, code in ((4096, 5), (256, 0)):
+        nml = tmp_path / f"s{n}.nml"
+        nml.write_text(text.format(n=n))
+        proc = subprocess.run([executable(), str(nml)], cwd=tmp_path, capture_output=True, text=True, timeout=600,
+                              preexec_fn=limited_address_space(2.0))
+        assert proc.returncode == code, proc.stderr
+        if code == 5:
+            assert "not enough memory: this scene (16777216 grid points) needs about 4.5 GiB" in proc.stderr
+            assert "the address space limit (ulimit -v)" in proc.stderr and "Slurm: --mem" in proc.stderr
+            assert not (tmp_path / f"r{n}.h5").exists() and not list(tmp_path.glob("*.tmp"))
+        else:
+            assert (tmp_path / f"r{n}.h5").exists()
+
+
+def test_python_raises_for_a_grid_too_large_for_the_memory():
+    """The same check from Python: LayercontactError with code 5, the interpreter lives on."""
+    script = ("import numpy as np, layercontact as lc\n"
+              "h = 1e-3 * np.cos(2 * np.pi * np.arange(2**24) / 2**24)\n"
+              "try:\n"
+              "    lc.solve_line(h, thickness=0.16, friction=0.5, mean_pressure=0.01, max_iter=2)\n"
+              "except lc.LayercontactError as err:\n"
+              "    print('code', err.code, str(err))\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=600,
+                          preexec_fn=limited_address_space(2.5))
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("code 5 ") and "(16777216 grid points) needs about 3.8 GiB" in proc.stdout

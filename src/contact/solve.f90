@@ -22,6 +22,7 @@ module lc_contact_solve
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_progress, only: progress_log
+   use lc_memory, only: check_memory
    use lc_observables, only: observe
    implicit none (type, external)
    private
@@ -92,6 +93,11 @@ contains
             & ' NaN or infinite values; allowed: finite heights', code_input)
          return
       end if
+      ! a grid too large for this machine (or job) ends here, with how much it needs
+      call check_memory(n, kernel%viscoelastic .or. (friction > 0.0_wp .and. &
+         & .not. (kernel%halfspace .and. kernel%poisson == 0.5_wp)), scene%solver%memory, &
+         & scene%stress .and. grid%ny > 1, error)
+      if (allocated(error)) return
       lambda_max = maxval(height)
       g_ref = maxval(height) - minval(height)
       if (g_ref <= 0.0_wp) g_ref = scene%period   ! flat punch: any length scale will do
