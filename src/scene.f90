@@ -109,6 +109,9 @@ module lc_scene
       logical :: overwrite = .false.
       logical :: stress = .true.      !< compute u_x, tau and the surface stress sigma_xx
       integer :: gap_bins = 64        !< bins of the gap histogram (0: none)
+      !> write the maps (the profile and the solution fields) to the result file; without
+      !> them a result holds the scalars, histograms, spots and patches (sweeps of large grids)
+      logical :: fields = .true.
    end type scene_type
 
 contains

@@ -308,3 +308,22 @@ def test_python_raises_for_a_grid_too_large_for_the_memory():
                           preexec_fn=limited_address_space(2.5))
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith("code 5 ") and "(16777216 grid points) needs about 3.8 GiB" in proc.stdout
+
+
+def test_result_without_maps_holds_the_same_scalars(tmp_path):
+    """&output fields = .false.: no /profile and /fields, every scalar as with the maps;
+    read_result gives the maps as None."""
+    text = ("&scene\n geometry = 'areal'\n n = 64\n/\n&friction\n coefficient = 0.5\n companion = .true.\n/\n"
+            "&loading\n normalised_pressure = 0.1\n/\n&output\n file = '{name}.h5'\n fields = {fields}\n/\n")
+    for name, fields in (("maps", ".true."), ("scalars", ".false.")):
+        (tmp_path / f"{name}.nml").write_text(text.format(name=name, fields=fields))
+        assert run_exe(tmp_path / f"{name}.nml", tmp_path).returncode == 0
+    with h5py.File(tmp_path / "maps.h5") as full, h5py.File(tmp_path / "scalars.h5") as small:
+        assert {"profile", "fields"} <= set(full) and not {"profile", "fields"} & set(small)
+        assert "fields" not in small["companion"] and "patches" in small
+        for group in ("results", "companion/results"):
+            a, b = dict(full[group].attrs), dict(small[group].attrs)
+            assert a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) for k in a if k != "wall_time")
+    r = lc.read_result(tmp_path / "scalars.h5")
+    assert r.pressure is None and r.height is None and r.companion.gap is None
+    assert r.contact_fraction == lc.read_result(tmp_path / "maps.h5").contact_fraction

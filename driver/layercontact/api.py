@@ -495,15 +495,26 @@ def surface_stress(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson
     return SurfaceStress(displacement_x=ux, stress_xx=sxx, displacement_y=uy, stress_yy=syy, stress_xy=sxy)
 
 
+def _maps(base) -> dict:
+    """The solution fields of a result group; {} if it was written without maps
+    (``&output fields = .false.``: the fields are then None)."""
+    return {k: base["fields"][k][()] for k in base["fields"]} if "fields" in base else {}
+
+
+def _profile(f):
+    return f["profile/height"][()] if "profile" in f else None
+
+
 def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResult | ArealResult:
     """Read a result file written by the executable or :func:`run` (a :class:`LineResult`,
     or an :class:`ArealResult` for an areal scene); the frictionless companion run stored
-    in it (if any) becomes ``result.companion``."""
+    in it (if any) becomes ``result.companion``. A file written with ``&output fields =
+    .false.`` has no maps: the fields and ``height`` are then None."""
     import h5py
 
     def one(f, base) -> LineResult:
         r = dict(base["results"].attrs)
-        fields = {k: base["fields"][k][()] for k in base["fields"]}
+        fields = _maps(base)
         spots = (np.column_stack([base["spots/trailing_edge"][()], base["spots/leading_edge"][()]])
                  if "spots" in base else np.zeros((0, 2)))
         names = set(_SCALARS) - {"history_length", "solver"}
@@ -513,9 +524,9 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
         values["converged"] = bool(r["converged"])
         values["monotone"] = bool(r.get("monotone", 1))
         return LineResult(
-            pressure=fields["pressure"], gap=fields["gap"], displacement_z=fields["displacement_z"],
+            pressure=fields.get("pressure"), gap=fields.get("gap"), displacement_z=fields.get("displacement_z"),
             displacement_x=fields.get("displacement_x"), shear=fields.get("shear"),
-            stress_xx=fields.get("stress_xx"), height=f["profile/height"][()],
+            stress_xx=fields.get("stress_xx"), height=_profile(f),
             spot_max_tension=base["spots/max_tension"][()] if "spots/max_tension" in base else None,
             spot_tension_offset=base["spots/max_tension_offset"][()] if "spots/max_tension_offset" in base else None,
             spot_max_tension_grid=(base["spots/max_tension_grid"][()] if "spots/max_tension_grid" in base
@@ -536,14 +547,14 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
         attrs = f["input"].attrs
         lx = float(attrs["period"])
         ly = float(attrs["period_y"]) if float(attrs["period_y"]) > 0 else lx
-        fields = {k: base["fields"][k][()] for k in base["fields"]}
+        fields = _maps(base)
         patches = (np.column_stack([base["patches/area"][()], base["patches/perimeter"][()]])
                    if "patches" in base else np.zeros((0, 2)))
         return ArealResult(
-            pressure=fields["pressure"], gap=fields["gap"], displacement_z=fields["displacement_z"],
+            pressure=fields.get("pressure"), gap=fields.get("gap"), displacement_z=fields.get("displacement_z"),
             displacement_x=fields.get("displacement_x"), displacement_y=fields.get("displacement_y"),
             stress_xx=fields.get("stress_xx"), stress_yy=fields.get("stress_yy"), stress_xy=fields.get("stress_xy"),
-            height=f["profile/height"][()], period=(lx, ly), friction=float(r["friction"]), patches=patches,
+            height=_profile(f), period=(lx, ly), friction=float(r["friction"]), patches=patches,
             residual_history=base["convergence/residual"][()],
             a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values)
 

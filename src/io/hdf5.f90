@@ -5,6 +5,7 @@
 !>   /input/namelist       the namelist text; /input attrs: every parsed scene value
 !>   /profile/x, height    grid positions j*period/n and the rigid profile r(x)
 !>   /fields/pressure, gap, displacement_z
+!>                         (/profile and /fields only with &output fields, the default)
 !>   /results              attrs: scalar observables, solver record, the seed's normalised values
 !>   /convergence/residual residual per iteration
 !>   /companion/...        the same fields/results/convergence for the frictionless companion
@@ -222,15 +223,17 @@ contains
          call write_scene_attrs(group, scene, st)
          call close_group(group, st)
 
-         call create_group(file, 'profile', group, st)
-         call write_dataset_1d(group, 'x', [(j*scene%period/scene%n, j=0, scene%n - 1)], 'L', st)
-         if (is_areal(scene)) then
-            associate (ly => merge(scene%period_y, scene%period, scene%period_y > 0.0_wp))
-               call write_dataset_1d(group, 'y', [(j*ly/scene%ny, j=0, scene%ny - 1)], 'L', st)
-            end associate
+         if (scene%fields) then
+            call create_group(file, 'profile', group, st)
+            call write_dataset_1d(group, 'x', [(j*scene%period/scene%n, j=0, scene%n - 1)], 'L', st)
+            if (is_areal(scene)) then
+               associate (ly => merge(scene%period_y, scene%period, scene%period_y > 0.0_wp))
+                  call write_dataset_1d(group, 'y', [(j*ly/scene%ny, j=0, scene%ny - 1)], 'L', st)
+               end associate
+            end if
+            call write_field(group, 'height', height, 'L', scene, st)
+            call close_group(group, st)
          end if
-         call write_field(group, 'height', height, 'L', scene, st)
-         call close_group(group, st)
 
          if (present(companion)) then
             call write_solution(file, result, scene, st, &
@@ -430,21 +433,23 @@ contains
       real(wp), intent(in), optional :: a_over_a0
       integer(hid_t) :: group
 
-      call create_group(loc, 'fields', group, st)
-      call write_field(group, 'pressure', res%pressure, 'S', scene, st)
-      call write_field(group, 'gap', res%gap, 'L', scene, st)
-      call write_field(group, 'displacement_z', res%displacement_z, 'L', scene, st)
-      if (allocated(res%stress_xx)) then
-         call write_field(group, 'displacement_x', res%displacement_x, 'L', scene, st)
-         call write_field(group, 'shear', res%shear, 'S', scene, st)
-         call write_field(group, 'stress_xx', res%stress_xx, 'S', scene, st)
+      if (scene%fields) then
+         call create_group(loc, 'fields', group, st)
+         call write_field(group, 'pressure', res%pressure, 'S', scene, st)
+         call write_field(group, 'gap', res%gap, 'L', scene, st)
+         call write_field(group, 'displacement_z', res%displacement_z, 'L', scene, st)
+         if (allocated(res%stress_xx)) then
+            call write_field(group, 'displacement_x', res%displacement_x, 'L', scene, st)
+            call write_field(group, 'shear', res%shear, 'S', scene, st)
+            call write_field(group, 'stress_xx', res%stress_xx, 'S', scene, st)
+         end if
+         if (allocated(res%stress_yy)) then
+            call write_field(group, 'displacement_y', res%displacement_y, 'L', scene, st)
+            call write_field(group, 'stress_yy', res%stress_yy, 'S', scene, st)
+            call write_field(group, 'stress_xy', res%stress_xy, 'S', scene, st)
+         end if
+         call close_group(group, st)
       end if
-      if (allocated(res%stress_yy)) then
-         call write_field(group, 'displacement_y', res%displacement_y, 'L', scene, st)
-         call write_field(group, 'stress_yy', res%stress_yy, 'S', scene, st)
-         call write_field(group, 'stress_xy', res%stress_xy, 'S', scene, st)
-      end if
-      call close_group(group, st)
 
       if (allocated(res%patch_area)) then
          call create_group(loc, 'patches', group, st)

@@ -30,7 +30,7 @@ module lc_io_namelist
       & 'amplitude, mode, mode_y, radius, file, dataset', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
       & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose', &
-      & 'file, overwrite, stress, gap_bins']
+      & 'file, overwrite, stress, gap_bins, fields']
 
    character(len=*), parameter :: newline = new_line('a')
    !> Marks array entries a namelist did not set (any real a user could type is a value,
@@ -185,6 +185,7 @@ contains
             & // entry('overwrite', logical_value(scene%overwrite)) &
             & // entry('stress', logical_value(scene%stress)) &
             & // entry('gap_bins', to_string(scene%gap_bins)) &
+            & // entry('fields', logical_value(scene%fields)) &
             & // '/' // newline
       end associate
    end subroutine write_scene_namelist
@@ -512,20 +513,22 @@ contains
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
       character(len=max_string) :: file
-      logical :: overwrite, stress
+      logical :: overwrite, stress, fields
       integer :: gap_bins
-      namelist /output/ file, overwrite, stress, gap_bins
+      namelist /output/ file, overwrite, stress, gap_bins, fields
 
       file = config%output_file
       overwrite = config%overwrite
       stress = config%stress
       gap_bins = config%gap_bins
+      fields = config%fields
       read (lines, nml=output, iostat=stat, iomsg=msg)
       if (stat /= 0) return
       config%output_file = file
       config%overwrite = overwrite
       config%stress = stress
       config%gap_bins = gap_bins
+      config%fields = fields
    end subroutine read_group_output
 
    ! ---------------------------------------------------------------------------------------
