@@ -86,6 +86,11 @@ BAD = [
     ("&profile\n kind = 'sinusoid'\n amplitude = 0.1\n mode = 2000000000\n/\n", "&profile: mode"),
     ("&solver\n max_iter = 2000000000\n/\n", "&solver: max_iter"),
     ("&layer\n thickness = 0.1\n/\n poisson = 0.3\n", "line 4: text outside a namelist group"),
+    # strings that the scene could keep only cut are refused, not cut
+    (f"&scene\n title = '{'t' * 513}'\n/\n", "group &scene: title = 'tttttttttttttttttttttttt...' is longer than 512"),
+    (f"&material\n model = 'prony'\n prony_file = '{'p' * 600}'\n/\n", "prony_file = 'pppp"),
+    (f"&profile\n kind = 'file'\n file = 'x.h5'\n dataset = '/{'d' * 520}'\n/\n", "dataset = '/ddd"),
+    (f"&solver\n method = '{'m' * 700}'\n/\n", "method = 'mmm"),
 ]
 
 

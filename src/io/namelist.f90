@@ -33,6 +33,9 @@ module lc_io_namelist
       & 'file, overwrite, stress, gap_bins, fields']
 
    character(len=*), parameter :: newline = new_line('a')
+   !> The status of a string variable too long for the scene (not an iostat value: those
+   !> are positive for errors, -1 and -2 for the ends of file and record)
+   integer, parameter :: stat_too_long = -4242
    !> Marks array entries a namelist did not set (any real a user could type is a value,
    !> so that a wrong sign is reported rather than taken for "not given").
    real(wp), parameter :: unset_entry = -huge(1.0_wp)
@@ -101,9 +104,10 @@ contains
          if (stat /= 0) then
             if (stat == iostat_end) msg = trim(msg) // " (is the closing '/' of the group missing?)"
             name = trim(group_names(groups(i)%index))
+            if (stat /= stat_too_long) msg = trim(msg) // '; allowed variables in &' // name // ': ' &
+               & // trim(group_variables(groups(i)%index))
             call fatal_error(error, source // ', line ' // to_string(groups(i)%line - 1 + line) &
-               & // ', group &' // name // ': ' // trim(msg) // '; allowed variables in &' // name // ': ' &
-               & // trim(group_variables(groups(i)%index)), code_input)
+               & // ', group &' // name // ': ' // trim(msg), code_input)
             return
          end if
       end do
@@ -235,7 +239,7 @@ contains
       type(scene_type), intent(inout) :: config
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
-      character(len=max_string) :: geometry, title
+      character(len=max_string + 1) :: geometry, title
       real(wp) :: period, period_x, period_y
       integer :: n, nx, ny
       namelist /scene/ geometry, title, period, n, period_x, period_y, nx, ny
@@ -252,6 +256,8 @@ contains
       period_y = config%period_y
       read (lines, nml=scene, iostat=stat, iomsg=msg)
       if (stat /= 0) return
+      if (too_long('geometry', geometry, stat, msg)) return
+      if (too_long('title', title, stat, msg)) return
       config%geometry = geometry
       config%title = title
       config%period = merge(period_x, period, period_x /= not_set)
@@ -284,7 +290,7 @@ contains
       type(scene_type), intent(inout) :: config
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
-      character(len=max_string) :: model, prony_form, prony_file
+      character(len=max_string + 1) :: model, prony_form, prony_file
       real(wp) :: e0, e_inf, tau, speed, prony_equilibrium
       real(wp) :: prony_times(max_prony_terms), prony_values(max_prony_terms)
       namelist /material/ model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, &
@@ -305,6 +311,9 @@ contains
          if (allocated(m%values)) prony_values(:size(m%values)) = m%values
          read (lines, nml=material, iostat=stat, iomsg=msg)
          if (stat /= 0) return
+      if (too_long('model', model, stat, msg)) return
+      if (too_long('prony_form', prony_form, stat, msg)) return
+      if (too_long('prony_file', prony_file, stat, msg)) return
          if (count_set(prony_times) /= count(prony_times /= unset_entry) .or. &
             & count_set(prony_values) /= count(prony_values /= unset_entry)) then
             stat = -1
@@ -326,6 +335,20 @@ contains
          if (count_set(prony_values) > 0) m%values = prony_values(:count_set(prony_values))
       end associate
    end subroutine read_group_material
+
+   !> A string variable read into a buffer one character longer than the scene keeps: if it
+   !> fills more than max_string characters it would be cut, so it is refused
+   !> (stat = stat_too_long).
+   logical function too_long(name, value, stat, msg)
+      character(len=*), intent(in) :: name, value
+      integer, intent(inout) :: stat
+      character(len=*), intent(inout) :: msg
+      too_long = len_trim(value) > max_string
+      if (.not. too_long) return
+      stat = stat_too_long
+      msg = name // " = '" // value(:24) // "...' is longer than " // to_string(max_string) // &
+         & ' characters; allowed: at most ' // to_string(max_string) // ' characters'
+   end function too_long
 
    !> Number of leading entries that were given (not `unset_entry`).
    pure integer function count_set(values)
@@ -413,7 +436,7 @@ contains
       type(scene_type), intent(inout) :: config
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
-      character(len=max_string) :: kind, file, dataset
+      character(len=max_string + 1) :: kind, file, dataset
       real(wp) :: hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, amplitude, radius
       integer(i8) :: seed
       integer :: mode, mode_y
@@ -436,6 +459,9 @@ contains
          dataset = p%dataset
          read (lines, nml=profile, iostat=stat, iomsg=msg)
          if (stat /= 0) return
+      if (too_long('kind', kind, stat, msg)) return
+      if (too_long('file', file, stat, msg)) return
+      if (too_long('dataset', dataset, stat, msg)) return
          p%kind = kind
          p%hurst = hurst
          p%seed = seed
@@ -457,7 +483,7 @@ contains
       type(scene_type), intent(inout) :: config
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
-      character(len=max_string) :: control
+      character(len=max_string + 1) :: control
       real(wp) :: mean_pressure, normalised_pressure, penetration
       namelist /loading/ control, mean_pressure, normalised_pressure, penetration
 
@@ -467,6 +493,7 @@ contains
       penetration = config%penetration
       read (lines, nml=loading, iostat=stat, iomsg=msg)
       if (stat /= 0) return
+      if (too_long('control', control, stat, msg)) return
       config%control = control
       config%mean_pressure = mean_pressure
       config%normalised_pressure = normalised_pressure
@@ -478,7 +505,7 @@ contains
       type(scene_type), intent(inout) :: config
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
-      character(len=max_string) :: method
+      character(len=max_string + 1) :: method
       real(wp) :: tol
       integer :: max_iter, memory, threads
       real(wp) :: target_error
@@ -496,6 +523,7 @@ contains
       verbose = config%solver%verbose
       read (lines, nml=solver, iostat=stat, iomsg=msg)
       if (stat /= 0) return
+      if (too_long('method', method, stat, msg)) return
       config%solver%method = method
       config%solver%tol = tol
       config%solver%max_iter = max_iter
@@ -512,7 +540,7 @@ contains
       type(scene_type), intent(inout) :: config
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
-      character(len=max_string) :: file
+      character(len=max_string + 1) :: file
       logical :: overwrite, stress, fields
       integer :: gap_bins
       namelist /output/ file, overwrite, stress, gap_bins, fields
@@ -524,6 +552,7 @@ contains
       fields = config%fields
       read (lines, nml=output, iostat=stat, iomsg=msg)
       if (stat /= 0) return
+      if (too_long('file', file, stat, msg)) return
       config%output_file = file
       config%overwrite = overwrite
       config%stress = stress
