@@ -131,7 +131,7 @@ def layer_problem(n, thickness, normalised_pressure):
     heights = lc.self_affine_profile(n, 0.8, seed=1, short_wavelength=1 / 64, rms_gradient=0.1)
     poisson = 0.3
     contact_modulus = YOUNG / (1 - poisson**2)
-    # README's scale: p_m/(E* Lambda0/lambda), Lambda0 = max r - mean r
+    # the seed's scale: p_m/(E* Lambda0/lambda), Lambda0 = max r - mean r
     pm = normalised_pressure * contact_modulus * (heights.max() - heights.mean()) / PERIOD
     return Problem(f"layer h/lambda={thickness:g}", heights, thickness, poisson, pm)
 

@@ -21,7 +21,7 @@ on as many threads as there are cores, spinning while waiting (a single-process 
 burnt ~1.8 cores, and (d) was faster than (a)). It now solves a small Gram system, and (d)
 checks that nothing threaded is left (measured: no gain).
 
-(c), (e) and (g) need a second venv built with the meson option ``openmp`` (README: &solver
+(c), (e) and (g) need a second venv built with the meson option ``openmp`` (docs/namelist.md: &solver
 threads), e.g. ``--build-openmp`` or by hand::
 
     python3 -m venv build/venv-openmp

@@ -1,5 +1,5 @@
 """The seed's Fig. 2 from the sweeps in inputs/sweeps/ (reads only HDF5), and the table of
-numbers quoted in the README.
+numbers quoted in docs/figures.md.
 
     .venv/bin/python -m layercontact sweep inputs/sweeps/fig2a.nml   # and fig2b, fig2c, fig2d
     .venv/bin/python postproc/fig2.py [--out docs/fig2.png]
@@ -125,7 +125,7 @@ def panel_d(ax, cols):
 
 
 def print_table(b, c, d, robustness) -> None:
-    """The README's table: a/a0 extremes, thick-layer limit, Delta mu trends, robustness."""
+    """The table of docs/figures.md: a/a0 extremes, thick-layer limit, Delta mu trends, robustness."""
     print("| quantity | value (mean +- standard error over realisations) |")
     print("|---|---|")
     for mu in (min(b), max(b)):

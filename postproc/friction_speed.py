@@ -1,5 +1,5 @@
 """Friction against sliding speed on a viscoelastic layer (reads only HDF5), and the table
-of numbers quoted in the README.
+of numbers quoted in docs/figures.md.
 
     .venv/bin/python -m layercontact sweep inputs/sweeps/viscoelastic_speed.nml
     .venv/bin/python postproc/friction_speed.py [--out docs/friction_speed.png]

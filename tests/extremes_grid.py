@@ -1,5 +1,5 @@
 """The parameter grid of the stability tests at the extremes, shared by
-tests/test_extremes.py (assertions) and bench/extremes.py (iteration table for the README).
+tests/test_extremes.py (assertions) and bench/extremes.py (iteration table of docs/performance.md).
 
 Grid: three profiles (a self-affine rough line, one cosine bump = Westergaard's sinusoid,
 a narrow Gaussian bump whose tip is Hertz-like) x h/lambda in {1e-4, 1e-3, 1e-2, 0.16, 1,
@@ -88,7 +88,7 @@ def independent_residual(res: lc.LineResult, thickness: float, nu: float, materi
     recomputed from the returned pressure with numpy FFTs and without the uniform mode
     (the penetration is the mean gap on the contact set, as in the solver). Gaps within the
     rounding floor 256 eps max(|w|, |r|, max p max|G|) count as zero, as in the solver
-    (README, stopping rule): below it a gap is rounding noise of w - r."""
+    (docs/numerics.md, stopping rule): below it a gap is rounding noise of w - r."""
     r, p = res.height, res.pressure
     g = g_eff(r.size, thickness, nu, res.friction, material, speed)
     ph = np.fft.rfft(p)

@@ -17,7 +17,7 @@
 7. Partial contact on larger grids (coarse start; odd sizes), elastic and viscoelastic: the
    residual recomputed independently and the Delta mu identities.
 
-Fields are (ny, nx) arrays, axis 1 = x = the sliding direction; convention P (README).
+Fields are (ny, nx) arrays, axis 1 = x = the sliding direction; convention P (docs/theory.md).
 """
 
 from __future__ import annotations
@@ -273,7 +273,7 @@ SLS_SPEED = 0.1
 
 def sls_compliance(omega):
     """Creep compliance of the standard linear solid for steady sliding, J*(omega) =
-    1/E_inf + (1/E0 - 1/E_inf)/(1 - i omega tau) (README, Viscoelastic layers; written out
+    1/E_inf + (1/E0 - 1/E_inf)/(1 - i omega tau) (docs/problems.md, viscoelastic layers; written out
     here, not taken from the library)."""
     return 1 / SLS["e_inf"] + (1 / SLS["e0"] - 1 / SLS["e_inf"]) / (1 - 1j * omega * SLS["tau"])
 
@@ -554,7 +554,7 @@ def full_contact_pressure_areal(r, g):
 
 
 def independent_areal_residual(res, g):
-    """The solver's stopping quantity max_j |min(p_j/p_m, g_j/ptp(r))| (README, stopping
+    """The solver's stopping quantity max_j |min(p_j/p_m, g_j/ptp(r))| (docs/numerics.md, stopping
     rule; src/contact/solver_gcr.f90 evaluate), recomputed from the returned pressure with
     numpy FFTs and the closed-form G_eff, without the uniform mode: the gap constant is the
     mean of w - r over the contact set, as in the solver. Gaps within the rounding floor

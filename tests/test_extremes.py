@@ -15,7 +15,7 @@ thin incompressible layers (h/lambda <= 1e-3) where the operator is nearly skew
 (|mu_c c|/(1-A) ~ 1.5 mu_c/(kh) at the fundamental) on tiny grids: the GCR stalls, the
 outer Anderson iteration stagnates too even with its history grown to 48 and stops,
 returning its best iterate. `.venv/bin/python bench/extremes.py --list` prints them; its
-tables of iteration counts are in the README.
+tables of iteration counts are in docs/performance.md.
 
 A second grid does the same for viscoelastic layers (test_viscoelastic_runs_converge_or_say_so;
 `bench/extremes.py --viscoelastic`).

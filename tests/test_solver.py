@@ -311,7 +311,7 @@ def test_dense_newton_agrees(case):
     bound the tolerances allow (a gap residual tol * ptp(profile) times the operator's
     largest stiffness max 1/|G_eff(k)|), with the same penetration multiplier. The first
     case is of the class whose n = 1024 versions the library cannot solve within the grid's
-    budget (README, stability at the extremes); at n = 256 it does."""
+    budget (docs/performance.md, stability at the extremes); at n = 256 it does."""
     n = 256
     r = extremes_grid.profiles(n)["bump" if "bump" in case else "rough"]
     thickness, nu, friction, material, speed, factor = {

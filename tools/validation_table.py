@@ -1,4 +1,4 @@
-"""Print the README's validation table: each row is an independent check of the code,
+"""Print the validation table of docs/validation.md: each row is an independent check of the code,
 computed here and now (the tests in tests/ assert the same quantities).
 
     .venv/bin/python tools/validation_table.py

@@ -1,7 +1,7 @@
 """layercontact: sliding contact of rough rigid surfaces on thin elastic layers with
 Coulomb friction, by the Green's function (Fourier multiplier) method.
 
-Sign convention P (see README): ``x`` is the sliding direction of the indenter, ``z``
+Sign convention P (see docs/theory.md): ``x`` is the sliding direction of the indenter, ``z``
 points into the layer, ``p > 0`` is compressive, ``w = u_z > 0`` is indentation and the
 friction traction on the layer is ``tau = +mu_c p``.
 """
