@@ -179,6 +179,7 @@ BAD_SWEEPS = [
     ("mean_pressure = 0.1\n normalised_pressure = 1\n", "&sweep mean_pressure, normalised_pressure"),
     ("realisations = 0\n", "&sweep realisations: 0 is not allowed"),
     ("processes = -2\n", "&sweep processes: -2 is not allowed"),
+    ("seed = 1\n/\n&sweep\n seed = 2\n", "&sweep is given more than once; allowed: one &sweep group"),
 ]
 
 
@@ -238,3 +239,19 @@ def test_example_sweep_runs(tmp_path, monkeypatch):
     assert all(0 < r["a_over_a0"] for r in rows)
     summary = lc.read_summary("out/sweeps/example/example_summary.csv")
     assert summary["friction"].size == 8
+
+
+def test_poisson_hurst_and_grid_size_can_be_swept(tmp_path, monkeypatch):
+    """&sweep poisson, hurst and n land in &layer, &profile and &scene of each scene; each
+    scene solves as the same scene run alone."""
+    monkeypatch.chdir(tmp_path)
+    path = write_sweep(tmp_path, lists="poisson = 0.3, 0.5\n hurst = 0.6\n n = 256, 512\n")
+    rows = lc.sweep(path, progress=False)
+    assert [(r["poisson"], r["hurst"], r["n"]) for r in rows] == [(0.3, 0.6, 256), (0.3, 0.6, 512),
+                                                                   (0.5, 0.6, 256), (0.5, 0.6, 512)]
+    for row in rows:
+        scene = f90nml.read(row["scene_file"])
+        assert (scene["layer"]["poisson"], scene["profile"]["hurst"], scene["scene"]["n"]) == (
+            row["poisson"], row["hurst"], row["n"])
+        result = lc.read_result(row["result_file"])
+        assert result.pressure.size == row["n"] and result.converged

@@ -102,7 +102,10 @@ PARAMETERS: dict[str, _Parameter] = {
     "normalised_pressure": _Parameter("loading", "normalised_pressure", float, _LOADING, _LOAD),
     "mean_pressure": _Parameter("loading", "mean_pressure", float, _LOADING, _LOAD),
     "thickness": _Parameter("layer", "thickness", float),
+    "poisson": _Parameter("layer", "poisson", float),
     "speed": _Parameter("material", "speed", float),
+    "hurst": _Parameter("profile", "hurst", float),
+    "n": _Parameter("scene", "n", int),
     "seed": _Parameter("profile", "seed", int),
 }
 
@@ -208,11 +211,18 @@ def _name_setting(source: Path, variable: str, raw: object) -> str:
 
 def _read_namelist(source: Path) -> f90nml.Namelist:
     try:
-        return f90nml.read(os.fspath(source))
+        nml = f90nml.read(os.fspath(source))
     except FileNotFoundError:
         raise
     except Exception as err:  # f90nml raises several types for syntax errors
         raise ValueError(f"{source}: cannot parse the namelist file: {err}") from err
+    # f90nml keeps a repeated group as a "cogroup" (its name twice in keys()); the library
+    # reads each group once
+    names = list(nml.keys())
+    repeated = [name for name in dict.fromkeys(names) if names.count(name) > 1]
+    if repeated:
+        raise ValueError(f"{source}: &{repeated[0]} is given more than once; allowed: one &{repeated[0]} group")
+    return nml
 
 
 def _swept_values(source: Path, group: f90nml.Namelist) -> dict[str, list]:
