@@ -35,6 +35,7 @@ import csv
 import io
 import itertools
 import json
+import signal
 import multiprocessing
 import os
 import sys
@@ -548,6 +549,13 @@ def _pool_context() -> multiprocessing.context.BaseContext:
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
+def _start_worker(directory: str) -> None:
+    """A worker runs in the caller's working directory (a forkserver keeps its own) and
+    leaves Ctrl-C to the sweep's process, which lets the running scenes finish and stops."""
+    os.chdir(directory)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _run_pending(
     name: str, pending: list[Scene], total: int, processes: int, progress: bool
 ) -> dict[int, dict[str, object]]:
@@ -557,9 +565,8 @@ def _run_pending(
     outcomes: dict[int, dict[str, object]] = {}
     bar = tqdm(total=total, initial=total - len(pending), desc=name, unit="scene", file=sys.stderr,
                disable=not progress)
-    # the workers run in the caller's working directory (a forkserver keeps its own)
     pool = ProcessPoolExecutor(max_workers=min(processes, len(pending)), mp_context=_pool_context(),
-                               initializer=os.chdir, initargs=(os.getcwd(),))
+                               initializer=_start_worker, initargs=(os.getcwd(),))
     try:
         futures = {
             pool.submit(_solve, str(s.scene_file), str(s.result_file), str(_record_file(s))): s
@@ -596,6 +603,9 @@ def execute(plan: SweepPlan, processes: int | None = None, progress: bool = True
     if dry_run:
         return [scene.planned_row() for scene in scenes]
     pending = [scene for scene in scenes if not _is_complete(scene)]
+    if progress and len(pending) < len(scenes):
+        print(f"sweep '{plan.name}': {len(scenes) - len(pending)} of {len(scenes)} scenes already have their "
+              f"result (same input): skipped; running {len(pending)}", file=sys.stderr)
     outcomes = _run_pending(plan.name, pending, len(scenes), workers, progress) if pending else {}
     rows = [_row(scene, outcomes) for scene in scenes]
     write_summary(rows, plan)
