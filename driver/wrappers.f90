@@ -93,7 +93,7 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
    integer, intent(in) :: model, form, nt, capacity, n_fields, spot_capacity, n_columns
    real(8), intent(in) :: height(n), period, period_y, thickness, young, poisson, friction, mean_pressure, penetration
    real(8), intent(in) :: tol, e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
-   real(8), intent(out) :: fields(n, n_fields), spots(spot_capacity, n_columns), scalars(33), history(capacity)
+   real(8), intent(out) :: fields(n, n_fields), spots(spot_capacity, n_columns), scalars(34), history(capacity)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n, nt
@@ -167,7 +167,7 @@ subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, po
       & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), &
       & r%pressure_shift, r%summit_shift, r%max_tension_grid, real(findloc(solvers, r%solver, dim=1), 8), &
       & r%normalised_pressure, r%normalised_thickness, r%max_tension_y, r%max_principal_stress, &
-      & r%max_principal_x, r%max_principal_y]
+      & r%max_principal_x, r%max_principal_y, r%gap_resolution]
 end subroutine py_solve
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless

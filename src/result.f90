@@ -70,6 +70,9 @@ module lc_result
       character(len=16) :: solver = ''
       integer :: fft_pairs = 0                !< FFT r2c+c2r pairs spent
       real(wp) :: residual = huge(1.0_wp)     !< final dimensionless complementarity residual
+      !> an upper bound of the rounding of w - r relative to the profile's peak-to-valley:
+      !> the smallest gap that double precision resolves at this load (see solve_on_grid)
+      real(wp) :: gap_resolution = 0.0_wp
       real(wp) :: wall_time = 0.0_wp          !< seconds spent in the solver
    end type contact_result
 end module lc_result

@@ -8,9 +8,11 @@ and 1024: 2100 runs per n, 8400 in all (~5 s; the viscoelastic grid ~11 s).
 The measured contact fraction spans one node (1/1024 ~ 0.1 %) to full contact for every
 profile.
 
-Measured (tol 1e-9, max_iter 10000), portable core: converged 2099 of 2100 at n = 8, 2096
-at n = 9, 2097 at n = 63, 2100 at n = 1024 (8392 of 8400); x86-64-v3 core: 2100, 2094, 2099,
-2100 (8393). All the others are coupled scenes (mu_c > 0) on
+Measured (tol 1e-9, max_iter 10000), x86-64-v3 core: converged 2098 of 2100 at n = 8, 2093
+at n = 9, 2100 at n = 63, 2099 at n = 1024. A run whose gaps the rounding of w - r hides
+above tol (thin incompressible layers at the heaviest loads: gap_resolution > tol) reports
+the residual without the floor and is not converged (1-7 runs per size). The others are
+coupled scenes (mu_c > 0) on
 thin incompressible layers (h/lambda <= 1e-3) where the operator is nearly skew
 (|mu_c c|/(1-A) ~ 1.5 mu_c/(kh) at the fundamental) on tiny grids: the GCR stalls, the
 outer Anderson iteration stagnates too even with its history grown to 48 and stops,
@@ -55,10 +57,14 @@ def check_run(scene: dict, r: lc.LineResult) -> None:
     # returned as its best is evaluated again with w = G p afresh, which differs from
     # the incrementally updated w by rounding)
     assert r.residual_history.size >= 1, where
+    # (at loads where the rounding of w - r hides gaps larger than tol, gap_resolution > tol,
+    # the solver stops on its floor-masked residual and the run reports the residual
+    # recomputed without the floor, unconverged)
+    unresolved = not r.converged and r.gap_resolution > TOL and r.residual_history[-1] <= TOL < r.residual
     if coupled(scene):
-        assert r.residual == pytest.approx(r.residual_history.min(), rel=1e-9), where
+        assert unresolved or r.residual == pytest.approx(r.residual_history.min(), rel=1e-9), where
     else:
-        assert r.residual == r.residual_history[-1], where
+        assert unresolved or r.residual == r.residual_history[-1], where
     assert 1 <= r.iterations <= MAX_ITER and r.outer_iterations >= 1, where
     assert np.all(r.pressure >= 0), where
     # load control: the mean pressure is imposed by rescaling, exact to rounding (n terms)

@@ -143,13 +143,32 @@ def test_not_converged_is_reported_honestly(rough_profile):
     assert not sym.converged and contact_violation(sym, 0.16, 1.0, 0.5)["w_error"] <= 1e-12
 
 
-def test_extreme_load_full_contact_converges():
-    """At loads far beyond full contact the gap is rounding noise of a large w - r; the
-    residual treats gaps below that floor as zero instead of iterating forever."""
+def test_extreme_load_full_contact_stops_and_is_honest():
+    """At loads far beyond full contact the gap is rounding noise of a large w - r. The
+    solver stops (gaps below the rounding floor count as zero) instead of iterating
+    forever, and the flag stays honest: converged only if the residual recomputed without
+    the floor is within tol, otherwise unconverged with that residual and a gap
+    resolution above tol. The pressure is the exact full-contact one either way."""
     h = lc.self_affine_profile(1024, 0.8, short_wavelength=1 / 32)
     for thickness, nu in ((0.16, 0.5), (0.16, 0.3), (np.inf, 0.5)):
-        res = lc.solve_line(h, thickness=thickness, poisson=nu, mean_pressure=1e8 * h.max(), max_iter=200)
-        assert res.converged and res.contact_fraction == 1.0
+        for load, tol in ((1e8, 1e-10), (1e8, 1e-6), (1e300, 1e-6)):
+            pm = load * h.max()
+            res = lc.solve_line(h, thickness=thickness, poisson=nu, mean_pressure=pm, max_iter=200, tol=tol)
+            assert res.iterations < 200 and res.contact_fraction == 1.0
+            plain = np.abs(np.minimum(res.pressure / pm, res.gap / np.ptp(h))).max()
+            if res.converged:
+                assert plain <= tol
+            else:
+                assert res.gap_resolution > tol and res.residual > tol
+                assert res.residual == pytest.approx(plain, rel=1e-12)
+            # full contact: p = p_m + the pressure that flattens r - mean r, exact from numpy
+            g = g_eff(1024, 1.0, thickness, 1.0, nu, 0.0)
+            g[0] = np.inf   # the uniform mode carries p_m
+            exact = pm + apply(1 / g, h - h.mean())
+            assert np.abs(res.pressure - exact).max() <= 1e-10 * pm
+        # at 1e8 x the profile's peak a tolerance of 1e-6 is resolved; at 1e300 it is not
+        assert lc.solve_line(h, thickness=thickness, poisson=nu, mean_pressure=1e8 * h.max(), tol=1e-6).converged
+        assert not lc.solve_line(h, thickness=thickness, poisson=nu, mean_pressure=1e300, tol=1e-6).converged
 
 
 def test_partial_contact_on_odd_grid(rough_profile):

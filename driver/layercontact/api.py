@@ -22,7 +22,7 @@ _SCALARS = (
     "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
     "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
     "max_tension_grid", "solver", "normalised_pressure", "normalised_thickness", "max_tension_y",
-    "max_principal_stress", "max_principal_x", "max_principal_y",
+    "max_principal_stress", "max_principal_x", "max_principal_y", "gap_resolution",
 )
 # The solver that ran, by the code in the scalars (driver/wrappers.f90 `solvers`).
 _SOLVERS = {1: "cg", 2: "gcr", 3: "anderson", 4: "gcr+anderson", 5: "gfmd"}
@@ -129,6 +129,9 @@ class LineResult:
     residual: float
     wall_time: float
     residual_history: np.ndarray = field(repr=False)
+    #: the smallest gap, relative to the profile's height range, that double precision
+    #: resolves at this load; above ``tol`` the run reports ``converged = False``
+    gap_resolution: float = 0.0
     n_spots: int = 0
     spots: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
     mean_gap: float = float("nan")
@@ -288,7 +291,7 @@ _AREAL_SCALARS = (
     "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
     "mean_gap", "dissipated_power", "monotone", "solver", "normalised_pressure", "normalised_thickness",
     "max_tension", "max_tension_x", "max_tension_y", "max_tension_offset", "max_principal_stress",
-    "max_principal_x", "max_principal_y",
+    "max_principal_x", "max_principal_y", "gap_resolution",
 )
 _AREAL_ONLY = ("max_tension_y", "max_principal_stress", "max_principal_x", "max_principal_y")
 _STRESS_SCALARS = ("max_tension", "max_tension_x", "max_tension_y", "max_tension_offset", "max_principal_stress",
@@ -339,6 +342,9 @@ class ArealResult:
     residual: float
     wall_time: float
     residual_history: np.ndarray = field(repr=False)
+    #: the smallest gap, relative to the profile's height range, that double precision
+    #: resolves at this load; above ``tol`` the run reports ``converged = False``
+    gap_resolution: float = 0.0
     dissipated_power: float = 0.0
     monotone: bool = True
     normalised_pressure: float = float("nan")

@@ -495,6 +495,7 @@ contains
       call write_attr_string(group, 'solver', trim(res%solver), st)
       call write_attr_int(group, 'fft_pairs', res%fft_pairs, st)
       call write_attr_real(group, 'residual', res%residual, st)
+      call write_attr_real(group, 'gap_resolution', res%gap_resolution, st)
       call write_attr_real(group, 'wall_time', res%wall_time, st)
       call write_attr_real(group, 'friction', res%friction, st)
       call write_attr_int(group, 'n_spots', res%n_spots, st)
