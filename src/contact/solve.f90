@@ -226,8 +226,6 @@ contains
          call record_solve(result, 'cg', cg%converged, cg%iterations, 1, cg%fft_pairs, cg%residual, &
             & history(1:cg%iterations))
       end if
-      if (progress%enabled) call progress%level_done(result%solver, result%converged, result%iterations, &
-         & result%residual, count(p > 0.0_wp)/real(size(p), wp))
       result%fft_pairs = result%fft_pairs + coarse_pairs
       ! The solvers stop when the residual, with gaps below the rounding floor of w - r
       ! counted as zero, reaches tol: no iteration resolves such gaps. At loads so large that
@@ -242,6 +240,8 @@ contains
             result%residual = plain
          end if
       end if
+      if (progress%enabled) call progress%level_done(result%solver, result%converged, result%iterations, &
+         & result%residual, count(p > 0.0_wp)/real(size(p), wp))
       ! the uniform mode's rigid shift (see drop_uniform_mode)
       w = w + uniform*pm
       s = s + uniform*pm
