@@ -315,7 +315,7 @@ def test_python_raises_for_a_grid_too_large_for_the_memory():
     assert proc.stdout.startswith("code 5 ") and "(16777216 grid points) needs about 3.8 GiB" in proc.stdout
 
 
-def test_result_without_maps_holds_the_same_scalars(tmp_path):
+def test_result_without_maps_holds_the_same_scalars(tmp_path, monkeypatch, capsys):
     """&output fields = .false.: no /profile and /fields, every scalar as with the maps;
     read_result gives the maps as None."""
     text = ("&scene\n geometry = 'areal'\n n = 64\n/\n&friction\n coefficient = 0.5\n companion = .true.\n/\n"
@@ -332,3 +332,11 @@ def test_result_without_maps_holds_the_same_scalars(tmp_path):
     r = lc.read_result(tmp_path / "scalars.h5")
     assert r.pressure is None and r.height is None and r.companion.gap is None
     assert r.contact_fraction == lc.read_result(tmp_path / "maps.h5").contact_fraction
+    # `python -m layercontact run` draws no picture then, and says so
+    from layercontact.__main__ import main
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "scalars.h5").unlink()
+    assert main(["run", "scalars.nml"]) == 0
+    assert "none (&output fields = .false.: the result has no maps)" in capsys.readouterr().out
+    assert not (tmp_path / "scalars.png").exists()

@@ -126,11 +126,18 @@ def run_command(args: argparse.Namespace) -> int:
         return err.code
     h5 = Path(out.decode().strip() if isinstance(out, bytes) else str(out).strip())
     if not args.no_png:
+        import h5py
+
         from .plot import plot_result
 
-        png = Path(args.png) if args.png else h5.with_suffix(".png")
-        plot_result(h5, png)
-        print(f"  {'picture':<32}{png}")
+        with h5py.File(h5, "r") as f:
+            has_maps = "fields" in f
+        if has_maps:
+            png = Path(args.png) if args.png else h5.with_suffix(".png")
+            plot_result(h5, png)
+            print(f"  {'picture':<32}{png}")
+        else:
+            print(f"  {'picture':<32}none (&output fields = .false.: the result has no maps)")
     if not converged:
         print("layercontact: warning: the solver did not reach its tolerance", file=sys.stderr)
         return 3
