@@ -158,7 +158,7 @@ def sweep_command(nml: str, processes: int | None, progress: bool, dry_run: bool
         return 2
     except KeyboardInterrupt:
         # the scenes finished so far keep their results; the scene files say what is left
-        print(f"\nlayercontact: sweep interrupted; run the same command again to resume (finished scenes "
+        print("\nlayercontact: sweep interrupted; run the same command again to resume (finished scenes "
               "are kept and skipped)", file=sys.stderr)
         return 130
     if dry_run:

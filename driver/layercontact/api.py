@@ -232,8 +232,7 @@ def solve_line(
 
 def _solve_native(h, nx, areal, *, period, period_y, thickness, young, poisson, friction, mean_pressure,
                   penetration, stress, method, precondition, coarse_start, progress, tol, max_iter, memory, threads,
-                  material,
-                  speed):
+                  material, speed):
     """One call of the library's solve (py_solve): fields (n, 5), spots, scalars, history."""
     from .materials import material_codes
 
@@ -426,7 +425,8 @@ def solve_areal(
     flat = np.ascontiguousarray(h).ravel()
     settings = dict(thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
                     penetration=penetration, method=method, precondition=precondition, coarse_start=coarse_start,
-                    progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
+                    progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, material=material,
+                    speed=speed)
     stress = bool(stress)
 
     def once(mu):

@@ -23,7 +23,8 @@ state : str
     ``"running"``, ``"finished"`` or ``"killed"``.
 exit_code : int or None
     The executable's exit code (0 converged, 2 bad input, 3 not converged, 4 I/O failure,
-    5 not enough memory or internal failure; 127 not found; 128 + N killed by signal N); None while running.
+    5 not enough memory or internal failure; 127 not found; 128 + N killed by signal N);
+    None while running.
 host : str
     The machine that ran the scene.
 pid : int
