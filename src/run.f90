@@ -120,7 +120,8 @@ contains
       end if
       if (.not. result%monotone) write (unit, '(2x, a)') 'WARNING: Re G_eff < 0 on some modes: ' // &
          & 'the contact solution may not be unique (viscoelastic coupling with friction)'
-      if (.not. result%converged .and. result%gap_resolution > scene%solver%tol) write (unit, '(2x, a, es10.2e3, a, es9.2, a)') &
+      if (.not. result%converged .and. result%gap_resolution > scene%solver%tol) &
+         & write (unit, '(2x, a, es10.2e3, a, es9.2, a)') &
          & 'WARNING: at this load double precision resolves gaps only to', result%gap_resolution, &
          & ' of the profile''s height range, above tol =', scene%solver%tol, &
          & ': the pressure''s variation is lost in the rounding of p_m (not converged)'
