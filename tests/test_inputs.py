@@ -86,6 +86,14 @@ BAD = [
     ("&profile\n kind = 'sinusoid'\n amplitude = 0.1\n mode = 2000000000\n/\n", "&profile: mode"),
     ("&solver\n max_iter = 2000000000\n/\n", "&solver: max_iter"),
     ("&layer\n thickness = 0.1\n/\n poisson = 0.3\n", "line 4: text outside a namelist group"),
+    # a value of the wrong type names the value, the variable and what it takes
+    ("&scene\n n = 4096.5\n/\n", "line 2, group &scene: 'n = 4096.5': n takes an integer"),
+    ("&scene\n n = 1e3\n/\n", "'n = 1e3': n takes an integer (no decimal point or exponent)"),
+    ("&layer\n thickness = .true.\n/\n", "'thickness = .true.': thickness takes a number"),
+    ("&layer\n poisson = half\n/\n", "'poisson = half': poisson takes a number"),
+    ("&material\n model = 'prony'\n prony_times(100) = 1.0\n/\n",
+     "line 3, group &material: Index 1 out of range for namelist variable prony_times (prony_times and "
+     "prony_values hold at most 64 terms"),
     # strings that the scene could keep only cut are refused, not cut
     (f"&scene\n title = '{'t' * 513}'\n/\n", "group &scene: title = 'tttttttttttttttttttttttt...' is longer than 512"),
     (f"&material\n model = 'prony'\n prony_file = '{'p' * 600}'\n/\n", "prony_file = 'pppp"),

@@ -226,8 +226,56 @@ contains
          call read_group_output(lines, config, stat, msg)
       end select
       line = 1
-      if (stat /= 0) line = offending_line(lines, msg)
+      if (stat /= 0) then
+         line = offending_line(lines, msg)
+         call explain_value(code_of(lines(line), line == 1), msg)
+      end if
    end subroutine read_group
+
+   !> The namelist library reports a value of the wrong type as an unknown name (`n = 4096.5`:
+   !> "Cannot match namelist object name .5"): when the name it quotes is not the variable
+   !> assigned on the offending line, say which value does not fit which variable and what
+   !> the variable takes. An index beyond an array gets the array's length.
+   pure subroutine explain_value(code, msg)
+      character(len=*), intent(in) :: code   !< the offending line, lower case, no comment
+      character(len=*), intent(inout) :: msg
+      character(len=*), parameter :: marker = 'Cannot match namelist object name '
+      character(len=:), allocatable :: token, name, value
+      integer :: k
+      if (index(msg, 'out of range for namelist variable prony_') > 0) then
+         msg = trim(msg) // ' (prony_times and prony_values hold at most ' // to_string(max_prony_terms) // &
+            & ' terms, indexed from 1)'
+         return
+      end if
+      k = index(msg, marker)
+      if (k /= 1) return
+      token = lower_case(trim(msg(len(marker) + 1:)))
+      k = index(code, '=')
+      if (k <= 1) return
+      name = trim(adjustl(code(:k - 1)))
+      value = trim(adjustl(code(k + 1:)))
+      if (len(name) == 0 .or. name == token .or. index(value, token) == 0) return
+      msg = "'" // name // ' = ' // value // "': " // name // ' takes ' // value_kind(name)
+   end subroutine explain_value
+
+   !> What a namelist variable takes, for messages.
+   pure function value_kind(name) result(kind)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: kind
+      character(len=*), parameter :: integers = ' n nx ny seed mode mode_y max_iter memory threads gap_bins '
+      character(len=*), parameter :: logicals = ' companion precondition coarse_start verbose overwrite stress fields '
+      character(len=*), parameter :: strings = ' geometry title model prony_form prony_file kind file dataset ' // &
+         & 'control method '
+      if (index(integers, ' ' // name // ' ') > 0) then
+         kind = 'an integer (no decimal point or exponent)'
+      else if (index(logicals, ' ' // name // ' ') > 0) then
+         kind = '.true. or .false.'
+      else if (index(strings, ' ' // name // ' ') > 0) then
+         kind = "a quoted string ('...')"
+      else
+         kind = 'a number (e.g. 0.16 or 1.6e-1)'
+      end if
+   end function value_kind
 
    ! ---------------------------------------------------------------------------------------
    ! One reader per group. Each declares the group's variables locally, starts them from the
@@ -695,8 +743,14 @@ contains
 
       line = 1
       k = index(msg, marker)
-      if (k == 0) return
-      token = lower_case(trim(msg(k + len(marker):)))
+      if (k > 0) then
+         token = lower_case(trim(msg(k + len(marker):)))
+      else
+         ! "Index 1 out of range for namelist variable prony_times": the line of that variable
+         k = index(msg, 'namelist variable ')
+         if (k == 0) return
+         token = lower_case(trim(msg(k + len('namelist variable '):)))
+      end if
       if (len(token) == 0) return
       do k = 1, size(lines)
          if (is_assigned(code_of(lines(k), k == 1), token)) then

@@ -64,6 +64,15 @@ contains
       close (unit)
    end subroutine write_text
 
+   !> No file ending in .tmp in `directory` (the writer's temporary files are NAME.HOST.PID.tmp).
+   logical function no_temporary_files(directory)
+      character(len=*), intent(in) :: directory
+      integer :: status
+      call execute_command_line('test -z "$(find ' // directory // " -maxdepth 1 -name '*.tmp')" // '"', &
+         & exitstat=status)
+      no_temporary_files = status == 0
+   end function no_temporary_files
+
    logical function file_exists(filename)
       character(len=*), intent(in) :: filename
       inquire (file=filename, exist=file_exists)
@@ -244,11 +253,29 @@ contains
       type(error_type), allocatable :: error
       logical :: exists
 
+      type(scene_type) :: scene
+      type(contact_result) :: result
+      real(wp) :: height(8)
+
+      ! a file that is not an HDF5 file is never replaced, overwrite or not
       call write_text(dir // '/existing.h5', 'x')
       call check_output(dir // '/existing.h5', .false., error)
-      call check_error(error, code_io, [character(len=40) :: 'existing.h5', 'set &output overwrite = .true.'], &
-         & 'existing output file is refused')
+      call check_error(error, code_io, [character(len=40) :: 'existing.h5', 'is not an HDF5 file'], &
+         & 'an existing file that is not HDF5 is refused')
       call check_output(dir // '/existing.h5', .true., error)
+      call check_error(error, code_io, [character(len=40) :: 'existing.h5', 'is not an HDF5 file'], &
+         & 'an existing file that is not HDF5 is refused with overwrite')
+
+      ! an existing result: refused without overwrite, accepted with it
+      scene%n = 8
+      height = 0.0_wp
+      call fake_result(8, 0.0_wp, 0.5_wp, result)
+      call write_results(dir // '/result_there.h5', scene, '', height, result, version='x', error=error)
+      call check(.not. allocated(error), 'a result to be in the way is written')
+      call check_output(dir // '/result_there.h5', .false., error)
+      call check_error(error, code_io, [character(len=40) :: 'result_there.h5', 'set &output overwrite = .true.'], &
+         & 'existing output file is refused')
+      call check_output(dir // '/result_there.h5', .true., error)
       call check(.not. allocated(error), 'existing output file with overwrite is accepted')
 
       call check_output(dir // '/new/deeper/result.h5', .false., error)
@@ -277,12 +304,16 @@ contains
       call fake_result(n, 0.2_wp, 0.5_wp, result)
       call fake_result(n, 0.0_wp, 0.4_wp, companion)
 
-      call write_text(file // '.tmp', 'stale')
       call write_results(file, scene, '&scene n = 16 /', height, result, companion, '0.1.0-test', error)
       call check(.not. allocated(error), 'write_results succeeds')
       if (allocated(error)) write (*, '(a)') error%message
       call check(file_exists(file), 'the result file exists')
-      call check(.not. file_exists(file // '.tmp'), 'no .tmp remains')
+      call check(no_temporary_files(dir // '/new/deeper'), 'no temporary file remains')
+      ! without overwrite a second write keeps the first result and says why
+      call write_results(file, scene, '&scene n = 16 /', height, result, companion, '0.1.0-test', error)
+      call check_error(error, code_io, [character(len=40) :: 'was written by another run'], &
+         & 'a result written meanwhile is not replaced')
+      call check(no_temporary_files(dir // '/new/deeper'), 'no temporary file remains after the refusal')
 
       ! again, over the existing file and without a companion (HDF5 opened and closed again)
       call write_results(dir // '/plain.h5', scene, '', height, result, version='0.1.0-test', error=error)
@@ -291,7 +322,7 @@ contains
       call write_results(dir // '/no_such_dir/result.h5', scene, '', height, result, version='x', error=error)
       call check_error(error, code_io, [character(len=40) :: 'no_such_dir/result.h5', 'HDF5 failed at'], &
          & 'write into a missing directory')
-      call check(.not. file_exists(dir // '/no_such_dir/result.h5.tmp'), 'no .tmp after a failure')
+      call check(no_temporary_files(dir), 'no temporary file after a failure')
 
       call read_profile_heights(file, '/profile/height', n, back, error)
       call check(.not. allocated(error), 'read_profile_heights succeeds')
