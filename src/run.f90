@@ -6,7 +6,7 @@
 !> anything is computed; the result file appears only when it is complete.
 module lc_run
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, fatal_error, code_input
    use lc_scene, only: scene_type, not_set
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
@@ -35,6 +35,7 @@ contains
       real(wp), allocatable :: height(:)
       type(run_record) :: run
       integer(i8) :: start, finish, rate
+      logical :: found
 
       converged = .false.
       call system_clock(start, rate)
@@ -43,6 +44,15 @@ contains
       call read_scene(input, scene, text, error)
       if (allocated(error)) return
       output_file = trim(scene%output_file)
+      ! a profile file that is not there is bad input, found before anything is created
+      if (trim(scene%profile%kind) == 'file') then
+         inquire (file=trim(scene%profile%file), exist=found)
+         if (.not. found) then
+            call fatal_error(error, "&profile: file = '" // trim(scene%profile%file) // "' is not found; allowed: " // &
+               & 'an existing file (HDF5, .npy or text), relative to the working directory', code_input)
+            return
+         end if
+      end if
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
       if (scene%solver%target_error /= not_set) then

@@ -134,6 +134,7 @@ BAD = [
     ("&solver\n memory = 0\n/\n", "allowed: 1 <= memory <= 100"),
     ("&solver\n threads = 0\n/\n", "allowed: 1 <= threads <= 1024"),
     ("&solver\n target_error = 0.9\n/\n", "&solver: target_error"),
+    ("&profile\n kind = 'file'\n file = 'nope.h5'\n/\n", "&profile: file = 'nope.h5' is not found"),
     # strings that the scene could keep only cut are refused, not cut
     (f"&scene\n title = '{'t' * 513}'\n/\n", "group &scene: title = 'tttttttttttttttttttttttt...' is longer than 512"),
     (f"&material\n model = 'prony'\n prony_file = '{'p' * 600}'\n/\n", "prony_file = 'pppp"),
@@ -388,3 +389,13 @@ def test_result_without_maps_holds_the_same_scalars(tmp_path, monkeypatch, capsy
     assert main(["run", "scalars.nml"]) == 0
     assert "none (&output fields = .false.: the result has no maps)" in capsys.readouterr().out
     assert not (tmp_path / "scalars.png").exists()
+
+
+def test_a_missing_profile_file_is_bad_input_and_creates_nothing(tmp_path):
+    """Found before the output's directories are made: exit 2, no directory, no file."""
+    nml = tmp_path / "scene.nml"
+    nml.write_text("&profile\n kind = 'file'\n file = 'measured.npy'\n/\n&loading\n normalised_pressure = 1.0\n/\n"
+                   "&output\n file = 'deep/er/r.h5'\n/\n")
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2 and "&profile: file = 'measured.npy' is not found" in proc.stderr
+    assert not (tmp_path / "deep").exists()
