@@ -168,7 +168,7 @@ def test_a_bad_scene_fails_before_anything_runs(change, lists, words, tmp_path, 
     assert err.value.code == 2
     for word in words:
         assert word in str(err.value)
-    assert not (tmp_path / "out/s/results").exists() and not (tmp_path / "out/s/s_summary.csv").exists()
+    assert not (tmp_path / "out").exists()   # not even the scene files
 
 
 BAD_SWEEPS = [

@@ -354,16 +354,22 @@ def _write_scene(scene: Scene) -> None:
         tmp.write_text(scene.text)
 
 
-def _check_scene(plan: SweepPlan, scene: Scene) -> None:
+def _check_scene(plan: SweepPlan, scene: Scene, scratch: Path) -> None:
+    """Check the scene's text with the library from a scratch copy (the sweep's directory is
+    not touched until every scene passed); the message names the scene file it will be."""
+    copy = scratch / scene.scene_file.name
+    copy.write_text(scene.text)
     try:
-        check_scene_file(scene.scene_file)
+        check_scene_file(copy)
     except LayercontactError as err:
         where = f"&sweep '{plan.name}' ({plan.source}): scene file {scene.scene_file}"
-        raise LayercontactError(f"{where} ({_describe(scene.values)}): {err}", err.code) from err
+        message = str(err).replace(str(copy), str(scene.scene_file))
+        raise LayercontactError(f"{where} ({_describe(scene.values)}): {message}", err.code) from err
 
 
 def write_scenes(plan: SweepPlan) -> list[Scene]:
-    """Write every scene file of ``plan`` and check all of them with the library.
+    """Check every scene of ``plan`` with the library, then write the scene files (a sweep
+    with a bad scene leaves nothing behind).
 
     Raises
     ------
@@ -371,11 +377,14 @@ def write_scenes(plan: SweepPlan) -> list[Scene]:
         For the first invalid scene, naming its scene file, its swept values and the
         library's message (group, variable, value, allowed range).
     """
+    import tempfile
+
     scenes = plan_scenes(plan)
+    with tempfile.TemporaryDirectory(prefix="layercontact-sweep-") as scratch:
+        for scene in scenes:
+            _check_scene(plan, scene, Path(scratch))
     for scene in scenes:
         _write_scene(scene)
-    for scene in scenes:
-        _check_scene(plan, scene)
     return scenes
 
 
