@@ -180,6 +180,7 @@ BAD_SWEEPS = [
     ("realisations = 0\n", "&sweep realisations: 0 is not allowed"),
     ("processes = -2\n", "&sweep processes: -2 is not allowed"),
     ("seed = 1\n/\n&sweep\n seed = 2\n", "&sweep is given more than once; allowed: one &sweep group"),
+    ("seed = 1\n/\n friction = 0.5\n&solver\n tol = 1e-8\n", "line 20: text outside a namelist group"),
 ]
 
 

@@ -210,7 +210,35 @@ def _name_setting(source: Path, variable: str, raw: object) -> str:
     return raw.strip()
 
 
+def _text_outside_groups(text: str) -> int | None:
+    """The first line (1-based) with text outside a namelist group (the library refuses it
+    in scene files; f90nml would drop it silently), or None."""
+    inside, quote = False, ""
+    for number, line in enumerate(text.splitlines(), start=1):
+        k = 0
+        while k < len(line):
+            char = line[k]
+            if quote:
+                quote = "" if char == quote else quote
+            elif char in "'\"":
+                quote = char
+            elif char == "!":
+                break
+            elif not inside and char == "&":
+                inside = True
+            elif inside and char == "/":
+                inside = False
+            elif not inside and not char.isspace():
+                return number
+            k += 1
+    return None
+
+
 def _read_namelist(source: Path) -> f90nml.Namelist:
+    outside = _text_outside_groups(source.read_text()) if source.is_file() else None
+    if outside is not None:
+        raise ValueError(f"{source}, line {outside}: text outside a namelist group; allowed: comments (!) and "
+                         "blank lines between groups")
     try:
         nml = f90nml.read(os.fspath(source))
     except FileNotFoundError:
