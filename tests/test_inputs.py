@@ -399,3 +399,20 @@ def test_a_missing_profile_file_is_bad_input_and_creates_nothing(tmp_path):
     proc = run_exe(nml, tmp_path)
     assert proc.returncode == 2 and "&profile: file = 'measured.npy' is not found" in proc.stderr
     assert not (tmp_path / "deep").exists()
+
+
+def test_every_result_attribute_has_its_unit(tmp_path):
+    """/results@units names the unit of each dimensional attribute; the others are said to
+    be dimensionless or counts."""
+    nml = tmp_path / "scene.nml"
+    nml.write_text((ROOT / "inputs" / "default.nml").read_text())
+    assert run_exe(nml, tmp_path).returncode == 0
+    with h5py.File(tmp_path / "out" / "default.h5") as f:
+        attrs = dict(f["results"].attrs)
+    units = attrs.pop("units").decode()
+    named = {entry.split()[0] for entry in units.split("; ")[:-1]}
+    assert units.endswith("dimensionless (fractions, friction coefficients, residuals, normalised values) or counts")
+    dimensional = {"mean_pressure", "penetration", "contact_length", "mean_gap", "leak_rate", "pressure_shift",
+                   "summit_shift", "max_tension", "max_tension_grid", "max_tension_x", "max_tension_offset",
+                   "dissipated_power", "wall_time"}
+    assert dimensional <= named and dimensional <= set(attrs)

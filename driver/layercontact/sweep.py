@@ -475,6 +475,9 @@ def _result_columns(result_file: Path) -> dict[str, object]:
         columns = _scalar_attributes(f["results"].attrs)
         if "companion/results" in f:
             columns.update(_scalar_attributes(f["companion/results"].attrs, "companion_"))
+        # (the units of the attributes are a text about them, not a result)
+        columns.pop("units", None)
+        columns.pop("companion_units", None)
         root = _scalar_attributes(f.attrs)
     columns.update({name: root.get(name) for name in _ROOT_COLUMNS})
     for name in provenance.PROVENANCE_FIELDS:

@@ -41,6 +41,12 @@ module lc_io_hdf5
    character(len=*), parameter :: units_note = "lengths in the input's length unit L, " // &
       & 'pressures/moduli in its stress unit S'
    character(len=*), parameter :: overwrite_hint = 'set &output overwrite = .true.'
+   !> The unit of every /results attribute (L and S: the input's length and stress units).
+   character(len=*), parameter :: results_units = 'mean_pressure S; penetration L; contact_length L; ' // &
+      & 'mean_gap L; leak_rate L^3 (<g^3>/12); pressure_shift L; summit_shift L; max_tension S; ' // &
+      & 'max_tension_grid S; max_principal_stress S; max_tension_x L; max_tension_y L; max_tension_offset L; ' // &
+      & 'max_principal_x L; max_principal_y L; dissipated_power S L/T; wall_time s; ' // &
+      & 'the others are dimensionless (fractions, friction coefficients, residuals, normalised values) or counts'
 
    !> Sticky status of a sequence of HDF5 calls: after the first failure every helper does
    !> nothing, so a writer reads as a plain list of objects and is checked once at the end.
@@ -477,6 +483,7 @@ contains
       end if
 
       call create_group(loc, 'results', group, st)
+      call write_attr_string(group, 'units', results_units, st)
       call write_attr_real(group, 'mean_pressure', res%mean_pressure, st)
       call write_attr_real(group, 'penetration', res%penetration, st)
       call write_attr_real(group, 'contact_fraction', res%contact_fraction, st)
