@@ -5,6 +5,7 @@
 !> output checked (an existing result is never overwritten unless &output overwrite) before
 !> anything is computed; the result file appears only when it is complete.
 module lc_run
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_scene, only: scene_type, not_set
@@ -96,6 +97,20 @@ contains
       end if
    end subroutine run_scene_file
 
+   !> The largest |dw/dx| of the surface displacement along the sliding direction.
+   pure real(wp) function largest_slope(w, scene) result(slope)
+      real(wp), intent(in) :: w(:)
+      type(scene_type), intent(in) :: scene
+      integer :: nx, ny
+      nx = scene%n
+      ny = max(scene%ny, 1)
+      slope = 0.0_wp
+      if (nx < 2 .or. size(w) /= nx*ny) return
+      associate (rows => reshape(w, [nx, ny]))
+         slope = maxval(abs(rows(2:, :) - rows(:nx - 1, :)))*nx/scene%period
+      end associate
+   end function largest_slope
+
    subroutine print_summary(unit, input, output_file, scene, result, companion)
       integer, intent(in) :: unit
       character(len=*), intent(in) :: input, output_file
@@ -104,6 +119,7 @@ contains
       type(contact_result), intent(in), optional :: companion
       character(len=*), parameter :: real_fmt = '(2x, a, t34, es14.6, 1x, a)'
       character(len=*), parameter :: int_fmt = '(2x, a, t34, i14, 1x, a)'
+      real(wp) :: resolution
 
       write (unit, '(a)') 'layercontact ' // version_string // ' (' // build_isa // '): ' // trim(input)
       if (len_trim(scene%title) > 0) write (unit, '(2x, a)') trim(scene%title)
@@ -116,6 +132,10 @@ contains
       end if
       write (unit, real_fmt) 'Coulomb friction mu_c', result%friction
       write (unit, real_fmt) 'mean pressure p_m', result%mean_pressure, '(S)'
+      if (ieee_is_finite(result%normalised_pressure)) &
+         & write (unit, real_fmt) 'normalised pressure', result%normalised_pressure, &
+         & trim(merge('(p_m/(E* h/lambda))      ', '(p_m/(E* Lambda0/lambda))', &
+         & scene%ny > 1 .and. ieee_is_finite(scene%thickness)))
       write (unit, real_fmt) 'contact fraction', result%contact_fraction
       if (present(companion)) then
          write (unit, real_fmt) 'contact fraction, mu_c = 0', companion%contact_fraction
@@ -135,8 +155,17 @@ contains
          & 'WARNING: at this load double precision resolves gaps only to', result%gap_resolution, &
          & ' of the profile''s height range, above tol =', scene%solver%tol, &
          & ': the pressure''s variation is lost in the rounding of p_m (not converged)'
-      write (unit, real_fmt) 'interlocking friction Delta mu', result%delta_mu
-      write (unit, real_fmt) 'total friction mu_c + Delta mu', result%friction + result%delta_mu
+      ! Delta mu = <p w'>/p_m carries the rounding of w' (a frictionless elastic scene's is
+      ! zero exactly): below that it is printed as zero (the result file keeps the value)
+      resolution = 64*epsilon(1.0_wp)*largest_slope(result%displacement_z, scene)
+      if (abs(result%delta_mu) > resolution) then
+         write (unit, real_fmt) 'interlocking friction Delta mu', result%delta_mu
+         write (unit, real_fmt) 'total friction mu_c + Delta mu', result%friction + result%delta_mu
+      else
+         write (unit, '(2x, a, t34, a14, a, es8.1, a)') 'interlocking friction Delta mu', '0', &
+            & ' (|Delta mu| <', resolution, ', the rounding of w'')'
+         write (unit, real_fmt) 'total friction mu_c + Delta mu', result%friction
+      end if
       write (unit, '(2x, a, t34, a14)') 'solver', trim(result%solver)
       write (unit, int_fmt) 'iterations', result%iterations
       if (index(result%solver, 'anderson') > 0) write (unit, int_fmt) 'outer (Anderson) iterations', &

@@ -416,3 +416,22 @@ def test_every_result_attribute_has_its_unit(tmp_path):
                    "summit_shift", "max_tension", "max_tension_grid", "max_tension_x", "max_tension_offset",
                    "dissipated_power", "wall_time"}
     assert dimensional <= named and dimensional <= set(attrs)
+
+
+def test_summary_echoes_the_normalised_load_and_prints_rounding_as_zero(tmp_path):
+    """The summary states p_m in the seed's scale, and a frictionless elastic Delta mu (zero
+    exactly; its computed value is rounding, ~1e-19 here) as 0 with the bound below which
+    it is rounding; the result file keeps the computed value."""
+    nml = tmp_path / "scene.nml"
+    nml.write_text((ROOT / "inputs" / "westergaard.nml").read_text())
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    lines = {line[:34].strip(): line[34:].strip() for line in proc.stdout.splitlines()[1:]}
+    # the file gives p_m = 0.25 pi E* h0 with h0 = Lambda0 = max r - mean r: p_m/(E* Lambda0/lambda) = pi/4
+    value, scale = lines["normalised pressure"].split(maxsplit=1)
+    assert scale == "(p_m/(E* Lambda0/lambda))" and float(value) == pytest.approx(np.pi / 4, rel=1e-6)   # 7 digits printed
+    assert lines["interlocking friction Delta mu"].startswith("0 (|Delta mu| <")
+    with h5py.File(next(tmp_path.rglob("*.h5"))) as f:
+        delta_mu = f["results"].attrs["delta_mu"]
+    bound = float(lines["interlocking friction Delta mu"].split("<")[1].split(",")[0])
+    assert abs(delta_mu) < bound < 1e-13
