@@ -5,8 +5,8 @@ numbers quoted in docs/figures.md.
     .venv/bin/python postproc/fig2.py [--out docs/fig2.png]
 
 a/a0 is the contact length with friction over the frictionless one for the same profile
-realisation and load; means and spreads (one standard deviation; the standard error is the
-spread / sqrt(realisations)) are over the profile realisations.
+realisation and load; means and their standard errors (the spread over the profile
+realisations / sqrt(realisations); the figure's bars) are over the realisations.
 """
 
 from __future__ import annotations
@@ -87,9 +87,9 @@ def panel_a(ax):
 
 
 def draw(ax, stats, label, xlabel, ylabel, title, unity=True):
-    """Mean +- spread curves (one per group) on a log x axis."""
-    for group, (x, m, s, _) in stats.items():
-        ax.errorbar(x, m, yerr=s, capsize=2, lw=1, label=label.format(group))
+    """Mean +- standard error curves (one per group) on a log x axis."""
+    for group, (x, m, s, n) in stats.items():
+        ax.errorbar(x, m, yerr=s / np.sqrt(n), capsize=2, lw=1, label=label.format(group))
     if unity:
         ax.axhline(1, color="0.5", lw=0.5)
     ax.set_xscale("log")
@@ -175,6 +175,7 @@ def main() -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(2, 2, figsize=(11, 8), constrained_layout=True)
+    fig.suptitle("means over profile realisations; bars: standard errors of the means", fontsize=9)
     panel_a(axes[0, 0])
     b = panel_b(axes[0, 1], summary("b"))
     c = panel_c(axes[1, 0], summary("c"), rms_gradient("c"))
