@@ -126,8 +126,10 @@ DefMemPerCPU=$(( memory / cpus ))
 MpiDefault=none
 MailProg=/bin/true
 ReturnToService=2
-# a short grace period between SIGTERM and SIGKILL (scancel, time limit) keeps tests quick
-KillWait=2
+# the grace period between SIGTERM and SIGKILL (scancel, time limit): a task's trap writes
+# its run record then; 2 s was too short on a loaded 2-core machine, 10 s costs nothing when
+# the task ends at once
+KillWait=10
 # keep finished jobs visible to scontrol for ten minutes (there is no accounting database)
 MinJobAge=600
 SchedulerParameters=sched_min_interval=100000
