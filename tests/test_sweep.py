@@ -286,3 +286,45 @@ def test_ctrl_c_stops_the_sweep_cleanly_and_a_rerun_resumes(tmp_path):
     assert rerun.returncode == 0, rerun.stderr
     skipped = int(rerun.stderr.split("sweep 's': ")[1].split(" of 200 scenes already")[0])
     assert skipped >= done - 2   # a result being written at the signal may be cut (its .tmp is not a result)
+
+
+def descendants(pid: int) -> set[int]:
+    """The processes below ``pid`` (Linux /proc)."""
+    found, todo = set(), [pid]
+    while todo:
+        parent = todo.pop()
+        for task in Path(f"/proc/{parent}/task").glob("*"):
+            try:
+                children = {int(c) for c in (task / "children").read_text().split()}
+            except OSError:
+                continue
+            todo.extend(children - found)
+            found |= children
+    return found
+
+
+def test_workers_end_when_the_sweep_process_is_killed(tmp_path):
+    """SIGKILL of the sweep's process (it cannot stop its workers then): the workers notice
+    within seconds and end, with the rest of the process tree."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    path = write_sweep(tmp_path, lists="seed = " + ", ".join(map(str, range(1, 101))) + "\n",
+                       base=BASE.replace("n = 256", "n = 65536"))
+    proc = subprocess.Popen([sys.executable, "-m", "layercontact", "sweep", str(path), "--no-progress"],
+                            cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    results = tmp_path / "out/s/results"
+    deadline = time.monotonic() + 120
+    while not (results.is_dir() and any(results.glob("*.h5"))) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    tree = descendants(proc.pid)
+    assert len(tree) >= 2   # the forkserver and its workers (and the resource tracker)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=10)
+    deadline = time.monotonic() + 30
+    while any(Path(f"/proc/{pid}").exists() for pid in tree) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    left = [pid for pid in tree if Path(f"/proc/{pid}").exists()]
+    assert not left, [Path(f"/proc/{pid}/cmdline").read_bytes()[:80] for pid in left]

@@ -36,6 +36,7 @@ import io
 import itertools
 import json
 import signal
+import threading
 import multiprocessing
 import os
 import sys
@@ -589,11 +590,24 @@ def _pool_context() -> multiprocessing.context.BaseContext:
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
-def _start_worker(directory: str) -> None:
-    """A worker runs in the caller's working directory (a forkserver keeps its own) and
-    leaves Ctrl-C to the sweep's process, which lets the running scenes finish and stops."""
+def _start_worker(directory: str, sweep_pid: int) -> None:
+    """A worker runs in the caller's working directory (a forkserver keeps its own),
+    leaves Ctrl-C to the sweep's process (which lets the running scenes finish and stops),
+    and ends when that process is gone (killed with SIGKILL, it cannot stop its workers)."""
     os.chdir(directory)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch() -> None:
+        while True:
+            time.sleep(1.0)
+            try:
+                os.kill(sweep_pid, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except PermissionError:  # the pid now belongs to another user's process
+                os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="layercontact-sweep-watch").start()
 
 
 def _run_pending(
@@ -606,7 +620,7 @@ def _run_pending(
     bar = tqdm(total=total, initial=total - len(pending), desc=name, unit="scene", file=sys.stderr,
                disable=not progress)
     pool = ProcessPoolExecutor(max_workers=min(processes, len(pending)), mp_context=_pool_context(),
-                               initializer=_start_worker, initargs=(os.getcwd(),))
+                               initializer=_start_worker, initargs=(os.getcwd(), os.getpid()))
     try:
         futures = {
             pool.submit(_solve, str(s.scene_file), str(s.result_file), str(_record_file(s))): s
