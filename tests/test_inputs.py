@@ -435,3 +435,19 @@ def test_summary_echoes_the_normalised_load_and_prints_rounding_as_zero(tmp_path
         delta_mu = f["results"].attrs["delta_mu"]
     bound = float(lines["interlocking friction Delta mu"].split("<")[1].split(",")[0])
     assert abs(delta_mu) < bound < 1e-13
+
+
+def test_picture_title_carries_the_scene_and_its_outcome(tmp_path):
+    """The picture of a result says what was solved and how it came out."""
+    from layercontact.plot import _headline
+
+    nml = tmp_path / "scene.nml"
+    nml.write_text((ROOT / "inputs" / "default.nml").read_text())
+    assert run_exe(nml, tmp_path).returncode == 0
+    with h5py.File(tmp_path / "out" / "default.h5") as f:
+        title, scene, outcome = _headline(f).splitlines()
+        attrs = dict(f["results"].attrs)
+    assert title.startswith("default: self-affine profile on a thin incompressible layer")
+    assert scene == "h/lambda = 0.16, nu = 0.5, mu_c = 0.5, p_m = 0.0235 (3 in the seed's scale)"
+    assert outcome == (f"contact fraction {attrs['contact_fraction']:.3f}, Delta mu = {attrs['delta_mu']:.3g}, "
+                       "converged")

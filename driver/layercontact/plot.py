@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 
 
@@ -27,8 +28,10 @@ def plot_result(h5file: str | os.PathLike, png: str | os.PathLike) -> None:
         if "companion" in f:
             runs.append(("companion", f["companion/results"].attrs, f["companion/fields"]))
         runs = [(name, dict(a), {k: g[k][()] for k in g}) for name, a, g in runs]
+        headline = _headline(f)
 
     fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(8, 6), constrained_layout=True)
+    fig.suptitle(headline, fontsize=9)
     lam = r.max()
     # Heights point out of the layer, in the indenter's frame: the indenter is Lambda - r
     # (its highest asperity at 0), the deformed layer surface Delta - w (equal in contact).
@@ -47,6 +50,29 @@ def plot_result(h5file: str | os.PathLike, png: str | os.PathLike) -> None:
     plt.close(fig)
 
 
+def _headline(f) -> str:
+    """The scene's key parameters and results, for a picture's title: its title, h/lambda,
+    nu, mu_c, the load (also in the seed's scale), contact fraction, Delta mu, convergence."""
+    inp = dict(f["input"].attrs)
+    res = dict(f["results"].attrs)
+
+    def text(value) -> str:
+        return value.decode() if isinstance(value, bytes) else str(value)
+
+    thickness = float(inp["thickness"]) / float(inp["period"])
+    layer = "half-space" if math.isinf(thickness) else f"h/lambda = {thickness:.3g}"
+    load = f"p_m = {float(res['mean_pressure']):.3g}"
+    normalised = float(res.get("normalised_pressure", float("nan")))
+    if math.isfinite(normalised):
+        load += f" ({normalised:.3g} in the seed's scale)"
+    state = "converged" if int(res["converged"]) else f"NOT converged (residual {float(res['residual']):.2g})"
+    first = text(inp.get("title", "")).strip()
+    scene = f"{layer}, nu = {float(inp['poisson']):g}, mu_c = {float(res['friction']):g}, {load}"
+    outcome = (f"contact fraction {float(res['contact_fraction']):.3f}, Delta mu = {float(res['delta_mu']):.3g}, "
+               f"{state}")
+    return "\n".join(line for line in (first, scene, outcome) if line)
+
+
 def _plot_areal(f, png, plt) -> None:
     """Pressure and gap maps of an areal result (x, the sliding direction, to the right)."""
     import numpy as np
@@ -59,6 +85,7 @@ def _plot_areal(f, png, plt) -> None:
     attrs = dict(f["results"].attrs)
     extent = (0.0, 1.0, 0.0, ly / lx)
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.8), constrained_layout=True)
+    fig.suptitle(_headline(f), fontsize=9)
     shown = left.imshow(p, origin="lower", extent=extent, cmap="magma")
     fig.colorbar(shown, ax=left, label="pressure p (S)")
     left.set_title(f"contact fraction {attrs['contact_fraction']:.3f},  mu_c = {attrs['friction']:g}")
