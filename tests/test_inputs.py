@@ -91,6 +91,9 @@ BAD = [
     ("&scene\n n = 1e3\n/\n", "'n = 1e3': n takes an integer (no decimal point or exponent)"),
     ("&layer\n thickness = .true.\n/\n", "'thickness = .true.': thickness takes a number"),
     ("&layer\n poisson = half\n/\n", "'poisson = half': poisson takes a number"),
+    ("&solver\n tol = 1e-8\n precondition = 1.5\n/\n",
+     "line 3, group &solver: 'precondition = 1.5': precondition takes .true. or .false."),
+    ("&friction\n companion = yes\n/\n", "'companion = yes': companion takes .true. or .false."),
     ("&material\n model = 'prony'\n prony_times(100) = 1.0\n/\n",
      "line 3, group &material: Index 1 out of range for namelist variable prony_times (prony_times and "
      "prony_values hold at most 64 terms"),

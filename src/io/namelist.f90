@@ -207,6 +207,14 @@ contains
 
       call split_lines(segment, lines)
       msg = ''
+      ! values of the wrong type, found before the namelist library reports them by an item
+      ! number (`overwrite = 1.5`: "Bad repeat count in item 1 of list input")
+      do line = 1, size(lines)
+         if (wrong_type(code_of(lines(line), line == 1), msg)) then
+            stat = stat_too_long
+            return
+         end if
+      end do
       select case (trim(group_names(group)))
       case ('scene')
          call read_group_scene(lines, config, stat, msg)
@@ -254,9 +262,46 @@ contains
       if (k <= 1) return
       name = trim(adjustl(code(:k - 1)))
       value = trim(adjustl(code(k + 1:)))
+      ! (only the first value on the line: `n = 64, period = abc` is about period, not n)
+      if (index(value, ',') > 0) value = value(:index(value, ',') - 1)
       if (len(name) == 0 .or. name == token .or. index(value, token) == 0) return
       msg = "'" // name // ' = ' // value // "': " // name // ' takes ' // value_kind(name)
    end subroutine explain_value
+
+   !> True (and the message) if `code` assigns a scalar variable a value that its type cannot
+   !> read: an integer with a decimal point, a number for a logical, a word for a number.
+   !> Names that are not scalar variables of a known type are left to the namelist library.
+   logical function wrong_type(code, msg)
+      character(len=*), intent(in) :: code   !< one line, lower case, without its comment
+      character(len=*), intent(inout) :: msg
+      character(len=*), parameter :: reals = ' period period_x period_y thickness young poisson e0 e_inf tau ' // &
+         & 'speed prony_equilibrium coefficient hurst rolloff_wavelength short_wavelength rms_gradient rms_height ' // &
+         & 'amplitude radius mean_pressure normalised_pressure penetration tol target_error '
+      character(len=:), allocatable :: name, value, kind
+      integer :: k, stat
+      integer(i8) :: as_integer   ! (the widest integer variable, &profile seed)
+      real(wp) :: as_real
+      logical :: as_logical
+      wrong_type = .false.
+      k = index(code, '=')
+      if (k <= 1) return
+      name = trim(adjustl(code(:k - 1)))
+      value = trim(adjustl(code(k + 1:)))
+      if (len(name) == 0 .or. len(value) == 0 .or. verify(name, 'abcdefghijklmnopqrstuvwxyz0123456789_') /= 0) return
+      kind = value_kind(name)
+      if (kind == '.true. or .false.') then
+         read (value, *, iostat=stat) as_logical
+      else if (kind(1:4) == 'an i') then
+         read (value, *, iostat=stat) as_integer
+      else if (index(reals, ' ' // name // ' ') > 0) then
+         read (value, *, iostat=stat) as_real
+      else
+         return
+      end if
+      if (stat == 0) return
+      wrong_type = .true.
+      msg = "'" // name // ' = ' // value // "': " // name // ' takes ' // kind
+   end function wrong_type
 
    !> What a namelist variable takes, for messages.
    pure function value_kind(name) result(kind)

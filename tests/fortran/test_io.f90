@@ -140,7 +140,7 @@ contains
       call read_scene_text(loading // '&scene' // nl // '  period = 2.0' // nl // '  n = 2.5' // nl // '/', &
          & 'e.nml', scene, error)
       call check_error(error, code_input, [character(len=40) :: 'e.nml', 'line 4', 'group &scene', &
-         & 'allowed variables in &scene'], 'bad integer value')
+         & "'n = 2.5': n takes an integer"], 'bad integer value')
 
       call read_scene_text(loading // '&friction companion = yes /', 'f.nml', scene, error)
       call check_error(error, code_input, [character(len=40) :: 'f.nml', 'line 2', 'group &friction'], &
