@@ -5,7 +5,7 @@ module lc_strings
    use, intrinsic :: iso_fortran_env, only: int32, int64
    implicit none (type, external)
    private
-   public :: to_string, lower_case
+   public :: to_string, lower_case, formatted
 
    !> Shortest text of an integer; a real with 6 significant digits (es12.5).
    interface to_string
@@ -33,10 +33,18 @@ contains
    pure function real_string(x) result(s)
       real(wp), intent(in) :: x
       character(len=:), allocatable :: s
-      character(len=32) :: buffer
-      write (buffer, '(es12.5)') x
-      s = trim(adjustl(buffer))
+      s = formatted(x, '(es12.5)')
    end function real_string
+
+   !> x written with the edit descriptor `format` (e.g. '(f6.4)'), without blanks around it.
+   pure function formatted(x, format) result(s)
+      real(wp), intent(in) :: x
+      character(len=*), intent(in) :: format
+      character(len=:), allocatable :: s
+      character(len=40) :: buffer
+      write (buffer, format) x
+      s = trim(adjustl(buffer))
+   end function formatted
    !> The text with ASCII letters in lower case.
    pure function lower_case(text) result(low)
       character(len=*), intent(in) :: text

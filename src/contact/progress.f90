@@ -5,7 +5,7 @@
 module lc_contact_progress
    use, intrinsic :: iso_fortran_env, only: error_unit
    use lc_kinds, only: wp, i8
-   use lc_strings, only: to_string
+   use lc_strings, only: to_string, formatted
    implicit none (type, external)
    private
    public :: progress_log
@@ -65,7 +65,8 @@ contains
       if (real(now - self%last, wp) < interval*self%rate) return
       self%last = now
       call say(self%level // ': iteration ' // to_string(self%offset + iteration) // ', residual ' // &
-         & scientific(residual) // ', contact fraction ' // fraction(contact_fraction) // ', ' // self%elapsed())
+         & formatted(residual, '(es10.3)') // ', contact fraction ' // formatted(contact_fraction, '(f6.4)') // &
+         & ', ' // self%elapsed())
    end subroutine tick
 
    !> The level is solved: which solver, its iterations, residual and contact fraction.
@@ -78,35 +79,17 @@ contains
       if (.not. self%enabled) return
       call system_clock(self%last)
       call say(self%level // ': ' // trim(solver) // trim(merge(' converged    ', ' NOT converged', converged)) // &
-         & ' in ' // to_string(iterations) // ' iterations, residual ' // scientific(residual) // &
-         & ', contact fraction ' // fraction(contact_fraction) // ', ' // self%elapsed())
+         & ' in ' // to_string(iterations) // ' iterations, residual ' // formatted(residual, '(es10.3)') // &
+         & ', contact fraction ' // formatted(contact_fraction, '(f6.4)') // ', ' // self%elapsed())
    end subroutine level_done
 
    function elapsed(self) result(text)
       class(progress_log), intent(in) :: self
       character(len=:), allocatable :: text
       integer(i8) :: now
-      character(len=16) :: seconds
       call system_clock(now)
-      write (seconds, '(f16.2)') real(now - self%start, wp)/self%rate
-      text = trim(adjustl(seconds)) // ' s'
+      text = formatted(real(now - self%start, wp)/self%rate, '(f16.2)') // ' s'
    end function elapsed
-
-   function scientific(x) result(text)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: text
-      character(len=16) :: buffer
-      write (buffer, '(es10.3)') x
-      text = trim(adjustl(buffer))
-   end function scientific
-
-   function fraction(x) result(text)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: text
-      character(len=16) :: buffer
-      write (buffer, '(f6.4)') x
-      text = trim(adjustl(buffer))
-   end function fraction
 
    subroutine say(line)
       character(len=*), intent(in) :: line
