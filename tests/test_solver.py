@@ -371,10 +371,11 @@ def test_progress_lines_name_every_level_and_the_final_count(capfd):
 
 
 def test_broadband_line_needs_few_cg_iterations():
-    """A regression guard (not a timing): a self-affine line with roughness down to 8 grid
-    points at n = 65536 (~1000 contact spots) took 5698 CG iterations (at p_m = 0.013) when
-    the conjugacy restarted at every point let in and the preconditioner was dropped after
-    a stall; it takes ~300 now (docs/decisions/005-broadband-iterations.md, bench/scaling.py)."""
+    """A regression guard (not a timing): on a self-affine line with roughness down to 8 grid
+    points at n = 65536 (~1000 contact spots) points enter the contact set at most
+    iterations; the constrained CG keeps its conjugacy through them and needs ~300
+    iterations, where restarting at every entry (and dropping the preconditioner after a
+    stall) needs ~5700 (docs/decisions/005-broadband-iterations.md, bench/scaling.py)."""
     n = 65536
     h = lc.self_affine_profile(n, 0.8, seed=1, short_wavelength=8 / n, rms_gradient=0.1)
     res = lc.solve_line(h, mean_pressure=0.0167, tol=1e-8, stress=False)
