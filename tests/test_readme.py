@@ -42,3 +42,10 @@ def test_readme_scene_file_runs(tmp_path):
     proc = subprocess.run([executable(), "scene.nml"], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert "contact fraction" in proc.stdout and (tmp_path / "out/scene.h5").exists()
+
+
+def test_python_reference_is_current():
+    """docs/python.md is generated from the package's docstrings: it matches them."""
+    proc = subprocess.run([sys.executable, str(ROOT / "tools" / "python_reference.py"), "--check"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
