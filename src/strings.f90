@@ -45,6 +45,7 @@ contains
       write (buffer, format) x
       s = trim(adjustl(buffer))
    end function formatted
+
    !> The text with ASCII letters in lower case.
    pure function lower_case(text) result(low)
       character(len=*), intent(in) :: text

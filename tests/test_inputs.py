@@ -29,6 +29,22 @@ def run_exe(nml: Path, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run([executable(), str(nml)], cwd=cwd, capture_output=True, text=True, timeout=600)
 
 
+def run_example(name: str, directory: Path) -> subprocess.CompletedProcess:
+    """Run inputs/NAME.nml through the executable in `directory` (its result goes there)."""
+    nml = directory / f"{name}.nml"
+    nml.write_text((ROOT / "inputs" / f"{name}.nml").read_text())
+    return run_exe(nml, directory)
+
+
+@pytest.fixture(scope="module")
+def default_result(tmp_path_factory) -> Path:
+    """The result file of inputs/default.nml, run once for the checks that read it."""
+    directory = tmp_path_factory.mktemp("default")
+    proc = run_example("default", directory)
+    assert proc.returncode == 0, proc.stderr
+    return directory / "out" / "default.h5"
+
+
 @pytest.mark.parametrize("nml", INPUTS, ids=[p.stem for p in INPUTS])
 def test_every_input_runs_the_same_in_fortran_and_python(nml, tmp_path, monkeypatch):
     exe_dir, py_dir = tmp_path / "exe", tmp_path / "py"
@@ -404,13 +420,10 @@ def test_a_missing_profile_file_is_bad_input_and_creates_nothing(tmp_path):
     assert not (tmp_path / "deep").exists()
 
 
-def test_every_result_attribute_has_its_unit(tmp_path):
+def test_every_result_attribute_has_its_unit(default_result):
     """/results@units names the unit of each dimensional attribute; the others are said to
     be dimensionless or counts."""
-    nml = tmp_path / "scene.nml"
-    nml.write_text((ROOT / "inputs" / "default.nml").read_text())
-    assert run_exe(nml, tmp_path).returncode == 0
-    with h5py.File(tmp_path / "out" / "default.h5") as f:
+    with h5py.File(default_result) as f:
         attrs = dict(f["results"].attrs)
     units = attrs.pop("units").decode()
     named = {entry.split()[0] for entry in units.split("; ")[:-1]}
@@ -425,14 +438,13 @@ def test_summary_echoes_the_normalised_load_and_prints_rounding_as_zero(tmp_path
     """The summary states p_m in the seed's scale, and a frictionless elastic Delta mu (zero
     exactly; its computed value is rounding, ~1e-19 here) as 0 with the bound below which
     it is rounding; the result file keeps the computed value."""
-    nml = tmp_path / "scene.nml"
-    nml.write_text((ROOT / "inputs" / "westergaard.nml").read_text())
-    proc = run_exe(nml, tmp_path)
+    proc = run_example("westergaard", tmp_path)
     assert proc.returncode == 0, proc.stderr
     lines = {line[:34].strip(): line[34:].strip() for line in proc.stdout.splitlines()[1:]}
     # the file gives p_m = 0.25 pi E* h0 with h0 = Lambda0 = max r - mean r: p_m/(E* Lambda0/lambda) = pi/4
     value, scale = lines["normalised pressure"].split(maxsplit=1)
-    assert scale == "(p_m/(E* Lambda0/lambda))" and float(value) == pytest.approx(np.pi / 4, rel=1e-6)   # 7 digits printed
+    # (7 digits printed)
+    assert scale == "(p_m/(E* Lambda0/lambda))" and float(value) == pytest.approx(np.pi / 4, rel=1e-6)
     assert lines["interlocking friction Delta mu"].startswith("0 (|Delta mu| <")
     with h5py.File(next(tmp_path.rglob("*.h5"))) as f:
         delta_mu = f["results"].attrs["delta_mu"]
@@ -440,14 +452,11 @@ def test_summary_echoes_the_normalised_load_and_prints_rounding_as_zero(tmp_path
     assert abs(delta_mu) < bound < 1e-13
 
 
-def test_picture_title_carries_the_scene_and_its_outcome(tmp_path):
+def test_picture_title_carries_the_scene_and_its_outcome(default_result):
     """The picture of a result says what was solved and how it came out."""
     from layercontact.plot import _headline
 
-    nml = tmp_path / "scene.nml"
-    nml.write_text((ROOT / "inputs" / "default.nml").read_text())
-    assert run_exe(nml, tmp_path).returncode == 0
-    with h5py.File(tmp_path / "out" / "default.h5") as f:
+    with h5py.File(default_result) as f:
         title, scene, outcome = _headline(f).splitlines()
         attrs = dict(f["results"].attrs)
     assert title.startswith("default: self-affine profile on a thin incompressible layer")

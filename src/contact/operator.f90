@@ -136,9 +136,7 @@ contains
             & code_input)
          return
       end if
-      ! A half-space of an incompressible material has c = 0: friction changes nothing.
-      op%coupled = kernel%viscoelastic .or. (friction > 0.0_wp .and. &
-         & .not. (kernel%halfspace .and. kernel%poisson == 0.5_wp))
+      op%coupled = kernel%coupled(friction)
 
       allocate (op%metric(op%nk))
       if (op%coupled) allocate (op%full(op%nk))

@@ -94,9 +94,7 @@ contains
          return
       end if
       ! a grid too large for this machine (or job) ends here, with how much it needs
-      call check_memory(n, kernel%viscoelastic .or. (friction > 0.0_wp .and. &
-         & .not. (kernel%halfspace .and. kernel%poisson == 0.5_wp)), scene%solver%memory, &
-         & scene%stress .and. grid%ny > 1, error)
+      call check_memory(n, kernel%coupled(friction), scene%solver%memory, scene%stress .and. grid%ny > 1, error)
       if (allocated(error)) return
       lambda_max = maxval(height)
       g_ref = maxval(height) - minval(height)

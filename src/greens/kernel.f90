@@ -36,6 +36,7 @@ module lc_greens_kernel
       procedure :: contact_compliance
       procedure :: factors
       procedure :: compliance_falls
+      procedure :: coupled
       procedure :: normal_uniform
       procedure :: shear_uniform
       procedure :: antiplane
@@ -75,6 +76,15 @@ contains
       ! x = +Inf (half-space) gives 1-A = 1-B = 1 and Dundurs' c
       call layer_coefficients(q*self%thickness, self%poisson, one_minus_a, one_minus_b, c)
    end subroutine factors
+
+   !> Whether the normal and tangential fields are coupled under Coulomb friction
+   !> `friction` (a complex, non-symmetric operator): always for a moving viscoelastic law;
+   !> with friction unless on an incompressible half-space, whose c = 0.
+   pure logical function coupled(self, friction)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: friction
+      coupled = self%viscoelastic .or. (friction > 0.0_wp .and. .not. (self%halfspace .and. self%poisson == 0.5_wp))
+   end function coupled
 
    !> Whether the normal compliance (1-A(|q| h))/|q| falls with |q| on [q_min, q_max] (1/L),
    !> sampled at 64 points per decade: true for a half-space and for compressible layers
