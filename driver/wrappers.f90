@@ -219,16 +219,16 @@ subroutine py_check_scene_file(input, stat, errmsg)
    end if
 end subroutine py_check_scene_file
 
-!> The grid size n and tolerance tol the accuracy rule picks for a scene file with
-!> &solver target_error (runs the pilot solve; writes nothing).
-subroutine py_choose_resolution(input, n, tol, stat, errmsg)
+!> The grid (n, and ny: 1 on a line) and tolerance tol the accuracy rule picks for a scene
+!> file with &solver target_error (runs the pilot solve; writes nothing).
+subroutine py_choose_resolution(input, n, ny, tol, stat, errmsg)
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_scene, only: scene_type, not_set
    use lc_io_namelist, only: read_scene
    use lc_accuracy, only: choose_resolution
    implicit none (type, external)
    character(len=*), intent(in) :: input
-   integer, intent(out) :: n
+   integer, intent(out) :: n, ny
    real(8), intent(out) :: tol
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
@@ -238,6 +238,7 @@ subroutine py_choose_resolution(input, n, tol, stat, errmsg)
    stat = 0
    errmsg = ''
    n = 0
+   ny = 0
    tol = 0
    call read_scene(input, scene, text, error)
    if (.not. allocated(error) .and. scene%solver%target_error == not_set) &
@@ -249,6 +250,7 @@ subroutine py_choose_resolution(input, n, tol, stat, errmsg)
       return
    end if
    n = scene%n
+   ny = scene%ny
    tol = scene%solver%tol
 end subroutine py_choose_resolution
 

@@ -217,9 +217,6 @@ contains
          else if (is_areal(scene) .and. .not. one_of(p%kind, [character(len=16) :: 'self_affine', 'sinusoid', &
             & 'sphere', 'file'])) then
             call input_error(error, 'profile', 'kind', trim(p%kind), "'self_affine', 'sinusoid', 'sphere' or 'file'")
-         else if (is_areal(scene) .and. scene%solver%target_error /= not_set) then
-            call input_error(error, 'solver', 'target_error', to_string(scene%solver%target_error), &
-               & "not set with geometry = 'areal' (the accuracy rule is measured for line contacts)")
          end if
          if (allocated(error)) return
          call check_material(scene%material, error)

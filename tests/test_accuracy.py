@@ -134,7 +134,7 @@ def test_target_error_range_and_profile_kind(tmp_path):
     text = text.replace("kind = 'self_affine'", f"kind = 'file'\n file = '{h5}'").replace("n = 4096", "n = 256")
     text = text.replace(" hurst = 0.8\n seed = 1\n short_wavelength = 0.015625\n rms_gradient = 0.1\n", "")
     path.write_text(text)
-    with pytest.raises(lc.LayercontactError, match=r"target_error.*profile file fixes n") as err:
+    with pytest.raises(lc.LayercontactError, match=r"target_error.*profile file fixes the grid") as err:
         lc.choose_resolution(path)
     assert err.value.code == 2
 
@@ -147,3 +147,98 @@ def test_run_uses_the_chosen_settings(tmp_path):
     assert result.pressure.size == n
     assert result.converged and result.residual <= tol
     assert np.isclose(result.mean_pressure, 0.3 * (4 / 3) * (result.height.max() - result.height.mean()))
+
+
+# ---- areal scenes: bench/accuracy_areal.py, shortest wavelength period/16 ---------------
+
+AREAL_TABLE = Path(__file__).resolve().parents[1] / "bench" / "accuracy_areal_table.csv"
+AREAL_TARGETS = (1e-1, 3e-2, 1e-2)
+AREAL_MODES = 16
+# (thickness, friction, P): p_m = P E* h/lambda on a layer, P E* Lambda0/lambda on the
+# half-space with Lambda0 = max r - mean r of the bench's finest surface (2048^2)
+AREAL_SCENES = {"half-space": ("Inf", 0.0, 0.3), "h0.16": ("0.16", 0.5, 0.05), "h0.01": ("0.01", 0.5, 3.0)}
+
+
+def _areal_scene_file(tmp_path, scene, eps, lambda0):
+    thickness, friction, pressure = AREAL_SCENES[scene]
+    scale = lambda0 if thickness == "Inf" else float(thickness)
+    text = f"""&scene
+ geometry = 'areal'
+ n = 64
+/
+&layer
+ thickness = {thickness}
+ poisson = 0.5
+/
+&friction
+ coefficient = {friction}
+/
+&profile
+ kind = 'self_affine'
+ hurst = 0.8
+ seed = 1
+ short_wavelength = {1 / AREAL_MODES}
+ rms_gradient = 0.1
+/
+&loading
+ mean_pressure = {pressure * 4 / 3 * scale!r}
+/
+&solver
+ target_error = {eps}
+/
+&output
+ file = '{tmp_path / 'unused.h5'}'
+/
+"""
+    path = tmp_path / f"areal_{scene}_{eps}.nml"
+    path.write_text(text)
+    return path
+
+
+def test_areal_rule_meets_the_measured_table(tmp_path):
+    """The areal rule's (ppw, tol) for the bench's three scenes and targets 1e-1 .. 1e-2 meet
+    the target on every counted observable but the max tension (contact fraction, a/a0,
+    Delta mu, penetration, k_eff along and across x), wherever the reference (ppw 128
+    against 64) can tell."""
+    rows = {}
+    with AREAL_TABLE.open() as f:
+        for row in csv.DictReader(f):
+            if row["role"] == "sweep" and row["seed"] == "1" and row["method"] == "auto":
+                rows[(row["scene"], int(row["ppw"]), float(row["tol"]))] = row
+    fine = lc.self_affine_surface(n=2048, hurst=0.8, seed=1, short_wavelength=1 / AREAL_MODES, rms_gradient=0.1)
+    lambda0 = float(fine.max() - fine.mean())
+    verified = 0
+    for scene in AREAL_SCENES:
+        chosen = []
+        for eps in AREAL_TARGETS:
+            (nx, ny), tol = lc.choose_resolution(_areal_scene_file(tmp_path, scene, eps, lambda0))
+            assert nx == ny and nx % AREAL_MODES == 0 and tol in (1e-2, 1e-3, 1e-4, 1e-6, 1e-8)
+            chosen.append((nx, tol))
+            row = rows.get((scene, nx // AREAL_MODES, tol))
+            assert row is not None, (scene, eps, nx, tol)  # the bench measures every choice
+            uncertainty = max(float(row[k]) for k in row if k.startswith("unc_") and row[k] != "nan"
+                              and k != "unc_max_tension")
+            if 3 * uncertainty > eps:
+                continue
+            assert float(row["max_error_no_tension"]) <= eps, (scene, eps, nx, tol, row["max_error_no_tension"])
+            verified += 1
+        # a tighter target never asks for a coarser grid or a looser tolerance
+        assert all(a[0] <= b[0] and a[1] >= b[1] for a, b in zip(chosen, chosen[1:]))
+    assert verified == 9
+
+
+def test_areal_run_uses_the_chosen_grid(tmp_path):
+    """An areal scene with target_error runs on the (nx, ny) the rule picks; a sphere has no
+    shortest wavelength and is refused."""
+    path = _areal_scene_file(tmp_path, "h0.16", 0.1, 0.0)
+    (nx, ny), tol = lc.choose_resolution(path)
+    result = lc.run(path)
+    assert result.pressure.shape == (ny, nx)
+    assert result.converged and result.residual <= tol
+    sphere = path.read_text().replace("kind = 'self_affine'", "kind = 'sphere'\n radius = 1.0")
+    sphere = sphere.replace(" hurst = 0.8\n seed = 1\n", "").replace(f" short_wavelength = {1 / AREAL_MODES}\n", "")
+    sphere = sphere.replace(" rms_gradient = 0.1\n", "")
+    path.write_text(sphere)
+    with pytest.raises(lc.LayercontactError, match=r"target_error.*a sphere has no shortest wavelength") as err:
+        lc.choose_resolution(path)
+    assert err.value.code == 2

@@ -581,13 +581,13 @@ def check_scene_file(filename: str | os.PathLike) -> None:
     _check(stat, errmsg)
 
 
-def choose_resolution(filename: str | os.PathLike) -> tuple[int, float]:
-    """The grid size ``n`` and tolerance ``tol`` that a scene file with ``&solver
-    target_error`` will be solved with (the accuracy rule of docs/accuracy.md; runs the
-    pilot solve, writes nothing)."""
-    n, tol, stat, errmsg = _core.py_choose_resolution(os.fspath(filename))
+def choose_resolution(filename: str | os.PathLike) -> tuple[int | tuple[int, int], float]:
+    """The grid and tolerance ``tol`` that a scene file with ``&solver target_error`` will be
+    solved with (the accuracy rule of docs/accuracy.md; runs the pilot solve, writes
+    nothing): ``(n, tol)`` for a line, ``((nx, ny), tol)`` for an areal scene."""
+    n, ny, tol, stat, errmsg = _core.py_choose_resolution(os.fspath(filename))
     _check(stat, errmsg)
-    return int(n), float(tol)
+    return (int(n) if ny == 1 else (int(n), int(ny))), float(tol)
 
 
 def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult | ArealResult:
