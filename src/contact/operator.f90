@@ -73,7 +73,8 @@ module lc_contact_operator
       logical :: metric_falls = .false.
       complex(wp), allocatable :: full(:)   !< G_eff(q), only when coupled
       !> M in real space: (M p)(x_i) = sum_j column(i - j) p_j, i - j taken periodically on
-      !> both axes (L/S)
+      !> both axes (L/S); for the constrained CG only (prepare_cg: a coupled solve by GCR
+      !> does without this array of n doubles)
       real(wp), allocatable :: column(:)
       !> For the constrained GCR only (prepare_gcr): 1/G_eff(k) (0 where G_eff = 0), the
       !> real-space column of G_eff, and the real-space diagonal of 1/G_eff
@@ -91,6 +92,7 @@ module lc_contact_operator
       procedure :: column_mode
       procedure :: metric_in_buffer
       procedure :: inverse_metric_in_buffer
+      procedure :: prepare_cg
       procedure :: prepare_gcr
       procedure :: full_in_buffer
       procedure :: inverse_full_in_buffer
@@ -182,10 +184,10 @@ contains
       call derive(op)
    end subroutine build_operator
 
-   !> The quantities derived from the multipliers: diagonal, largest, column.
+   !> The quantities derived from the multipliers: diagonal, largest (the real-space column
+   !> is made when a CG solve asks for it: prepare_cg).
    subroutine derive(op)
       type(compliance_operator), intent(inout) :: op
-      real(wp), allocatable :: unit_load(:)
       integer :: n, row, nkx, first, last
       n = op%n
       nkx = op%grid%nkx()
@@ -201,12 +203,19 @@ contains
       op%diagonal = op%diagonal/n
       op%largest = maxval(op%metric)
       if (op%coupled) op%largest = max(op%largest, maxval(abs(op%full)))
-      allocate (unit_load(n))
+      if (allocated(op%column)) deallocate (op%column)
+   end subroutine derive
+
+   !> Make the real-space column of M that the constrained CG's column updates need.
+   subroutine prepare_cg(self)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), allocatable :: unit_load(:)
+      if (allocated(self%column)) return
+      allocate (unit_load(self%n), self%column(self%n))
       unit_load = 0.0_wp
       unit_load(1) = 1.0_wp
-      if (.not. allocated(op%column)) allocate (op%column(n))
-      call op%apply_metric(unit_load, op%column)
-   end subroutine derive
+      call self%apply_metric(unit_load, self%column)
+   end subroutine prepare_cg
 
    !> Leave the uniform (k = 0) mode out of the operator and return its multiplier (h/M for
    !> a compressible layer, L/S). Under load control the uniform mode of p is the given

@@ -88,6 +88,7 @@ contains
       n = size(p)
       associate (d => gap)
       allocate (t(n))
+      call op%prepare_cg()
       buffer => op%buffer()
       t = 0.0_wp
       t_sum = 0.0_wp
