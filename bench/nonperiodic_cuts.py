@@ -21,10 +21,10 @@ import numpy as np
 import layercontact as lc
 
 TREATMENTS = {
-    "as is": dict(detrend="none"),
-    "plane": dict(detrend="plane"),
-    "mirror": dict(boundary="mirror"),
-    "mirror, none": dict(boundary="mirror", detrend="none"),
+    "as is": {"detrend": "none"},
+    "plane": {"detrend": "plane"},
+    "mirror": {"boundary": "mirror"},
+    "mirror, none": {"boundary": "mirror", "detrend": "none"},
 }
 
 
@@ -40,7 +40,7 @@ def main() -> None:
     period = 1.0
     h = lc.self_affine_surface(n=n, hurst=0.8, period=period, short_wavelength=period / 32,
                                rolloff_wavelength=period / 4, seed=11, rms_gradient=0.1)
-    common = dict(thickness=args.thickness, young=1.0, poisson=0.5, tol=1e-8)
+    common = {"thickness": args.thickness, "young": 1.0, "poisson": 0.5, "tol": 1e-8}
     full = lc.solve_areal(h, period=period, mean_pressure=args.pressure, **common)
     print(f"full periodic surface {n}², thickness {args.thickness:g}, mean pressure {args.pressure:g}: "
           f"contact fraction {full.contact_fraction:.4f}")

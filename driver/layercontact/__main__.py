@@ -313,7 +313,7 @@ def convert_command(source: str, output: str, unit: str | None, channel: int | N
     except ImportError as err:
         print(f"layercontact: error: {err}", file=sys.stderr)
         return 4
-    except Exception as err:  # the readers of SurfaceTopography raise many kinds
+    except Exception as err:  # noqa: BLE001 (the readers of SurfaceTopography raise many kinds)
         print(f"layercontact: error: {source}: cannot be read as a topography: {err}", file=sys.stderr)
         return 2
     try:

@@ -28,7 +28,8 @@ class Topography:
     height : numpy.ndarray
         Heights (``unit``): 1D for a line scan, ``(ny, nx)`` for a map (x along the rows).
     size : tuple of float
-        Physical size along x (and y) (``unit``): the measured length, n grid steps.
+        Physical size along x (and y) (``unit``): the measured length, n grid steps; NaN
+        when the file states none.
     unit : str
         Length unit of ``height`` and ``size`` ('' when the file states none).
     periodic : bool
@@ -45,14 +46,15 @@ class Topography:
     source: str
 
 
-def _surface_topography():
+def _open_topography():
+    """SurfaceTopography's file opener, or ImportError naming the extra to install."""
     try:
-        import SurfaceTopography
+        from SurfaceTopography.IO import open_topography
     except ImportError as error:
         raise ImportError(
             "reading instrument topography files needs the SurfaceTopography package: " + EXTRA_HINT
         ) from error
-    return SurfaceTopography
+    return open_topography
 
 
 def read_topography(path: str | os.PathLike, *, unit: str | None = None, channel: int | None = None) -> Topography:
@@ -77,9 +79,7 @@ def read_topography(path: str | os.PathLike, *, unit: str | None = None, channel
         command to install the extra) when SurfaceTopography is missing, and ValueError
         for a file with undefined (missing) points, which a contact solve cannot take.
     """
-    surface_topography = _surface_topography()
-    from SurfaceTopography.IO import open_topography
-
+    open_topography = _open_topography()
     path = os.fspath(path)
     reader = open_topography(path)
     index = reader.default_channel.index if channel is None else int(channel)
@@ -97,8 +97,10 @@ def read_topography(path: str | os.PathLike, *, unit: str | None = None, channel
     height = np.asarray(topography.heights(), dtype=np.float64)
     if height.ndim == 2:
         height = height.T
-    size = tuple(float(s) for s in topography.physical_sizes)
-    del surface_topography
+    # some formats state no physical size: then the scene's period is the user's to give
+    sizes = topography.physical_sizes
+    sizes = sizes if sizes is not None else [None] * height.ndim
+    size = tuple(float("nan") if s is None else float(s) for s in sizes)
     return Topography(
         height=np.ascontiguousarray(height),
         size=size,
@@ -129,6 +131,8 @@ def scene_lines(topography: Topography, file: str) -> str:
     h = np.asarray(topography.height)
     factor = 1 if topography.periodic else 2
     unit = f"({topography.unit})" if topography.unit else "(the file's length unit)"
+    if not np.all(np.isfinite(topography.size)):
+        unit = "(the file states no size: give the period in the heights' unit)"
     lines = ["&scene"]
     if h.ndim == 2:
         ny, nx = h.shape
