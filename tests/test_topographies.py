@@ -141,6 +141,10 @@ def test_curvature_and_mean_detrend(tmp_path):
     expected = (bowl + ripple) - np.polyval(np.polyfit(u, bowl + ripple, 2), u)
     assert np.max(np.abs(out - expected)) < 1e-14
     assert abs(np.mean(lc.prepare_heights(bowl, detrend="mean"))) < 1e-15
+    # a quadratic needs three points along each axis
+    with pytest.raises(lc.LayercontactError, match=r"holds shape \(2, 5\); allowed: at least 3 points") as err:
+        lc.prepare_heights(np.ones((2, 5)), detrend="curvature")
+    assert err.value.code == 2
 
 
 def test_fourier_resampling_of_band_limited_heights_is_exact(tmp_path):
@@ -263,7 +267,9 @@ def test_read_topography_and_convert_an_instrument_file(tmp_path):
 
 
 def test_without_the_extra_the_error_says_what_to_install(tmp_path, monkeypatch):
-    monkeypatch.setitem(sys.modules, "SurfaceTopography", None)
+    # as if not installed, also when an earlier test imported it
+    for name in ("SurfaceTopography", "SurfaceTopography.IO"):
+        monkeypatch.setitem(sys.modules, name, None)
     with pytest.raises(ImportError, match=r"pip install 'layercontact\[topography\]'"):
         lc.read_topography(tmp_path / "scan.x3p")
     from layercontact.__main__ import main

@@ -109,6 +109,17 @@ contains
          return
       end if
 
+      ! a polynomial of degree d needs d + 1 points along each axis it varies along
+      select case (mode)
+      case ('plane', 'curvature')
+         if (size(raw, 1) < merge(3, 2, mode == 'curvature') .or. &
+            & (areal .and. size(raw, 2) < merge(3, 2, mode == 'curvature'))) then
+            call fatal_error(error, 'holds shape ' // c_shape(raw) // "; allowed: at least " // &
+               & trim(merge('3', '2', mode == 'curvature')) // " points along each axis with detrend = '" // &
+               & mode // "'", code_input)
+            return
+         end if
+      end select
       work = raw
       call detrend_heights(work, mode)
       if (trim(boundary) == 'mirror') call mirror_heights(work, areal)
