@@ -96,6 +96,8 @@ module lc_scene
       !> areal geometry: grid points and period along y (period_y not_set: = period)
       integer :: ny = 1
       real(wp) :: period_y = not_set
+      !> &scene n, nx or ny given: without them a profile file sets the grid (its size)
+      logical :: grid_given = .false.
       real(wp) :: thickness = 0.16_wp      !< h (L); +Inf = half-space
       real(wp) :: young = 1.0_wp           !< E (S)
       real(wp) :: poisson = 0.5_wp         !< nu

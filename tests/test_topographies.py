@@ -174,6 +174,23 @@ def test_coarsening_keeps_the_long_wavelengths_only():
     assert np.max(np.abs(coarse - np.cos(2 * np.pi * 3 * np.arange(64) / 64))) < 1e-14
 
 
+def test_without_a_grid_size_the_file_sets_it(tmp_path, surface):
+    line = lc.self_affine_profile(200, 0.8, short_wavelength=1 / 16)
+    write(tmp_path / "line.txt", line)
+    nml = tmp_path / "line.nml"
+    nml.write_text(f"&profile\n kind = 'file'\n file = '{tmp_path / 'line.txt'}'\n/\n"
+                   f"&loading\n mean_pressure = 0.01\n/\n&output\n file = '{tmp_path / 'l.h5'}'\n/\n")
+    assert np.array_equal(lc.run(nml).height, line)
+    write(tmp_path / "patch.npy", surface)
+    nml = tmp_path / "surface.nml"
+    nml.write_text(f"&scene\n geometry = 'areal'\n period = 2.0\n period_y = 1.5\n/\n&layer\n thickness = 0.2\n/\n"
+                   f"&profile\n kind = 'file'\n file = '{tmp_path / 'patch.npy'}'\n boundary = 'mirror'\n/\n"
+                   f"&loading\n mean_pressure = 0.02\n/\n&output\n file = '{tmp_path / 's.h5'}'\n/\n")
+    result = lc.run(nml)
+    assert result.height.shape == (48, 64)
+    assert np.array_equal(result.height, lc.prepare_heights(surface, boundary="mirror"))
+
+
 def test_mirror_makes_the_patch_periodic_with_twice_its_length(tmp_path):
     m = 32
     j = np.arange(m)

@@ -358,6 +358,7 @@ contains
       config%title = title
       config%period = merge(period_x, period, period_x /= not_set)
       config%period_y = period_y
+      config%grid_given = n /= unset_count .or. nx /= unset_count .or. ny /= unset_count
       if (n == unset_count) n = merge(default_areal_n, config%n, trim(geometry) == 'areal')
       config%n = merge(nx, n, nx /= unset_count)
       config%ny = merge(ny, merge(n, 1, trim(geometry) == 'areal'), ny /= unset_count)

@@ -31,7 +31,7 @@ module lc_profiles_measured
    use lc_profiles_height_file, only: read_height_file, named, shape_text
    implicit none (type, external)
    private
-   public :: measured_heights, prepare_heights, detrend_heights, mirror_heights, resample_heights
+   public :: measured_heights, measured_grid, prepare_heights, detrend_heights, mirror_heights, resample_heights
    public :: detrend_modes, boundary_modes, resample_modes
 
    !> Allowed values of &profile detrend, boundary and resample, for checks and messages.
@@ -78,6 +78,34 @@ contains
          if (index(error%message, '&profile') /= 1) error%message = named(filename) // ' ' // error%message
       end if
    end subroutine measured_heights
+
+   !> The grid a file's heights give without resampling: the file's size after the shape
+   !> rule, twice along each mirrored axis with boundary = 'mirror' (ny = 1 for a line).
+   subroutine measured_grid(filename, dataset, areal, boundary, nx, ny, error)
+      character(len=*), intent(in) :: filename, dataset, boundary
+      logical, intent(in) :: areal
+      integer, intent(out) :: nx, ny
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: raw(:, :)
+      integer :: factor
+
+      nx = 0
+      ny = 1
+      call read_height_file(filename, dataset, raw, error)
+      if (allocated(error)) return
+      factor = merge(2, 1, trim(boundary) == 'mirror')
+      if (.not. areal) then
+         if (size(raw, 2) /= 1 .and. size(raw, 1) /= 1) then
+            call fatal_error(error, named(filename) // ' holds shape ' // c_shape(raw) // "; allowed: one row " // &
+               & "or one column of heights with geometry = 'line'", code_input)
+            return
+         end if
+         nx = factor*size(raw)
+      else
+         nx = factor*size(raw, 1)
+         ny = factor*size(raw, 2)
+      end if
+   end subroutine measured_grid
 
    !> Steps 2 to 4 of the module header on heights raw(mx, my) (my = 1 for a line): the
    !> heights on an nx x ny grid. Messages of the grid's size start with 'holds'.
