@@ -472,3 +472,105 @@ subroutine py_surface_stress(n, p, nx, period, period_y, thickness, young, poiss
    end if
    call surface_stress(op, p, fields(:, 1), fields(:, 2), fields(:, 3), fields(:, 4), fields(:, 5))
 end subroutine py_surface_stress
+
+!> Sizes of the heights in a file (&profile file, dataset), read by the reader of
+!> &profile kind = 'file' (lc_profiles_height_file): nx x ny with x fastest, (n, 1) for a
+!> 1D array.
+subroutine py_height_file_shape(filename, dataset, nx, ny, stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_profiles_height_file, only: read_height_file
+   implicit none (type, external)
+   character(len=*), intent(in) :: filename, dataset
+   integer, intent(out) :: nx, ny
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   real(8), allocatable :: height(:, :)
+   stat = 0
+   errmsg = ''
+   nx = 0
+   ny = 0
+   call read_height_file(filename, dataset, height, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+      return
+   end if
+   nx = size(height, 1)
+   ny = size(height, 2)
+end subroutine py_height_file_shape
+
+!> The heights of a file as the reader of &profile kind = 'file' reads them, flat with x
+!> fastest; nx x ny from py_height_file_shape (a file of another size now is an error).
+subroutine py_read_height_file(filename, dataset, nx, ny, height, stat, errmsg)
+   use lc_errors, only: error_type, fatal_error, code_io
+   use lc_profiles_height_file, only: read_height_file, named
+   implicit none (type, external)
+   character(len=*), intent(in) :: filename, dataset
+   integer, intent(in) :: nx, ny
+   real(8), intent(out) :: height(nx*ny)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   real(8), allocatable :: read_back(:, :)
+   stat = 0
+   errmsg = ''
+   height = 0
+   call read_height_file(filename, dataset, read_back, error)
+   if (.not. allocated(error)) then
+      if (size(read_back, 1) /= nx .or. size(read_back, 2) /= ny) &
+         & call fatal_error(error, named(filename) // ' changed while it was read', code_io)
+   end if
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+      return
+   end if
+   height = reshape(read_back, [nx*ny])
+end subroutine py_read_height_file
+
+!> Heights of a file on a scene's grid (lc_profiles_measured: the shape rule, detrend,
+!> boundary, resample), as &profile kind = 'file' makes them; areal = 0: a line of nx
+!> points (ny = 1).
+subroutine py_measured_heights(filename, dataset, areal, detrend, boundary, resample, nx, ny, height, stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_profiles_measured, only: measured_heights
+   implicit none (type, external)
+   character(len=*), intent(in) :: filename, dataset, detrend, boundary, resample
+   integer, intent(in) :: areal, nx, ny
+   real(8), intent(out) :: height(nx*ny)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   stat = 0
+   errmsg = ''
+   call measured_heights(filename, dataset, areal /= 0, detrend, boundary, resample, nx, ny, height, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+   end if
+end subroutine py_measured_heights
+
+!> Detrend, boundary and resample (lc_profiles_measured) of heights raw (mx x n/mx, x
+!> fastest) onto an nx x ny grid; areal = 0: a line (ny = 1).
+subroutine py_prepare_heights(n, raw, mx, areal, detrend, boundary, resample, nx, ny, height, stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_profiles_measured, only: prepare_heights
+   implicit none (type, external)
+   integer, intent(in) :: n, mx, areal, nx, ny
+   real(8), intent(in) :: raw(n)
+   character(len=*), intent(in) :: detrend, boundary, resample
+   real(8), intent(out) :: height(nx*ny)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   !f2py intent(hide) :: n
+   type(error_type), allocatable :: error
+   stat = 0
+   errmsg = ''
+   height = 0
+   call prepare_heights(reshape(raw, [mx, n/mx]), areal /= 0, detrend, boundary, resample, nx, ny, height, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+   end if
+end subroutine py_prepare_heights

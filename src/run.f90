@@ -8,11 +8,12 @@ module lc_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
-   use lc_scene, only: scene_type, not_set
+   use lc_scene, only: scene_type, not_set, is_areal, check_scene
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
    use lc_profiles_profile, only: make_profile
+   use lc_profiles_measured, only: measured_grid
    use lc_contact_solve, only: solve_contact
    use lc_accuracy, only: choose_resolution
    use lc_version, only: version_string, build_isa
@@ -53,6 +54,14 @@ contains
                & 'an existing file (HDF5, .npy or text), relative to the working directory', code_input)
             return
          end if
+      end if
+      ! without &scene n (nx, ny) a profile file sets the grid: its own size
+      if (trim(scene%profile%kind) == 'file' .and. .not. scene%grid_given) then
+         call measured_grid(trim(scene%profile%file), trim(scene%profile%dataset), is_areal(scene), &
+            & scene%profile%boundary, scene%n, scene%ny, error)
+         if (allocated(error)) return
+         call check_scene(scene, error)
+         if (allocated(error)) return
       end if
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return

@@ -50,9 +50,16 @@ module lc_scene
       !> sphere (areal): a spherical cap of this radius (L), its apex at the cell's centre
       real(wp) :: radius = not_set
       !> file: heights (L) from an HDF5 file (dataset below), a .npy file, or a text file
-      !> (whitespace-separated; a surface: one row of nx heights per line, ny lines)
+      !> (whitespace-separated; a surface: one row of nx heights per line, ny lines; a line
+      !> profile: one row or one column), fitted to the grid by lc_profiles_measured
       character(len=max_string) :: file = ''
       character(len=max_string) :: dataset = '/profile/height'
+      !> file: auto | none | mean | plane | curvature (auto: none if periodic, plane if mirrored)
+      character(len=max_string) :: detrend = 'auto'
+      !> file: periodic (the file is one period) | mirror (the patch and its mirror image)
+      character(len=max_string) :: boundary = 'periodic'
+      !> file: none (the file has the grid's size) | fourier (Fourier interpolation/truncation)
+      character(len=max_string) :: resample = 'none'
    end type profile_spec
 
    !> Solver choice and stopping rule.
@@ -89,6 +96,8 @@ module lc_scene
       !> areal geometry: grid points and period along y (period_y not_set: = period)
       integer :: ny = 1
       real(wp) :: period_y = not_set
+      !> &scene n, nx or ny given: without them a profile file sets the grid (its size)
+      logical :: grid_given = .false.
       real(wp) :: thickness = 0.16_wp      !< h (L); +Inf = half-space
       real(wp) :: young = 1.0_wp           !< E (S)
       real(wp) :: poisson = 0.5_wp         !< nu
@@ -277,14 +286,33 @@ contains
                call input_error(error, 'profile', 'radius', to_string(p%radius), '> 0 and finite')
             end if
          case ('file')
-            if (len_trim(p%file) == 0 .and. is_areal(scene)) then
+            if (len_trim(p%file) == 0) then
                call input_error(error, 'profile', 'file', "''", &
                   & 'the name of a file holding the heights (.h5/.hdf5, .npy or text)')
-            else if (len_trim(p%file) == 0) then
-               call input_error(error, 'profile', 'file', "''", 'the name of an HDF5 file holding the heights')
+            else if (.not. one_of(p%detrend, [character(len=16) :: 'auto', 'none', 'mean', 'plane', 'curvature'])) then
+               call input_error(error, 'profile', 'detrend', "'" // trim(p%detrend) // "'", &
+                  & "'auto', 'none', 'mean', 'plane' or 'curvature'")
+            else if (.not. one_of(p%boundary, [character(len=16) :: 'periodic', 'mirror'])) then
+               call input_error(error, 'profile', 'boundary', "'" // trim(p%boundary) // "'", "'periodic' or 'mirror'")
+            else if (.not. one_of(p%resample, [character(len=16) :: 'none', 'fourier'])) then
+               call input_error(error, 'profile', 'resample', "'" // trim(p%resample) // "'", "'none' or 'fourier'")
             end if
          end select
          if (allocated(error)) return
+         ! the treatment of measured heights means nothing for a generated profile
+         if (trim(p%kind) /= 'file') then
+            if (trim(p%detrend) /= 'auto') then
+               call input_error(error, 'profile', 'detrend', "'" // trim(p%detrend) // "'", &
+                  & "not set unless kind = 'file'")
+            else if (trim(p%boundary) /= 'periodic') then
+               call input_error(error, 'profile', 'boundary', "'" // trim(p%boundary) // "'", &
+                  & "not set unless kind = 'file'")
+            else if (trim(p%resample) /= 'none') then
+               call input_error(error, 'profile', 'resample', "'" // trim(p%resample) // "'", &
+                  & "not set unless kind = 'file'")
+            end if
+            if (allocated(error)) return
+         end if
 
          if (.not. one_of(scene%control, [character(len=16) :: 'load', 'displacement'])) then
             call input_error(error, 'loading', 'control', trim(scene%control), "'load' or 'displacement'")

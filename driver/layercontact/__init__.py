@@ -28,6 +28,9 @@ from .native import BUILD
 from .profiles import (
     load_profile,
     load_surface,
+    prepare_heights,
+    read_profile,
+    read_surface,
     self_affine_profile,
     self_affine_surface,
     sinusoid_profile,
@@ -35,6 +38,7 @@ from .profiles import (
     spherical_cap,
 )
 from .sweep import read_summary, sweep
+from .topography import Topography, read_topography, write_height_file
 
 __all__ = [
     "ArealResult",
@@ -51,6 +55,10 @@ __all__ = [
     "layer_multipliers_lapack",
     "load_profile",
     "load_surface",
+    "prepare_heights",
+    "read_profile",
+    "read_surface",
+    "read_topography",
     "read_result",
     "read_summary",
     "reynolds_leakage",
@@ -66,5 +74,7 @@ __all__ = [
     "surface_fields",
     "surface_stress",
     "surface_tensor",
+    "Topography",
+    "write_height_file",
 ]
 __version__ = "0.1.0"

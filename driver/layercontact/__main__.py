@@ -5,12 +5,16 @@
     python -m layercontact sweep FILE.nml --slurm [--dry-run] [Slurm options]
     python -m layercontact status DIR [--all]
     python -m layercontact collect DIR
+    python -m layercontact convert INPUT OUTPUT.h5 [--unit UNIT] [--channel N]
 
 ``run`` runs a scene like the ``layercontact`` executable (same library routine, same
 HDF5 file, same summary and exit codes) and draws the seed's Fig. 2(a) view next to the
 result file. ``sweep`` runs a parameter sweep here in worker processes, or with ``--slurm``
 submits it as a Slurm job array (layercontact.submit). ``status`` and ``collect`` read a
-sweep directory (or a sweep file): where each scene stands, and the summary.
+sweep directory (or a sweep file): where each scene stands, and the summary. ``convert``
+reads an instrument topography file (with the optional SurfaceTopography package) and
+writes the HDF5 height file that ``&profile kind = 'file'`` reads, printing the &scene and
+&profile lines that run it.
 
 Exit codes:
     run       0 converged, 2 bad input, 3 not converged, 4 I/O failure, 5 internal failure
@@ -22,6 +26,8 @@ Exit codes:
               sweep (directory)
     collect   0 every scene converged, 1 some did not or are not done (the summary is
               written all the same), 2 not a sweep (directory)
+    convert   0 written, 2 the input cannot be read as a topography, 4 SurfaceTopography
+              missing or the output not writable
 """
 
 from __future__ import annotations
@@ -93,6 +99,14 @@ def _parser() -> argparse.ArgumentParser:
         "collect", help="write the summary (CSV and HDF5) of a sweep from its directory"
     )
     collect_p.add_argument("directory", help="the sweep directory (or the sweep file)")
+    convert_p = sub.add_parser(
+        "convert",
+        help="write an instrument topography file as the HDF5 height file &profile kind = 'file' reads",
+    )
+    convert_p.add_argument("input", help="topography file (a format SurfaceTopography reads)")
+    convert_p.add_argument("output", help="HDF5 file to write (/profile/height)")
+    convert_p.add_argument("--unit", help="length unit of heights and sizes, e.g. um (default: the file's)")
+    convert_p.add_argument("--channel", type=int, help="data channel (default: the file's default)")
     return parser
 
 
@@ -113,6 +127,8 @@ def main(argv: list[str] | None = None) -> int:
         return status_command(args.directory, args.all)
     if args.command == "collect":
         return collect_command(args.directory)
+    if args.command == "convert":
+        return convert_command(args.input, args.output, args.unit, args.channel)
     return run_command(args)
 
 
@@ -285,6 +301,32 @@ def collect_command(directory: str) -> int:
         if scene.state != DONE:
             print(f"layercontact: scene {scene.stem}: {scene.state}: {scene.reason}", file=sys.stderr)
     return 1 if bad else 0
+
+
+def convert_command(source: str, output: str, unit: str | None, channel: int | None) -> int:
+    """``python -m layercontact convert INPUT OUTPUT.h5``: 0 written, 2 unreadable as a
+    topography, 4 SurfaceTopography missing or the output not writable."""
+    from .topography import read_topography, scene_lines, write_height_file
+
+    try:
+        topography = read_topography(source, unit=unit, channel=channel)
+    except ImportError as err:
+        print(f"layercontact: error: {err}", file=sys.stderr)
+        return 4
+    except Exception as err:  # noqa: BLE001 (the readers of SurfaceTopography raise many kinds)
+        print(f"layercontact: error: {source}: cannot be read as a topography: {err}", file=sys.stderr)
+        return 2
+    try:
+        write_height_file(output, topography)
+    except OSError as err:
+        print(f"layercontact: error: {output}: {err}", file=sys.stderr)
+        return 4
+    shape = " x ".join(str(s) for s in topography.height.shape[::-1])
+    size = " x ".join(f"{s:g}" for s in topography.size)
+    print(f"{output}: {shape} heights over {size} {topography.unit or '(no unit stated)'}, "
+          f"{'periodic' if topography.periodic else 'not periodic'}, from {topography.source}")
+    print(scene_lines(topography, output))
+    return 0
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """Rigid profiles and surfaces: seeded self-affine synthesis (the Fortran routines, so that
 a namelist run and Python give the same heights for the same seed), sinusoids, a spherical
-cap, and measured profiles read from files.
+cap, and measured profiles read from files by the library's reader (the one a namelist run
+uses, so that both take the same files by the same rules; docs/topographies.md).
 
 Surfaces are (ny, nx) float64 arrays, ``height[iy, ix] = r(x = ix*lx/nx, y = iy*ly/ny)``:
 the C order of the Fortran library's flat fields with x fastest."""
@@ -12,7 +13,7 @@ import os
 import numpy as np
 
 from .native import core as _core
-from .api import NOT_SET, _check
+from .api import NOT_SET, LayercontactError, _check
 
 # Length of the Fortran scene's file-name fields (lc_scene max_string).
 _MAX_STRING = 512
@@ -58,21 +59,39 @@ def sinusoid_profile(n: int, amplitude: float, *, mode: int = 1, period: float =
 
 
 def load_profile(path: str | os.PathLike, dataset: str = "/profile/height") -> np.ndarray:
-    """Heights from a file: ``.npy``, an HDF5 file (``dataset``), or a text column."""
-    path = os.fspath(path)
-    if path.endswith(".npy"):
-        h = np.load(path)
-    elif path.endswith((".h5", ".hdf5")):
-        import h5py
+    """Heights of a line profile file, as the library reads them for
+    ``&profile kind='file'`` of a line scene: a file of one row or one column.
 
-        with h5py.File(path, "r") as f:
-            h = f[dataset][()]
-    else:
-        h = np.loadtxt(path)
-    h = np.asarray(h, dtype=np.float64)
-    if h.ndim != 1 or not np.all(np.isfinite(h)):
-        raise ValueError(f"{path}: expected one column of finite heights, got shape {h.shape}")
-    return h
+    ``.h5``/``.hdf5``: the floating-point ``dataset`` (1D, or 2D of one row or column);
+    ``.npy``: dtype ``'<f8'``, C order; anything else: text, one number per line or one
+    line of numbers (blank lines and ``#`` comments skipped). Every height must be finite.
+    Raises ValueError for content that breaks these rules and OSError for unreadable files.
+    """
+    h = _read_heights(path, dataset)
+    if h.shape[0] != 1 and h.shape[1] != 1:
+        raise ValueError(
+            f"&profile: file = '{os.fspath(path)}' holds shape {h.shape}; "
+            "allowed: one row or one column of heights for a line profile"
+        )
+    return h.ravel()
+
+
+def _read_heights(path: str | os.PathLike, dataset: str | None) -> np.ndarray:
+    """The heights of a file by the library's reader, as a (ny, nx) array ((1, n) for a
+    1D array); its errors as ValueError (bad content) or OSError (unreadable file)."""
+    path = os.fspath(path)
+    dataset = _DEFAULT_DATASET if dataset is None else dataset
+    if len(path) > _MAX_STRING or len(dataset) > _MAX_STRING:
+        raise ValueError(f"file and dataset names are limited to {_MAX_STRING} characters")
+    try:
+        nx, ny, stat, errmsg = _core.py_height_file_shape(path, dataset)
+        _check(stat, errmsg)
+        height, stat, errmsg = _core.py_read_height_file(path, dataset, nx, ny)
+        _check(stat, errmsg)
+    except LayercontactError as error:
+        kind = OSError if error.code == 4 else ValueError
+        raise kind(str(error)) from None
+    return height.reshape(ny, nx)
 
 
 def _surface_grid(n, period, nx, ny) -> tuple[int, int, float, float]:
@@ -214,59 +233,122 @@ def spherical_cap(
     return _make_surface("sphere", nx, ny, lx, ly, radius=radius)
 
 
-def read_surface(path: str | os.PathLike, nx: int, ny: int, dataset: str | None = None) -> np.ndarray:
-    """Heights of a surface file read by the library for an ``nx`` x ``ny`` areal scene
-    (``&profile kind='file'``): ``.h5``/``.hdf5`` (a 2D dataset ``[ny, nx]``), ``.npy``
-    (``'<f8'``, C order, shape ``(ny, nx)``) or text (ny lines of nx numbers). Raises
-    LayercontactError (code 2 bad content, 4 unreadable file) with the library's message.
+def read_surface(
+    path: str | os.PathLike,
+    nx: int,
+    ny: int,
+    dataset: str | None = None,
+    *,
+    detrend: str = "auto",
+    boundary: str = "periodic",
+    resample: str = "none",
+) -> np.ndarray:
+    """Heights of a surface file on an ``nx`` x ``ny`` grid, made by the library exactly as
+    ``&profile kind='file'`` of an areal scene makes them.
+
+    The file: ``.h5``/``.hdf5`` (a 2D dataset ``[ny, nx]``), ``.npy`` (``'<f8'``, C order,
+    2D) or text (lines of numbers, one row of x per line). Then, as in the namelist
+    (docs/topographies.md): ``detrend`` (``'auto'``, ``'none'``, ``'mean'``, ``'plane'``,
+    ``'curvature'``), ``boundary`` (``'periodic'``: the file is one period; ``'mirror'``:
+    the patch and its mirror images, twice as many points each way) and ``resample``
+    (``'none'``: the file must have the grid's size; ``'fourier'``: Fourier
+    interpolation or truncation onto the grid). Raises LayercontactError (code 2 bad
+    content, 4 unreadable file) with the library's message.
     """
-    return _make_surface(
-        "file",
-        nx,
-        ny,
-        1.0,
-        1.0,
-        path=os.fspath(path),
-        dataset=_DEFAULT_DATASET if dataset is None else dataset,
+    return _measured(path, dataset, True, detrend, boundary, resample, nx, ny).reshape(ny, nx)
+
+
+def read_profile(
+    path: str | os.PathLike,
+    n: int,
+    dataset: str | None = None,
+    *,
+    detrend: str = "auto",
+    boundary: str = "periodic",
+    resample: str = "none",
+) -> np.ndarray:
+    """Heights of a line profile file on a grid of ``n`` points, made by the library
+    exactly as ``&profile kind='file'`` of a line scene makes them: a file of one row or
+    one column, then ``detrend``, ``boundary`` and ``resample`` as in
+    :func:`read_surface`. Raises LayercontactError (code 2 bad content, 4 unreadable file).
+    """
+    return _measured(path, dataset, False, detrend, boundary, resample, n, 1)
+
+
+def _measured(path, dataset, areal, detrend, boundary, resample, nx, ny) -> np.ndarray:
+    path = os.fspath(path)
+    dataset = _DEFAULT_DATASET if dataset is None else dataset
+    if len(path) > _MAX_STRING or len(dataset) > _MAX_STRING:
+        raise ValueError(f"file and dataset names are limited to {_MAX_STRING} characters")
+    height, stat, errmsg = _core.py_measured_heights(
+        path, dataset, int(areal), str(detrend), str(boundary), str(resample), int(nx), int(ny)
     )
+    _check(stat, errmsg)
+    return height
+
+
+def prepare_heights(
+    height,
+    *,
+    shape: int | tuple[int, int] | None = None,
+    detrend: str = "auto",
+    boundary: str = "periodic",
+) -> np.ndarray:
+    """Measured heights made ready for a periodic solve by the library's routines (those of
+    ``&profile detrend``, ``boundary`` and ``resample``; docs/topographies.md).
+
+    Parameters
+    ----------
+    height : array_like
+        A line profile (1D) or a surface ``(ny, nx)`` (L).
+    shape : int or (int, int), optional
+        The grid to resample onto by Fourier interpolation or truncation: ``n`` for a line,
+        ``(ny, nx)`` for a surface; None keeps the size (twice the size with ``'mirror'``).
+    detrend : str
+        ``'auto'`` (``'none'`` for ``'periodic'``, ``'plane'`` for ``'mirror'``), ``'none'``,
+        ``'mean'``, ``'plane'`` or ``'curvature'``: the least-squares polynomial subtracted.
+    boundary : str
+        ``'periodic'`` (the heights are one period) or ``'mirror'`` (the patch and its mirror
+        images: the period is twice the patch's length along each axis).
+
+    Returns
+    -------
+    numpy.ndarray
+        The heights, 1D for a line, ``(ny, nx)`` for a surface. Raises LayercontactError
+        (code 2) for a bad value.
+    """
+    raw = np.asarray(height, dtype=np.float64)
+    if raw.ndim not in (1, 2) or raw.size == 0 or not np.all(np.isfinite(raw)):
+        raise ValueError(f"heights of shape {raw.shape}: allowed a 1D or 2D array of finite heights")
+    areal = raw.ndim == 2
+    factor = 2 if boundary == "mirror" else 1
+    if shape is None:
+        ny, nx = (raw.shape[0] * factor, raw.shape[1] * factor) if areal else (1, raw.shape[0] * factor)
+        resample = "none"
+    else:
+        ny, nx = (int(shape[0]), int(shape[1])) if areal else (1, int(shape))
+        resample = "fourier"
+    mx = raw.shape[-1]
+    out, stat, errmsg = _core.py_prepare_heights(
+        np.ascontiguousarray(raw).ravel(), mx, int(areal), str(detrend), str(boundary), resample, nx, ny
+    )
+    _check(stat, errmsg)
+    return out.reshape(ny, nx) if areal else out
 
 
 def load_surface(path: str | os.PathLike, dataset: str | None = None) -> np.ndarray:
-    """Heights of a surface file as a ``(ny, nx)`` array, by the rules of the library's
-    reader (:func:`read_surface`, which also checks the grid size).
+    """Heights of a surface file as a ``(ny, nx)`` array, read by the library's reader (the
+    one of ``&profile kind='file'``; :func:`read_surface` also fits them to a grid).
 
     ``.h5``/``.hdf5``: the 2D floating-point ``dataset`` (default ``/profile/height``);
     ``.npy``: dtype ``'<f8'``, C order, 2D; anything else: text, one row of x per line
     (blank lines and ``#`` comments skipped). Every height must be finite. Raises
     ValueError for content that breaks these rules and OSError for unreadable files.
     """
-    path = os.fspath(path)
-    lowered = path.lower()
-    if lowered.endswith((".h5", ".hdf5")):
-        import h5py
-
-        dataset = _DEFAULT_DATASET if dataset is None else dataset
-        with h5py.File(path, "r") as f:
-            if dataset not in f:
-                raise ValueError(f"{path}: no dataset {dataset!r}")
-            data = f[dataset]
-            if data.ndim != 2 or data.dtype.kind != "f":
-                raise ValueError(
-                    f"{path}, dataset {dataset!r}: shape {data.shape}, dtype {data.dtype}; "
-                    "allowed: a 2D floating-point dataset of shape (ny, nx)"
-                )
-            h = np.asarray(data[()], dtype=np.float64)
-    elif lowered.endswith(".npy"):
-        h = np.load(path, allow_pickle=False)
-        if h.dtype.str != "<f8":
-            raise ValueError(f"{path}: dtype {h.dtype.str!r}; allowed: '<f8' (little-endian float64)")
-        # numpy.save writes fortran_order = True exactly for these arrays
-        if np.isfortran(h):
-            raise ValueError(f"{path}: fortran_order = True; allowed: C order (numpy.ascontiguousarray)")
-        if h.ndim != 2:
-            raise ValueError(f"{path}: shape {h.shape}; allowed: a 2D array of shape (ny, nx)")
-    else:
-        h = np.loadtxt(path, ndmin=2)
-    if not np.all(np.isfinite(h)):
-        raise ValueError(f"{path}: non-finite heights; allowed: finite heights")
-    return np.ascontiguousarray(h, dtype=np.float64)
+    h = _read_heights(path, dataset)
+    if h.shape[0] < 2 or h.shape[1] < 2:
+        raise ValueError(
+            f"&profile: file = '{os.fspath(path)}' holds shape {h.shape}; "
+            "allowed: a 2D array (ny, nx) of at least 2 x 2 heights for a surface"
+        )
+    return h

@@ -34,7 +34,7 @@ module lc_io_hdf5
    use lc_version, only: build_isa
    implicit none (type, external)
    private
-   public :: check_output, write_results, read_profile_heights, run_record, utc_now
+   public :: check_output, write_results, run_record, utc_now
 
    character(len=*), parameter :: convention = 'P: x = sliding direction of the indenter, z into the layer, ' // &
       & 'p > 0 compressive, w = u_z > 0 indentation, tau = +mu_c p'
@@ -304,65 +304,6 @@ contains
       call h5close_f(ignore)
    end function is_hdf5_file
 
-   !> Read n heights from an HDF5 file/dataset (1D float64 dataset of exactly n values).
-   subroutine read_profile_heights(filename, dataset, n, height, error)
-      character(len=*), intent(in) :: filename
-      !> path of the dataset inside the file, e.g. /profile/height
-      character(len=*), intent(in) :: dataset
-      !> number of heights expected (the scene's grid size)
-      integer, intent(in) :: n
-      !> the heights (L)
-      real(wp), intent(out) :: height(n)
-      type(error_type), allocatable, intent(out) :: error
-      integer(hid_t) :: fapl, file, dset, space, dtype
-      integer(hsize_t) :: dims(1), maxdims(1)
-      integer :: hdferr, ignore, rank, class
-      character(len=:), allocatable :: where
-
-      where = "profile file '" // filename // "', dataset '" // dataset // "'"
-      call h5open_f(hdferr)
-      call h5eset_auto_f(0, ignore)
-      call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, ignore)
-      call h5pset_fclose_degree_f(fapl, H5F_CLOSE_STRONG_F, ignore)
-      reading: block
-         if (hdferr /= 0) then
-            call fatal_error(error, 'cannot initialise HDF5 to read ' // where, code_io)
-            exit reading
-         end if
-         call h5fopen_f(filename, H5F_ACC_RDONLY_F, file, hdferr, access_prp=fapl)
-         if (hdferr /= 0) then
-            call fatal_error(error, "cannot open profile file '" // filename // "' as HDF5", code_io)
-            exit reading
-         end if
-         call h5dopen_f(file, dataset, dset, hdferr)
-         if (hdferr /= 0) then
-            call fatal_error(error, 'cannot open ' // where, code_io)
-         else
-            call h5dget_space_f(dset, space, hdferr)
-            call h5sget_simple_extent_ndims_f(space, rank, ignore)
-            dims = 0
-            if (rank == 1) call h5sget_simple_extent_dims_f(space, dims, maxdims, ignore)
-            call h5sclose_f(space, ignore)
-            call h5dget_type_f(dset, dtype, ignore)
-            call h5tget_class_f(dtype, class, ignore)
-            call h5tclose_f(dtype, ignore)
-            if (rank /= 1 .or. dims(1) /= n .or. class /= H5T_FLOAT_F) then
-               call fatal_error(error, where // ' holds ' // shape_str(rank, dims, class == H5T_FLOAT_F) &
-                  & // '; expected a 1D float64 dataset of n = ' // to_string(int(n, hsize_t)) // ' values', &
-                  & code_input)
-            else
-               dims(1) = n
-               call h5dread_f(dset, H5T_NATIVE_DOUBLE, height, dims, hdferr)
-               if (hdferr /= 0) call fatal_error(error, 'cannot read ' // where, code_io)
-            end if
-            call h5dclose_f(dset, ignore)
-         end if
-         call h5fclose_f(file, ignore)
-      end block reading
-      call h5pclose_f(fapl, ignore)
-      call h5close_f(ignore)
-   end subroutine read_profile_heights
-
    ! ---------------------------------------------------------------------------------------
    ! Pieces of the layout.
 
@@ -410,6 +351,9 @@ contains
          call write_attr_int(loc, 'mode', p%mode, st)
          call write_attr_string(loc, 'profile_file', trim(p%file), st)
          call write_attr_string(loc, 'profile_dataset', trim(p%dataset), st)
+         call write_attr_string(loc, 'profile_detrend', trim(p%detrend), st)
+         call write_attr_string(loc, 'profile_boundary', trim(p%boundary), st)
+         call write_attr_string(loc, 'profile_resample', trim(p%resample), st)
       end associate
       call write_attr_string(loc, 'control', trim(scene%control), st)
       call write_attr_real(loc, 'mean_pressure', scene%mean_pressure, st)
@@ -852,20 +796,5 @@ contains
       if (c_remove(filename // c_null_char) /= 0) &
          & call fatal_error(error, "cannot delete the stale temporary file '" // filename // "'", code_io)
    end subroutine delete_file
-
-   !> What a dataset holds, for messages.
-   pure function shape_str(space_rank, dims, is_float) result(s)
-      integer, intent(in) :: space_rank
-      integer(hsize_t), intent(in) :: dims(1)
-      logical, intent(in) :: is_float
-      character(len=:), allocatable :: s
-      if (.not. is_float) then
-         s = 'values that are not floating point'
-      else if (space_rank == 1) then
-         s = to_string(dims(1)) // ' values'
-      else
-         s = 'a rank-' // to_string(int(space_rank, hsize_t)) // ' dataset'
-      end if
-   end function shape_str
 
 end module lc_io_hdf5

@@ -27,7 +27,7 @@ module lc_io_namelist
       & 'model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, prony_values, prony_file', &
       & 'coefficient, companion', &
       & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
-      & 'amplitude, mode, mode_y, radius, file, dataset', &
+      & 'amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, resample', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
       & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose', &
       & 'file, overwrite, stress, gap_bins, fields']
@@ -169,6 +169,9 @@ contains
             & // entry('radius', real_value(p%radius)) &
             & // entry('file', str_value(p%file)) &
             & // entry('dataset', str_value(p%dataset)) &
+            & // entry('detrend', str_value(p%detrend)) &
+            & // entry('boundary', str_value(p%boundary)) &
+            & // entry('resample', str_value(p%resample)) &
             & // '/' // newline // '&loading' // newline &
             & // entry('control', str_value(scene%control)) &
             & // entry('mean_pressure', real_value(scene%mean_pressure)) &
@@ -310,7 +313,7 @@ contains
       character(len=*), parameter :: integers = ' n nx ny seed mode mode_y max_iter memory threads gap_bins '
       character(len=*), parameter :: logicals = ' companion precondition coarse_start verbose overwrite stress fields '
       character(len=*), parameter :: strings = ' geometry title model prony_form prony_file kind file dataset ' // &
-         & 'control method '
+         & 'detrend boundary resample control method '
       if (index(integers, ' ' // name // ' ') > 0) then
          kind = 'an integer (no decimal point or exponent)'
       else if (index(logicals, ' ' // name // ' ') > 0) then
@@ -355,6 +358,7 @@ contains
       config%title = title
       config%period = merge(period_x, period, period_x /= not_set)
       config%period_y = period_y
+      config%grid_given = n /= unset_count .or. nx /= unset_count .or. ny /= unset_count
       if (n == unset_count) n = merge(default_areal_n, config%n, trim(geometry) == 'areal')
       config%n = merge(nx, n, nx /= unset_count)
       config%ny = merge(ny, merge(n, 1, trim(geometry) == 'areal'), ny /= unset_count)
@@ -529,12 +533,12 @@ contains
       type(scene_type), intent(inout) :: config
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: kind, file, dataset
+      character(len=max_string + 1) :: kind, file, dataset, detrend, boundary, resample
       real(wp) :: hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, amplitude, radius
       integer(i8) :: seed
       integer :: mode, mode_y
       namelist /profile/ kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
-         & rms_height, amplitude, mode, mode_y, radius, file, dataset
+         & rms_height, amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, resample
 
       associate (p => config%profile)
          kind = p%kind
@@ -550,11 +554,17 @@ contains
          radius = p%radius
          file = p%file
          dataset = p%dataset
+         detrend = p%detrend
+         boundary = p%boundary
+         resample = p%resample
          read (lines, nml=profile, iostat=stat, iomsg=msg)
          if (stat /= 0) return
       if (too_long('kind', kind, stat, msg)) return
       if (too_long('file', file, stat, msg)) return
       if (too_long('dataset', dataset, stat, msg)) return
+      if (too_long('detrend', detrend, stat, msg)) return
+      if (too_long('boundary', boundary, stat, msg)) return
+      if (too_long('resample', resample, stat, msg)) return
          p%kind = kind
          p%hurst = hurst
          p%seed = seed
@@ -568,6 +578,9 @@ contains
          p%radius = radius
          p%file = file
          p%dataset = dataset
+         p%detrend = detrend
+         p%boundary = boundary
+         p%resample = resample
       end associate
    end subroutine read_group_profile
 

@@ -1,8 +1,8 @@
 !> The rigid indenter profile of a scene (docs/theory.md): made from
 !> scene%profile (self_affine | sinusoid | file; on an areal scene also sphere) on the
 !> scene's grid, and the statistics of a line profile. A line scene gets n heights
-!> (lc_profiles_self_affine), an areal scene n*ny heights, x fastest (lc_profiles_surface,
-!> lc_profiles_surface_file).
+!> (lc_profiles_self_affine), an areal scene n*ny heights, x fastest (lc_profiles_surface;
+!> a file's heights through lc_profiles_measured, for lines and surfaces alike).
 !>
 !> Statistics of heights r_j on x_j = j*period/n, with mean r0 = sum_j r_j / n:
 !>   rms height   = sqrt(sum_j (r_j - r0)^2 / n)
@@ -21,8 +21,7 @@ module lc_profiles_profile
    use lc_fft_plans, only: fft_plan
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
    use lc_profiles_surface, only: self_affine_surface, sinusoid_surface, spherical_cap
-   use lc_profiles_surface_file, only: read_surface_heights
-   use lc_io_hdf5, only: read_profile_heights
+   use lc_profiles_measured, only: measured_heights
    implicit none (type, external)
    private
    public :: make_profile, profile_statistics
@@ -59,7 +58,8 @@ contains
             ! amplitude and mode were validated with the scene (check_scene)
             call sinusoid_profile(scene%n, scene%period, p%amplitude, p%mode, height)
          case ('file')
-            call read_profile_heights(trim(p%file), trim(p%dataset), scene%n, height, error)
+            call measured_heights(trim(p%file), trim(p%dataset), .false., p%detrend, p%boundary, p%resample, &
+               & scene%n, 1, height, error)
          case default
             call fatal_error(error, "&profile: kind = '" // trim(p%kind) // "' is not allowed; allowed: " // &
                & "'self_affine', 'sinusoid' or 'file'", code_input)
@@ -109,7 +109,8 @@ contains
                call spherical_cap(nx, ny, lx, period_y, p%radius, height)
             end if
          case ('file')
-            call read_surface_heights(trim(p%file), trim(p%dataset), nx, ny, height, error)
+            call measured_heights(trim(p%file), trim(p%dataset), .true., p%detrend, p%boundary, p%resample, &
+               & nx, ny, height, error)
          case default
             call fatal_error(error, "&profile: kind = '" // trim(p%kind) // "' is not allowed; allowed: " // &
                & "'self_affine', 'sinusoid', 'sphere' or 'file'", code_input)

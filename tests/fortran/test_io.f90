@@ -8,7 +8,8 @@ program test_io
    use lc_scene, only: scene_type, not_set
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene, read_scene_text, write_scene_namelist
-   use lc_io_hdf5, only: check_output, write_results, read_profile_heights
+   use lc_io_hdf5, only: check_output, write_results
+   use lc_profiles_measured, only: measured_heights
    implicit none (type, external)
 
    character(len=*), parameter :: dir = 'test_io_scratch'
@@ -324,17 +325,20 @@ contains
          & 'write into a missing directory')
       call check(no_temporary_files(dir), 'no temporary file after a failure')
 
-      call read_profile_heights(file, '/profile/height', n, back, error)
-      call check(.not. allocated(error), 'read_profile_heights succeeds')
+      ! a result's profile is a line profile the reader of &profile kind = 'file' takes
+      call measured_heights(file, '/profile/height', .false., 'auto', 'periodic', 'none', n, 1, back, error)
+      call check(.not. allocated(error), 'measured_heights reads a result file')
       call check(all(back == height), 'the heights read back exactly')
 
-      call read_profile_heights(file, '/profile/height', n/2, short, error)
-      call check_error(error, code_input, [character(len=40) :: 'result.h5', '/profile/height', '16 values', &
-         & 'n = 8'], 'wrong number of heights')
-      call read_profile_heights(file, '/profile/nothing', n, back, error)
-      call check_error(error, code_io, [character(len=40) :: 'result.h5', '/profile/nothing'], 'missing dataset')
-      call read_profile_heights(dir // '/valid.nml', '/profile/height', n, back, error)
-      call check_error(error, code_io, [character(len=40) :: 'valid.nml'], 'not an HDF5 file')
+      call measured_heights(file, '/profile/height', .false., 'auto', 'periodic', 'none', n/2, 1, short, error)
+      call check_error(error, code_input, [character(len=40) :: 'result.h5', 'holds 16 heights', 'n = 8'], &
+         & 'wrong number of heights')
+      call measured_heights(file, '/profile/nothing', .false., 'auto', 'periodic', 'none', n, 1, back, error)
+      call check_error(error, code_input, [character(len=40) :: 'result.h5', '/profile/nothing'], 'missing dataset')
+      call measured_heights(dir // '/valid.nml', '/profile/height', .false., 'auto', 'periodic', 'none', n, 1, &
+         & back, error)
+      ! the extension picks the format: a namelist is text, and not numbers
+      call check_error(error, code_input, [character(len=40) :: 'valid.nml', 'is not a number'], 'not heights')
    end subroutine test_write_and_read
 
    !> A made-up result with recognisable values (no solver involved).

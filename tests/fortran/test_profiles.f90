@@ -1,5 +1,5 @@
 !> Tests of profile synthesis (lc_profiles_random, lc_profiles_self_affine,
-!> lc_profiles_surface, lc_profiles_surface_file, lc_profiles_profile). One line per check;
+!> lc_profiles_surface, lc_profiles_height_file, lc_profiles_measured, lc_profiles_profile). One line per check;
 !> exit 0 on pass, error stop 1 on failure.
 !>
 !> Tolerances:
@@ -19,7 +19,7 @@ program test_profiles
    use lc_profiles_random, only: splitmix64, splitmix64_uniform
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
    use lc_profiles_surface, only: self_affine_surface, sinusoid_surface, spherical_cap, surface_mode_index
-   use lc_profiles_surface_file, only: read_surface_heights
+   use lc_profiles_measured, only: measured_heights, detrend_heights, mirror_heights, resample_heights
    use lc_profiles_profile, only: make_profile, profile_statistics
    implicit none (type, external)
 
@@ -48,6 +48,7 @@ program test_profiles
    call check_sinusoid_surface()
    call check_spherical_cap()
    call check_surface_text_file()
+   call check_measured()
    call check_make_surface()
 
    if (failures > 0) then
@@ -459,18 +460,81 @@ contains
          write (unit, '(*(es25.17, 1x))') written(:, iy)
       end do
       close (unit)
-      call read_surface_heights(name, '', nx, ny, read_back, error)
+      call measured_heights(name, '', .true., 'auto', 'periodic', 'none', nx, ny, read_back, error)
       call report(.not. allocated(error) .and. all(read_back == written), 'text surface file round trip (17 digits)')
-      call read_surface_heights(name, '', nx, ny - 1, small, error)
+      call measured_heights(name, '', .true., 'auto', 'periodic', 'none', nx, ny - 1, small, error)
       call report(allocated(error), 'text surface file with too many lines is rejected')
       if (allocated(error)) call report(error%code == code_input .and. index(error%message, "&profile: file = '") > 0, &
          & 'its message names &profile file: ' // error%message)
       open (newunit=unit, file=name, status='old')
       close (unit, status='delete')
-      call read_surface_heights('/nonexistent/surface.npy', '', nx, ny, read_back, error)
+      call measured_heights('/nonexistent/surface.npy', '', .true., 'auto', 'periodic', 'none', nx, ny, read_back, &
+         & error)
       call report(allocated(error), 'missing .npy surface file is an error')
       if (allocated(error)) call report(error%code == code_io, 'its code is code_io: ' // error%message)
    end subroutine check_surface_text_file
+
+   !> Detrending, mirroring and resampling of measured heights against closed forms.
+   subroutine check_measured()
+      real(wp), allocatable :: height(:, :), expected(:, :), resampled(:, :)
+      type(error_type), allocatable :: error
+      integer :: ix, iy, sizes(2, 3), k
+
+      ! a plane and a quadric in physical coordinates go to zero (rounding)
+      allocate (height(7, 5))
+      do iy = 1, 5
+         do ix = 1, 7
+            height(ix, iy) = 3.0_wp + 0.2_wp*ix - 0.7_wp*iy
+         end do
+      end do
+      call detrend_heights(height, 'plane')
+      call report(maxval(abs(height)) < 1.0e-13_wp, 'detrend plane removes a plane', maxval(abs(height)))
+      do iy = 1, 5
+         do ix = 1, 7
+            height(ix, iy) = 1.0_wp + 0.2_wp*ix - 0.7_wp*iy + 0.05_wp*ix**2 - 0.1_wp*iy**2 + 0.03_wp*ix*iy
+         end do
+      end do
+      call detrend_heights(height, 'curvature')
+      call report(maxval(abs(height)) < 1.0e-12_wp, 'detrend curvature removes a quadric', maxval(abs(height)))
+
+      ! mirror: (mx, my) -> (2 mx, 2 my), h(2m-1-j) = h(j)
+      height = reshape([(real(ix, wp), ix=1, 6)], [3, 2])
+      call mirror_heights(height, .true.)
+      call report(all(shape(height) == [6, 4]) .and. all(height(:, 1) == [1, 2, 3, 3, 2, 1]) .and. &
+         & all(height(:, 4) == height(:, 1)) .and. all(height(:, 3) == height(:, 2)), 'mirror of a surface patch')
+
+      ! Fourier resampling of a band-limited surface (modes 2 along x, 1 along y) is exact
+      sizes = reshape([16, 12, 24, 20, 9, 7], [2, 3])
+      do k = 2, 3
+         height = band_limited(sizes(1, 1), sizes(2, 1))
+         expected = band_limited(sizes(1, k), sizes(2, k))
+         allocate (resampled(sizes(1, k), sizes(2, k)))
+         call resample_heights(height, resampled, error)
+         call report(.not. allocated(error) .and. maxval(abs(resampled - expected)) < 1.0e-13_wp, &
+            & 'Fourier resampling of a band-limited surface ' // trim(adjustl(to_text(sizes(:, k)))), &
+            & maxval(abs(resampled - expected)))
+         deallocate (resampled)
+      end do
+   end subroutine check_measured
+
+   !> A surface of modes (2, 1) and (0, 1) on an nx x ny grid of one period.
+   function band_limited(nx, ny) result(h)
+      integer, intent(in) :: nx, ny
+      real(wp) :: h(nx, ny)
+      integer :: i, j
+      do j = 1, ny
+         do i = 1, nx
+            h(i, j) = 0.3_wp*cos((8*atan(1.0_wp))*(2*(i - 1)/real(nx, wp) + (j - 1)/real(ny, wp)) + 0.4_wp) + &
+               & 0.1_wp*sin((8*atan(1.0_wp))*(j - 1)/real(ny, wp))
+         end do
+      end do
+   end function band_limited
+
+   function to_text(n) result(s)
+      integer, intent(in) :: n(2)
+      character(len=24) :: s
+      write (s, '(i0, " x ", i0)') n
+   end function to_text
 
    subroutine check_make_surface()
       type(scene_type) :: scene

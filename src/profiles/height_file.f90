@@ -1,20 +1,23 @@
-!> Measured surfaces read from a file (&profile kind = 'file' of an areal scene): the
-!> heights of an nx x ny grid, returned as height(nx, ny), x fastest. The format follows
-!> the file name's extension:
+!> Heights read from a file (&profile kind = 'file'): one reader for line profiles and
+!> areal surfaces. It returns the file's array as it is, height(nx, ny) with x fastest and
+!> (nx, ny) the file's own sizes; lc_profiles_measured fits it to the scene's grid. The
+!> format follows the file name's extension:
 !>
-!> - '.h5', '.hdf5': HDF5 file, `dataset` a 2D floating-point dataset of shape [ny, nx] in
-!>   C order (what h5py writes for a numpy array height[ny, nx]; the HDF5 Fortran API
-!>   reports it as (nx, ny));
+!> - '.h5', '.hdf5': HDF5 file, `dataset` a 1D or 2D floating-point dataset; a 2D dataset
+!>   of shape [ny, nx] in C order (what h5py writes for a numpy array height[ny, nx]; the
+!>   HDF5 Fortran API reports it as (nx, ny)), a 1D dataset of n values as (n, 1);
 !> - '.npy': NumPy format 1.0, 2.0 or 3.0 (the header is parsed here), dtype '<f8'
-!>   (little-endian float64), C order, shape (ny, nx);
+!>   (little-endian float64), C order, shape (ny, nx) or (n,);
 !> - anything else: text, ny lines of nx whitespace-separated numbers (one row y = const
-!>   per line, x growing along the line); blank lines and text after '#' are skipped, as
-!>   numpy.loadtxt does.
+!>   per line, x growing along the line, every line as long as the first); blank lines and
+!>   text after '#' are skipped, as numpy.loadtxt does.
 !>
-!> Every height must be finite. Errors name &profile file and the value found, with code
-!> code_io when the file cannot be opened or read and code_input when its content is not
-!> what the scene needs.
-module lc_profiles_surface_file
+!> A line profile is a file of one row or one column: a 1D dataset or array, a 2D one of
+!> shape (1, n) or (n, 1), a text file of one line or of one number per line (what
+!> numpy.savetxt writes for a 1D array). Every height must be finite. Errors name
+!> &profile file and the value found, with code code_io when the file cannot be opened or
+!> read and code_input when its content is not heights.
+module lc_profiles_height_file
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use, intrinsic :: iso_fortran_env, only: int8, int16, int32, iostat_end
    use hdf5, only: hid_t, hsize_t, h5open_f, h5close_f, h5eset_auto_f, h5fopen_f, h5fclose_f, H5F_ACC_RDONLY_F, &
@@ -26,47 +29,59 @@ module lc_profiles_surface_file
    use lc_strings, only: to_string, lower_case
    implicit none (type, external)
    private
-   public :: read_surface_heights
+   public :: read_height_file, named, shape_text
 
    !> The largest rank HDF5 allows (H5S_MAX_RANK).
    integer, parameter :: max_rank = 32
+   !> The most heights a file may hold (more than the largest grid, 2**28 points, so that a
+   !> finer measurement can still be resampled onto it).
+   integer(i8), parameter :: max_heights = 2_i8**30
 
 contains
 
-   !> Heights of an nx x ny surface from `filename` (format from its extension, see the
-   !> module header).
-   subroutine read_surface_heights(filename, dataset, nx, ny, height, error)
+   !> Heights of `filename` (format from its extension, see the module header) as
+   !> height(nx, ny), x fastest, with the file's sizes.
+   subroutine read_height_file(filename, dataset, height, error)
       !> File name (&profile file)
       character(len=*), intent(in) :: filename
       !> Dataset inside an HDF5 file (&profile dataset), e.g. /profile/height
       character(len=*), intent(in) :: dataset
-      !> Grid points along x and y expected
-      integer, intent(in) :: nx, ny
-      !> Heights (L)
-      real(wp), intent(out) :: height(nx, ny)
+      !> Heights (L): (nx, ny) of a surface, (n, 1) of a 1D array
+      real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
       integer :: ix, iy
 
-      height = 0.0_wp
       if (ends_with(filename, '.h5') .or. ends_with(filename, '.hdf5')) then
-         call read_hdf5(filename, dataset, nx, ny, height, error)
+         call read_hdf5(filename, dataset, height, error)
       else if (ends_with(filename, '.npy')) then
-         call read_npy(filename, nx, ny, height, error)
+         call read_npy(filename, height, error)
       else
-         call read_text(filename, nx, ny, height, error)
+         call read_text(filename, height, error)
       end if
-      if (allocated(error)) return
-      do iy = 1, ny
-         do ix = 1, nx
+      if (.not. allocated(error) .and. .not. allocated(height)) &
+         & call fatal_error(error, named(filename) // ': no heights read', code_internal)
+      if (allocated(error)) then
+         if (allocated(height)) deallocate (height)
+         return
+      end if
+      if (size(height) == 0) then
+         call fatal_error(error, named(filename) // ' holds no heights; allowed: one or more rows of heights', &
+            & code_input)
+         deallocate (height)
+         return
+      end if
+      do iy = 1, size(height, 2)
+         do ix = 1, size(height, 1)
             if (.not. ieee_is_finite(height(ix, iy))) then
                call fatal_error(error, named(filename) // ' holds the height ' // to_string(height(ix, iy)) // &
                   & ' at (ix, iy) = (' // to_string(ix - 1) // ', ' // to_string(iy - 1) // &
                   & '), 0-based; allowed: finite heights', code_input)
+               deallocate (height)
                return
             end if
          end do
       end do
-   end subroutine read_surface_heights
+   end subroutine read_height_file
 
    !> "&profile: file = '<filename>'", the start of every message.
    pure function named(filename) result(s)
@@ -83,21 +98,12 @@ contains
       if (n >= len(tail)) ends_with = lower_case(text(n - len(tail) + 1:n)) == tail
    end function ends_with
 
-
-   !> "(ny, nx) = (a, b)", the shape a surface file must have, in C order.
-   pure function expected_shape(nx, ny) result(s)
-      integer, intent(in) :: nx, ny
-      character(len=:), allocatable :: s
-      s = '(ny, nx) = (' // to_string(ny) // ', ' // to_string(nx) // ')'
-   end function expected_shape
-
    ! ---------------------------------------------------------------------------------------
    ! HDF5
 
-   subroutine read_hdf5(filename, dataset, nx, ny, height, error)
+   subroutine read_hdf5(filename, dataset, height, error)
       character(len=*), intent(in) :: filename, dataset
-      integer, intent(in) :: nx, ny
-      real(wp), intent(out) :: height(nx, ny)
+      real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
       integer(hid_t) :: fapl, file, dset, space, dtype
       integer(hsize_t) :: dims(max_rank), maxdims(max_rank)
@@ -122,7 +128,7 @@ contains
          call h5dopen_f(file, dataset, dset, hdferr)
          if (hdferr /= 0) then
             call fatal_error(error, named(filename) // " has no dataset '" // dataset // "' (&profile dataset); " // &
-               & 'allowed: the path of a 2D floating-point dataset in the file', code_input)
+               & 'allowed: the path of a 1D or 2D floating-point dataset in the file', code_input)
          else
             call h5dget_space_f(dset, space, hdferr)
             call h5sget_simple_extent_ndims_f(space, rank, ignore)
@@ -132,7 +138,7 @@ contains
             call h5dget_type_f(dset, dtype, ignore)
             call h5tget_class_f(dtype, class, ignore)
             call h5tclose_f(dtype, ignore)
-            if (class /= H5T_FLOAT_F .or. rank /= 2 .or. dims(1) /= nx .or. dims(2) /= ny) then
+            if (class /= H5T_FLOAT_F .or. rank < 1 .or. rank > 2) then
                ! The Fortran API lists the dimensions fastest first; print them in C order.
                found = '('
                do i = rank, 1, -1
@@ -142,10 +148,11 @@ contains
                found = found // ')'
                if (class /= H5T_FLOAT_F) found = found // ' of numbers that are not floating point'
                call fatal_error(error, named(filename) // ", dataset '" // dataset // "' holds shape " // found // &
-                  & '; allowed: a 2D floating-point dataset of shape ' // expected_shape(nx, ny) // &
-                  & ' (C order, as h5py writes height[ny, nx])', code_input)
+                  & '; allowed: a 1D or 2D floating-point dataset (C order, as h5py writes height[ny, nx])', &
+                  & code_input)
             else
-               dims(1:2) = [integer(hsize_t) :: nx, ny]
+               if (rank == 1) dims(2) = 1
+               allocate (height(dims(1), dims(2)))
                call h5dread_f(dset, H5T_NATIVE_DOUBLE, height, dims(1:2), hdferr)
                if (hdferr /= 0) call fatal_error(error, named(filename) // ": cannot read dataset '" // dataset // "'", &
                   & code_io)
@@ -164,10 +171,9 @@ contains
    ! dict literal: {'descr': '<f8', 'fortran_order': False, 'shape': (ny, nx), }, padded
    ! with spaces and a newline), then the data.
 
-   subroutine read_npy(filename, nx, ny, height, error)
+   subroutine read_npy(filename, height, error)
       character(len=*), intent(in) :: filename
-      integer, intent(in) :: nx, ny
-      real(wp), intent(out) :: height(nx, ny)
+      real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
       character(len=6) :: magic
       integer(int8) :: version(2)
@@ -233,20 +239,31 @@ contains
          else if (order /= 'False') then
             call fatal_error(error, named(filename) // ' holds fortran_order = ' // order // '; allowed: False ' // &
                & '(C order: save numpy.ascontiguousarray(height))', code_input)
-         else if (rank /= 2 .or. shape(1) /= ny .or. shape(2) /= nx) then
+         else if (rank < 1 .or. rank > 2) then
             if (rank < 0) then
                found = 'that cannot be parsed'
             else
                found = shape_text(shape(1:rank))
             end if
-            call fatal_error(error, named(filename) // ' holds shape ' // found // '; allowed: ' // &
-               & expected_shape(nx, ny), code_input)
+            call fatal_error(error, named(filename) // ' holds shape ' // found // '; allowed: a 1D or 2D array, ' // &
+               & '(ny, nx) or (n,)', code_input)
          end if
          if (allocated(error)) exit parsing
+         if (product(shape(1:rank)) > max_heights) then
+            call fatal_error(error, named(filename) // ' holds shape ' // shape_text(shape(1:rank)) // &
+               & '; allowed: at most 2**30 heights', code_input)
+            exit parsing
+         end if
+         ! C order (ny, nx) is x fastest: height(nx, ny); a 1D array (n,) is (n, 1)
+         if (rank == 1) then
+            allocate (height(shape(1), 1))
+         else
+            allocate (height(shape(2), shape(1)))
+         end if
          read (unit, pos=data_start, iostat=ios, iomsg=message) height
          if (ios == iostat_end) then
-            call fatal_error(error, named(filename) // ' ends before its ' // to_string(nx*ny) // ' heights; ' // &
-               & 'allowed: a complete .npy file of shape ' // expected_shape(nx, ny), code_input)
+            call fatal_error(error, named(filename) // ' ends before its ' // to_string(size(height, kind=i8)) // &
+               & ' heights; allowed: a complete .npy file of shape ' // shape_text(shape(1:rank)), code_input)
          else if (ios /= 0) then
             call fatal_error(error, named(filename) // ': cannot read the heights (' // trim(message) // ')', code_io)
          end if
@@ -349,14 +366,15 @@ contains
    ! ---------------------------------------------------------------------------------------
    ! Text
 
-   subroutine read_text(filename, nx, ny, height, error)
+   subroutine read_text(filename, height, error)
       character(len=*), intent(in) :: filename
-      integer, intent(in) :: nx, ny
-      real(wp), intent(out) :: height(nx, ny)
+      real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: line, token, found
+      character(len=:), allocatable :: line, token
       character(len=256) :: message
-      integer :: unit, ios, line_number, rows, count, start, finish, hash
+      real(wp), allocatable :: values(:), grown(:)
+      integer(i8) :: stored
+      integer :: unit, ios, line_number, rows, columns, count, start, finish, hash
       real(wp) :: value
 
       open (newunit=unit, file=filename, status='old', action='read', form='formatted', iostat=ios, iomsg=message)
@@ -365,8 +383,11 @@ contains
             & '); allowed: an existing, readable text file', code_io)
          return
       end if
+      allocate (values(4096))
+      stored = 0
       line_number = 0
       rows = 0
+      columns = 0
       lines: do
          call read_line(unit, line, ios)
          if (ios == iostat_end) exit lines
@@ -380,11 +401,6 @@ contains
          line = tabs_to_spaces(line)
          if (len_trim(line) == 0) cycle lines
          rows = rows + 1
-         if (rows > ny) then
-            call fatal_error(error, named(filename) // ' holds more than ny = ' // to_string(ny) // &
-               & ' lines of numbers; allowed: ny lines of nx numbers, ' // expected_shape(nx, ny), code_input)
-            exit lines
-         end if
          count = 0
          finish = 0
          tokens: do
@@ -394,7 +410,6 @@ contains
             if (finish < start) finish = len(line)
             token = line(start:finish)
             count = count + 1
-            if (count > nx) exit tokens
             ! list-directed input would take ',', '/' and 'r*' as separators and repeats
             ios = 1
             if (scan(token, ",/*;'""()") == 0) read (token, *, iostat=ios) value
@@ -403,24 +418,31 @@ contains
                   & "' is not a number; allowed: whitespace-separated numbers", code_input)
                exit lines
             end if
-            height(count, rows) = value
-         end do tokens
-         if (count /= nx) then
-            if (count > nx) then
-               found = 'more than ' // to_string(nx)
-            else
-               found = to_string(count)
+            if (stored == size(values, kind=i8)) then
+               if (stored >= max_heights) then
+                  call fatal_error(error, named(filename) // ' holds more than 2**30 heights; allowed: at most ' // &
+                     & '2**30', code_input)
+                  exit lines
+               end if
+               allocate (grown(2*stored))
+               grown(1:stored) = values
+               call move_alloc(grown, values)
             end if
-            call fatal_error(error, named(filename) // ', line ' // to_string(line_number) // ' holds ' // found // &
-               & ' numbers; allowed: nx = ' // to_string(nx) // ' per line, ' // expected_shape(nx, ny), code_input)
+            stored = stored + 1
+            values(stored) = value
+         end do tokens
+         if (rows == 1) columns = count
+         if (count /= columns) then
+            call fatal_error(error, named(filename) // ', line ' // to_string(line_number) // ' holds ' // &
+               & to_string(count) // ' numbers; allowed: ' // to_string(columns) // ' per line, as on the first ' // &
+               & 'line of numbers (ny lines of nx numbers)', code_input)
             exit lines
          end if
       end do lines
       close (unit)
-      if (.not. allocated(error) .and. rows < ny) then
-         call fatal_error(error, named(filename) // ' holds ' // to_string(rows) // ' lines of numbers; allowed: ny = ' // &
-            & to_string(ny) // ' lines of nx = ' // to_string(nx) // ' numbers, ' // expected_shape(nx, ny), code_input)
-      end if
+      if (allocated(error)) return
+      ! one row y = const per line: x fastest, as stored
+      height = reshape(values(1:stored), [columns, rows])
    end subroutine read_text
 
    !> One whole line of a formatted file, of any length.
@@ -451,4 +473,4 @@ contains
          if (s(i:i) == achar(9) .or. s(i:i) == achar(13)) s(i:i) = ' '
       end do
    end function tabs_to_spaces
-end module lc_profiles_surface_file
+end module lc_profiles_height_file
