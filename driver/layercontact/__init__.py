@@ -22,7 +22,7 @@ from .api import (
     surface_stress,
     surface_tensor,
 )
-from .leakage import LeakageResult, reynolds_leakage
+from .leakage import CoreLeakage, LeakageResult, core_leakage, reynolds_leakage
 from .materials import Prony, StandardLinearSolid, creep_compliance
 from .native import BUILD
 from .profiles import (
@@ -39,6 +39,7 @@ from .sweep import read_summary, sweep
 __all__ = [
     "ArealResult",
     "BUILD",
+    "CoreLeakage",
     "Prony",
     "StandardLinearSolid",
     "creep_compliance",
@@ -47,6 +48,7 @@ __all__ = [
     "LineResult",
     "check_scene_file",
     "choose_resolution",
+    "core_leakage",
     "layer_multipliers",
     "layer_multipliers_lapack",
     "load_profile",

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .leakage import CoreLeakage
 from .native import core as _core
 
 # The library's "not given" (lc_scene's not_set): a value nobody types.
@@ -363,6 +364,9 @@ class ArealResult:
     max_principal_y: float = float("nan")
     a_over_a0: float | None = None
     companion: "ArealResult | None" = field(default=None, repr=False)
+    #: the Reynolds leakage of the gap computed by the run (``&output leakage = .true.``):
+    #: :class:`layercontact.leakage.CoreLeakage` with ``k_eff_x``, ``k_eff_y``, ...; None otherwise
+    leakage: "CoreLeakage | None" = None
 
     @property
     def n_patches(self) -> int:
@@ -562,6 +566,7 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             stress_xx=fields.get("stress_xx"), stress_yy=fields.get("stress_yy"), stress_xy=fields.get("stress_xy"),
             height=_profile(f), period=(lx, ly), friction=float(r["friction"]), patches=patches,
             residual_history=base["convergence/residual"][()],
+            leakage=CoreLeakage.from_attributes(base["leakage"].attrs) if "leakage" in base else None,
             a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values)
 
     with h5py.File(filename, "r") as f:
