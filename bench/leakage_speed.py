@@ -13,10 +13,9 @@ default call (AMG + CG, tol 1e-6 on k_eff) and the error of its k_eff against a 
 same systems, the sparse direct solver and pyamg's stock smoothed aggregation
 (``smoothed_aggregation_solver`` defaults) under the same CG. --core adds the compiled
 core's leakage (what ``&output leakage`` computes: CG with hypre's BoomerAMG, both
-directions) against the Python solver on both directions of the same gap, with
---pfmg also the core's CG with hypre's PFMG.
+directions) against the Python solver on both directions of the same gap.
 
-    .venv/bin/python bench/leakage_speed.py [--sizes 512 1024 2048] [--solve] [--compare] [--core [--pfmg]]
+    .venv/bin/python bench/leakage_speed.py [--sizes 512 1024 2048] [--solve] [--compare] [--core]
 
 The stock pyamg comparison calls threaded BLAS (its coarse ``pinv``), which is slow when
 the cores are shared; OPENBLAS_NUM_THREADS=1 makes the comparison fairer on a busy machine.
@@ -78,7 +77,6 @@ def main() -> None:
     parser.add_argument("--tol", type=float, default=1e-6)
     parser.add_argument("--compare", action="store_true", help="also the direct solver and stock pyamg")
     parser.add_argument("--core", action="store_true", help="the core's leakage (both directions) against Python's")
-    parser.add_argument("--pfmg", action="store_true", help="with --core: also the core's CG with hypre's PFMG")
     args = parser.parse_args()
 
     source = "elastic half-space solve" if args.solve else f"bearing-area cut at {args.contact_fraction}"
@@ -98,7 +96,7 @@ def main() -> None:
             else synthetic_gap(n, args.contact_fraction, args.seed)
         )
         if args.core:
-            core_rows += core_against_python(n, gap, contact, args.tol, args.pfmg)
+            core_rows += core_against_python(n, gap, contact, args.tol)
         res, wall, cpu = timed(lc.reynolds_leakage, gap, contact=contact, method="amg", tol=args.tol)
         if not res.percolating:
             print(f"| {n} | {1 - res.fluid_fraction:.3f} | 0 | 0 | - | {wall:.2f} | {cpu:.2f} | 0 | - | - |")
@@ -136,7 +134,7 @@ def main() -> None:
         print("\n".join(core_rows))
 
 
-def core_against_python(n, gap, contact, tol, pfmg):
+def core_against_python(n, gap, contact, tol):
     """Rows of the core's leakage (x and y in one call) and of the Python solver (one call
     per direction) on the same gap."""
     rows = []
@@ -151,18 +149,17 @@ def core_against_python(n, gap, contact, tol, pfmg):
         f"{python['x'].iterations}, {python['y'].iterations} | {wall_python:.2f} | "
         f"{python['x'].k_eff:.6e} | {python['y'].k_eff:.6e} | - |"
     )
-    for preconditioner in ("boomeramg", "pfmg") if pfmg else ("boomeramg",):
-        core, wall, _ = timed(lc.core_leakage, gap, contact=contact, tol=tol, preconditioner=preconditioner)
-        difference = [
-            (k - python[d].k_eff) / python[d].k_eff if python[d].k_eff > 0 else k
-            for d, k in (("x", core.k_eff_x), ("y", core.k_eff_y))
-        ]
-        note = "" if core.converged else " (not converged)"
-        rows.append(
-            f"| {n} | core: {core.solver}{note} | {core.unknowns_x}, {core.unknowns_y} | "
-            f"{core.iterations_x}, {core.iterations_y} | {wall:.2f} | {core.k_eff_x:.6e} | {core.k_eff_y:.6e} | "
-            f"{difference[0]:.1e}, {difference[1]:.1e} |"
-        )
+    core, wall, _ = timed(lc.core_leakage, gap, contact=contact, tol=tol)
+    difference = [
+        (k - python[d].k_eff) / python[d].k_eff if python[d].k_eff > 0 else k
+        for d, k in (("x", core.k_eff_x), ("y", core.k_eff_y))
+    ]
+    note = "" if core.converged else " (not converged)"
+    rows.append(
+        f"| {n} | core: {core.solver}{note} | {core.unknowns_x}, {core.unknowns_y} | "
+        f"{core.iterations_x}, {core.iterations_y} | {wall:.2f} | {core.k_eff_x:.6e} | {core.k_eff_y:.6e} | "
+        f"{difference[0]:.1e}, {difference[1]:.1e} |"
+    )
     return rows
 
 

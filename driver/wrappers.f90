@@ -472,16 +472,14 @@ subroutine py_surface_stress(n, p, nx, period, period_y, thickness, young, poiss
 end subroutine py_surface_stress
 
 !> Reynolds leakage of a gap (nx*ny, x fastest) by the core: k_eff along x and y and the
-!> diagnostics (lc_leakage_reynolds). closed(j) /= 0 marks contact; preconditioner 1 =
-!> BoomerAMG, 2 = PFMG. values = [k_eff_x, k_eff_y, connected_fraction_x, connected_fraction_y,
+!> diagnostics (lc_leakage_reynolds). closed(j) /= 0 marks contact. values = [k_eff_x, k_eff_y, connected_fraction_x, connected_fraction_y,
 !> fluid_fraction, residual_x, residual_y, wall_time]; counts = [percolating_x, percolating_y,
 !> iterations_x, iterations_y, unknowns_x, unknowns_y, converged_x, converged_y].
-subroutine py_reynolds_leakage(n, gap, closed, nx, lx, ly, tol, max_iter, preconditioner, values, counts, &
-      & stat, errmsg)
+subroutine py_reynolds_leakage(n, gap, closed, nx, lx, ly, tol, max_iter, values, counts, stat, errmsg)
    use lc_errors, only: error_type
    use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
    implicit none (type, external)
-   integer, intent(in) :: n, nx, max_iter, preconditioner
+   integer, intent(in) :: n, nx, max_iter
    real(8), intent(in) :: gap(n), lx, ly, tol
    integer, intent(in) :: closed(n)
    real(8), intent(out) :: values(8)
@@ -495,7 +493,7 @@ subroutine py_reynolds_leakage(n, gap, closed, nx, lx, ly, tol, max_iter, precon
    errmsg = ''
    values = 0
    counts = 0
-   call reynolds_leakage(gap, closed /= 0, nx, n/nx, lx, ly, tol, max_iter, preconditioner, res, error)
+   call reynolds_leakage(gap, closed /= 0, nx, n/nx, lx, ly, tol, max_iter, res, error)
    if (allocated(error)) then
       stat = error%code
       errmsg = error%message

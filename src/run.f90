@@ -10,7 +10,7 @@ module lc_run
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_scene, only: scene_type, not_set, grid_of
    use lc_grid, only: grid_type
-   use lc_leakage_reynolds, only: reynolds_leakage, preconditioner_boomeramg
+   use lc_leakage_reynolds, only: reynolds_leakage
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
@@ -120,7 +120,7 @@ contains
       grid = grid_of(scene)
       allocate (result%leakage)
       call reynolds_leakage(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
-         & scene%leakage_tol, leakage_max_iter, preconditioner_boomeramg, result%leakage, error)
+         & scene%leakage_tol, leakage_max_iter, result%leakage, error)
    end subroutine leakage_of
 
    !> The largest |dw/dx| of the surface displacement along the sliding direction.

@@ -642,11 +642,6 @@ class CoreLeakage:
         return cls(**values)
 
 
-# Preconditioners of the core's CG (lc_leakage_reynolds): BoomerAMG is the one runs use;
-# PFMG (geometric, on the whole grid) is kept for the measurements of bench/leakage_speed.py.
-_CORE_PRECONDITIONERS = {"boomeramg": 1, "pfmg": 2}
-
-
 def core_leakage(
     gap,
     period=1.0,
@@ -654,7 +649,6 @@ def core_leakage(
     contact=None,
     tol: float = 1e-6,
     max_iter: int = 500,
-    preconditioner: str = "boomeramg",
 ) -> CoreLeakage:
     """The Reynolds leakage along x and along y of ``gap`` by the compiled core, as a run
     with ``&output leakage = .true.`` computes it (:class:`CoreLeakage`).
@@ -671,9 +665,6 @@ def core_leakage(
         Relative accuracy of ``k_eff`` at which CG stops (energy-error estimate).
     max_iter : int
         Largest number of CG iterations per direction.
-    preconditioner : {"boomeramg", "pfmg"}
-        hypre's BoomerAMG on the flow-carrying cells (what runs use) or PFMG on the whole
-        grid (not robust near contact: docs/decisions/006-leakage-in-the-core.md).
     """
     from .native import core
 
@@ -685,8 +676,6 @@ def core_leakage(
     lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else tuple(float(p) for p in period)
     if not (lx > 0 and ly > 0 and np.isfinite(lx) and np.isfinite(ly)):
         raise ValueError(f"period must be positive and finite; got {(lx, ly)}")
-    if preconditioner not in _CORE_PRECONDITIONERS:
-        raise ValueError(f"preconditioner must be 'boomeramg' or 'pfmg'; got {preconditioner!r}")
     if not (1e-14 <= tol <= 1e-2) or max_iter < 1:
         raise ValueError("tol must be in [1e-14, 1e-2] and max_iter >= 1")
     closed = np.zeros(g.shape, dtype=np.int32) if contact is None else np.asarray(contact, dtype=np.int32)
@@ -694,7 +683,7 @@ def core_leakage(
         raise ValueError(f"contact has shape {closed.shape}, the gap {g.shape}")
     values, counts, stat, errmsg = core.py_reynolds_leakage(
         np.ascontiguousarray(g.ravel()), np.ascontiguousarray(closed.ravel()), g.shape[1], lx, ly, tol,
-        max_iter, _CORE_PRECONDITIONERS[preconditioner],
+        max_iter,
     )
     if stat != 0:
         raise RuntimeError(errmsg.decode().strip() if isinstance(errmsg, bytes) else str(errmsg).strip())
@@ -707,6 +696,6 @@ def core_leakage(
         iterations_x=int(counts[2]), iterations_y=int(counts[3]),
         residual_x=float(values[5]), residual_y=float(values[6]),
         converged=bool(counts[6] and counts[7]), tol=tol,
-        solver="cg + hypre " + ("BoomerAMG" if preconditioner == "boomeramg" else "PFMG"),
+        solver="cg + hypre BoomerAMG",
         wall_time=float(values[7]),
     )

@@ -15,8 +15,8 @@
 !> positive terms that stays accurate when k_eff is 1e-12 of <g^3> near percolation.
 !>
 !> Linear solver: conjugate gradients preconditioned by one V-cycle of hypre's BoomerAMG on
-!> the free cells (or PFMG on the whole grid; docs/decisions/006-leakage-in-the-core.md has
-!> the measurements), stopped on the energy error of phi as in Python: the decrease of the
+!> the free cells (chosen by measurement: docs/decisions/006-leakage-in-the-core.md),
+!> stopped on the energy error of phi as in Python: the decrease of the
 !> energy over the last five iterations (Strakos and Tichy's lower bound of the error) below
 !> tol times the dissipation, so tol is the relative accuracy of k_eff.
 module lc_leakage_reynolds
@@ -26,10 +26,6 @@ module lc_leakage_reynolds
    implicit none (type, external)
    private
    public :: leakage_flow, leakage_result, reynolds_leakage
-   public :: preconditioner_boomeramg, preconditioner_pfmg
-
-   integer, parameter :: preconditioner_boomeramg = 1
-   integer, parameter :: preconditioner_pfmg = 2
    !> Default contact threshold relative to the largest gap: a converged contact solve leaves
    !> residual gaps of about 1e-8 of the largest gap in contact, and a cell at 1e-6 of it
    !> conducts 1e-18 of the largest cell, far below any solver tolerance.
@@ -71,11 +67,6 @@ module lc_leakage_reynolds
          real(c_double), intent(in) :: value(*)
          real(c_double), value :: strength
       end function lc_hypre_setup_boomeramg
-      integer(c_int) function lc_hypre_setup_pfmg(nx, ny, stencil_values) bind(C)
-         import :: c_int, c_double
-         integer(c_int), value :: nx, ny
-         real(c_double), intent(in) :: stencil_values(*)
-      end function lc_hypre_setup_pfmg
       integer(c_int) function lc_hypre_apply(r, z) bind(C)
          import :: c_int, c_double
          real(c_double), intent(in) :: r(*)
@@ -89,10 +80,10 @@ contains
 
    !> k_eff along x and y of the gap g (nx*ny, x fastest) of the lx x ly cell. Cells with
    !> closed(j) or g <= 1e-6 max(g) are in contact. tol: relative accuracy of k_eff.
-   subroutine reynolds_leakage(g, closed, nx, ny, lx, ly, tol, max_iter, preconditioner, result, error)
+   subroutine reynolds_leakage(g, closed, nx, ny, lx, ly, tol, max_iter, result, error)
       real(wp), intent(in) :: g(:)
       logical, intent(in) :: closed(:)
-      integer, intent(in) :: nx, ny, max_iter, preconditioner
+      integer, intent(in) :: nx, ny, max_iter
       real(wp), intent(in) :: lx, ly, tol
       type(leakage_result), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
@@ -106,7 +97,7 @@ contains
 
       call system_clock(start, rate)
       result%tol = tol
-      result%solver = merge('cg + hypre BoomerAMG', 'cg + hypre PFMG     ', preconditioner == preconditioner_boomeramg)
+      result%solver = 'cg + hypre BoomerAMG'
       hx = lx/nx
       hy = ly/ny
       threshold = max(contact_threshold_relative*max(maxval(g), 0.0_wp), smallest_gap)
@@ -141,7 +132,7 @@ contains
          flow%connected_fraction = real(count(active), wp)/size(g)
          if (.not. flow%percolating) return
          call flow_solve(direction, active, cluster, east, north, nx, ny, hx, hy, tol, max_iter, &
-            & preconditioner, prepared, flow, error)
+            & prepared, flow, error)
       end subroutine solve_direction
    end subroutine reynolds_leakage
 
@@ -232,8 +223,8 @@ contains
 
    !> Solve for phi along `direction` (1: x, 2: y) on the `active` cells and set k_eff.
    subroutine flow_solve(direction, active, cluster, east, north, nx, ny, hx, hy, tol, max_iter, &
-         & preconditioner, prepared, flow, error)
-      integer, intent(in) :: direction, nx, ny, max_iter, preconditioner
+         & prepared, flow, error)
+      integer, intent(in) :: direction, nx, ny, max_iter
       logical, intent(in) :: active(:)
       !> a preconditioner of this matrix is set up (the other direction's, same cells)
       logical, intent(inout) :: prepared
@@ -241,10 +232,12 @@ contains
       real(wp), intent(in) :: east(:), north(:), hx, hy, tol
       type(leakage_flow), intent(inout) :: flow
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: we(:), wn(:), b(:), phi(:), r(:), z(:), p(:), q(:)
-      real(wp), allocatable :: decreases(:)
+      real(wp), allocatable :: we(:), wn(:), b(:), phi(:), r(:), z(:), p(:), q(:), decreases(:)
+      real(wp), allocatable :: phi_grid(:)
       logical, allocatable :: free(:), pinned_cluster(:)
       integer, allocatable :: number(:), free_cells(:)
+      integer(c_int), allocatable :: row_start(:), column(:)
+      real(c_double), allocatable :: value(:)
       real(wp) :: jump_x, jump_y, rho, rho_next, alpha, bound, b_norm
       integer :: k, n_cells, n_free, iteration, status
 
@@ -269,7 +262,7 @@ contains
       end do
       n_free = count(free)
       flow%unknowns = n_free
-      allocate (number(n_cells), free_cells(n_free))
+      allocate (number(n_cells), free_cells(n_free), phi_grid(n_cells))
       number = 0
       n_free = 0
       do k = 1, n_cells
@@ -280,28 +273,28 @@ contains
          end if
       end do
       ! b = -D^T W j: the jump on the faces along the flow
-      b = rhs(we, wn, jump_x, jump_y)
-      where (.not. free) b = 0.0_wp
-      allocate (phi(n_cells))
+      b = rhs_on_free_cells()
+      allocate (phi(n_free))
       phi = 0.0_wp
       b_norm = sqrt(sum(b*b))
       if (n_free == 0 .or. b_norm == 0.0_wp) then
          flow%k_eff = dissipation(phi)/n_cells
          return
       end if
+      call assemble()
       if (.not. prepared) then
-         status = setup()
-         prepared = status == 0
+         status = lc_hypre_setup_boomeramg(int(n_free, c_int), row_start, column, value, amg_strength)
          if (status /= 0) then
-            call fatal_error(error, 'leakage: the hypre preconditioner failed to set up (status ' // &
+            call fatal_error(error, 'leakage: hypre''s BoomerAMG failed to set up (status ' // &
                & char(48 + min(status, 9)) // ')', code_internal)
             return
          end if
+         prepared = .true.
       end if
 
-      allocate (r(n_cells), z(n_cells), q(n_cells), decreases(max_iter))
+      allocate (r(n_free), z(n_free), q(n_free), decreases(max_iter))
       r = b
-      call precondition(r, z)
+      status = lc_hypre_apply(r, z)
       p = z
       rho = sum(r*z)
       bound = dissipation(phi)
@@ -328,7 +321,7 @@ contains
                end if
             end if
          end if
-         call precondition(r, z)
+         status = lc_hypre_apply(r, z)
          rho_next = sum(r*z)
          p = z + (rho_next/rho)*p
          rho = rho_next
@@ -339,139 +332,80 @@ contains
 
    contains
 
-      !> The right-hand side: the divergence of the face fluxes of the imposed jump.
-      pure function rhs(we, wn, jump_x, jump_y) result(b)
-         real(wp), intent(in) :: we(:), wn(:), jump_x, jump_y
-         real(wp) :: b(size(we))
-         integer :: i, j, k
-         do j = 1, ny
-            do i = 1, nx
-               k = i + (j - 1)*nx
-               b(k) = jump_x*(we(modulo(i - 2, nx) + 1 + (j - 1)*nx) - we(k)) &
-                  & + jump_y*(wn(i + modulo(j - 2, ny)*nx) - wn(k))
+      !> The right-hand side on the free cells: the divergence of the face fluxes of the
+      !> imposed jump.
+      function rhs_on_free_cells() result(b)
+         real(wp) :: b(n_free)
+         integer :: i, j, k, m
+         do m = 1, n_free
+            k = free_cells(m)
+            i = modulo(k - 1, nx) + 1
+            j = (k - 1)/nx + 1
+            b(m) = jump_x*(we(modulo(i - 2, nx) + 1 + (j - 1)*nx) - we(k)) &
+               & + jump_y*(wn(i + modulo(j - 2, ny)*nx) - wn(k))
+         end do
+      end function rhs_on_free_cells
+
+      !> The matrix on the free cells in CSR form (zero-based, as hypre takes it): rows of the
+      !> diagonal and the open faces to free neighbours; a face to a pinned cell only adds
+      !> to the diagonal.
+      subroutine assemble()
+         integer :: i, j, k, m, f, nnz, neighbours(4)
+         real(wp) :: weights(4)
+         allocate (row_start(n_free + 1), column(5*n_free), value(5*n_free))
+         nnz = 0
+         do m = 1, n_free
+            k = free_cells(m)
+            i = modulo(k - 1, nx) + 1
+            j = (k - 1)/nx + 1
+            neighbours = [modulo(i, nx) + 1 + (j - 1)*nx, modulo(i - 2, nx) + 1 + (j - 1)*nx, &
+               & i + modulo(j, ny)*nx, i + modulo(j - 2, ny)*nx]
+            weights = [we(k), we(neighbours(2)), wn(k), wn(neighbours(4))]
+            row_start(m) = nnz
+            nnz = nnz + 1
+            column(nnz) = m - 1
+            value(nnz) = sum(weights)
+            do f = 1, 4
+               if (weights(f) /= 0.0_wp .and. free(neighbours(f))) then
+                  nnz = nnz + 1
+                  column(nnz) = number(neighbours(f)) - 1
+                  value(nnz) = -weights(f)
+               end if
             end do
          end do
-      end function rhs
+         row_start(n_free + 1) = nnz
+      end subroutine assemble
 
-      !> q = A v on the free cells (v zero elsewhere), zero elsewhere.
+      !> q = A v on the free cells.
       subroutine apply_matrix(v, q)
          real(wp), intent(in) :: v(:)
          real(wp), intent(out) :: q(:)
-         integer :: i, j, k, kw, ke, ks, kn
-         do j = 1, ny
-            do i = 1, nx
-               k = i + (j - 1)*nx
-               if (.not. free(k)) then
-                  q(k) = 0.0_wp
-                  cycle
-               end if
-               ke = modulo(i, nx) + 1 + (j - 1)*nx
-               kw = modulo(i - 2, nx) + 1 + (j - 1)*nx
-               kn = i + modulo(j, ny)*nx
-               ks = i + modulo(j - 2, ny)*nx
-               q(k) = we(k)*(v(k) - v(ke)) + we(kw)*(v(k) - v(kw)) + wn(k)*(v(k) - v(kn)) + wn(ks)*(v(k) - v(ks))
+         integer :: m, e
+         do m = 1, n_free
+            q(m) = 0.0_wp
+            do e = row_start(m) + 1, row_start(m + 1)
+               q(m) = q(m) + value(e)*v(column(e) + 1)
             end do
          end do
       end subroutine apply_matrix
 
-      !> sum_faces w (phi - phi_next + jump)^2: n_cells k_eff at the solution.
-      pure real(wp) function dissipation(v) result(total)
+      !> sum_faces w (phi - phi_next + jump)^2: n_cells k_eff at the solution (phi zero at the
+      !> pinned and inactive cells).
+      real(wp) function dissipation(v) result(total)
          real(wp), intent(in) :: v(:)
          integer :: i, j, k
          real(wp) :: dx, dy
+         phi_grid = 0.0_wp
+         phi_grid(free_cells) = v
          total = 0.0_wp
          do j = 1, ny
             do i = 1, nx
                k = i + (j - 1)*nx
-               dx = v(k) - v(modulo(i, nx) + 1 + (j - 1)*nx) + jump_x
-               dy = v(k) - v(i + modulo(j, ny)*nx) + jump_y
+               dx = phi_grid(k) - phi_grid(modulo(i, nx) + 1 + (j - 1)*nx) + jump_x
+               dy = phi_grid(k) - phi_grid(i + modulo(j, ny)*nx) + jump_y
                total = total + we(k)*dx*dx + wn(k)*dy*dy
             end do
          end do
       end function dissipation
-
-      !> z = M^-1 r (zero outside the free cells).
-      subroutine precondition(r, z)
-         real(wp), intent(in) :: r(:)
-         real(wp), intent(out) :: z(:)
-         real(wp), allocatable :: compact(:), compact_z(:)
-         select case (preconditioner)
-         case (preconditioner_boomeramg)
-            compact = r(free_cells)
-            allocate (compact_z(n_free))
-            status = lc_hypre_apply(compact, compact_z)
-            z = 0.0_wp
-            z(free_cells) = compact_z
-         case default
-            status = lc_hypre_apply(r, z)
-            where (.not. free) z = 0.0_wp
-         end select
-      end subroutine precondition
-
-      !> Set up the preconditioner of the matrix on the free cells.
-      integer function setup() result(status)
-         integer(c_int), allocatable :: row_start(:), column(:)
-         real(c_double), allocatable :: value(:), stencil(:, :)
-         integer :: i, j, k, m, nnz, neighbours(4)
-         real(wp) :: weights(4)
-         select case (preconditioner)
-         case (preconditioner_boomeramg)
-            allocate (row_start(n_free + 1), column(5*n_free), value(5*n_free))
-            nnz = 0
-            do m = 1, n_free
-               k = free_cells(m)
-               i = modulo(k - 1, nx) + 1
-               j = (k - 1)/nx + 1
-               call stencil_of(i, j, neighbours, weights)
-               row_start(m) = nnz
-               nnz = nnz + 1
-               column(nnz) = m - 1
-               value(nnz) = sum(weights)
-               do i = 1, 4
-                  ! a face to a pinned cell only adds to the diagonal
-                  if (weights(i) /= 0.0_wp .and. free(neighbours(i))) then
-                     nnz = nnz + 1
-                     column(nnz) = number(neighbours(i)) - 1
-                     value(nnz) = -weights(i)
-                  end if
-               end do
-            end do
-            row_start(n_free + 1) = nnz
-            status = lc_hypre_setup_boomeramg(int(n_free, c_int), row_start, column, value, amg_strength)
-         case default
-            ! the whole grid: identity rows outside the free cells, no coupling to them
-            allocate (stencil(5, n_cells))
-            do j = 1, ny
-               do i = 1, nx
-                  k = i + (j - 1)*nx
-                  stencil(:, k) = [1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-                  if (.not. free(k)) cycle
-                  ! order of lc_hypre_setup_pfmg: centre, west, east, south, north
-                  call stencil_of(i, j, neighbours, weights)
-                  ! PFMG interpolates with weights a_w/(a_c + a_s + a_n) (coarsening along x): zero
-                  ! over zero at a cell whose faces along x are closed. A relative shift of the
-                  ! preconditioner's diagonal keeps them finite (zero) and changes M by 1e-10.
-                  stencil(1, k) = sum(weights)*(1.0_wp + 1.0e-10_wp)
-                  stencil(2:5, k) = [merge(-weights(2), 0.0_wp, free(neighbours(2))), &
-                     & merge(-weights(1), 0.0_wp, free(neighbours(1))), &
-                     & merge(-weights(4), 0.0_wp, free(neighbours(4))), &
-                     & merge(-weights(3), 0.0_wp, free(neighbours(3)))]
-               end do
-            end do
-            status = lc_hypre_setup_pfmg(int(nx, c_int), int(ny, c_int), stencil)
-         end select
-      end function setup
-
-      !> East, west, north, south neighbours of cell (i, j) and the weights of their faces.
-      pure subroutine stencil_of(i, j, neighbours, weights)
-         integer, intent(in) :: i, j
-         integer, intent(out) :: neighbours(4)
-         real(wp), intent(out) :: weights(4)
-         integer :: k
-         k = i + (j - 1)*nx
-         neighbours = [modulo(i, nx) + 1 + (j - 1)*nx, modulo(i - 2, nx) + 1 + (j - 1)*nx, &
-            & i + modulo(j, ny)*nx, i + modulo(j - 2, ny)*nx]
-         weights = [we(k), we(neighbours(2)), wn(k), wn(neighbours(4))]
-      end subroutine stencil_of
    end subroutine flow_solve
 end module lc_leakage_reynolds
