@@ -317,7 +317,11 @@ class ArealResult:
     ``stress_xx``, at (``max_tension_x``, ``max_tension_y``), ``max_tension_offset`` its
     distance along x from the trailing edge of the nearest contact on its row (negative:
     behind it); ``max_principal_stress`` the largest principal surface stress and where it
-    sits. The solver statistics are those of :class:`LineResult`.
+    sits. The solver statistics are those of :class:`LineResult`. ``leakage``: with
+    ``&output leakage = .true.``, the Reynolds leakage of the gap computed by the run
+    (:class:`~layercontact.leakage.CoreLeakage`: ``k_eff_x``, ``k_eff_y`` (L^3),
+    ``percolating_x``, ``percolating_y``, ...; the companion's in ``companion.leakage``),
+    else None.
     """
 
     pressure: np.ndarray
