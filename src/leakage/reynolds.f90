@@ -16,9 +16,9 @@
 !>
 !> Linear solver: conjugate gradients preconditioned by one V-cycle of hypre's BoomerAMG on
 !> the free cells (chosen by measurement: docs/decisions/006-leakage-in-the-core.md),
-!> stopped on the energy error of phi as in Python: the decrease of the
-!> energy over the last five iterations (Strakos and Tichy's lower bound of the error) below
-!> tol times the dissipation, so tol is the relative accuracy of k_eff.
+!> stopped on the energy error of phi as in Python: the decrease of the energy over the last
+!> five iterations (Strakos and Tichy's lower bound of the error) below tol times the
+!> dissipation, so tol is the relative accuracy of k_eff.
 module lc_leakage_reynolds
    use, intrinsic :: iso_c_binding, only: c_int, c_double
    use lc_kinds, only: wp, i8
@@ -35,8 +35,8 @@ module lc_leakage_reynolds
    real(wp), parameter :: smallest_gap = 1.0e-100_wp
    !> Iterations over which the energy decrease estimates the error (as in Python).
    integer, parameter :: cg_delay = 5
-   !> BoomerAMG strength threshold: 0.25 is hypre's default for 2D Laplacians, and faces of
-   !> tiny conductance near contact are weak at any threshold.
+   !> BoomerAMG strength threshold: hypre's default for 2D Laplacians; 0.5 took more CG
+   !> iterations and more time near percolation (docs/decisions/006-leakage-in-the-core.md).
    real(c_double), parameter :: amg_strength = 0.25_c_double
 
    !> The flow along one direction.
