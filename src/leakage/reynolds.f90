@@ -244,6 +244,7 @@ contains
       n_cells = size(active)
       ! weights restricted to the flow-carrying clusters: an open face joins two cells of one
       ! cluster, so these are exactly its faces
+      allocate (we(n_cells), wn(n_cells))
       we = merge(east, 0.0_wp, active)
       wn = merge(north, 0.0_wp, active)
       jump_x = merge(hx, 0.0_wp, direction == 1)
