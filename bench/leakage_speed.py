@@ -11,9 +11,11 @@ Each size reports the flow-carrying unknowns, the CG iterations, wall and CPU se
 default call (AMG + CG, tol 1e-6 on k_eff) and the error of its k_eff against a reference
 (the sparse direct solver up to 1024^2, AMG with tol 1e-13 beyond). --compare adds, on the
 same systems, the sparse direct solver and pyamg's stock smoothed aggregation
-(``smoothed_aggregation_solver`` defaults) under the same CG.
+(``smoothed_aggregation_solver`` defaults) under the same CG. --core adds the compiled
+core's leakage (what ``&output leakage`` computes: CG with hypre's BoomerAMG, both
+directions) against the Python solver on both directions of the same gap.
 
-    .venv/bin/python bench/leakage_speed.py [--sizes 512 1024 2048] [--solve] [--compare]
+    .venv/bin/python bench/leakage_speed.py [--sizes 512 1024 2048] [--solve] [--compare] [--core]
 
 The stock pyamg comparison calls threaded BLAS (its coarse ``pinv``), which is slow when
 the cores are shared; OPENBLAS_NUM_THREADS=1 makes the comparison fairer on a busy machine.
@@ -74,19 +76,27 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--tol", type=float, default=1e-6)
     parser.add_argument("--compare", action="store_true", help="also the direct solver and stock pyamg")
+    parser.add_argument("--core", action="store_true", help="the core's leakage (both directions) against Python's")
     args = parser.parse_args()
 
     source = "elastic half-space solve" if args.solve else f"bearing-area cut at {args.contact_fraction}"
     print(f"gaps: {source}, H = 0.8, cutoff 8 grid steps, seed {args.seed}; tol = {args.tol:g} on k_eff\n")
     print("| n | contact | connected | unknowns | it. | wall s | CPU s | k_eff | rel. error | reference |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    extra = []
+    extra, core_rows = [], []
+    if args.core:
+        # the first call of the process starts MPI (for hypre): timed apart, once
+        stripes = np.tile(1.0 + 0.5 * np.cos(2 * np.pi * np.arange(8) / 8), (8, 1))  # flow across needs a solve
+        _, start_wall, _ = timed(lc.core_leakage, stripes)
+        core_rows.append(f"| - | core: MPI and hypre start (once per process) | - | - | {start_wall:.2f} | - | - | - | - |")
     for n in args.sizes:
         gap, contact = (
             solved_gap(n, args.pressure, args.seed)
             if args.solve
             else synthetic_gap(n, args.contact_fraction, args.seed)
         )
+        if args.core:
+            core_rows += core_against_python(n, gap, contact, args.tol)
         res, wall, cpu = timed(lc.reynolds_leakage, gap, contact=contact, method="amg", tol=args.tol)
         if not res.percolating:
             print(f"| {n} | {1 - res.fluid_fraction:.3f} | 0 | 0 | - | {wall:.2f} | {cpu:.2f} | 0 | - | - |")
@@ -117,6 +127,41 @@ def main() -> None:
         print("\n| n | solver | it. | wall s | CPU s | rel. error |")
         print("|---|---|---|---|---|---|")
         print("\n".join(extra))
+    if core_rows:
+        print("\nBoth directions; rel. difference of k_eff against the Python solver's\n")
+        print("| n | solver | unknowns x, y | it. x, y | wall s | CPU s | k_eff_x | k_eff_y | rel. diff. x, y |")
+        print("|---|---|---|---|---|---|---|---|---|")
+        print("\n".join(core_rows))
+
+
+def core_against_python(n, gap, contact, tol):
+    """Rows of the core's leakage (x and y in one call) and of the Python solver (one call
+    per direction) on the same gap."""
+    rows = []
+    python = {}
+    wall_python = cpu_python = 0.0
+    for direction in ("x", "y"):
+        res, wall, cpu = timed(lc.reynolds_leakage, gap, contact=contact, direction=direction, method="auto", tol=tol)
+        python[direction] = res
+        wall_python += wall
+        cpu_python += cpu
+    rows.append(
+        f"| {n} | Python (pyamg SA + CG) | {python['x'].unknowns}, {python['y'].unknowns} | "
+        f"{python['x'].iterations}, {python['y'].iterations} | {wall_python:.2f} | {cpu_python:.2f} | "
+        f"{python['x'].k_eff:.6e} | {python['y'].k_eff:.6e} | - |"
+    )
+    core, wall, cpu = timed(lc.core_leakage, gap, contact=contact, tol=tol)
+    difference = [
+        (k - python[d].k_eff) / python[d].k_eff if python[d].k_eff > 0 else k
+        for d, k in (("x", core.k_eff_x), ("y", core.k_eff_y))
+    ]
+    note = "" if core.converged else " (not converged)"
+    rows.append(
+        f"| {n} | core: {core.solver}{note} | {core.unknowns_x}, {core.unknowns_y} | "
+        f"{core.iterations_x}, {core.iterations_y} | {wall:.2f} | {cpu:.2f} | {core.k_eff_x:.6e} | {core.k_eff_y:.6e} | "
+        f"{difference[0]:.1e}, {difference[1]:.1e} |"
+    )
+    return rows
 
 
 if __name__ == "__main__":

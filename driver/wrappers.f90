@@ -574,3 +574,37 @@ subroutine py_prepare_heights(n, raw, mx, areal, detrend, boundary, resample, nx
       errmsg = error%message
    end if
 end subroutine py_prepare_heights
+
+!> Reynolds leakage of a gap (nx*ny, x fastest) by the core: k_eff along x and y and the
+!> diagnostics (lc_leakage_reynolds). closed(j) /= 0 marks contact. values = [k_eff_x, k_eff_y, connected_fraction_x, connected_fraction_y,
+!> fluid_fraction, residual_x, residual_y, wall_time]; counts = [percolating_x, percolating_y,
+!> iterations_x, iterations_y, unknowns_x, unknowns_y, converged_x, converged_y].
+subroutine py_reynolds_leakage(n, gap, closed, nx, lx, ly, tol, max_iter, values, counts, stat, errmsg)
+   use lc_errors, only: error_type
+   use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
+   implicit none (type, external)
+   integer, intent(in) :: n, nx, max_iter
+   real(8), intent(in) :: gap(n), lx, ly, tol
+   integer, intent(in) :: closed(n)
+   real(8), intent(out) :: values(8)
+   integer, intent(out) :: counts(8)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   !f2py intent(hide) :: n
+   type(error_type), allocatable :: error
+   type(leakage_result) :: res
+   stat = 0
+   errmsg = ''
+   values = 0
+   counts = 0
+   call reynolds_leakage(gap, closed /= 0, nx, n/nx, lx, ly, tol, max_iter, res, error)
+   if (allocated(error)) then
+      stat = error%code
+      errmsg = error%message
+      return
+   end if
+   values = [res%x%k_eff, res%y%k_eff, res%x%connected_fraction, res%y%connected_fraction, &
+      & res%fluid_fraction, res%x%residual, res%y%residual, res%wall_time]
+   counts = [merge(1, 0, res%x%percolating), merge(1, 0, res%y%percolating), res%x%iterations, &
+      & res%y%iterations, res%x%unknowns, res%y%unknowns, merge(1, 0, res%x%converged), merge(1, 0, res%y%converged)]
+end subroutine py_reynolds_leakage

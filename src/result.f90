@@ -2,6 +2,7 @@
 !> convergence record. Units are the scene's (lengths L, pressures S).
 module lc_result
    use lc_kinds, only: wp
+   use lc_leakage_reynolds, only: leakage_result
    implicit none (type, external)
    private
    public :: contact_result
@@ -74,5 +75,7 @@ module lc_result
       !> the smallest gap that double precision resolves at this load (see solve_on_grid)
       real(wp) :: gap_resolution = 0.0_wp
       real(wp) :: wall_time = 0.0_wp          !< seconds spent in the solver
+      !> areal contacts, with &output leakage: the Reynolds leakage of the gap (lc_leakage_reynolds)
+      type(leakage_result), allocatable :: leakage
    end type contact_result
 end module lc_result

@@ -121,6 +121,9 @@ module lc_scene
       !> write the maps (the profile and the solution fields) to the result file; without
       !> them a result holds the scalars, histograms, spots and patches (sweeps of large grids)
       logical :: fields = .true.
+      !> areal scenes: the Reynolds leakage of the gap (k_eff along x and y, lc_leakage_reynolds)
+      logical :: leakage = .false.
+      real(wp) :: leakage_tol = 1.0e-6_wp !< relative accuracy of k_eff
    end type scene_type
 
 contains
@@ -340,6 +343,11 @@ contains
             call input_error(error, 'solver', 'method', trim(s%method), "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'")
          else if (.not. (s%tol >= 1.0e-14_wp .and. s%tol <= 1.0e-2_wp)) then
             call input_error(error, 'solver', 'tol', to_string(s%tol), '1e-14 <= tol <= 1e-2')
+         else if (scene%leakage .and. .not. is_areal(scene)) then
+            call input_error(error, 'output', 'leakage', '.true.', &
+               & ".false. with geometry = 'line' (the Reynolds leakage needs the gap of an areal contact)")
+         else if (.not. (scene%leakage_tol >= 1.0e-14_wp .and. scene%leakage_tol <= 1.0e-2_wp)) then
+            call input_error(error, 'output', 'leakage_tol', to_string(scene%leakage_tol), '1e-14 <= leakage_tol <= 1e-2')
          else if (scene%gap_bins < 0 .or. scene%gap_bins > 100000) then
             call input_error(error, 'output', 'gap_bins', to_string(scene%gap_bins), '0 <= gap_bins <= 100000')
          else if (s%max_iter < 1 .or. s%max_iter > max_iterations) then

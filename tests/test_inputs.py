@@ -163,6 +163,12 @@ BAD = [
     (f"&material\n model = 'prony'\n prony_file = '{'p' * 600}'\n/\n", "prony_file = 'pppp"),
     (f"&profile\n kind = 'file'\n file = 'x.h5'\n dataset = '/{'d' * 520}'\n/\n", "dataset = '/ddd"),
     (f"&solver\n method = '{'m' * 700}'\n/\n", "method = 'mmm"),
+    # the leakage needs an areal gap (cases that bring their own &output, writing bad.h5)
+    ("&output\n file = 'bad.h5'\n leakage = .true.\n/\n",
+     "&output: leakage = .true. is not allowed; allowed: .false. with geometry = 'line'"),
+    ("&scene\n geometry = 'areal'\n n = 32\n/\n&output\n file = 'bad.h5'\n leakage = .true.\n leakage_tol = 0.5\n/\n",
+     "&output: leakage_tol = 5.00000E-01 is not allowed; allowed: 1e-14 <= leakage_tol <= 1e-2"),
+    ("&output\n file = 'bad.h5'\n leakage = 1\n/\n", "'leakage = 1': leakage takes .true. or .false."),
 ]
 
 
@@ -170,7 +176,8 @@ BAD = [
 def test_bad_input_is_refused_and_writes_nothing(text, message, tmp_path, monkeypatch):
     base = "&loading\n normalised_pressure = 1.0\n/\n" if "&loading" not in text else ""
     nml = tmp_path / "bad.nml"
-    nml.write_text(text + base + "&output\n file = 'bad.h5'\n/\n")
+    output = "" if "file = 'bad.h5'" in text else "&output\n file = 'bad.h5'\n/\n"
+    nml.write_text(text + base + output)
     proc = run_exe(nml, tmp_path)
     assert proc.returncode == 2, proc.stderr
     assert message in proc.stderr

@@ -477,3 +477,30 @@ def test_a_job_array_survives_a_cancelled_task_and_resubmits_only_what_is_missin
     assert not temporary_files(tmp_path)
     with open(out / "slurm/s_002.json") as f:
         assert json.load(f)["job_id"] == second.job_id
+
+
+def test_a_leakage_scene_runs_in_a_slurm_array_task(slurm_cluster, tmp_path, monkeypatch, capsys):
+    # the executable alone on the node computes the leakage (hypre starts MPI by itself, no
+    # mpirun) and the collected summary carries it
+    from test_leakage_core import AREAL
+
+    monkeypatch.setenv("SLURM_CONF", str(slurm_cluster))
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "leak.nml"
+    path.write_text(AREAL + "&output\n leakage = .true.\n/\n&sweep\n directory = 'out/leak'\n"
+                    " normalised_pressure = 0.1, 0.3\n slurm_memory = '500M'\n slurm_time = '5'\n/\n")
+    out = tmp_path / "out/leak"
+    assert main(["sweep", str(path), "--slurm"]) == 0
+    assert "submitted Slurm job" in capsys.readouterr().out
+    wait_for(lambda: sweep_status.sweep_status(out).finished, "the leakage scenes")
+    assert main(["collect", str(out)]) == 0
+    summary = lc.read_summary(out / "leak_summary.h5")
+    assert (summary["error"] == "").all() and (summary["leakage_converged"] == 1).all()
+    assert (summary["slurm_array_job_id"] > 0).all()
+    # each equals the same scene run here
+    for result_file, k in zip(summary["result_file"], summary["leakage_k_eff_x"]):
+        gap_result = lc.read_result(tmp_path / result_file)
+        ref = lc.reynolds_leakage(gap_result.gap, period=gap_result.period, contact=gap_result.pressure > 0,
+                                  method="direct")
+        assert k == pytest.approx(ref.k_eff, rel=2e-6)
+    assert summary["leakage_k_eff_x"][0] > summary["leakage_k_eff_x"][1] > 0

@@ -6,7 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(gfortran libfftw3-dev liblapack-dev libopenblas-dev libhdf5-dev pkg-config)
+# libhypre-dev: the leakage's algebraic multigrid (it brings Open MPI)
+packages=(gfortran libfftw3-dev liblapack-dev libopenblas-dev libhdf5-dev libhypre-dev pkg-config)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -22,7 +22,7 @@ from .api import (
     surface_stress,
     surface_tensor,
 )
-from .leakage import LeakageResult, reynolds_leakage
+from .leakage import CoreLeakage, LeakageResult, core_leakage, reynolds_leakage
 from .materials import Prony, StandardLinearSolid, creep_compliance
 from .native import BUILD
 from .profiles import (
@@ -43,6 +43,7 @@ from .topography import Topography, read_topography, write_height_file
 __all__ = [
     "ArealResult",
     "BUILD",
+    "CoreLeakage",
     "Prony",
     "StandardLinearSolid",
     "creep_compliance",
@@ -51,6 +52,7 @@ __all__ = [
     "LineResult",
     "check_scene_file",
     "choose_resolution",
+    "core_leakage",
     "layer_multipliers",
     "layer_multipliers_lapack",
     "load_profile",

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .leakage import CoreLeakage
 from .native import core as _core
 
 # The library's "not given" (lc_scene's not_set): a value nobody types.
@@ -316,7 +317,11 @@ class ArealResult:
     ``stress_xx``, at (``max_tension_x``, ``max_tension_y``), ``max_tension_offset`` its
     distance along x from the trailing edge of the nearest contact on its row (negative:
     behind it); ``max_principal_stress`` the largest principal surface stress and where it
-    sits. The solver statistics are those of :class:`LineResult`.
+    sits. The solver statistics are those of :class:`LineResult`. ``leakage``: with
+    ``&output leakage = .true.``, the Reynolds leakage of the gap computed by the run
+    (:class:`~layercontact.leakage.CoreLeakage`: ``k_eff_x``, ``k_eff_y`` (L^3),
+    ``percolating_x``, ``percolating_y``, ...; the companion's in ``companion.leakage``),
+    else None.
     """
 
     pressure: np.ndarray
@@ -363,6 +368,9 @@ class ArealResult:
     max_principal_y: float = float("nan")
     a_over_a0: float | None = None
     companion: "ArealResult | None" = field(default=None, repr=False)
+    #: the Reynolds leakage of the gap computed by the run (``&output leakage = .true.``):
+    #: :class:`layercontact.leakage.CoreLeakage` with ``k_eff_x``, ``k_eff_y``, ...; None otherwise
+    leakage: "CoreLeakage | None" = None
 
     @property
     def n_patches(self) -> int:
@@ -562,6 +570,7 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             stress_xx=fields.get("stress_xx"), stress_yy=fields.get("stress_yy"), stress_xy=fields.get("stress_xy"),
             height=_profile(f), period=(lx, ly), friction=float(r["friction"]), patches=patches,
             residual_history=base["convergence/residual"][()],
+            leakage=CoreLeakage.from_attributes(base["leakage"].attrs) if "leakage" in base else None,
             a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values)
 
     with h5py.File(filename, "r") as f:

@@ -467,7 +467,8 @@ _ROOT_COLUMNS = ("layercontact_version", "layercontact_build")
 
 def _result_columns(result_file: Path) -> dict[str, object]:
     """Every scalar attribute of ``/results`` and of ``/companion/results``
-    (``companion_`` prefix) of a result file, the version and build that wrote it, and
+    (``companion_`` prefix) of a result file, of ``/leakage`` (``leakage_``, with the
+    companion's ``companion_leakage_``) where the scene asked for the leakage, the version and build that wrote it, and
     the provenance fields of the run record where the file holds them itself (a result
     file that records its host and Slurm ids is believed over the run record)."""
     import h5py
@@ -476,9 +477,13 @@ def _result_columns(result_file: Path) -> dict[str, object]:
         columns = _scalar_attributes(f["results"].attrs)
         if "companion/results" in f:
             columns.update(_scalar_attributes(f["companion/results"].attrs, "companion_"))
+        # the Reynolds leakage, where the scene asked for it (&output leakage)
+        for group, prefix in (("leakage", "leakage_"), ("companion/leakage", "companion_leakage_")):
+            if group in f:
+                columns.update(_scalar_attributes(f[group].attrs, prefix))
         # (the units of the attributes are a text about them, not a result)
-        columns.pop("units", None)
-        columns.pop("companion_units", None)
+        for prefix in ("", "companion_", "leakage_", "companion_leakage_"):
+            columns.pop(f"{prefix}units", None)
         root = _scalar_attributes(f.attrs)
     columns.update({name: root.get(name) for name in _ROOT_COLUMNS})
     for name in provenance.PROVENANCE_FIELDS:
@@ -720,7 +725,7 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     list of dict
         One row per scene: the swept values, ``scene_file``, ``result_file``, every
         scalar attribute of ``/results`` and of ``/companion/results`` (``companion_``
-        prefix), the provenance (``layercontact_version``, ``layercontact_build``,
+        prefix), of ``/leakage`` (``leakage_`` prefix, with ``&output leakage``), the provenance (``layercontact_version``, ``layercontact_build``,
         ``host``, ``slurm_job_id``, ``slurm_array_job_id``, ``slurm_array_task_id``,
         ``started``, ``run_time``) and ``error`` (empty if the scene ran and converged). A swept value is
         the input value; a result attribute of the same name is not repeated. A scene

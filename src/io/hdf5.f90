@@ -31,6 +31,7 @@ module lc_io_hdf5
    use lc_strings, only: to_string, lower_case
    use lc_scene, only: scene_type, is_areal
    use lc_result, only: contact_result
+   use lc_leakage_reynolds, only: leakage_result
    use lc_version, only: build_isa
    implicit none (type, external)
    private
@@ -47,6 +48,9 @@ module lc_io_hdf5
       & 'max_tension_grid S; max_principal_stress S; max_tension_x L; max_tension_y L; max_tension_offset L; ' // &
       & 'max_principal_x L; max_principal_y L; dissipated_power S L/T; wall_time s; ' // &
       & 'the others are dimensionless (fractions, friction coefficients, residuals, normalised values) or counts'
+   character(len=*), parameter :: leakage_units = 'k_eff_x L^3; k_eff_y L^3 (12 eta times the mean flux per ' // &
+      & 'unit width per unit mean pressure gradient: g^3 for a uniform gap g); wall_time s; ' // &
+      & 'the others are dimensionless (fractions, residuals, tolerances, flags 0/1) or counts'
 
    !> Sticky status of a sequence of HDF5 calls: after the first failure every helper does
    !> nothing, so a writer reads as a plain list of objects and is checked once at the end.
@@ -470,6 +474,8 @@ contains
       if (present(a_over_a0)) call write_attr_real(group, 'a_over_a0', a_over_a0, st)
       call close_group(group, st)
 
+      if (allocated(res%leakage)) call write_leakage(loc, res%leakage, st)
+
       call create_group(loc, 'convergence', group, st)
       if (allocated(res%residual_history)) then
          call write_dataset_1d(group, 'residual', res%residual_history, '1', st)
@@ -478,6 +484,34 @@ contains
       end if
       call close_group(group, st)
    end subroutine write_solution
+
+   !> The Reynolds leakage (computed in the run, lc_leakage_reynolds) as attributes of /leakage.
+   subroutine write_leakage(loc, leakage, st)
+      integer(hid_t), intent(in) :: loc
+      type(leakage_result), intent(in) :: leakage
+      type(h5_status), intent(inout) :: st
+      integer(hid_t) :: group
+      call create_group(loc, 'leakage', group, st)
+      call write_attr_string(group, 'units', leakage_units, st)
+      call write_attr_real(group, 'k_eff_x', leakage%x%k_eff, st)
+      call write_attr_real(group, 'k_eff_y', leakage%y%k_eff, st)
+      call write_attr_int(group, 'percolating_x', merge(1, 0, leakage%x%percolating), st)
+      call write_attr_int(group, 'percolating_y', merge(1, 0, leakage%y%percolating), st)
+      call write_attr_real(group, 'fluid_fraction', leakage%fluid_fraction, st)
+      call write_attr_real(group, 'connected_fraction_x', leakage%x%connected_fraction, st)
+      call write_attr_real(group, 'connected_fraction_y', leakage%y%connected_fraction, st)
+      call write_attr_int(group, 'unknowns_x', leakage%x%unknowns, st)
+      call write_attr_int(group, 'unknowns_y', leakage%y%unknowns, st)
+      call write_attr_int(group, 'iterations_x', leakage%x%iterations, st)
+      call write_attr_int(group, 'iterations_y', leakage%y%iterations, st)
+      call write_attr_real(group, 'residual_x', leakage%x%residual, st)
+      call write_attr_real(group, 'residual_y', leakage%y%residual, st)
+      call write_attr_int(group, 'converged', merge(1, 0, leakage%x%converged .and. leakage%y%converged), st)
+      call write_attr_real(group, 'tol', leakage%tol, st)
+      call write_attr_string(group, 'solver', trim(leakage%solver), st)
+      call write_attr_real(group, 'wall_time', leakage%wall_time, st)
+      call close_group(group, st)
+   end subroutine write_leakage
 
    !> Fields must match the profile's grid (a mismatch is a bug in the caller).
    subroutine check_sizes(res, n, label, error)

@@ -193,6 +193,8 @@ contains
             & // entry('stress', logical_value(scene%stress)) &
             & // entry('gap_bins', to_string(scene%gap_bins)) &
             & // entry('fields', logical_value(scene%fields)) &
+            & // entry('leakage', logical_value(scene%leakage)) &
+            & // entry('leakage_tol', real_value(scene%leakage_tol)) &
             & // '/' // newline
       end associate
    end subroutine write_scene_namelist
@@ -279,7 +281,7 @@ contains
       character(len=*), intent(inout) :: msg
       character(len=*), parameter :: reals = ' period period_x period_y thickness young poisson e0 e_inf tau ' // &
          & 'speed prony_equilibrium coefficient hurst rolloff_wavelength short_wavelength rms_gradient rms_height ' // &
-         & 'amplitude radius mean_pressure normalised_pressure penetration tol target_error '
+         & 'amplitude radius mean_pressure normalised_pressure penetration tol target_error leakage_tol '
       character(len=:), allocatable :: name, value, kind
       integer :: k, stat
       integer(i8) :: as_integer   ! (the widest integer variable, &profile seed)
@@ -311,7 +313,7 @@ contains
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: kind
       character(len=*), parameter :: integers = ' n nx ny seed mode mode_y max_iter memory threads gap_bins '
-      character(len=*), parameter :: logicals = ' companion precondition coarse_start verbose overwrite stress fields '
+      character(len=*), parameter :: logicals = ' companion precondition coarse_start verbose overwrite stress fields leakage '
       character(len=*), parameter :: strings = ' geometry title model prony_form prony_file kind file dataset ' // &
          & 'detrend boundary resample control method '
       if (index(integers, ' ' // name // ' ') > 0) then
@@ -647,15 +649,18 @@ contains
       integer, intent(out) :: stat
       character(len=*), intent(inout) :: msg
       character(len=max_string + 1) :: file
-      logical :: overwrite, stress, fields
+      logical :: overwrite, stress, fields, leakage
       integer :: gap_bins
-      namelist /output/ file, overwrite, stress, gap_bins, fields
+      real(wp) :: leakage_tol
+      namelist /output/ file, overwrite, stress, gap_bins, fields, leakage, leakage_tol
 
       file = config%output_file
       overwrite = config%overwrite
       stress = config%stress
       gap_bins = config%gap_bins
       fields = config%fields
+      leakage = config%leakage
+      leakage_tol = config%leakage_tol
       read (lines, nml=output, iostat=stat, iomsg=msg)
       if (stat /= 0) return
       if (too_long('file', file, stat, msg)) return
@@ -664,6 +669,8 @@ contains
       config%stress = stress
       config%gap_bins = gap_bins
       config%fields = fields
+      config%leakage = leakage
+      config%leakage_tol = leakage_tol
    end subroutine read_group_output
 
    ! ---------------------------------------------------------------------------------------

@@ -1,0 +1,412 @@
+!> Reynolds thin-film leakage through the gap of an areal contact: the effective conductance
+!> k_eff along x and along y, the same discretisation as the Python `reynolds_leakage`
+!> (docs/leakage.md).
+!>
+!> div(g^3 grad P) = 0 on the periodic cell; a mean pressure gradient -G is imposed along the
+!> flow direction s, P = G (-s + phi) with phi periodic. k_eff = 12 eta <q_s>/G (L^3), g^3 for
+!> a uniform gap. Finite volumes with the unknown at each grid point; the face conductance is
+!> the harmonic mean of the two g^3 (zero on every face of a closed cell). Fluid cells connect
+!> through faces only. Clusters that do not wind around the cell along the flow carry no net
+!> flux and are removed; one cell of each remaining cluster is pinned (phi = 0), so the system
+!> is symmetric positive definite.
+!>
+!> k_eff is the mean dissipation sum_faces w (phi - phi_next + jump)^2/N: equal to the mean
+!> flux at the solution and above it by the squared energy norm of the solver error, a sum of
+!> positive terms that stays accurate when k_eff is 1e-12 of <g^3> near percolation.
+!>
+!> Linear solver: conjugate gradients preconditioned by one V-cycle of hypre's BoomerAMG on
+!> the free cells (chosen by measurement: docs/decisions/006-leakage-in-the-core.md),
+!> stopped on the energy error of phi as in Python: the decrease of the energy over the last
+!> five iterations (Strakos and Tichy's lower bound of the error) below tol times the
+!> dissipation, so tol is the relative accuracy of k_eff.
+module lc_leakage_reynolds
+   use, intrinsic :: iso_c_binding, only: c_int, c_double
+   use lc_kinds, only: wp, i8
+   use lc_errors, only: error_type, fatal_error, code_internal
+   implicit none (type, external)
+   private
+   public :: leakage_flow, leakage_result, reynolds_leakage
+   !> Default contact threshold relative to the largest gap: a converged contact solve leaves
+   !> residual gaps of about 1e-8 of the largest gap in contact, and a cell at 1e-6 of it
+   !> conducts 1e-18 of the largest cell, far below any solver tolerance.
+   real(wp), parameter :: contact_threshold_relative = 1.0e-6_wp
+   !> Gaps below this are closed whatever the threshold: above it g^3, 1/g^3 and their sums
+   !> are normal floats, so a face between two open cells never conducts zero.
+   real(wp), parameter :: smallest_gap = 1.0e-100_wp
+   !> Iterations over which the energy decrease estimates the error (as in Python).
+   integer, parameter :: cg_delay = 5
+   !> BoomerAMG strength threshold: hypre's default for 2D Laplacians; 0.5 took more CG
+   !> iterations and more time near percolation (docs/decisions/006-leakage-in-the-core.md).
+   real(c_double), parameter :: amg_strength = 0.25_c_double
+
+   !> The flow along one direction.
+   type :: leakage_flow
+      real(wp) :: k_eff = 0.0_wp             !< 12 eta <q_s>/G (L^3)
+      logical :: percolating = .false.       !< a fluid cluster winds around the cell along s
+      real(wp) :: connected_fraction = 0.0_wp !< cells of the flow-carrying clusters
+      integer :: unknowns = 0                 !< size of the linear system
+      integer :: iterations = 0               !< CG iterations
+      real(wp) :: residual = 0.0_wp           !< ||b - A phi||/||b||
+      logical :: converged = .true.
+   end type leakage_flow
+
+   !> Both directions and what they share.
+   type :: leakage_result
+      type(leakage_flow) :: x, y
+      real(wp) :: fluid_fraction = 0.0_wp    !< cells with a gap (not in contact)
+      real(wp) :: tol = 0.0_wp               !< relative accuracy of k_eff asked for
+      character(len=32) :: solver = ''       !< the preconditioned CG that ran
+      real(wp) :: wall_time = 0.0_wp         !< seconds
+   end type leakage_result
+
+   interface
+      integer(c_int) function lc_hypre_setup_boomeramg(n, row_start, column, value, strength) bind(C)
+         import :: c_int, c_double
+         integer(c_int), value :: n
+         integer(c_int), intent(in) :: row_start(*), column(*)
+         real(c_double), intent(in) :: value(*)
+         real(c_double), value :: strength
+      end function lc_hypre_setup_boomeramg
+      integer(c_int) function lc_hypre_apply(r, z) bind(C)
+         import :: c_int, c_double
+         real(c_double), intent(in) :: r(*)
+         real(c_double), intent(out) :: z(*)
+      end function lc_hypre_apply
+      subroutine lc_hypre_free() bind(C)
+      end subroutine lc_hypre_free
+   end interface
+
+contains
+
+   !> k_eff along x and y of the gap g (nx*ny, x fastest) of the lx x ly cell. Cells with
+   !> closed(j) or g <= 1e-6 max(g) are in contact. tol: relative accuracy of k_eff.
+   subroutine reynolds_leakage(g, closed, nx, ny, lx, ly, tol, max_iter, result, error)
+      real(wp), intent(in) :: g(:)
+      logical, intent(in) :: closed(:)
+      integer, intent(in) :: nx, ny, max_iter
+      real(wp), intent(in) :: lx, ly, tol
+      type(leakage_result), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      logical, allocatable :: fluid(:), active_x(:), active_y(:)
+      real(wp), allocatable :: east(:), north(:)
+      integer, allocatable :: cluster(:)
+      logical, allocatable :: winds_x(:), winds_y(:)
+      real(wp) :: threshold, hx, hy
+      integer(i8) :: start, finish, rate
+      logical :: same, prepared
+
+      call system_clock(start, rate)
+      result%tol = tol
+      result%solver = 'cg + hypre BoomerAMG'
+      hx = lx/nx
+      hy = ly/ny
+      threshold = max(contact_threshold_relative*max(maxval(g), 0.0_wp), smallest_gap)
+      fluid = .not. closed .and. g > threshold
+      result%fluid_fraction = real(count(fluid), wp)/size(g)
+      call face_weights(g, fluid, nx, ny, hx, hy, east, north)
+      call flow_clusters(fluid, nx, ny, cluster, winds_x, winds_y)
+      active_x = fluid
+      active_y = fluid
+      where (fluid) active_x = winds_x(max(cluster, 1))
+      where (fluid) active_y = winds_y(max(cluster, 1))
+      ! the matrix depends on the flow-carrying cells only, not on the direction: one
+      ! preconditioner serves both when they are the same
+      same = all(active_x .eqv. active_y)
+      prepared = .false.
+      call solve_direction(1, active_x, result%x)
+      if (allocated(error)) return
+      if (.not. same) prepared = .false.
+      call solve_direction(2, active_y, result%y)
+      if (allocated(error)) return
+      call lc_hypre_free()
+      call system_clock(finish)
+      result%wall_time = real(finish - start, wp)/real(rate, wp)
+
+   contains
+
+      subroutine solve_direction(direction, active, flow)
+         integer, intent(in) :: direction
+         logical, intent(in) :: active(:)
+         type(leakage_flow), intent(out) :: flow
+         flow%percolating = any(active)
+         flow%connected_fraction = real(count(active), wp)/size(g)
+         if (.not. flow%percolating) return
+         call flow_solve(direction, active, cluster, east, north, nx, ny, hx, hy, tol, max_iter, &
+            & prepared, flow, error)
+      end subroutine solve_direction
+   end subroutine reynolds_leakage
+
+   !> c/h^2 of the face from each cell to its east (+x) and north (+y) neighbour: the harmonic
+   !> mean of the two g^3, zero when either cell is closed.
+   pure subroutine face_weights(g, fluid, nx, ny, hx, hy, east, north)
+      real(wp), intent(in) :: g(:), hx, hy
+      logical, intent(in) :: fluid(:)
+      integer, intent(in) :: nx, ny
+      real(wp), allocatable, intent(out) :: east(:), north(:)
+      real(wp), allocatable :: resistance(:)
+      integer :: i, j, k, ke, kn
+      allocate (resistance(size(g)), east(size(g)), north(size(g)))
+      where (fluid)
+         resistance = 1.0_wp/(g*g*g)
+      elsewhere
+         resistance = 0.0_wp
+      end where
+      do j = 1, ny
+         do i = 1, nx
+            k = i + (j - 1)*nx
+            ke = modulo(i, nx) + 1 + (j - 1)*nx
+            kn = i + modulo(j, ny)*nx
+            east(k) = 0.0_wp
+            north(k) = 0.0_wp
+            ! in series: c = 2/(r + r_next) with r = 1/g^3
+            if (fluid(k) .and. fluid(ke)) east(k) = 2.0_wp/(resistance(k) + resistance(ke))/(hx*hx)
+            if (fluid(k) .and. fluid(kn)) north(k) = 2.0_wp/(resistance(k) + resistance(kn))/(hy*hy)
+         end do
+      end do
+   end subroutine face_weights
+
+   !> Fluid clusters (4-connected, periodic) by a breadth-first search that carries each
+   !> cell's unwrapped coordinates: an edge that reaches a labelled cell at other unwrapped
+   !> coordinates closes a loop around the cell, along x when the x coordinates differ. Every
+   !> loop is a sum of the loops the edges outside the search tree close, so the cluster winds
+   !> along x exactly when one of its edges says so.
+   pure subroutine flow_clusters(fluid, nx, ny, cluster, winds_x, winds_y)
+      logical, intent(in) :: fluid(:)
+      integer, intent(in) :: nx, ny
+      integer, allocatable, intent(out) :: cluster(:)
+      logical, allocatable, intent(out) :: winds_x(:), winds_y(:)
+      integer, allocatable :: queue(:), ux(:), uy(:)
+      logical, allocatable :: winds(:, :)
+      integer, parameter :: step_x(4) = [1, -1, 0, 0], step_y(4) = [0, 0, 1, -1]
+      integer :: seed, head, tail, k, m, i, j, ni, nj, next, label, n_labels
+      allocate (cluster(size(fluid)), queue(size(fluid)), ux(size(fluid)), uy(size(fluid)))
+      allocate (winds(2, size(fluid)/2 + 1))
+      cluster = 0
+      winds = .false.
+      n_labels = 0
+      do seed = 1, size(fluid)
+         if (.not. fluid(seed) .or. cluster(seed) /= 0) cycle
+         n_labels = n_labels + 1
+         label = n_labels
+         cluster(seed) = label
+         ux(seed) = modulo(seed - 1, nx)
+         uy(seed) = (seed - 1)/nx
+         head = 1
+         tail = 1
+         queue(1) = seed
+         do while (head <= tail)
+            k = queue(head)
+            head = head + 1
+            i = modulo(k - 1, nx)
+            j = (k - 1)/nx
+            do m = 1, 4
+               ni = modulo(i + step_x(m), nx)
+               nj = modulo(j + step_y(m), ny)
+               next = ni + nj*nx + 1
+               if (.not. fluid(next)) cycle
+               if (cluster(next) == 0) then
+                  cluster(next) = label
+                  ux(next) = ux(k) + step_x(m)
+                  uy(next) = uy(k) + step_y(m)
+                  tail = tail + 1
+                  queue(tail) = next
+               else
+                  if (ux(next) /= ux(k) + step_x(m)) winds(1, label) = .true.
+                  if (uy(next) /= uy(k) + step_y(m)) winds(2, label) = .true.
+               end if
+            end do
+         end do
+      end do
+      winds_x = winds(1, :max(n_labels, 1))
+      winds_y = winds(2, :max(n_labels, 1))
+   end subroutine flow_clusters
+
+   !> Solve for phi along `direction` (1: x, 2: y) on the `active` cells and set k_eff.
+   subroutine flow_solve(direction, active, cluster, east, north, nx, ny, hx, hy, tol, max_iter, &
+         & prepared, flow, error)
+      integer, intent(in) :: direction, nx, ny, max_iter
+      logical, intent(in) :: active(:)
+      !> a preconditioner of this matrix is set up (the other direction's, same cells)
+      logical, intent(inout) :: prepared
+      integer, intent(in) :: cluster(:)
+      real(wp), intent(in) :: east(:), north(:), hx, hy, tol
+      type(leakage_flow), intent(inout) :: flow
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: we(:), wn(:), b(:), phi(:), r(:), z(:), p(:), q(:), decreases(:)
+      real(wp), allocatable :: phi_grid(:)
+      logical, allocatable :: free(:), pinned_cluster(:)
+      integer, allocatable :: number(:), free_cells(:)
+      integer(c_int), allocatable :: row_start(:), column(:)
+      real(c_double), allocatable :: value(:)
+      real(wp) :: jump_x, jump_y, rho, rho_next, alpha, bound, b_norm
+      integer :: k, n_cells, n_free, iteration, status
+
+      n_cells = size(active)
+      ! weights restricted to the flow-carrying clusters: an open face joins two cells of one
+      ! cluster, so these are exactly its faces
+      allocate (we(n_cells), wn(n_cells))
+      we = merge(east, 0.0_wp, active)
+      wn = merge(north, 0.0_wp, active)
+      jump_x = merge(hx, 0.0_wp, direction == 1)
+      jump_y = merge(hy, 0.0_wp, direction == 2)
+      ! pin the first cell of each flow-carrying cluster
+      allocate (free(n_cells), pinned_cluster(maxval(cluster)))
+      pinned_cluster = .false.
+      free = active
+      do k = 1, n_cells
+         if (active(k)) then
+            if (.not. pinned_cluster(cluster(k))) then
+               pinned_cluster(cluster(k)) = .true.
+               free(k) = .false.
+            end if
+         end if
+      end do
+      n_free = count(free)
+      flow%unknowns = n_free
+      allocate (number(n_cells), free_cells(n_free), phi_grid(n_cells))
+      number = 0
+      n_free = 0
+      do k = 1, n_cells
+         if (free(k)) then
+            n_free = n_free + 1
+            number(k) = n_free
+            free_cells(n_free) = k
+         end if
+      end do
+      ! b = -D^T W j: the jump on the faces along the flow
+      b = rhs_on_free_cells()
+      allocate (phi(n_free))
+      phi = 0.0_wp
+      b_norm = sqrt(sum(b*b))
+      if (n_free == 0 .or. b_norm == 0.0_wp) then
+         flow%k_eff = dissipation(phi)/n_cells
+         return
+      end if
+      call assemble()
+      if (.not. prepared) then
+         status = lc_hypre_setup_boomeramg(int(n_free, c_int), row_start, column, value, amg_strength)
+         if (status /= 0) then
+            call fatal_error(error, 'leakage: hypre''s BoomerAMG failed to set up (status ' // &
+               & char(48 + min(status, 9)) // ')', code_internal)
+            return
+         end if
+         prepared = .true.
+      end if
+
+      allocate (r(n_free), z(n_free), q(n_free), decreases(max_iter))
+      r = b
+      status = lc_hypre_apply(r, z)
+      p = z
+      rho = sum(r*z)
+      bound = dissipation(phi)
+      flow%converged = .false.
+      do iteration = 1, max_iter
+         flow%iterations = iteration - 1
+         if (rho <= 0.0_wp) then ! the residual vanished
+            flow%converged = rho == 0.0_wp
+            exit
+         end if
+         call apply_matrix(p, q)
+         alpha = rho/sum(p*q)
+         phi = phi + alpha*p
+         r = r - alpha*q
+         decreases(iteration) = alpha*rho
+         flow%iterations = iteration
+         if (iteration >= cg_delay) then
+            ! the dissipation only falls: a stale bound screens the test, a fresh one decides
+            if (sum(decreases(iteration - cg_delay + 1:iteration)) <= tol*bound) then
+               bound = dissipation(phi)
+               if (sum(decreases(iteration - cg_delay + 1:iteration)) <= tol*bound) then
+                  flow%converged = .true.
+                  exit
+               end if
+            end if
+         end if
+         status = lc_hypre_apply(r, z)
+         rho_next = sum(r*z)
+         p = z + (rho_next/rho)*p
+         rho = rho_next
+      end do
+      flow%k_eff = dissipation(phi)/n_cells
+      call apply_matrix(phi, q)
+      flow%residual = sqrt(sum((b - q)**2))/b_norm
+
+   contains
+
+      !> The right-hand side on the free cells: the divergence of the face fluxes of the
+      !> imposed jump.
+      function rhs_on_free_cells() result(b)
+         real(wp) :: b(n_free)
+         integer :: i, j, k, m
+         do m = 1, n_free
+            k = free_cells(m)
+            i = modulo(k - 1, nx) + 1
+            j = (k - 1)/nx + 1
+            b(m) = jump_x*(we(modulo(i - 2, nx) + 1 + (j - 1)*nx) - we(k)) &
+               & + jump_y*(wn(i + modulo(j - 2, ny)*nx) - wn(k))
+         end do
+      end function rhs_on_free_cells
+
+      !> The matrix on the free cells in CSR form (zero-based, as hypre takes it): rows of the
+      !> diagonal and the open faces to free neighbours; a face to a pinned cell only adds
+      !> to the diagonal.
+      subroutine assemble()
+         integer :: i, j, k, m, f, nnz, neighbours(4)
+         real(wp) :: weights(4)
+         allocate (row_start(n_free + 1), column(5*n_free), value(5*n_free))
+         nnz = 0
+         do m = 1, n_free
+            k = free_cells(m)
+            i = modulo(k - 1, nx) + 1
+            j = (k - 1)/nx + 1
+            neighbours = [modulo(i, nx) + 1 + (j - 1)*nx, modulo(i - 2, nx) + 1 + (j - 1)*nx, &
+               & i + modulo(j, ny)*nx, i + modulo(j - 2, ny)*nx]
+            weights = [we(k), we(neighbours(2)), wn(k), wn(neighbours(4))]
+            row_start(m) = nnz
+            nnz = nnz + 1
+            column(nnz) = m - 1
+            value(nnz) = sum(weights)
+            do f = 1, 4
+               if (weights(f) /= 0.0_wp .and. free(neighbours(f))) then
+                  nnz = nnz + 1
+                  column(nnz) = number(neighbours(f)) - 1
+                  value(nnz) = -weights(f)
+               end if
+            end do
+         end do
+         row_start(n_free + 1) = nnz
+      end subroutine assemble
+
+      !> q = A v on the free cells.
+      subroutine apply_matrix(v, q)
+         real(wp), intent(in) :: v(:)
+         real(wp), intent(out) :: q(:)
+         integer :: m, e
+         do m = 1, n_free
+            q(m) = 0.0_wp
+            do e = row_start(m) + 1, row_start(m + 1)
+               q(m) = q(m) + value(e)*v(column(e) + 1)
+            end do
+         end do
+      end subroutine apply_matrix
+
+      !> sum_faces w (phi - phi_next + jump)^2: n_cells k_eff at the solution (phi zero at the
+      !> pinned and inactive cells).
+      real(wp) function dissipation(v) result(total)
+         real(wp), intent(in) :: v(:)
+         integer :: i, j, k
+         real(wp) :: dx, dy
+         phi_grid = 0.0_wp
+         phi_grid(free_cells) = v
+         total = 0.0_wp
+         do j = 1, ny
+            do i = 1, nx
+               k = i + (j - 1)*nx
+               dx = phi_grid(k) - phi_grid(modulo(i, nx) + 1 + (j - 1)*nx) + jump_x
+               dy = phi_grid(k) - phi_grid(i + modulo(j, ny)*nx) + jump_y
+               total = total + we(k)*dx*dx + wn(k)*dy*dy
+            end do
+         end do
+      end function dissipation
+   end subroutine flow_solve
+end module lc_leakage_reynolds

@@ -1,0 +1,109 @@
+!> Tests of the Reynolds leakage in the core (lc_leakage_reynolds). One line per check;
+!> exit 0 on pass, error stop 1 on failure.
+!>
+!> Tolerances:
+!> - tol_exact = 1e-12: a uniform gap and the flow along stripes need no linear solve (the
+!>   right-hand side vanishes): the dissipation sums rounding only.
+!> - tol_solve = 1e-10: the flow across stripes is solved by CG stopped at tol = 1e-12 on
+!>   k_eff; its energy-error estimate lags a few iterations, so two orders above it.
+program test_leakage
+   use lc_kinds, only: wp
+   use lc_errors, only: error_type
+   use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
+   implicit none (type, external)
+
+   real(wp), parameter :: tol_exact = 1.0e-12_wp
+   real(wp), parameter :: tol_solve = 1.0e-10_wp
+   integer :: failures
+
+   failures = 0
+   call check_uniform()
+   call check_stripes()
+   call check_blocked()
+   call check_diagonal_channel()
+   if (failures > 0) then
+      write (*, '(a, i0, a)') 'FAILED: ', failures, ' check(s)'
+      error stop 1
+   end if
+   write (*, '(a)') 'all leakage checks passed'
+
+contains
+
+   subroutine check(ok, what)
+      logical, intent(in) :: ok
+      character(len=*), intent(in) :: what
+      if (ok) then
+         write (*, '(a)') 'ok    ' // what
+      else
+         write (*, '(a)') 'FAIL  ' // what
+         failures = failures + 1
+      end if
+   end subroutine check
+
+   subroutine leakage_of(g, nx, ny, lx, ly, tol, res)
+      real(wp), intent(in) :: g(:), lx, ly, tol
+      integer, intent(in) :: nx, ny
+      type(leakage_result), intent(out) :: res
+      type(error_type), allocatable :: error
+      call reynolds_leakage(g, spread(.false., 1, size(g)), nx, ny, lx, ly, tol, 500, res, error)
+      if (allocated(error)) call check(.false., 'leakage: ' // error%message)
+   end subroutine leakage_of
+
+   !> k_eff = g^3 both ways on a non-square cell.
+   subroutine check_uniform()
+      type(leakage_result) :: res
+      call leakage_of(spread(0.37_wp, 1, 60), 10, 6, 2.0_wp, 0.5_wp, 1.0e-6_wp, res)
+      call check(abs(res%x%k_eff/0.37_wp**3 - 1) < tol_exact .and. abs(res%y%k_eff/0.37_wp**3 - 1) < tol_exact, &
+         & 'uniform gap: k_eff = g^3 along x and y')
+      call check(res%x%percolating .and. res%y%percolating .and. res%x%unknowns == 59, &
+         & 'uniform gap: percolating, one pinned cell')
+   end subroutine check_uniform
+
+   !> g(y) only: the arithmetic mean of g^3 along x, the harmonic mean along y.
+   subroutine check_stripes()
+      integer, parameter :: nx = 16, ny = 24
+      real(wp) :: stripes(ny), g(nx*ny)
+      type(leakage_result) :: res
+      integer :: j
+      stripes = [(0.2_wp + 1.8_wp*modulo(7*j, ny)/real(ny - 1, wp), j=0, ny - 1)]
+      do j = 1, ny
+         g((j - 1)*nx + 1:j*nx) = stripes(j)
+      end do
+      call leakage_of(g, nx, ny, 1.0_wp, 1.0_wp, 1.0e-12_wp, res)
+      call check(abs(res%x%k_eff/(sum(stripes**3)/ny) - 1) < tol_exact, 'stripes: arithmetic mean of g^3 along them')
+      call check(abs(res%y%k_eff*sum(1/stripes**3)/ny - 1) < tol_solve .and. res%y%converged, &
+         & 'stripes: harmonic mean of g^3 across them')
+   end subroutine check_stripes
+
+   !> A contact column blocks the flow along x, not along y.
+   subroutine check_blocked()
+      integer, parameter :: nx = 20, ny = 12
+      real(wp) :: g(nx*ny)
+      type(leakage_result) :: res
+      integer :: j
+      g = 0.5_wp
+      do j = 1, ny
+         g((j - 1)*nx + 8) = 0.0_wp
+      end do
+      call leakage_of(g, nx, ny, 1.0_wp, 1.0_wp, 1.0e-6_wp, res)
+      call check(res%x%k_eff == 0.0_wp .and. .not. res%x%percolating .and. res%x%iterations == 0, &
+         & 'contact line across x: k_eff_x = 0, not percolating')
+      call check(abs(res%y%k_eff/(0.5_wp**3*19/20) - 1) < tol_exact, 'contact line across x: k_eff_y of 19 open columns')
+   end subroutine check_blocked
+
+   !> A diagonal contact line leaves a channel that winds along x and y at once.
+   subroutine check_diagonal_channel()
+      integer, parameter :: n = 16
+      real(wp) :: g(n*n)
+      type(leakage_result) :: res
+      integer :: i
+      g = 0.5_wp
+      do i = 1, n
+         g((i - 1)*n + i) = 0.0_wp
+      end do
+      call leakage_of(g, n, n, 1.0_wp, 1.0_wp, 1.0e-12_wp, res)
+      call check(res%x%percolating .and. res%y%percolating .and. res%x%k_eff > 0, &
+         & 'diagonal channel: percolates along x and y')
+      call check(abs(res%x%k_eff/res%y%k_eff - 1) < tol_solve, 'diagonal channel: symmetric, k_eff_x = k_eff_y')
+   end subroutine check_diagonal_channel
+end program test_leakage

@@ -1,0 +1,167 @@
+"""The Reynolds leakage computed by the core (&output leakage, lc.core_leakage): exact
+layered solutions, blocked flow, agreement with the Python reynolds_leakage on the same gap
+(synthetic and an areal result's), the /leakage group of the result file, and runs in a
+sweep's worker processes."""
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import layercontact as lc
+from test_inputs import run_exe
+from test_leakage import random_gap
+
+# Closed forms reached without a linear solve (a uniform gap, flow along stripes: the
+# right-hand side vanishes) or by a direct solve: rounding only.
+EXACT = 1e-12
+# CG stopped at tol = 1e-12 on k_eff: its energy-error estimate lags a few iterations, so
+# allow two orders above it (as the Python solver's tests do).
+ITERATIVE = 1e-10
+
+
+def test_uniform_gap_is_g_cubed_both_ways():
+    g = 0.37
+    res = lc.core_leakage(np.full((6, 10), g), period=(2.0, 0.5))
+    assert res.k_eff_x == pytest.approx(g**3, rel=EXACT)
+    assert res.k_eff_y == pytest.approx(g**3, rel=EXACT)
+    assert res.percolating_x and res.percolating_y and res.converged
+    assert res.fluid_fraction == 1.0 and res.connected_fraction_x == 1.0 == res.connected_fraction_y
+    # one cell pinned: the other 59 are unknowns
+    assert res.unknowns_x == res.unknowns_y == 59
+
+
+def test_stripes_give_the_arithmetic_and_harmonic_means():
+    # g depends on y only: flow along x sees parallel channels (arithmetic mean of g^3),
+    # flow along y the same channels in series (harmonic mean)
+    stripes = np.random.default_rng(4).uniform(0.2, 2.0, 24)
+    gap = np.tile(stripes[:, None], (1, 16))
+    res = lc.core_leakage(gap, tol=1e-12)
+    assert res.k_eff_x == pytest.approx(np.mean(stripes**3), rel=EXACT)
+    assert res.k_eff_y == pytest.approx(1 / np.mean(1 / stripes**3), rel=ITERATIVE)
+    assert res.converged and res.residual_y < 1e-5
+
+
+def test_a_contact_line_blocks_the_flow_across_it():
+    g = np.full((12, 20), 0.5)
+    g[:, 7] = 0.0  # a contact stripe across the whole cell at x = 7/20
+    res = lc.core_leakage(g)
+    assert res.k_eff_x == 0.0 and not res.percolating_x and res.connected_fraction_x == 0.0
+    assert res.iterations_x == 0 and res.unknowns_x == 0
+    assert res.percolating_y and res.k_eff_y == pytest.approx(0.5**3 * 19 / 20, rel=EXACT)
+    assert res.fluid_fraction == pytest.approx(19 / 20)
+
+
+@pytest.mark.parametrize("contact_fraction, seed", [(0.25, 1), (0.45, 2)])
+def test_agrees_with_the_python_solver(contact_fraction, seed):
+    # a correlated random gap on a non-square cell, up to near percolation (0.45)
+    g = random_gap((96, 80), contact_fraction, seed=seed)
+    period = (2.0, 1.5)
+    core = lc.core_leakage(g, period=period, tol=1e-12)
+    tight = lc.core_leakage(g, period=period)  # default tol = 1e-6 on k_eff
+    for d in ("x", "y"):
+        ref = lc.reynolds_leakage(g, period=period, direction=d, method="direct")
+        k = getattr(core, f"k_eff_{d}")
+        assert getattr(core, f"percolating_{d}") == ref.percolating
+        assert getattr(core, f"connected_fraction_{d}") == ref.connected_fraction
+        assert k == pytest.approx(ref.k_eff, rel=ITERATIVE, abs=1e-300)
+        # the dissipation is an upper bound, within tol of the converged value
+        k_default = getattr(tight, f"k_eff_{d}")
+        assert ref.k_eff * (1 - EXACT) <= k_default <= ref.k_eff * (1 + 1e-6)
+    assert core.fluid_fraction == pytest.approx(1 - contact_fraction, abs=1 / g.size)
+
+
+def test_a_gap_that_percolates_along_neither_axis():
+    g = np.full((16, 16), 0.2)
+    g[4, :] = 0.0
+    g[:, 9] = 0.0  # a closed cross: four-sided pockets only
+    res = lc.core_leakage(g)
+    assert (res.k_eff_x, res.k_eff_y) == (0.0, 0.0)
+    assert not res.percolating_x and not res.percolating_y
+    assert res.fluid_fraction == pytest.approx(225 / 256)
+
+
+AREAL = """\
+&scene
+   geometry = 'areal'
+   n = 64
+/
+&layer
+   thickness = 0.1
+   poisson = 0.5
+/
+&friction
+   coefficient = 0.5
+/
+&profile
+   kind = 'self_affine'
+   seed = 3
+   short_wavelength = 0.125
+   rms_gradient = 0.1
+/
+&loading
+   normalised_pressure = 0.3
+/
+&solver
+   tol = 1e-10
+/
+"""
+
+
+def write_scene(directory: Path, leakage: bool = True, name: str = "leak") -> Path:
+    nml = directory / f"{name}.nml"
+    extra = " leakage = .true.\n leakage_tol = 1e-12\n" if leakage else ""
+    nml.write_text(AREAL + f"&output\n file = '{name}.h5'\n{extra}/\n")
+    return nml
+
+
+def test_result_file_holds_the_leakage_of_its_gap(tmp_path, monkeypatch):
+    proc = run_exe(write_scene(tmp_path), tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "leakage k_eff along x" in proc.stdout and "leakage k_eff along y" in proc.stdout
+    res = lc.read_result(tmp_path / "leak.h5")
+    leak = res.leakage
+    assert leak.converged and leak.solver == "cg + hypre BoomerAMG" and leak.tol == 1e-12
+    assert 0.1 < res.contact_fraction < 0.4 and leak.percolating_x and leak.percolating_y
+    # the same gap and contact through the Python solver (direct): the core stops at
+    # leakage_tol = 1e-12 on k_eff
+    for d in ("x", "y"):
+        ref = lc.reynolds_leakage(res.gap, period=res.period, direction=d, contact=res.pressure > 0,
+                                  method="direct")
+        assert getattr(leak, f"k_eff_{d}") == pytest.approx(ref.k_eff, rel=ITERATIVE)
+        assert getattr(leak, f"connected_fraction_{d}") == ref.connected_fraction
+    assert leak.fluid_fraction == pytest.approx(1 - res.contact_fraction)
+    # sliding along x makes the gap anisotropic: the two conductances differ
+    assert abs(leak.k_eff_x / leak.k_eff_y - 1) > 1e-3
+    with h5py.File(tmp_path / "leak.h5") as f:
+        assert "k_eff_x L^3" in f["leakage"].attrs["units"].decode()
+    # lc.run is the same library routine: the same numbers
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(lc.api, "_core", lc.native.portable)
+    again = lc.run(write_scene(tmp_path, name="again"))
+    assert again.leakage.k_eff_x == pytest.approx(leak.k_eff_x, rel=ITERATIVE)
+
+
+def test_no_leakage_unless_asked(tmp_path):
+    proc = run_exe(write_scene(tmp_path, leakage=False), tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "leakage k_eff" not in proc.stdout
+    assert lc.read_result(tmp_path / "leak.h5").leakage is None
+    with h5py.File(tmp_path / "leak.h5") as f:
+        assert "leakage" not in f
+
+
+def test_sweep_workers_compute_the_leakage(tmp_path, monkeypatch):
+    # two scenes in two worker processes, each starting MPI for hypre on its own
+    sweep = tmp_path / "s.nml"
+    base = AREAL.replace("&solver\n   tol = 1e-10\n/\n", "&solver\n   tol = 1e-8\n/\n")
+    sweep.write_text(base + "&output\n leakage = .true.\n/\n"
+                     "&sweep\n directory = 'out/s'\n processes = 2\n normalised_pressure = 0.1, 0.3\n/\n")
+    monkeypatch.chdir(tmp_path)
+    rows = lc.sweep(sweep, progress=False)
+    assert len(rows) == 2 and all(row["error"] == "" for row in rows)
+    k = [lc.read_result(tmp_path / row["result_file"]).leakage.k_eff_x for row in rows]
+    # a larger load closes the gap: less leakage
+    assert k[0] > k[1] > 0
+    assert [row["leakage_k_eff_x"] for row in rows] == k
