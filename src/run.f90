@@ -8,7 +8,7 @@ module lc_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
-   use lc_scene, only: scene_type, not_set
+   use lc_scene, only: scene_type, not_set, companion_of
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
@@ -30,7 +30,7 @@ contains
       character(len=:), allocatable, intent(out) :: output_file
       logical, intent(out) :: converged
       type(error_type), allocatable, intent(out) :: error
-      type(scene_type) :: scene, companion_scene
+      type(scene_type) :: scene
       type(contact_result) :: result, companion
       character(len=:), allocatable :: text
       real(wp), allocatable :: height(:)
@@ -68,15 +68,7 @@ contains
       if (allocated(error)) return
       converged = result%converged
       if (scene%companion) then
-         ! the frictionless companion at the same load (whatever the scene's control)
-         associate (c => companion_scene)
-            c = scene
-            c%control = 'load'
-            c%mean_pressure = result%mean_pressure
-            c%normalised_pressure = not_set
-            c%penetration = not_set
-         end associate
-         call solve_contact(companion_scene, height, 0.0_wp, companion, error)
+         call solve_contact(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
          if (allocated(error)) return
          converged = converged .and. companion%converged
          call system_clock(finish)

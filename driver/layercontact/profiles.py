@@ -12,7 +12,7 @@ import os
 import numpy as np
 
 from .native import core as _core
-from .api import NOT_SET, _check
+from .api import NOT_SET, _check, _namelist
 
 # Length of the Fortran scene's file-name fields (lc_scene max_string).
 _MAX_STRING = 512
@@ -51,10 +51,15 @@ def self_affine_profile(
     return height
 
 
-def sinusoid_profile(n: int, amplitude: float, *, mode: int = 1, period: float = 1.0) -> np.ndarray:
-    """``amplitude * cos(2 pi mode x/period)`` on ``n`` points of one period."""
-    x = np.arange(n) * (period / n)
-    return amplitude * np.cos(2 * np.pi * mode * x / period)
+def sinusoid_profile(n: int, amplitude: float, *, mode: int | None = None, period: float | None = None) -> np.ndarray:
+    """``amplitude * cos(2 pi mode x/period)`` on ``n`` points of one period, the heights
+    of ``&profile kind='sinusoid'`` (``mode`` default 1, ``1 <= mode <= (n-1)/2``;
+    ``period`` default 1; raises LayercontactError otherwise)."""
+    text = _namelist({"scene": {"n": int(n), "period": period},
+                      "profile": {"kind": "sinusoid", "amplitude": amplitude, "mode": mode}})
+    height, stat, errmsg = _core.py_make_profile(text, int(n))
+    _check(stat, errmsg)
+    return height
 
 
 def load_profile(path: str | os.PathLike, dataset: str = "/profile/height") -> np.ndarray:
