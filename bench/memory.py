@@ -88,7 +88,7 @@ print(json.dumps(dict(base=base, current=current, peak=peak, seconds=t, iteratio
 
 #: n-sized double arrays alive in each phase of lc.solve_line (complex arrays of n/2 + 1
 #: modes count as one); see the module docstring of each file named.
-F2PY = 7        # driver/wrappers.f90 py_solve: fields(n, 5) + spots(n/2+1, 4), zero-filled by f2py
+F2PY = 9        # driver/wrappers.f90 py_solve_scene: fields(n, 6) + spots(n/2+1, 5), zero-filled by f2py
 SOLVE = 3       # src/contact/solve.f90: p, w, gap
 OPERATOR = 5    # src/contact/operator.f90: metric 1/2, preconditioner 1/2, compliance (complex) 1,
 #                 column 1; src/fft/plans.F90: real_buffer 1, spectrum (complex) 1
@@ -97,8 +97,8 @@ CG = 4          # src/contact/solver_cg.f90: t, r, z, inside (a real 0/1 mask)
 ANDERSON = 7    # src/contact/solver_anderson.f90: x, f, x_old, f_old, tx, b, nw
 OBSERVE = 9     # src/result.f90 pressure, gap, displacement_z, displacement_x, shear, stress_xx;
 #                 src/observables/surface.f90: ph, uh, sh (complex)
-WRAP_END = 6    # py_solve copying the result r (6 fields) into `fields`
-PYTHON = 7      # api._solve_once: 5 field copies, shear = friction * p, height copy
+WRAP_END = 6    # lc_scene_text copying the result (6 fields) into `fields`
+PYTHON = 7      # api._solve_scene: 6 field copies; solve_line: height copy
 MEMORY = 12     # Anderson memory (default)
 
 

@@ -1,7 +1,8 @@
 !> The only file f2py sees: thin py_* wrappers with plain, explicit-shape arguments.
 !> Each builds the library's types from its arguments, calls one library routine, copies
 !> the results out and maps an error to stat (the exit code it would have) and errmsg.
-!> stat = 0 means success.
+!> stat = 0 means success. A scene comes as namelist text (lc_scene_text), so that its
+!> defaults, checks and messages are those of scene_type and a namelist file.
 
 !> 1-A, 1-B and c (convention P) for kh = |k| h, closed forms.
 subroutine py_layer_coefficients(n, kh, nu, one_minus_a, one_minus_b, c)

@@ -4,7 +4,6 @@ Fortran messages become exceptions, results come back as plain dataclasses."""
 from __future__ import annotations
 
 import os
-import sys
 from dataclasses import dataclass, field
 from dataclasses import fields as dataclass_fields
 
