@@ -208,31 +208,25 @@ subroutine py_choose_resolution(input, n, tol, stat, errmsg)
    tol = scene%solver%tol
 end subroutine py_choose_resolution
 
-!> Surface displacement u_x and stress sigma_xx for a prescribed pressure p (no contact
-!> solve): tau = friction p on an elastic layer (thickness = Inf: half-space).
-subroutine py_surface_fields(n, p, period, thickness, young, poisson, friction, displacement_x, stress_xx, &
-      & stat, errmsg)
+!> In-plane surface displacements and stresses (fields(:, 1:5): u_x, u_y, sigma_xx,
+!> sigma_yy, sigma_xy) of the layer of the scene in the namelist `text` under a prescribed
+!> pressure p (n = nx*ny values, x fastest) and the shear friction*p along x (no contact
+!> solve; a line has u_x and sigma_xx only).
+subroutine py_surface_stress(text, n, p, fields, stat, errmsg)
    use lc_errors, only: error_type, status_of
-   use lc_greens_viscoelastic, only: material_law
-   use lc_grid, only: line_grid
-   use lc_greens_kernel, only: make_kernel
-   use lc_contact_operator, only: compliance_operator, build_operator
-   use lc_observables_surface, only: surface_fields
+   use lc_scene_text, only: surface_stress_of_text
    implicit none (type, external)
+   character(len=*), intent(in) :: text
    integer, intent(in) :: n
-   real(8), intent(in) :: p(n), period, thickness, young, poisson, friction
-   real(8), intent(out) :: displacement_x(n), stress_xx(n)
+   real(8), intent(in) :: p(n)
+   real(8), intent(out) :: fields(n, 5)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
    type(error_type), allocatable :: error
-   type(compliance_operator) :: op
-   call build_operator(op, line_grid(n, period), make_kernel(thickness, material_law(young=young), poisson, 0d0), &
-      & friction, 1, error)
+   call surface_stress_of_text(text, p, fields, error)
    call status_of(error, stat, errmsg)
-   if (allocated(error)) return
-   call surface_fields(op, p, displacement_x, stress_xx)
-end subroutine py_surface_fields
+end subroutine py_surface_stress
 
 !> J*(k) of seed Eq. (14) at omega = k V for the material law of the &layer and &material
 !> groups of the namelist `text`.
@@ -299,23 +293,22 @@ subroutine py_cpu_level(level, isa)
    isa = build_isa
 end subroutine py_cpu_level
 
-!> The layer's 3x3 surface compliance (lc_greens_kernel) for the wavevectors (qx, qy):
-!> (u_x^, u_y^, w^) = tensor(i, :, :) (tau_x^, tau_y^, p^), an elastic layer of thickness
-!> h (Inf: half-space).
-subroutine py_surface_tensor(n, qx, qy, thickness, young, poisson, tensor)
-   use lc_greens_viscoelastic, only: material_law
-   use lc_greens_kernel, only: layer_kernel, make_kernel
+!> The 3x3 surface compliance (lc_greens_kernel) of the layer of the scene in the namelist
+!> `text` for the wavevectors (qx, qy): (u_x^, u_y^, w^) = tensor(i, :, :) (tau_x^, tau_y^, p^).
+subroutine py_surface_tensor(text, n, qx, qy, tensor, stat, errmsg)
+   use lc_errors, only: error_type, status_of
+   use lc_scene_text, only: tensor_of_text
    implicit none (type, external)
+   character(len=*), intent(in) :: text
    integer, intent(in) :: n
-   real(8), intent(in) :: qx(n), qy(n), thickness, young, poisson
+   real(8), intent(in) :: qx(n), qy(n)
    complex(8), intent(out) :: tensor(n, 3, 3)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
-   type(layer_kernel) :: kernel
-   integer :: i
-   kernel = make_kernel(thickness, material_law(young=young), poisson, 0d0)
-   do i = 1, n
-      tensor(i, :, :) = kernel%tensor(qx(i), qy(i))
-   end do
+   type(error_type), allocatable :: error
+   call tensor_of_text(text, qx, qy, tensor, error)
+   call status_of(error, stat, errmsg)
 end subroutine py_surface_tensor
 
 !> A random isotropic self-affine surface (lc_profiles_surface), heights flat with x fastest
@@ -368,31 +361,3 @@ subroutine py_make_surface(profile_kind, nx, ny, lx, ly, amplitude, mode, mode_y
    call make_profile(scene, height, error)
    call status_of(error, stat, errmsg)
 end subroutine py_make_surface
-
-!> In-plane displacements and surface stresses of an elastic layer (thickness Inf: half-space)
-!> under a prescribed pressure p on a surface (n = nx*ny values, x fastest) and the shear
-!> friction*p along x (no contact solve). fields(:, 1:5): u_x, u_y, sigma_xx, sigma_yy,
-!> sigma_xy.
-subroutine py_surface_stress(n, p, nx, period, period_y, thickness, young, poisson, friction, fields, stat, errmsg)
-   use lc_errors, only: error_type, status_of
-   use lc_greens_viscoelastic, only: material_law
-   use lc_grid, only: surface_grid
-   use lc_greens_kernel, only: make_kernel
-   use lc_contact_operator, only: compliance_operator, build_operator
-   use lc_observables_stress, only: surface_stress
-   implicit none (type, external)
-   integer, intent(in) :: n, nx
-   real(8), intent(in) :: p(n), period, period_y, thickness, young, poisson, friction
-   real(8), intent(out) :: fields(n, 5)
-   integer, intent(out) :: stat
-   character(len=1024), intent(out) :: errmsg
-   !f2py intent(hide) :: n
-   type(error_type), allocatable :: error
-   type(compliance_operator) :: op
-   fields = 0
-   call build_operator(op, surface_grid(nx, n/nx, period, period_y), &
-      & make_kernel(thickness, material_law(young=young), poisson, 0d0), friction, 1, error)
-   call status_of(error, stat, errmsg)
-   if (allocated(error)) return
-   call surface_stress(op, p, fields(:, 1), fields(:, 2), fields(:, 3), fields(:, 4), fields(:, 5))
-end subroutine py_surface_stress

@@ -8,15 +8,20 @@ module lc_scene_text
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_internal
    use lc_strings, only: to_string
-   use lc_scene, only: scene_type, companion_of, is_areal, material_of, not_set
+   use lc_scene, only: scene_type, companion_of, is_areal, material_of, not_set, grid_of, kernel_of
    use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_io_namelist, only: read_scene_text
    use lc_contact_solve, only: solve_contact
    use lc_profiles_profile, only: make_profile
    use lc_greens_viscoelastic, only: material_law, max_prony_terms
+   use lc_greens_kernel, only: layer_kernel
+   use lc_contact_operator, only: compliance_operator, build_operator
+   use lc_observables_surface, only: surface_fields
+   use lc_observables_stress, only: surface_stress
    implicit none (type, external)
    private
-   public :: solve_scene_text, profile_of_text, material_of_text, library_constants
+   public :: solve_scene_text, profile_of_text, material_of_text, surface_stress_of_text, tensor_of_text, &
+      & library_constants
 
    !> Where keyword text comes from, for the messages of the namelist reader.
    character(len=*), parameter :: source = 'keywords'
@@ -111,6 +116,54 @@ contains
       call read_scene_text(any_load // text, source, scene, error)
       if (.not. allocated(error)) law = material_of(scene)
    end subroutine material_of_text
+
+   !> In-plane surface displacements and stresses of the scene's layer under the prescribed
+   !> pressure p (n*ny values, x fastest) and the shear friction*p along x, without a
+   !> contact solve: fields(:, 1:5) = u_x, u_y, sigma_xx, sigma_yy, sigma_xy (a line: u_y,
+   !> sigma_yy and sigma_xy zero). The text gives no &loading.
+   subroutine surface_stress_of_text(text, p, fields, error)
+      character(len=*), intent(in) :: text
+      real(wp), intent(in) :: p(:)
+      real(wp), intent(out) :: fields(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(compliance_operator) :: op
+      fields = 0
+      call read_scene_text(any_load // text, source, scene, error)
+      if (allocated(error)) return
+      if (size(p) /= scene%n*scene%ny .or. size(fields, 1) /= size(p) .or. size(fields, 2) < 5) then
+         call fatal_error(error, 'surface_stress_of_text: ' // to_string(size(p)) // ' pressures for a scene of ' // &
+            & to_string(scene%n*scene%ny) // ' points', code_internal)
+         return
+      end if
+      call build_operator(op, grid_of(scene), kernel_of(scene), scene%friction, 1, error)
+      if (allocated(error)) return
+      if (is_areal(scene)) then
+         call surface_stress(op, p, fields(:, 1), fields(:, 2), fields(:, 3), fields(:, 4), fields(:, 5))
+      else
+         call surface_fields(op, p, fields(:, 1), fields(:, 3))
+      end if
+   end subroutine surface_stress_of_text
+
+   !> The 3x3 surface compliance of the scene's layer (lc_greens_kernel) for the wavevectors
+   !> (qx(i), qy(i)): (u_x^, u_y^, w^) = tensor(i, :, :) (tau_x^, tau_y^, p^). The text gives
+   !> no &loading.
+   subroutine tensor_of_text(text, qx, qy, tensor, error)
+      character(len=*), intent(in) :: text
+      real(wp), intent(in) :: qx(:), qy(:)
+      complex(wp), intent(out) :: tensor(:, :, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(scene_type) :: scene
+      type(layer_kernel) :: kernel
+      integer :: i
+      tensor = 0
+      call read_scene_text(any_load // text, source, scene, error)
+      if (allocated(error)) return
+      kernel = kernel_of(scene)
+      do i = 1, min(size(qx), size(qy), size(tensor, 1))
+         tensor(i, :, :) = kernel%tensor(qx(i), qy(i))
+      end do
+   end subroutine tensor_of_text
 
    !> The library's limits and markers a caller needs, as `name = value` lines.
    pure function library_constants() result(text)

@@ -91,18 +91,19 @@ def layer_multipliers(kh, nu: float):
     return _core.py_layer_coefficients(kh, float(nu))
 
 
-def surface_tensor(qx, qy, *, thickness=np.inf, young=1.0, poisson=0.5):
+def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None):
     """The layer's 3x3 surface compliance for in-plane wavevectors ``(qx, qy)`` (1/L,
     broadcast together): ``(u_x^, u_y^, w^) = T (tau_x^, tau_y^, p^)`` in convention P,
     shape ``broadcast.shape + (3, 3)``, complex. In the frame ``(l, t, z)`` with
     ``l = q/|q|`` it is the plane-strain multiplier with ``|k| -> |q|`` in ``(l, z)`` and the
     antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t``; ``q = 0`` gives the uniform mode
-    ``(h/G, h/G, h/M)`` of a layer (zero for a half-space)."""
+    ``(h/G, h/G, h/M)`` of a layer (zero for a half-space). The layer's keywords and their
+    defaults are those of :func:`solve_line` (``&layer``)."""
     qx, qy = np.broadcast_arrays(np.asarray(qx, dtype=np.float64), np.asarray(qy, dtype=np.float64))
-    if not -1.0 < poisson <= 0.5:
-        raise ValueError(f"poisson = {poisson} is not allowed; allowed: -1 < poisson <= 0.5")
-    t = _core.py_surface_tensor(np.ascontiguousarray(qx.ravel()), np.ascontiguousarray(qy.ravel()),
-                                float(thickness), float(young), float(poisson))
+    text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson}})
+    t, stat, errmsg = _core.py_surface_tensor(text, np.ascontiguousarray(qx.ravel()),
+                                              np.ascontiguousarray(qy.ravel()))
+    _check(stat, errmsg)
     return t.reshape(qx.shape + (3, 3))
 
 
@@ -494,15 +495,24 @@ def solve_areal(
     return results[0]
 
 
-def surface_fields(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson=0.5, friction=0.0):
+def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None):
     """Surface displacement ``u_x`` (L) and in-plane stress ``sigma_xx`` (S, tension
     positive) of the layer under a prescribed pressure (S) and shear ``friction * p``,
-    without solving a contact problem."""
+    without solving a contact problem. The keywords and their defaults are those of
+    :func:`solve_line`."""
     p = np.ascontiguousarray(np.asarray(pressure, dtype=np.float64))
-    ux, sxx, stat, errmsg = _core.py_surface_fields(p, float(period), float(thickness), float(young),
-                                                    float(poisson), float(friction))
+    fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction)
+    return fields[:, 0].copy(), fields[:, 2].copy()
+
+
+def _surface_stress(p, scene: dict, thickness, young, poisson, friction) -> np.ndarray:
+    """fields(n, 5) = u_x, u_y, sigma_xx, sigma_yy, sigma_xy of the layer under the flat
+    pressure ``p`` (x fastest) on the grid of the &scene variables ``scene``."""
+    text = _namelist({"scene": scene, "layer": {"thickness": thickness, "young": young, "poisson": poisson},
+                      "friction": {"coefficient": friction}})
+    fields, stat, errmsg = _core.py_surface_stress(text, p)
     _check(stat, errmsg)
-    return ux, sxx
+    return fields
 
 
 @dataclass
@@ -518,25 +528,25 @@ class SurfaceStress:
     stress_xy: np.ndarray | None = None
 
 
-def surface_stress(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson=0.5,
-                   friction=0.0) -> SurfaceStress:
+def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson=None,
+                   friction=None) -> SurfaceStress:
     """Surface displacements and stresses of an elastic layer (``thickness=np.inf``:
-    half-space) under the prescribed pressure (S; 1D for a line, ``(ny, nx)`` for a surface,
-    x = axis 1) and the shear ``friction * p`` along x, without solving a contact problem.
-    ``period`` is one length or, for a surface, a pair ``(period_x, period_y)``."""
+    half-space, the default) under the prescribed pressure (S; 1D for a line, ``(ny, nx)``
+    for a surface, x = axis 1) and the shear ``friction * p`` along x, without solving a
+    contact problem. ``period`` is one length or, for a surface, a pair ``(period_x,
+    period_y)``; the keywords and their defaults are those of :func:`solve_areal`."""
     p = np.asarray(pressure, dtype=np.float64)
     if p.ndim == 1:
-        lx = float(period) if np.ndim(period) == 0 else float(period[0])
+        lx = period if np.ndim(period) == 0 else float(period[0])
         ux, sxx = surface_fields(p, period=lx, thickness=thickness, young=young, poisson=poisson,
                                  friction=friction)
         return SurfaceStress(displacement_x=ux, stress_xx=sxx)
     if p.ndim != 2:
         raise ValueError(f"pressure must be 1D (line) or (ny, nx) (surface); got shape {p.shape}")
-    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
     ny, nx = p.shape
-    fields, stat, errmsg = _core.py_surface_stress(np.ascontiguousarray(p).ravel(), nx, lx, ly, float(thickness),
-                                                   float(young), float(poisson), float(friction))
-    _check(stat, errmsg)
+    scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
+    fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction)
     ux, uy, sxx, syy, sxy = (fields[:, k].reshape(ny, nx).copy() for k in range(5))
     return SurfaceStress(displacement_x=ux, stress_xx=sxx, displacement_y=uy, stress_yy=syy, stress_xy=sxy)
 
