@@ -35,24 +35,6 @@ subroutine py_layer_coefficients_lapack(n, kh, nu, one_minus_a, one_minus_b, c, 
    call status_of(error, stat, errmsg)
 end subroutine py_layer_coefficients_lapack
 
-!> Seeded self-affine line profile (lengths as given; -huge = not set: layercontact.api.NOT_SET).
-subroutine py_self_affine_profile(n, period, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
-      & rms_height, height, stat, errmsg)
-   use lc_errors, only: error_type, status_of
-   use lc_profiles_self_affine, only: self_affine_profile
-   implicit none (type, external)
-   integer, intent(in) :: n
-   real(8), intent(in) :: period, hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height
-   integer(8), intent(in) :: seed
-   real(8), intent(out) :: height(n)
-   integer, intent(out) :: stat
-   character(len=1024), intent(out) :: errmsg
-   type(error_type), allocatable :: error
-   call self_affine_profile(n, period, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
-      & rms_height, height, error)
-   call status_of(error, stat, errmsg)
-end subroutine py_self_affine_profile
-
 !> Solve the scene that the namelist `text` describes (made from Python keywords: the
 !> defaults, checks and messages of a namelist file) on the given heights (n = nx*ny, x
 !> fastest); with &friction companion, the frictionless companion is run 2. `table` names

@@ -22,31 +22,30 @@ _DEFAULT_DATASET = "/profile/height"
 
 def self_affine_profile(
     n: int,
-    hurst: float = 0.8,
+    hurst: float | None = None,
     *,
-    period: float = 1.0,
-    seed: int = 1,
+    period: float | None = None,
+    seed: int | None = None,
     rolloff_wavelength: float | None = None,
     short_wavelength: float | None = None,
     rms_gradient: float | None = None,
     rms_height: float | None = None,
 ) -> np.ndarray:
-    """Seeded self-affine line profile of ``n`` heights on one ``period``.
+    """Seeded self-affine line profile of ``n`` heights on one ``period``: the heights of
+    ``&profile kind='self_affine'``, made by the same routine from the same variables (a
+    keyword not given takes the namelist default: hurst 0.8, seed 1, period 1).
 
-    Power spectrum flat below the roll-off wavenumber, ``~ q^(-1-2H)`` up to the short
-    cutoff (default: ``period/128``), zero beyond; random phases from SplitMix64 seeded
-    with ``seed``; scaled to exactly ``rms_gradient`` or ``rms_height`` (give one; default
-    rms_gradient = 0.1). Same arguments, same heights as ``&profile kind='self_affine'``.
+    Power spectrum flat below the roll-off wavenumber (default: the period), ``~ q^(-1-2H)``
+    up to the short cutoff (default: ``period/128``), zero beyond; random phases from
+    SplitMix64 seeded with ``seed``; scaled to exactly ``rms_gradient`` or ``rms_height``
+    (give at most one; neither: rms_gradient 0.1). Raises LayercontactError with the
+    namelist's message for a value it does not allow.
     """
-    if rms_gradient is None and rms_height is None:
-        rms_gradient = 0.1
-    height, stat, errmsg = _core.py_self_affine_profile(
-        int(n), float(period), float(hurst), int(seed),
-        NOT_SET if rolloff_wavelength is None else float(rolloff_wavelength),
-        NOT_SET if short_wavelength is None else float(short_wavelength),
-        NOT_SET if rms_gradient is None else float(rms_gradient),
-        NOT_SET if rms_height is None else float(rms_height),
-    )
+    text = _namelist({"scene": {"n": int(n), "period": period},
+                      "profile": {"kind": "self_affine", "hurst": hurst, "seed": seed,
+                                  "rolloff_wavelength": rolloff_wavelength, "short_wavelength": short_wavelength,
+                                  "rms_gradient": rms_gradient, "rms_height": rms_height}})
+    height, stat, errmsg = _core.py_make_profile(text, int(n))
     _check(stat, errmsg)
     return height
 
