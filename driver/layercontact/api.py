@@ -1,5 +1,6 @@
-"""Pythonic API over the Fortran library: validation and unit handling stay thin, the
-Fortran messages become exceptions, results come back as plain dataclasses."""
+"""Pythonic API over the Fortran library. Keywords become the namelist text of a scene,
+which the library reads, completes with its defaults and checks as it does a namelist
+file; its messages become exceptions; results come back by name as plain dataclasses."""
 
 from __future__ import annotations
 
@@ -10,7 +11,6 @@ from dataclasses import fields as dataclass_fields
 import numpy as np
 
 from .native import core as _core
-
 
 
 def _lines(text: bytes | str) -> dict[str, str]:
