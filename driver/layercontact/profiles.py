@@ -190,32 +190,44 @@ def sinusoid_surface(
     n: int,
     amplitude: float,
     *,
-    mode: int = 1,
-    mode_y: int = 0,
-    period: float | tuple[float, float] = 1.0,
+    mode: int | None = None,
+    mode_y: int | None = None,
+    period: float | tuple[float, float] | None = None,
     nx: int | None = None,
     ny: int | None = None,
 ) -> np.ndarray:
     """``amplitude * cos(2 pi (mode x/lx + mode_y y/ly))`` on an ``(ny, nx)`` grid, the
-    heights of ``&profile kind='sinusoid'`` on an areal scene (``0 <= mode <= (nx-1)/2``,
-    ``|mode_y| <= (ny-1)/2``, not both zero; raises LayercontactError otherwise)."""
-    nx, ny, lx, ly = _surface_grid(n, period, nx, ny)
-    return _make_surface("sinusoid", nx, ny, lx, ly, amplitude=amplitude, mode=mode, mode_y=mode_y)
+    heights of ``&profile kind='sinusoid'`` on an areal scene (``mode`` default 1,
+    ``mode_y`` default 0; ``0 <= mode <= (nx-1)/2``, ``|mode_y| <= (ny-1)/2``, not both
+    zero; raises LayercontactError otherwise)."""
+    return _areal_profile(n, period, nx, ny, {"kind": "sinusoid", "amplitude": amplitude, "mode": mode,
+                                              "mode_y": mode_y})
 
 
 def spherical_cap(
     n: int,
     radius: float,
     *,
-    period: float | tuple[float, float] = 1.0,
+    period: float | tuple[float, float] | None = None,
     nx: int | None = None,
     ny: int | None = None,
 ) -> np.ndarray:
     """Spherical cap of ``radius`` R with its apex (height 0, the maximum) at the grid
     point ``(ix, iy) = (nx//2, ny//2)``: ``sqrt(R^2 - rho^2) - R`` within the distance R of
     the apex, ``-R`` beyond; the heights of ``&profile kind='sphere'``."""
-    nx, ny, lx, ly = _surface_grid(n, period, nx, ny)
-    return _make_surface("sphere", nx, ny, lx, ly, radius=radius)
+    return _areal_profile(n, period, nx, ny, {"kind": "sphere", "radius": radius})
+
+
+def _areal_profile(n, period, nx, ny, profile: dict) -> np.ndarray:
+    """The heights of an areal scene's &profile variables ``profile`` (the library's
+    make_profile, from namelist text: its defaults and checks), ``(ny, nx)``."""
+    nx, ny = int(n if nx is None else nx), int(n if ny is None else ny)
+    lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    text = _namelist({"scene": {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly},
+                      "profile": profile})
+    height, stat, errmsg = _core.py_make_profile(text, nx * ny)
+    _check(stat, errmsg)
+    return height.reshape(ny, nx)
 
 
 def read_surface(path: str | os.PathLike, nx: int, ny: int, dataset: str | None = None) -> np.ndarray:
