@@ -8,7 +8,8 @@ module lc_scene_text
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_internal
    use lc_strings, only: to_string
-   use lc_scene, only: scene_type, companion_of, is_areal, material_of, not_set, grid_of, kernel_of
+   use lc_scene, only: scene_type, profile_spec, companion_of, is_areal, material_of, not_set, grid_of, &
+      & kernel_of, default_rms_gradient
    use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_io_namelist, only: read_scene_text
    use lc_contact_solve, only: solve_contact
@@ -165,11 +166,16 @@ contains
       end do
    end subroutine tensor_of_text
 
-   !> The library's limits and markers a caller needs, as `name = value` lines.
+   !> The library's limits, markers and the defaults of a self-affine &profile, as
+   !> `name = value` lines (for callers that take the profile's values one by one).
    pure function library_constants() result(text)
       character(len=:), allocatable :: text
+      type(profile_spec) :: profile
       text = 'max_prony_terms = ' // to_string(max_prony_terms) // newline // &
-         & 'not_set = ' // real_text(not_set) // newline
+         & 'not_set = ' // real_text(not_set) // newline // &
+         & 'profile/hurst = ' // real_text(profile%hurst) // newline // &
+         & 'profile/seed = ' // to_string(profile%seed) // newline // &
+         & 'profile/rms_gradient = ' // real_text(default_rms_gradient) // newline
    end function library_constants
 
    !> Append what one run returns to `description` (lines `name = value unit`, the names

@@ -12,7 +12,7 @@ import os
 import numpy as np
 
 from .native import core as _core
-from .api import NOT_SET, _check, _namelist
+from .api import _CONSTANTS, NOT_SET, _check, _namelist
 
 # Length of the Fortran scene's file-name fields (lc_scene max_string).
 _MAX_STRING = 512
@@ -90,9 +90,9 @@ def _surface_grid(n, period, nx, ny) -> tuple[int, int, float, float]:
 
 def self_affine_surface(
     n: int = 512,
-    hurst: float = 0.8,
+    hurst: float | None = None,
     *,
-    seed: int = 1,
+    seed: int | None = None,
     short_wavelength: float | None = 1 / 64,
     rms_gradient: float | None = None,
     rms_height: float | None = None,
@@ -108,16 +108,18 @@ def self_affine_surface(
     ----------
     n : int
         Grid points along x and y (unless ``nx``, ``ny`` are given; each >= 4).
-    hurst : float
-        Hurst exponent H, 0 < H < 1: power spectrum ``C(q) ~ |q|^(-2-2H)``.
-    seed : int
-        SplitMix64 seed (>= 0); the phase of mode (mx, my) depends on the seed and the mode
+    hurst : float, optional
+        Hurst exponent H, 0 < H < 1: power spectrum ``C(q) ~ |q|^(-2-2H)``; default that of
+        ``&profile`` (0.8).
+    seed : int, optional
+        SplitMix64 seed (>= 0; default that of ``&profile``, 1); the phase of mode (mx, my) depends on the seed and the mode
         only, so a finer grid at the same ``short_wavelength`` gives the same surface.
     short_wavelength : float or None
         Shortest wavelength (L); None: ``min(lx, ly)/128``. Modes shorter than the grid
         allows are left out along with it (a round cut, keeping the surface isotropic).
     rms_gradient, rms_height : float, optional
-        Scale target, met exactly on the grid; give at most one (default rms_gradient 0.1).
+        Scale target, met exactly on the grid; give at most one (neither: the rms_gradient
+        of ``&profile``, 0.1).
     period : float or (float, float)
         Period (L), or the pair ``(lx, ly)``.
     rolloff_wavelength : float, optional
@@ -134,8 +136,11 @@ def self_affine_surface(
         ``(ny, nx)`` heights (L), zero mean.
     """
     nx, ny, lx, ly = _surface_grid(n, period, nx, ny)
+    # the defaults of &profile (lc_scene's profile_spec)
+    hurst = float(_CONSTANTS["profile/hurst"]) if hurst is None else hurst
+    seed = int(_CONSTANTS["profile/seed"]) if seed is None else seed
     if rms_gradient is None and rms_height is None:
-        rms_gradient = 0.1
+        rms_gradient = float(_CONSTANTS["profile/rms_gradient"])
     height, stat, errmsg = _core.py_self_affine_surface(
         nx,
         ny,
