@@ -144,7 +144,8 @@ class Problem:
         self.target = (self.lc_row["fraction_points"], self.lc_row["gap_error"])
 
     def lc_solve(self, tol):
-        return lc.solve_areal(self.heights, period=1.0, thickness=np.inf, young=YOUNG, poisson=POISSON,
+        return lc.solve_areal(self.heights, stress=False,
+                              period=1.0, thickness=np.inf, young=YOUNG, poisson=POISSON,
                               friction=0.0, mean_pressure=self.mean_pressure, tol=tol, threads=1)
 
     def errors(self, pressure):

@@ -86,7 +86,8 @@ def calibrate(h: float, nu: float, target: float) -> float:
 
     def frac(p):
         return np.mean(
-            [lc.solve_areal(s, thickness=h, poisson=nu, mean_pressure=p, tol=1e-8).contact_fraction
+            [lc.solve_areal(s, stress=False,
+                            thickness=h, poisson=nu, mean_pressure=p, tol=1e-8).contact_fraction
              for s in surfs]
         )
 

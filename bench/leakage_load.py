@@ -57,7 +57,8 @@ def run_surface(args: tuple[float, int, np.ndarray]) -> dict[str, np.ndarray]:
     out = {k: np.zeros(len(loads)) for k in KEYS}
     converged = True
     for i, P in enumerate(loads):
-        res = lc.solve_areal(s, thickness=h, poisson=0.5, friction=MU_C, mean_pressure=P * E_STAR * h,
+        res = lc.solve_areal(s, stress=False,
+                             thickness=h, poisson=0.5, friction=MU_C, mean_pressure=P * E_STAR * h,
                              companion=True, tol=TOL)
         c = res.companion
         converged &= bool(res.converged) and bool(c.converged)

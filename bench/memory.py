@@ -33,9 +33,9 @@ takes minutes at n = 2^20 and holds the same arrays).
 else a numpy fallback; H = 0.8, shortest wavelength 8 points, rms gradient 0.1) on a
 frictionless incompressible half-space (p_m/E* = 0.0125, constrained CG) and on the
 coupled layer h/period = 0.16, nu = 0.5, mu_c = 0.5 (p_m/E* = 0.015, GCR), solve_areal's
-defaults (tol 1e-10, coarse start, memory 12, threads 1). The increase of the peak over
-the resident set after making the surface is printed in doubles per grid point (targets:
-<= 20 frictionless, <= 30 coupled), and the slope between the two largest sizes (the
+defaults (tol 1e-10, coarse start, memory 12, threads 1) without the stress fields. The
+increase of the peak over the resident set after making the surface is printed in doubles
+per grid point (targets: <= 20 frictionless, <= 30 coupled), and the slope between the two largest sizes (the
 fixed part removed). ``--big 4096`` adds one frictionless half-space solve at 4096^2
 (time and peak; skipped if the peak predicted from the largest measured size exceeds
 ~20 GiB or the memory available).
@@ -88,7 +88,7 @@ print(json.dumps(dict(base=base, current=current, peak=peak, seconds=t, iteratio
 
 #: n-sized double arrays alive in each phase of lc.solve_line (complex arrays of n/2 + 1
 #: modes count as one); see the module docstring of each file named.
-F2PY = 7        # driver/wrappers.f90 py_solve: fields(n, 5) + spots(n/2+1, 4), zero-filled by f2py
+F2PY = 9        # driver/wrappers.f90 py_solve_scene: fields(n, 6) + spots(n/2+1, 5), zero-filled by f2py
 SOLVE = 3       # src/contact/solve.f90: p, w, gap
 OPERATOR = 5    # src/contact/operator.f90: metric 1/2, preconditioner 1/2, compliance (complex) 1,
 #                 column 1; src/fft/plans.F90: real_buffer 1, spectrum (complex) 1
@@ -97,8 +97,8 @@ CG = 4          # src/contact/solver_cg.f90: t, r, z, inside (a real 0/1 mask)
 ANDERSON = 7    # src/contact/solver_anderson.f90: x, f, x_old, f_old, tx, b, nw
 OBSERVE = 9     # src/result.f90 pressure, gap, displacement_z, displacement_x, shear, stress_xx;
 #                 src/observables/surface.f90: ph, uh, sh (complex)
-WRAP_END = 6    # py_solve copying the result r (6 fields) into `fields`
-PYTHON = 7      # api._solve_once: 5 field copies, shear = friction * p, height copy
+WRAP_END = 6    # lc_scene_text copying the result (6 fields) into `fields`
+PYTHON = 7      # api._solve_scene: 6 field copies; solve_line: height copy
 MEMORY = 12     # Anderson memory (default)
 
 
@@ -145,7 +145,8 @@ pm = s["pressure"] * 4 / 3                                  # p_m/E*, E* = 4/3
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
 current = status('VmRSS:')
 t = time.perf_counter()
-r = lc.solve_areal(h, thickness=s["thickness"], poisson=0.5, friction=s["friction"], mean_pressure=pm)
+r = lc.solve_areal(h, stress=False,
+                   thickness=s["thickness"], poisson=0.5, friction=s["friction"], mean_pressure=pm)
 t = time.perf_counter() - t
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 print(json.dumps(dict(base=base, current=current, peak=peak, seconds=t, iterations=r.iterations,

@@ -1,7 +1,8 @@
 !> The only file f2py sees: thin py_* wrappers with plain, explicit-shape arguments.
 !> Each builds the library's types from its arguments, calls one library routine, copies
 !> the results out and maps an error to stat (the exit code it would have) and errmsg.
-!> stat = 0 means success.
+!> stat = 0 means success. A scene comes as namelist text (lc_scene_text), so that its
+!> defaults, checks and messages are those of scene_type and a namelist file.
 
 !> 1-A, 1-B and c (convention P) for kh = |k| h, closed forms.
 subroutine py_layer_coefficients(n, kh, nu, one_minus_a, one_minus_b, c)
@@ -16,7 +17,7 @@ end subroutine py_layer_coefficients
 
 !> The same from the 4x4 plane-strain mode problem solved with LAPACK.
 subroutine py_layer_coefficients_lapack(n, kh, nu, one_minus_a, one_minus_b, c, stat, errmsg)
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_greens_layer, only: layer_coefficients_lapack
    implicit none (type, external)
    integer, intent(in) :: n
@@ -27,154 +28,106 @@ subroutine py_layer_coefficients_lapack(n, kh, nu, one_minus_a, one_minus_b, c, 
    !f2py intent(hide) :: n
    type(error_type), allocatable :: error
    integer :: i
-   stat = 0
-   errmsg = ''
    do i = 1, n
       call layer_coefficients_lapack(kh(i), nu, one_minus_a(i), one_minus_b(i), c(i), error)
-      if (allocated(error)) then
-         stat = error%code
-         errmsg = error%message
-         return
-      end if
+      if (allocated(error)) exit
    end do
+   call status_of(error, stat, errmsg)
 end subroutine py_layer_coefficients_lapack
 
-!> Seeded self-affine line profile (lengths as given; -huge = not set: layercontact.api.NOT_SET).
-subroutine py_self_affine_profile(n, period, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
-      & rms_height, height, stat, errmsg)
-   use lc_errors, only: error_type
-   use lc_profiles_self_affine, only: self_affine_profile
+!> Solve the scene that the namelist `text` describes (made from Python keywords: the
+!> defaults, checks and messages of a namelist file) on the given heights (n = nx*ny, x
+!> fastest); with &friction companion, the frictionless companion is run 2. `table` names
+!> what each run returns (lc_scene_text): its scalars, the columns of fields(:, :, run) and
+!> spots(:, :, run), and how many of the last residuals history(:, run) holds.
+subroutine py_solve_scene(text, n, height, runs, n_fields, spot_capacity, spot_columns, capacity, fields, spots, &
+      & history, table, stat, errmsg)
+   use lc_errors, only: error_type, status_of
+   use lc_scene_text, only: solve_scene_text
    implicit none (type, external)
+   character(len=*), intent(in) :: text
+   integer, intent(in) :: n, runs, n_fields, spot_capacity, spot_columns, capacity
+   real(8), intent(in) :: height(n)
+   real(8), intent(out) :: fields(n, n_fields, runs), spots(spot_capacity, spot_columns, runs), history(capacity, runs)
+   character(len=16384), intent(out) :: table
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   !f2py intent(hide) :: n
+   type(error_type), allocatable :: error
+   call solve_scene_text(text, height, fields, spots, history, table, error)
+   call status_of(error, stat, errmsg)
+end subroutine py_solve_scene
+
+!> The heights of the &profile of the scene in the namelist `text` (n = nx*ny values, x
+!> fastest), made as a namelist run makes them.
+subroutine py_make_profile(text, n, height, stat, errmsg)
+   use lc_errors, only: error_type, status_of
+   use lc_scene_text, only: profile_of_text
+   implicit none (type, external)
+   character(len=*), intent(in) :: text
    integer, intent(in) :: n
-   real(8), intent(in) :: period, hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height
-   integer(8), intent(in) :: seed
    real(8), intent(out) :: height(n)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    type(error_type), allocatable :: error
-   stat = 0
-   errmsg = ''
-   call self_affine_profile(n, period, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
-      & rms_height, height, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-   end if
-end subroutine py_self_affine_profile
+   call profile_of_text(text, height, error)
+   call status_of(error, stat, errmsg)
+end subroutine py_make_profile
 
-!> Solve a contact on the given heights: a line (areal = 0; n heights) or a surface
-!> (areal = 1; n = nx*ny heights, x fastest, period_y its period along y). control: 0 load,
-!> 1 displacement; method: 0 auto, 1 cg, 2 anderson, 3 gcr, 4 gfmd; precondition, coarse_start,
-!> verbose (progress lines on standard error), stress: 0/1.
-!> fields(:, 1:n_fields): pressure, gap, displacement_z, then with stress = 1 (n_fields = 5
-!> for a line, 8 for a surface) displacement_x, stress_xx (line) or displacement_x,
-!> displacement_y, stress_xx, stress_yy, stress_xy (surface);
-!> spots(1:n_spots, 1:n_columns) of a line (capacity nx/2 + 1): trailing and leading edges,
-!> largest sigma_xx around the spot (sub-grid at the trailing edge with friction), its
-!> offset from the trailing edge and the largest grid value (the last three with stress);
-!> of a surface (capacity n/2 + 1, n_columns = 2): area and perimeter of each patch;
-!> scalars: in the order of layercontact.api._SCALARS (the solver that ran as its index in
-!> `solvers`); history(1:history_length): the last
-!> residuals of the run, at most `capacity` (an array of max_iter entries would cost more
-!> than a small solve).
-subroutine py_solve(n, height, nx, areal, period, period_y, thickness, young, poisson, friction, control, &
-      & mean_pressure, penetration, method, precondition, coarse_start, verbose, tol, max_iter, memory, threads, stress, &
-      & model, &
-      & form, e0, e_inf, tau, equilibrium, nt, times, values, speed, capacity, n_fields, spot_capacity, n_columns, &
-      & fields, spots, scalars, history, stat, errmsg)
-   use lc_errors, only: error_type
-   use lc_scene, only: scene_type, check_scene
-   use lc_result, only: contact_result
-   use lc_contact_solve, only: solve_contact
-   use lc_greens_viscoelastic, only: make_material_law
+!> The library's limits and markers as `name = value` lines (lc_scene_text).
+subroutine py_constants(table)
+   use lc_scene_text, only: library_constants
    implicit none (type, external)
-   integer, intent(in) :: n, nx, areal, control, method, precondition, coarse_start, verbose, max_iter, memory, threads
-   integer, intent(in) :: stress
-   integer, intent(in) :: model, form, nt, capacity, n_fields, spot_capacity, n_columns
-   real(8), intent(in) :: height(n), period, period_y, thickness, young, poisson, friction, mean_pressure, penetration
-   real(8), intent(in) :: tol, e0, e_inf, tau, equilibrium, times(nt), values(nt), speed
-   real(8), intent(out) :: fields(n, n_fields), spots(spot_capacity, n_columns), scalars(34), history(capacity)
+   character(len=1024), intent(out) :: table
+   table = library_constants()
+end subroutine py_constants
+
+!> Prony terms from a two-column text file, read as &material prony_file reads it: the
+!> first `count` of times and values (room for `capacity`).
+subroutine py_read_prony_file(filename, capacity, times, values, count, stat, errmsg)
+   use lc_errors, only: error_type, status_of
+   use lc_io_namelist, only: read_prony_file
+   implicit none (type, external)
+   character(len=*), intent(in) :: filename
+   integer, intent(in) :: capacity
+   real(8), intent(out) :: times(capacity), values(capacity)
+   integer, intent(out) :: count, stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   real(8), allocatable :: read_times(:), read_values(:)
+   call read_prony_file(filename, read_times, read_values, error)
+   count = min(size(read_times), capacity)
+   times = 0
+   values = 0
+   times(:count) = read_times(:count)
+   values(:count) = read_values(:count)
+   call status_of(error, stat, errmsg)
+end subroutine py_read_prony_file
+
+!> Check a Prony series of `nt` times and `nv` values as &material checks it (form
+!> 'relaxation' or 'creep', the number of terms, their signs and order); times and values
+!> have room for one more than the larger count.
+subroutine py_check_prony(form, equilibrium, nt, nv, capacity, times, values, stat, errmsg)
+   use lc_errors, only: error_type, status_of
+   use lc_greens_viscoelastic, only: material_law, check_material
+   implicit none (type, external)
+   character(len=*), intent(in) :: form
+   integer, intent(in) :: nt, nv, capacity
+   real(8), intent(in) :: equilibrium, times(capacity), values(capacity)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
-   !f2py intent(hide) :: n, nt
+   !f2py intent(hide) :: capacity
    type(error_type), allocatable :: error
-   type(scene_type) :: scene
-   type(contact_result) :: r
-   character(len=12), parameter :: controls(0:1) = [character(len=12) :: 'load', 'displacement']
-   integer :: stored
-   character(len=8), parameter :: methods(0:4) = [character(len=8) :: 'auto', 'cg', 'anderson', 'gcr', 'gfmd']
-   !> the solver that ran, as scalars(27) (layercontact.api._SOLVERS)
-   character(len=16), parameter :: solvers(5) = [character(len=16) :: 'cg', 'gcr', 'anderson', 'gcr+anderson', 'gfmd']
-   stat = 0
-   errmsg = ''
-   scene = scene_type(n=nx, ny=n/max(nx, 1), period=period, period_y=period_y, thickness=thickness, young=young, &
-      & poisson=poisson, friction=friction, control=controls(max(0, min(1, control))), mean_pressure=mean_pressure, &
-      & penetration=penetration, stress=stress == 1, gap_bins=0)
-   if (areal == 1) scene%geometry = 'areal'
-   scene%profile%kind = 'file'
-   scene%profile%file = '(array from Python)'
-   scene%material = make_material_law(model, form, young, e0, e_inf, tau, equilibrium, times, values)
-   scene%speed = speed
-   scene%solver%method = methods(max(0, min(4, method)))
-   scene%solver%tol = tol
-   scene%solver%max_iter = max_iter
-   scene%solver%memory = memory
-   scene%solver%threads = threads
-   scene%solver%precondition = precondition == 1
-   scene%solver%coarse_start = coarse_start == 1
-   scene%solver%verbose = verbose == 1
-   call check_scene(scene, error)
-   if (.not. allocated(error)) call solve_contact(scene, height, friction, r, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
-   fields = 0
-   fields(:, 1) = r%pressure
-   fields(:, 2) = r%gap
-   fields(:, 3) = r%displacement_z
-   spots = 0
-   if (allocated(r%patch_area)) then
-      spots(1:r%n_spots, 1) = r%patch_area
-      if (n_columns > 1) spots(1:r%n_spots, 2) = r%patch_perimeter
-   else
-      spots(1:r%n_spots, 1) = r%spot_trailing
-      spots(1:r%n_spots, 2) = r%spot_leading
-   end if
-   if (allocated(r%stress_xx) .and. n_fields >= 5) then
-      fields(:, 4) = r%displacement_x
-      if (allocated(r%stress_yy) .and. n_fields >= 8) then
-         fields(:, 5) = r%displacement_y
-         fields(:, 6) = r%stress_xx
-         fields(:, 7) = r%stress_yy
-         fields(:, 8) = r%stress_xy
-      else
-         fields(:, 5) = r%stress_xx
-      end if
-   end if
-   if (allocated(r%spot_max_tension) .and. n_columns >= 5) then
-      spots(1:r%n_spots, 3) = r%spot_max_tension
-      spots(1:r%n_spots, 4) = r%spot_tension_offset
-      spots(1:r%n_spots, 5) = r%spot_max_tension_grid
-   end if
-   stored = min(size(r%residual_history), capacity)
-   history(1:stored) = r%residual_history(size(r%residual_history) - stored + 1:)
-   scalars = [r%mean_pressure, r%penetration, r%contact_fraction, r%delta_mu, r%delta_mu_spectral, &
-      & r%delta_mu_energy, r%delta_mu_profile, merge(1.0d0, 0.0d0, r%converged), real(r%iterations, 8), &
-      & real(r%outer_iterations, 8), real(r%fft_pairs, 8), r%residual, r%wall_time, &
-      & real(stored, 8), real(r%n_spots, 8), r%contact_length, r%mean_gap, r%leak_rate, &
-      & r%max_tension, r%max_tension_x, r%max_tension_offset, r%dissipated_power, merge(1d0, 0d0, r%monotone), &
-      & r%pressure_shift, r%summit_shift, r%max_tension_grid, real(findloc(solvers, r%solver, dim=1), 8), &
-      & r%normalised_pressure, r%normalised_thickness, r%max_tension_y, r%max_principal_stress, &
-      & r%max_principal_x, r%max_principal_y, r%gap_resolution]
-end subroutine py_solve
+   call check_material(material_law(model='prony', form=form, equilibrium=equilibrium, times=times(:nt), &
+      & values=values(:nv)), error)
+   call status_of(error, stat, errmsg)
+end subroutine py_check_prony
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless
 !> verbose = 1). converged: 0/1.
 subroutine py_run(input, verbose, output_file, converged, stat, errmsg)
    use, intrinsic :: iso_fortran_env, only: output_unit
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_run, only: run_scene_file
    implicit none (type, external)
    character(len=*), intent(in) :: input
@@ -185,22 +138,17 @@ subroutine py_run(input, verbose, output_file, converged, stat, errmsg)
    type(error_type), allocatable :: error
    character(len=:), allocatable :: written
    logical :: ok
-   stat = 0
-   errmsg = ''
    output_file = ''
    call run_scene_file(input, merge(output_unit, -1, verbose == 1), written, ok, error)
    converged = merge(1, 0, ok)
    if (allocated(written)) output_file = written
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-   end if
+   call status_of(error, stat, errmsg)
    flush (output_unit)
 end subroutine py_run
 
 !> Read and validate a namelist file without solving (what the executable checks first).
 subroutine py_check_scene_file(input, stat, errmsg)
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_scene, only: scene_type
    use lc_io_namelist, only: read_scene
    implicit none (type, external)
@@ -210,19 +158,14 @@ subroutine py_check_scene_file(input, stat, errmsg)
    type(error_type), allocatable :: error
    type(scene_type) :: scene
    character(len=:), allocatable :: text
-   stat = 0
-   errmsg = ''
    call read_scene(input, scene, text, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-   end if
+   call status_of(error, stat, errmsg)
 end subroutine py_check_scene_file
 
 !> The grid (n, and ny: 1 on a line) and tolerance tol the accuracy rule picks for a scene
 !> file with &solver target_error (runs the pilot solve; writes nothing).
 subroutine py_choose_resolution(input, n, ny, tol, stat, errmsg)
-   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_errors, only: error_type, fatal_error, code_input, status_of
    use lc_scene, only: scene_type, not_set
    use lc_io_namelist, only: read_scene
    use lc_accuracy, only: choose_resolution
@@ -235,8 +178,6 @@ subroutine py_choose_resolution(input, n, ny, tol, stat, errmsg)
    type(error_type), allocatable :: error
    type(scene_type) :: scene
    character(len=:), allocatable :: text
-   stat = 0
-   errmsg = ''
    n = 0
    ny = 0
    tol = 0
@@ -244,79 +185,60 @@ subroutine py_choose_resolution(input, n, ny, tol, stat, errmsg)
    if (.not. allocated(error) .and. scene%solver%target_error == not_set) &
       & call fatal_error(error, '&solver: target_error is not given in ' // input, code_input)
    if (.not. allocated(error)) call choose_resolution(scene, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
+   call status_of(error, stat, errmsg)
+   if (allocated(error)) return
    n = scene%n
    ny = scene%ny
    tol = scene%solver%tol
 end subroutine py_choose_resolution
 
-!> Surface displacement u_x and stress sigma_xx for a prescribed pressure p (no contact
-!> solve): tau = friction p on an elastic layer (thickness = Inf: half-space).
-subroutine py_surface_fields(n, p, period, thickness, young, poisson, friction, displacement_x, stress_xx, &
-      & stat, errmsg)
-   use lc_errors, only: error_type
-   use lc_greens_viscoelastic, only: material_law
-   use lc_grid, only: line_grid
-   use lc_greens_kernel, only: make_kernel
-   use lc_contact_operator, only: compliance_operator, build_operator
-   use lc_observables_surface, only: surface_fields
+!> In-plane surface displacements and stresses (fields(:, 1:5): u_x, u_y, sigma_xx,
+!> sigma_yy, sigma_xy) of the layer of the scene in the namelist `text` under a prescribed
+!> pressure p (n = nx*ny values, x fastest) and the shear friction*p along x (no contact
+!> solve; a line has u_x and sigma_xx only).
+subroutine py_surface_stress(text, n, p, fields, stat, errmsg)
+   use lc_errors, only: error_type, status_of
+   use lc_scene_text, only: surface_stress_of_text
    implicit none (type, external)
+   character(len=*), intent(in) :: text
    integer, intent(in) :: n
-   real(8), intent(in) :: p(n), period, thickness, young, poisson, friction
-   real(8), intent(out) :: displacement_x(n), stress_xx(n)
+   real(8), intent(in) :: p(n)
+   real(8), intent(out) :: fields(n, 5)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
    type(error_type), allocatable :: error
-   type(compliance_operator) :: op
-   stat = 0
-   errmsg = ''
-   call build_operator(op, line_grid(n, period), make_kernel(thickness, material_law(young=young), poisson, 0d0), &
-      & friction, 1, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
-   call surface_fields(op, p, displacement_x, stress_xx)
-end subroutine py_surface_fields
+   call surface_stress_of_text(text, p, fields, error)
+   call status_of(error, stat, errmsg)
+end subroutine py_surface_stress
 
-!> J*(k) of seed Eq. (14) at omega = k V for a material law (codes as in py_solve_line).
-subroutine py_creep_compliance(nw, omega, model, form, young, e0, e_inf, tau, equilibrium, nt, times, values, &
-      & compliance, stat, errmsg)
-   use lc_errors, only: error_type
-   use lc_greens_viscoelastic, only: material_law, make_material_law, check_material, creep_compliance
+!> J*(k) of seed Eq. (14) at omega = k V for the material law of the &layer and &material
+!> groups of the namelist `text`.
+subroutine py_creep_compliance(text, nw, omega, compliance, stat, errmsg)
+   use lc_errors, only: error_type, status_of
+   use lc_greens_viscoelastic, only: material_law, creep_compliance
+   use lc_scene_text, only: material_of_text
    implicit none (type, external)
-   integer, intent(in) :: nw, model, form, nt
-   real(8), intent(in) :: omega(nw), young, e0, e_inf, tau, equilibrium, times(nt), values(nt)
+   character(len=*), intent(in) :: text
+   integer, intent(in) :: nw
+   real(8), intent(in) :: omega(nw)
    complex(8), intent(out) :: compliance(nw)
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
-   !f2py intent(hide) :: nw, nt
+   !f2py intent(hide) :: nw
    type(error_type), allocatable :: error
    type(material_law) :: law
-   stat = 0
-   errmsg = ''
    compliance = 0
-   law = make_material_law(model, form, young, e0, e_inf, tau, equilibrium, times, values)
-   call check_material(law, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
-   compliance = creep_compliance(law, omega)
+   call material_of_text(text, law, error)
+   if (.not. allocated(error)) compliance = creep_compliance(law, omega)
+   call status_of(error, stat, errmsg)
 end subroutine py_creep_compliance
 
 !> Seconds per FFTW r2c + c2r pair of size n (the cost unit of the benchmarks), the best
 !> of `rounds` timings of `repeats` pairs each.
 subroutine py_fft_pair_seconds(n, repeats, rounds, seconds, stat, errmsg)
    use, intrinsic :: iso_fortran_env, only: int64
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_fft_plans, only: fft_plan
    implicit none (type, external)
    integer, intent(in) :: n, repeats, rounds
@@ -327,14 +249,9 @@ subroutine py_fft_pair_seconds(n, repeats, rounds, seconds, stat, errmsg)
    type(fft_plan) :: fft
    integer(int64) :: start, finish, rate
    integer :: i, r
-   stat = 0
-   errmsg = ''
    call fft%init(n, 1, 1, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
+   call status_of(error, stat, errmsg)
+   if (allocated(error)) return
    call random_number(fft%real_buffer)
    seconds = huge(1d0)
    do r = 1, rounds
@@ -360,30 +277,29 @@ subroutine py_cpu_level(level, isa)
    isa = build_isa
 end subroutine py_cpu_level
 
-!> The layer's 3x3 surface compliance (lc_greens_kernel) for the wavevectors (qx, qy):
-!> (u_x^, u_y^, w^) = tensor(i, :, :) (tau_x^, tau_y^, p^), an elastic layer of thickness
-!> h (Inf: half-space).
-subroutine py_surface_tensor(n, qx, qy, thickness, young, poisson, tensor)
-   use lc_greens_viscoelastic, only: material_law
-   use lc_greens_kernel, only: layer_kernel, make_kernel
+!> The 3x3 surface compliance (lc_greens_kernel) of the layer of the scene in the namelist
+!> `text` for the wavevectors (qx, qy): (u_x^, u_y^, w^) = tensor(i, :, :) (tau_x^, tau_y^, p^).
+subroutine py_surface_tensor(text, n, qx, qy, tensor, stat, errmsg)
+   use lc_errors, only: error_type, status_of
+   use lc_scene_text, only: tensor_of_text
    implicit none (type, external)
+   character(len=*), intent(in) :: text
    integer, intent(in) :: n
-   real(8), intent(in) :: qx(n), qy(n), thickness, young, poisson
+   real(8), intent(in) :: qx(n), qy(n)
    complex(8), intent(out) :: tensor(n, 3, 3)
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
-   type(layer_kernel) :: kernel
-   integer :: i
-   kernel = make_kernel(thickness, material_law(young=young), poisson, 0d0)
-   do i = 1, n
-      tensor(i, :, :) = kernel%tensor(qx(i), qy(i))
-   end do
+   type(error_type), allocatable :: error
+   call tensor_of_text(text, qx, qy, tensor, error)
+   call status_of(error, stat, errmsg)
 end subroutine py_surface_tensor
 
 !> A random isotropic self-affine surface (lc_profiles_surface), heights flat with x fastest
 !> (numpy height.reshape(ny, nx)). Not-given lengths and targets are passed as -1.
 subroutine py_self_affine_surface(nx, ny, lx, ly, hurst, seed, rolloff, short, rms_gradient, rms_height, height, &
       & stat, errmsg)
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_profiles_surface, only: self_affine_surface
    implicit none (type, external)
    integer, intent(in) :: nx, ny
@@ -393,13 +309,8 @@ subroutine py_self_affine_surface(nx, ny, lx, ly, hurst, seed, rolloff, short, r
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    type(error_type), allocatable :: error
-   stat = 0
-   errmsg = ''
    call self_affine_surface(nx, ny, lx, ly, hurst, seed, rolloff, short, rms_gradient, rms_height, height, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-   end if
+   call status_of(error, stat, errmsg)
 end subroutine py_self_affine_surface
 
 !> The surface of an areal scene's &profile (kind = sinusoid | sphere | file) on an
@@ -407,7 +318,7 @@ end subroutine py_self_affine_surface
 !> x fastest. Not-given amplitude and radius are passed as -1.
 subroutine py_make_surface(profile_kind, nx, ny, lx, ly, amplitude, mode, mode_y, radius, filename, dataset, height, &
       & stat, errmsg)
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_scene, only: scene_type
    use lc_profiles_profile, only: make_profile
    implicit none (type, external)
@@ -419,8 +330,6 @@ subroutine py_make_surface(profile_kind, nx, ny, lx, ly, amplitude, mode, mode_y
    character(len=1024), intent(out) :: errmsg
    type(error_type), allocatable :: error
    type(scene_type) :: scene
-   stat = 0
-   errmsg = ''
    scene%geometry = 'areal'
    scene%n = nx
    scene%ny = ny
@@ -434,44 +343,8 @@ subroutine py_make_surface(profile_kind, nx, ny, lx, ly, amplitude, mode, mode_y
    scene%profile%file = filename
    scene%profile%dataset = dataset
    call make_profile(scene, height, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-   end if
+   call status_of(error, stat, errmsg)
 end subroutine py_make_surface
-
-!> In-plane displacements and surface stresses of an elastic layer (thickness Inf: half-space)
-!> under a prescribed pressure p on a surface (n = nx*ny values, x fastest) and the shear
-!> friction*p along x (no contact solve). fields(:, 1:5): u_x, u_y, sigma_xx, sigma_yy,
-!> sigma_xy.
-subroutine py_surface_stress(n, p, nx, period, period_y, thickness, young, poisson, friction, fields, stat, errmsg)
-   use lc_errors, only: error_type
-   use lc_greens_viscoelastic, only: material_law
-   use lc_grid, only: surface_grid
-   use lc_greens_kernel, only: make_kernel
-   use lc_contact_operator, only: compliance_operator, build_operator
-   use lc_observables_stress, only: surface_stress
-   implicit none (type, external)
-   integer, intent(in) :: n, nx
-   real(8), intent(in) :: p(n), period, period_y, thickness, young, poisson, friction
-   real(8), intent(out) :: fields(n, 5)
-   integer, intent(out) :: stat
-   character(len=1024), intent(out) :: errmsg
-   !f2py intent(hide) :: n
-   type(error_type), allocatable :: error
-   type(compliance_operator) :: op
-   stat = 0
-   errmsg = ''
-   fields = 0
-   call build_operator(op, surface_grid(nx, n/nx, period, period_y), &
-      & make_kernel(thickness, material_law(young=young), poisson, 0d0), friction, 1, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
-   call surface_stress(op, p, fields(:, 1), fields(:, 2), fields(:, 3), fields(:, 4), fields(:, 5))
-end subroutine py_surface_stress
 
 !> Sizes of the heights in a file (&profile file, dataset), read by the reader of
 !> &profile kind = 'file' (lc_profiles_height_file): nx x ny with x fastest, (n, 1) for a

@@ -8,7 +8,7 @@ module lc_errors
    use lc_kinds, only: wp
    implicit none (type, external)
    private
-   public :: error_type, fatal_error, input_error, positive_finite
+   public :: error_type, fatal_error, input_error, positive_finite, status_of
    public :: code_input, code_not_converged, code_io, code_internal
 
    integer, parameter :: code_input = 2
@@ -42,6 +42,19 @@ contains
       call fatal_error(error, '&' // group // ': ' // variable // ' = ' // value // ' is not allowed; allowed: ' &
          & // allowed, code_input)
    end subroutine input_error
+
+   !> An error as the plain status of the Python wrappers: stat = its code (0: no error)
+   !> and errmsg = its message (cut to the length of errmsg).
+   pure subroutine status_of(error, stat, errmsg)
+      type(error_type), allocatable, intent(in) :: error
+      integer, intent(out) :: stat
+      character(len=*), intent(out) :: errmsg
+      stat = 0
+      errmsg = ''
+      if (.not. allocated(error)) return
+      stat = error%code
+      errmsg = error%message
+   end subroutine status_of
 
    !> True for a finite x > 0 (the common input check; false for NaN and Inf).
    pure logical function positive_finite(x)

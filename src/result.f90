@@ -5,7 +5,7 @@ module lc_result
    use lc_leakage_reynolds, only: leakage_result
    implicit none (type, external)
    private
-   public :: contact_result
+   public :: contact_result, result_scalar, result_scalars
 
    !> One solved contact problem (a scene, or its frictionless companion).
    type :: contact_result
@@ -78,4 +78,81 @@ module lc_result
       !> areal contacts, with &output leakage: the Reynolds leakage of the gap (lc_leakage_reynolds)
       type(leakage_result), allocatable :: leakage
    end type contact_result
+
+   !> One scalar of a result under its name: the /results attribute of the result file and
+   !> the attribute of the Python result object. unit '1': dimensionless or a count. Counts
+   !> and flags (0/1) are integers; the solver that ran is text.
+   type :: result_scalar
+      character(len=24) :: name = ''
+      real(wp) :: value = 0.0_wp
+      character(len=8) :: unit = '1'
+      logical :: is_integer = .false.
+      logical :: is_text = .false.
+      character(len=16) :: text = ''
+   end type result_scalar
+
+contains
+
+   !> The scalars of a result by name, in the order the result file lists them: those of
+   !> the surface stress only when it was computed (and, for max_tension_y and the principal
+   !> stress, on a surface); a_over_a0 when a frictionless companion was solved.
+   pure function result_scalars(res, areal, a_over_a0) result(table)
+      type(contact_result), intent(in) :: res
+      logical, intent(in) :: areal
+      real(wp), intent(in), optional :: a_over_a0
+      type(result_scalar), allocatable :: table(:)
+
+      table = [real_scalar('mean_pressure', res%mean_pressure, 'S'), &
+         & real_scalar('penetration', res%penetration, 'L'), &
+         & real_scalar('contact_fraction', res%contact_fraction), &
+         & real_scalar('delta_mu', res%delta_mu), &
+         & real_scalar('delta_mu_spectral', res%delta_mu_spectral), &
+         & real_scalar('delta_mu_energy', res%delta_mu_energy), &
+         & real_scalar('delta_mu_profile', res%delta_mu_profile), &
+         & real_scalar('total_friction', res%friction + res%delta_mu), &
+         & real_scalar('dissipated_power', res%dissipated_power, 'S L/T'), &
+         & real_scalar('pressure_shift', res%pressure_shift, 'L'), &
+         & real_scalar('summit_shift', res%summit_shift, 'L'), &
+         & integer_scalar('monotone', merge(1, 0, res%monotone)), &
+         & integer_scalar('converged', merge(1, 0, res%converged)), &
+         & integer_scalar('iterations', res%iterations), &
+         & integer_scalar('outer_iterations', res%outer_iterations), &
+         & result_scalar('solver', is_text=.true., text=res%solver), &
+         & integer_scalar('fft_pairs', res%fft_pairs), &
+         & real_scalar('residual', res%residual), &
+         & real_scalar('gap_resolution', res%gap_resolution), &
+         & real_scalar('wall_time', res%wall_time, 's'), &
+         & real_scalar('friction', res%friction), &
+         & integer_scalar('n_spots', res%n_spots), &
+         & real_scalar('contact_length', res%contact_length, 'L'), &
+         & real_scalar('mean_gap', res%mean_gap, 'L'), &
+         & real_scalar('leak_rate', res%leak_rate, 'L^3')]
+      if (allocated(res%stress_xx)) then
+         table = [table, real_scalar('max_tension', res%max_tension, 'S'), &
+            & real_scalar('max_tension_grid', res%max_tension_grid, 'S'), &
+            & real_scalar('max_tension_x', res%max_tension_x, 'L'), &
+            & real_scalar('max_tension_offset', res%max_tension_offset, 'L')]
+         if (areal) table = [table, real_scalar('max_tension_y', res%max_tension_y, 'L'), &
+            & real_scalar('max_principal_stress', res%max_principal_stress, 'S'), &
+            & real_scalar('max_principal_x', res%max_principal_x, 'L'), &
+            & real_scalar('max_principal_y', res%max_principal_y, 'L')]
+      end if
+      table = [table, real_scalar('normalised_pressure', res%normalised_pressure), &
+         & real_scalar('normalised_thickness', res%normalised_thickness)]
+      if (present(a_over_a0)) table = [table, real_scalar('a_over_a0', a_over_a0)]
+   end function result_scalars
+
+   pure type(result_scalar) function real_scalar(name, value, unit)
+      character(len=*), intent(in) :: name
+      real(wp), intent(in) :: value
+      character(len=*), intent(in), optional :: unit
+      real_scalar = result_scalar(name, value)
+      if (present(unit)) real_scalar%unit = unit
+   end function real_scalar
+
+   pure type(result_scalar) function integer_scalar(name, value)
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: value
+      integer_scalar = result_scalar(name, real(value, wp), is_integer=.true.)
+   end function integer_scalar
 end module lc_result

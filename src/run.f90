@@ -8,7 +8,7 @@ module lc_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, fatal_error, code_input
-   use lc_scene, only: scene_type, not_set, is_areal, check_scene, grid_of
+   use lc_scene, only: scene_type, not_set, is_areal, check_scene, grid_of, companion_of
    use lc_grid, only: grid_type
    use lc_leakage_reynolds, only: reynolds_leakage
    use lc_result, only: contact_result
@@ -33,7 +33,7 @@ contains
       character(len=:), allocatable, intent(out) :: output_file
       logical, intent(out) :: converged
       type(error_type), allocatable, intent(out) :: error
-      type(scene_type) :: scene, companion_scene
+      type(scene_type) :: scene
       type(contact_result) :: result, companion
       character(len=:), allocatable :: text
       real(wp), allocatable :: height(:)
@@ -83,15 +83,7 @@ contains
          if (allocated(error)) return
       end if
       if (scene%companion) then
-         ! the frictionless companion at the same load (whatever the scene's control)
-         associate (c => companion_scene)
-            c = scene
-            c%control = 'load'
-            c%mean_pressure = result%mean_pressure
-            c%normalised_pressure = not_set
-            c%penetration = not_set
-         end associate
-         call solve_contact(companion_scene, height, 0.0_wp, companion, error)
+         call solve_contact(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
          if (allocated(error)) return
          if (scene%leakage) then
             call leakage_of(scene, companion, error)

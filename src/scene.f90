@@ -17,7 +17,7 @@ module lc_scene
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
-      & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale
+      & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale, companion_of
    public :: max_string, default_rms_gradient
 
    !> Sentinel for "not given" in optional positive quantities: a value nobody types, so
@@ -26,6 +26,8 @@ module lc_scene
    !> rms gradient of a self-affine profile when neither rms_gradient nor rms_height is given
    !> (under linear elasticity the scale only matters relative to the pressure).
    real(wp), parameter :: default_rms_gradient = 0.1_wp
+   !> +Inf (the bits of IEEE double +Inf): the thickness of a half-space.
+   real(wp), parameter :: half_space = transfer(int(z'7FF0000000000000', i8), 1.0_wp)
    !> Largest solver iteration budget (the residual history is kept for every iteration).
    integer, parameter :: max_iterations = 10000000
    !> Length of the fixed-size character components (file names, keywords).
@@ -98,7 +100,7 @@ module lc_scene
       real(wp) :: period_y = not_set
       !> &scene n, nx or ny given: without them a profile file sets the grid (its size)
       logical :: grid_given = .false.
-      real(wp) :: thickness = 0.16_wp      !< h (L); +Inf = half-space
+      real(wp) :: thickness = half_space   !< h (L); +Inf = half-space (the default: no length scale)
       real(wp) :: young = 1.0_wp           !< E (S)
       real(wp) :: poisson = 0.5_wp         !< nu
       !> material law (elastic: young; sls, prony: see lc_greens_viscoelastic) and the
@@ -188,6 +190,21 @@ contains
          pressure_scale = static_contact_modulus(scene)*lambda0/scene%period
       end if
    end function pressure_scale
+
+   !> The frictionless companion of a scene: a/a0 compares contact areas at the same load,
+   !> the scene's own under load control and otherwise the `mean_pressure` its solve found.
+   !> (The friction coefficient is passed to the solve, zero for the companion.)
+   pure function companion_of(scene, mean_pressure) result(companion)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: mean_pressure
+      type(scene_type) :: companion
+      companion = scene
+      if (trim(scene%control) == 'load') return
+      companion%control = 'load'
+      companion%mean_pressure = mean_pressure
+      companion%normalised_pressure = not_set
+      companion%penetration = not_set
+   end function companion_of
 
    !> Validate a scene; the message names the namelist group, the variable, the value
    !> and the allowed range.

@@ -8,6 +8,7 @@ friction traction on the layer is ``tau = +mu_c p``.
 
 from .api import (
     ArealResult,
+    InputError,
     LayercontactError,
     LineResult,
     check_scene_file,
@@ -47,6 +48,7 @@ __all__ = [
     "Prony",
     "StandardLinearSolid",
     "creep_compliance",
+    "InputError",
     "LayercontactError",
     "LeakageResult",
     "LineResult",

@@ -1,33 +1,29 @@
-"""Pythonic API over the Fortran library: validation and unit handling stay thin, the
-Fortran messages become exceptions, results come back as plain dataclasses."""
+"""Pythonic API over the Fortran library. Keywords become the namelist text of a scene,
+which the library reads, completes with its defaults and checks as it does a namelist
+file; its messages become exceptions; results come back by name as plain dataclasses."""
 
 from __future__ import annotations
 
 import os
-import sys
 from dataclasses import dataclass, field
+from dataclasses import fields as dataclass_fields
 
 import numpy as np
 
 from .leakage import CoreLeakage
 from .native import core as _core
 
+
+def _lines(text: bytes | str) -> dict[str, str]:
+    """The ``name = value`` lines of a text from the library, as text values by name."""
+    text = text.decode() if isinstance(text, bytes) else str(text)
+    pairs = (line.split(" = ", 1) for line in text.splitlines() if " = " in line)
+    return {name.strip(): value.strip() for name, value in pairs}
+
+
+_CONSTANTS = _lines(_core.py_constants())
 # The library's "not given" (lc_scene's not_set): a value nobody types.
-NOT_SET = -sys.float_info.max
-_CONTROLS = {"load": 0, "displacement": 1}
-_METHODS = {"auto": 0, "cg": 1, "anderson": 2, "gcr": 3, "gfmd": 4}
-# Order of the scalars returned by the wrapper py_solve (driver/wrappers.f90).
-_SCALARS = (
-    "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
-    "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
-    "history_length", "n_spots", "contact_length", "mean_gap", "leak_rate", "max_tension", "max_tension_x",
-    "max_tension_offset", "dissipated_power", "monotone", "pressure_shift", "summit_shift",
-    "max_tension_grid", "solver", "normalised_pressure", "normalised_thickness", "max_tension_y",
-    "max_principal_stress", "max_principal_x", "max_principal_y", "gap_resolution",
-)
-# The solver that ran, by the code in the scalars (driver/wrappers.f90 `solvers`).
-_SOLVERS = {1: "cg", 2: "gcr", 3: "anderson", 4: "gcr+anderson", 5: "gfmd"}
-_INTEGERS = ("iterations", "outer_iterations", "fft_pairs", "n_spots")
+NOT_SET = float(_CONSTANTS["not_set"])
 # Residuals returned per solve (the last ones): a max_iter-long array would cost more than
 # a small solve.
 HISTORY_CAPACITY = 10000
@@ -42,10 +38,43 @@ class LayercontactError(RuntimeError):
         self.code = code
 
 
+class InputError(LayercontactError, ValueError):
+    """Bad input (code 2): a value the library does not allow. The message is the one a
+    namelist file with that value gets: it names the group, the variable, the value and
+    the allowed range."""
+
+
 def _check(stat: int, errmsg: bytes | str) -> None:
     if stat != 0:
         text = errmsg.decode() if isinstance(errmsg, bytes) else str(errmsg)
-        raise LayercontactError(text.strip(), int(stat))
+        raise (InputError if int(stat) == 2 else LayercontactError)(text.strip(), int(stat))
+
+
+def _namelist_value(value) -> str:
+    """A Python value as a namelist value (reals with all the digits of a double)."""
+    if isinstance(value, (bool, np.bool_)):
+        return ".true." if value else ".false."
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        x = float(value)
+        return "NaN" if x != x else {float("inf"): "Inf", -float("inf"): "-Inf"}.get(x, repr(x))
+    if isinstance(value, str):
+        return "'" + value.replace("'", "''") + "'"
+    # a few values a line: long arrays (Prony terms) stay readable
+    items = [_namelist_value(v) for v in value]
+    return ",\n   ".join(", ".join(items[i:i + 4]) for i in range(0, len(items), 4))
+
+
+def _namelist(groups: dict[str, dict]) -> str:
+    """Namelist text of the given variables, group by group; None means not given (the
+    scene's default stays)."""
+    text = []
+    for group, variables in groups.items():
+        given = [f" {name} = {_namelist_value(value)}" for name, value in variables.items() if value is not None]
+        if given:
+            text += [f"&{group}", *given, "/"]
+    return "\n".join(text) + "\n"
 
 
 def layer_multipliers(kh, nu: float):
@@ -63,18 +92,19 @@ def layer_multipliers(kh, nu: float):
     return _core.py_layer_coefficients(kh, float(nu))
 
 
-def surface_tensor(qx, qy, *, thickness=np.inf, young=1.0, poisson=0.5):
+def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None):
     """The layer's 3x3 surface compliance for in-plane wavevectors ``(qx, qy)`` (1/L,
     broadcast together): ``(u_x^, u_y^, w^) = T (tau_x^, tau_y^, p^)`` in convention P,
     shape ``broadcast.shape + (3, 3)``, complex. In the frame ``(l, t, z)`` with
     ``l = q/|q|`` it is the plane-strain multiplier with ``|k| -> |q|`` in ``(l, z)`` and the
     antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t``; ``q = 0`` gives the uniform mode
-    ``(h/G, h/G, h/M)`` of a layer (zero for a half-space)."""
+    ``(h/G, h/G, h/M)`` of a layer (zero for a half-space). The layer's keywords and their
+    defaults are those of :func:`solve_line` (``&layer``)."""
     qx, qy = np.broadcast_arrays(np.asarray(qx, dtype=np.float64), np.asarray(qy, dtype=np.float64))
-    if not -1.0 < poisson <= 0.5:
-        raise ValueError(f"poisson = {poisson} is not allowed; allowed: -1 < poisson <= 0.5")
-    t = _core.py_surface_tensor(np.ascontiguousarray(qx.ravel()), np.ascontiguousarray(qy.ravel()),
-                                float(thickness), float(young), float(poisson))
+    text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson}})
+    t, stat, errmsg = _core.py_surface_tensor(text, np.ascontiguousarray(qx.ravel()),
+                                              np.ascontiguousarray(qy.ravel()))
+    _check(stat, errmsg)
     return t.reshape(qx.shape + (3, 3))
 
 
@@ -170,132 +200,159 @@ class LineResult:
 def solve_line(
     heights,
     *,
-    period: float = 1.0,
-    thickness: float = np.inf,
-    young: float = 1.0,
-    poisson: float = 0.5,
-    friction: float = 0.0,
+    period: float | None = None,
+    thickness: float | None = None,
+    young: float | None = None,
+    poisson: float | None = None,
+    friction: float | None = None,
     mean_pressure: float | None = None,
+    normalised_pressure: float | None = None,
     penetration: float | None = None,
     material=None,
-    speed: float = 0.0,
-    companion: bool = False,
-    stress: bool = True,
-    method: str = "auto",
-    precondition: bool = True,
-    coarse_start: bool = True,
-    progress: bool = False,
-    tol: float = 1e-10,
-    max_iter: int = 100000,
-    memory: int = 12,
-    threads: int = 1,
+    speed: float | None = None,
+    companion: bool | None = None,
+    stress: bool | None = None,
+    method: str | None = None,
+    precondition: bool | None = None,
+    coarse_start: bool | None = None,
+    progress: bool | None = None,
+    tol: float | None = None,
+    max_iter: int | None = None,
+    memory: int | None = None,
+    threads: int | None = None,
 ) -> LineResult:
     """Solve the sliding line contact of the rigid profile ``heights`` (L, on a uniform
     periodic grid of one ``period``) on a layer of ``thickness`` (``inf``: half-space)
     bonded to a rigid base, with Coulomb friction ``tau = friction * p``.
 
-    Give ``mean_pressure`` (load control) or ``penetration`` (displacement control, finite
+    Every keyword sets the namelist variable of the same meaning (docs/namelist.md); one
+    that is not given (None) takes that variable's default: ``period`` 1, ``thickness``
+    ``inf`` (a half-space), ``young`` 1, ``poisson`` 0.5, ``friction`` 0, ``stress``
+    True, ``method`` ``'auto'``, ``tol`` 1e-10, ``max_iter`` 100000, ``memory`` 12,
+    ``threads`` 1, ``precondition`` and ``coarse_start`` True. A bad value raises
+    :class:`InputError` with the message the namelist file would get.
+
+    Give ``mean_pressure`` (load control), ``normalised_pressure`` (the load in the seed's
+    scale ``E* Lambda0/period``) or ``penetration`` (displacement control, finite
     compressible layers only). ``material`` (a :class:`StandardLinearSolid` or
     :class:`Prony`; ``young`` is then ignored) makes the layer viscoelastic, sliding at
     ``speed`` (L/T); ``dissipated_power`` and ``monotone`` (``Re G_eff >= 0`` on every mode,
-    hence a unique solution) are reported. ``companion=True`` also solves the frictionless problem at
-    the same load and sets ``a_over_a0`` and ``companion``. ``stress`` computes
-    ``displacement_x``, ``shear`` and the surface stress ``stress_xx`` (one more FFT pair).
+    hence a unique solution) are reported. ``companion=True`` also solves the frictionless
+    problem at the load of this one (its computed mean pressure, whatever the control) and
+    sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
+    and the surface stress ``stress_xx`` (one more FFT pair).
     ``method``: ``'auto'`` (constrained CG for symmetric scenes, constrained GCR for coupled
-    ones, going on with Anderson if GCR stalls), ``'cg'``, ``'gcr'`` or ``'anderson'``.
-    ``precondition`` applies the Fourier stiffness 1/M to the residual on the contact set
-    (fewer CG iterations). ``coarse_start`` starts from the solution on the grid of every
-    second point, recursively down to 512 points (fine-grid iterations nearly flat in
-    the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard
+    ones, going on with Anderson if GCR stalls), ``'cg'``, ``'gcr'``, ``'anderson'`` or
+    ``'gfmd'``. ``precondition`` applies the Fourier stiffness 1/M to the residual on the
+    contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
+    of every second point, recursively down to 512 points (fine-grid iterations nearly flat
+    in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard
     error for each grid level solved and every 2 s within a level (iteration, residual,
     contact fraction, elapsed time): it comes from the compiled core, so it shows in a
     terminal, not in a notebook cell.
-    Raises :class:`LayercontactError` with the library's message for bad input. A run that
-    did not reach ``tol`` returns with ``converged = False``.
+    A run that did not reach ``tol`` returns with ``converged = False``.
     """
     h = np.ascontiguousarray(np.asarray(heights, dtype=np.float64))
     if h.ndim != 1:
         raise ValueError("heights must be one-dimensional (line contact); use solve_areal for a surface")
-    if (mean_pressure is None) == (penetration is None):
-        raise ValueError("give exactly one of mean_pressure (load control) and penetration")
-    settings = dict(period=period, thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
-                    penetration=penetration, stress=stress, method=method, precondition=precondition,
-                    coarse_start=coarse_start, progress=progress, tol=tol,
-                    max_iter=max_iter, memory=memory, threads=threads, material=material, speed=speed)
-    result = _solve_once(h, friction=friction, **settings)
-    if companion:
-        if mean_pressure is None:
-            raise ValueError("companion=True compares at the same load: give mean_pressure")
-        result.companion = _solve_once(h, friction=0.0, **settings)
-        result.a_over_a0 = result.contact_fraction / result.companion.contact_fraction
-    return result
+    groups = _keyword_groups(
+        thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
+        mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
+        material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
+        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress)
+    runs = _solve_scene(h, {"scene": {"n": h.size, "period": period}, **groups}, areal=False,
+                        companion=bool(companion), stress=stress)
+    results = [_line_result(**run, height=h.copy()) for run in runs]
+    if len(results) > 1:
+        results[0].companion = results[1]
+    return results[0]
 
 
-def _solve_native(h, nx, areal, *, period, period_y, thickness, young, poisson, friction, mean_pressure,
-                  penetration, stress, method, precondition, coarse_start, progress, tol, max_iter, memory, threads,
-                  material, speed):
-    """One call of the library's solve (py_solve): fields (n, 5), spots, scalars, history."""
-    from .materials import material_codes
+def _keyword_groups(*, thickness, young, poisson, friction, companion, mean_pressure, normalised_pressure,
+                    penetration, material, speed, method, precondition, coarse_start, progress, tol, max_iter,
+                    memory, threads, stress) -> dict[str, dict]:
+    """The namelist groups and variables that the keywords of solve_line and solve_areal set
+    (None: not given)."""
+    return {
+        "layer": {"thickness": thickness, "young": young, "poisson": poisson},
+        "material": {**(material._namelist() if material is not None else {}), "speed": speed},
+        "friction": {"coefficient": friction, "companion": companion},
+        "loading": {"control": None if penetration is None else "displacement", "mean_pressure": mean_pressure,
+                    "normalised_pressure": normalised_pressure, "penetration": penetration},
+        "solver": {"method": method, "tol": tol, "max_iter": max_iter, "memory": memory,
+                   "precondition": precondition, "coarse_start": coarse_start, "threads": threads,
+                   "verbose": progress},
+        "output": {"stress": stress},
+    }
 
-    if method not in _METHODS:
-        raise ValueError(f"method = {method!r} is not allowed; allowed: {sorted(_METHODS)}")
-    control = "load" if mean_pressure is not None else "displacement"
-    model, form, young, e0, e_inf, tau, eq, times, values = material_codes(material, young)
-    # what comes back: the three solution fields, plus the in-plane ones with stress; a
-    # line's contact spots (5 columns), or a surface's patches (area, perimeter)
-    n_fields = (8 if areal else 5) if stress else 3
-    spot_capacity, n_columns = (h.size // 2 + 1, 2) if areal else (h.size // 2 + 1, 5)
-    fields, spots, s, hist, stat, errmsg = _core.py_solve(
-        h, int(nx), int(areal), float(period), float(period_y), float(thickness), young, float(poisson),
-        float(friction), _CONTROLS[control],
-        NOT_SET if mean_pressure is None else float(mean_pressure),
-        NOT_SET if penetration is None else float(penetration),
-        _METHODS[method], int(bool(precondition)), int(bool(coarse_start)), int(bool(progress)), float(tol),
-        int(max_iter), int(memory), int(threads),
-        int(bool(stress)), model, form, e0, e_inf, tau, eq, times, values, float(speed),
-        min(int(max_iter), HISTORY_CAPACITY), n_fields, spot_capacity, n_columns,
-    )
+
+def _solve_scene(h, groups: dict, *, areal: bool, companion: bool, stress) -> list[dict]:
+    """Solve the scene of the namelist groups on the flat heights ``h`` (x fastest) in the
+    library (py_solve_scene); per run (the scene, then its companion) what it returned, by
+    the names of a result file: scalars, fields, spots (or patches), residual history and
+    the cell's periods."""
+    runs = 2 if companion else 1
+    n_fields = 3 if stress is False else (9 if areal else 6)
+    spot_columns = 2 if areal else 5
+    fields, spots, history, table, stat, errmsg = _core.py_solve_scene(
+        _namelist(groups), h, runs, n_fields, h.size // 2 + 1, spot_columns, HISTORY_CAPACITY)
     _check(stat, errmsg)
-    scalars = {name: (int(v) if name in _INTEGERS else float(v)) for name, v in zip(_SCALARS, s)}
-    n_hist = int(scalars.pop("history_length"))
-    scalars["converged"] = bool(scalars["converged"])
-    scalars["monotone"] = bool(scalars["monotone"])
-    scalars["solver"] = _SOLVERS.get(int(scalars["solver"]), "")
-    return fields, spots, scalars, hist[:n_hist].copy()
+    described = _lines(table)
+    period = (float(described["input/period"]), float(described["input/period_y"]))
+    out = []
+    for k, prefix in enumerate(("", "companion/")[:runs]):
+        scalars = {name[len(prefix) + 8:]: value for name, value in described.items()
+                   if name.startswith(prefix + "results/")}
+        n_spots = int(scalars["n_spots"].split()[0])
+        columns = described.get(prefix + ("patches" if areal else "spots"), "").split()
+        out.append(dict(
+            scalars=scalars,
+            fields={name: fields[:, i, k].copy() for i, name in enumerate(described[prefix + "fields"].split())},
+            spots={name: spots[:n_spots, i, k].copy() for i, name in enumerate(columns)},
+            history=history[: int(described[prefix + "convergence/residual"]), k].copy(),
+            period=period if areal else period[0]))
+    return out
 
 
-def _solve_once(h, *, period, stress, friction, **settings) -> LineResult:
-    fields, spots, scalars, history = _solve_native(h, h.size, 0, period=period, period_y=NOT_SET, stress=stress,
-                                                    friction=friction, **settings)
-    for name in _AREAL_ONLY:
-        scalars.pop(name)
-    if not stress:
-        for name in ("max_tension", "max_tension_x", "max_tension_offset", "max_tension_grid"):
-            scalars[name] = float("nan")
+def _typed(cls, scalars: dict) -> dict:
+    """The scalars of a result (text from the library, or /results attributes) that are
+    fields of ``cls``, as the types its fields declare (flags 0/1 become bool)."""
+    kinds = {f.name: f.type for f in dataclass_fields(cls)}
+    out = {}
+    for name, value in scalars.items():
+        kind = kinds.get(name)
+        if kind is None or name == "period":
+            continue
+        if isinstance(value, bytes):
+            value = value.decode()
+        if isinstance(value, str):
+            words = value.split()
+            value = "" if not words or words[0] == "''" else words[0]
+        out[name] = {"bool": lambda v: bool(int(v)), "int": int, "str": str}.get(kind, float)(value)
+    return out
+
+
+def _line_result(*, scalars: dict, fields: dict, spots: dict, history, height, period) -> LineResult:
+    """A LineResult from what a line run returned, by name (a solve or a result file)."""
+    edges = (np.column_stack([spots["trailing_edge"], spots["leading_edge"]]) if "trailing_edge" in spots
+             else np.zeros((0, 2)))
     return LineResult(
-        pressure=fields[:, 0].copy(), gap=fields[:, 1].copy(), displacement_z=fields[:, 2].copy(),
-        displacement_x=fields[:, 3].copy() if stress else None, shear=friction * fields[:, 0] if stress else None,
-        stress_xx=fields[:, 4].copy() if stress else None, height=h.copy(), period=float(period),
-        friction=float(friction), spots=spots[: scalars["n_spots"], :2].copy(), residual_history=history,
-        spot_max_tension=spots[: scalars["n_spots"], 2].copy() if stress else None,
-        spot_tension_offset=spots[: scalars["n_spots"], 3].copy() if stress else None,
-        spot_max_tension_grid=spots[: scalars["n_spots"], 4].copy() if stress else None,
-        **scalars,
-    )
+        pressure=fields.get("pressure"), gap=fields.get("gap"), displacement_z=fields.get("displacement_z"),
+        displacement_x=fields.get("displacement_x"), shear=fields.get("shear"), stress_xx=fields.get("stress_xx"),
+        height=height, period=float(np.atleast_1d(period)[0]), spots=edges, residual_history=history,
+        spot_max_tension=spots.get("max_tension"), spot_tension_offset=spots.get("max_tension_offset"),
+        spot_max_tension_grid=spots.get("max_tension_grid"), **_typed(LineResult, scalars))
 
 
-# What an areal result keeps of the library's scalars (the others describe line contacts),
-# and the scalars that only areal results have.
-_AREAL_SCALARS = (
-    "mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "delta_mu_energy",
-    "delta_mu_profile", "converged", "iterations", "outer_iterations", "fft_pairs", "residual", "wall_time",
-    "mean_gap", "dissipated_power", "monotone", "solver", "normalised_pressure", "normalised_thickness",
-    "max_tension", "max_tension_x", "max_tension_y", "max_tension_offset", "max_principal_stress",
-    "max_principal_x", "max_principal_y", "gap_resolution",
-)
-_AREAL_ONLY = ("max_tension_y", "max_principal_stress", "max_principal_x", "max_principal_y")
-_STRESS_SCALARS = ("max_tension", "max_tension_x", "max_tension_y", "max_tension_offset", "max_principal_stress",
-                   "max_principal_x", "max_principal_y")
+def _areal_result(*, scalars: dict, fields: dict, spots: dict, history, height, period) -> ArealResult:
+    """An ArealResult from what an areal run returned, by name (``spots``: the patches)."""
+    patches = (np.column_stack([spots["area"], spots["perimeter"]]) if "area" in spots else np.zeros((0, 2)))
+    return ArealResult(
+        pressure=fields.get("pressure"), gap=fields.get("gap"), displacement_z=fields.get("displacement_z"),
+        displacement_x=fields.get("displacement_x"), displacement_y=fields.get("displacement_y"),
+        stress_xx=fields.get("stress_xx"), stress_yy=fields.get("stress_yy"), stress_xy=fields.get("stress_xy"),
+        height=height, period=(float(period[0]), float(period[1])), patches=patches, residual_history=history,
+        **_typed(ArealResult, scalars))
 
 
 @dataclass
@@ -396,81 +453,74 @@ class ArealResult:
 def solve_areal(
     heights,
     *,
-    period=1.0,
-    thickness: float = np.inf,
-    young: float = 1.0,
-    poisson: float = 0.5,
-    friction: float = 0.0,
+    period=None,
+    thickness: float | None = None,
+    young: float | None = None,
+    poisson: float | None = None,
+    friction: float | None = None,
     mean_pressure: float | None = None,
+    normalised_pressure: float | None = None,
     penetration: float | None = None,
     material=None,
-    speed: float = 0.0,
-    companion: bool = False,
-    method: str = "auto",
-    precondition: bool = True,
-    coarse_start: bool = True,
-    progress: bool = False,
-    tol: float = 1e-10,
-    max_iter: int = 100000,
-    memory: int = 12,
-    threads: int = 1,
-    stress: bool = False,
+    speed: float | None = None,
+    companion: bool | None = None,
+    method: str | None = None,
+    precondition: bool | None = None,
+    coarse_start: bool | None = None,
+    progress: bool | None = None,
+    tol: float | None = None,
+    max_iter: int | None = None,
+    memory: int | None = None,
+    threads: int | None = None,
+    stress: bool | None = None,
 ) -> ArealResult:
     """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
     a uniform periodic grid, axis 1 = x = the sliding direction) on a layer of
     ``thickness`` (``inf``: half-space) bonded to a rigid base, with Coulomb friction
     ``tau_x = friction * p``. ``period`` is one length or a pair ``(period_x, period_y)``.
-    ``stress=True`` also computes the in-plane displacements and the surface stress tensor
-    (five more transforms). Every other keyword means what it means for :func:`solve_line`.
+    ``stress`` (default True) also computes the in-plane displacements and the surface
+    stress tensor (five more transforms). ``normalised_pressure`` is the load in the scale
+    ``E* h/period_x`` on a layer, ``E* Lambda0/period_x`` on a half-space. Every other
+    keyword means what it means for :func:`solve_line`, with the same defaults.
     """
     h = np.asarray(heights, dtype=np.float64)
     if h.ndim != 2:
         raise ValueError(f"heights must be a (ny, nx) array for an areal contact; got shape {h.shape}")
-    if (mean_pressure is None) == (penetration is None):
-        raise ValueError("give exactly one of mean_pressure (load control) and penetration")
-    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
     ny, nx = h.shape
-    flat = np.ascontiguousarray(h).ravel()
-    settings = dict(thickness=thickness, young=young, poisson=poisson, mean_pressure=mean_pressure,
-                    penetration=penetration, method=method, precondition=precondition, coarse_start=coarse_start,
-                    progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, material=material,
-                    speed=speed)
-    stress = bool(stress)
-
-    def once(mu):
-        fields, patches, scalars, history = _solve_native(flat, nx, 1, period=lx, period_y=ly, stress=stress,
-                                                          friction=mu, **settings)
-        kept = {name: scalars[name] for name in _AREAL_SCALARS}
-        if not stress:
-            kept.update({name: float("nan") for name in _STRESS_SCALARS})
-
-        def field_map(column):
-            return fields[:, column].reshape(ny, nx).copy() if column < fields.shape[1] else None
-
-        return ArealResult(
-            pressure=field_map(0), gap=field_map(1), displacement_z=field_map(2), displacement_x=field_map(3),
-            displacement_y=field_map(4), stress_xx=field_map(5), stress_yy=field_map(6), stress_xy=field_map(7),
-            height=h.copy(), period=(lx, ly), friction=float(mu), residual_history=history,
-            patches=patches[: int(scalars["n_spots"])].copy(), **kept)
-
-    result = once(friction)
-    if companion:
-        if mean_pressure is None:
-            raise ValueError("companion=True compares at the same load: give mean_pressure")
-        result.companion = once(0.0)
-        result.a_over_a0 = result.contact_fraction / result.companion.contact_fraction
-    return result
+    lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    groups = _keyword_groups(
+        thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
+        mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
+        material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
+        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress)
+    scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
+    runs = _solve_scene(np.ascontiguousarray(h).ravel(), {"scene": scene, **groups}, areal=True,
+                        companion=bool(companion), stress=stress)
+    results = [_areal_result(**dict(run, fields={k: v.reshape(ny, nx) for k, v in run["fields"].items()}),
+                             height=h.copy()) for run in runs]
+    if len(results) > 1:
+        results[0].companion = results[1]
+    return results[0]
 
 
-def surface_fields(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson=0.5, friction=0.0):
+def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None):
     """Surface displacement ``u_x`` (L) and in-plane stress ``sigma_xx`` (S, tension
     positive) of the layer under a prescribed pressure (S) and shear ``friction * p``,
-    without solving a contact problem."""
+    without solving a contact problem. The keywords and their defaults are those of
+    :func:`solve_line`."""
     p = np.ascontiguousarray(np.asarray(pressure, dtype=np.float64))
-    ux, sxx, stat, errmsg = _core.py_surface_fields(p, float(period), float(thickness), float(young),
-                                                    float(poisson), float(friction))
+    fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction)
+    return fields[:, 0].copy(), fields[:, 2].copy()
+
+
+def _surface_stress(p, scene: dict, thickness, young, poisson, friction) -> np.ndarray:
+    """fields(n, 5) = u_x, u_y, sigma_xx, sigma_yy, sigma_xy of the layer under the flat
+    pressure ``p`` (x fastest) on the grid of the &scene variables ``scene``."""
+    text = _namelist({"scene": scene, "layer": {"thickness": thickness, "young": young, "poisson": poisson},
+                      "friction": {"coefficient": friction}})
+    fields, stat, errmsg = _core.py_surface_stress(text, p)
     _check(stat, errmsg)
-    return ux, sxx
+    return fields
 
 
 @dataclass
@@ -486,25 +536,25 @@ class SurfaceStress:
     stress_xy: np.ndarray | None = None
 
 
-def surface_stress(pressure, *, period=1.0, thickness=np.inf, young=1.0, poisson=0.5,
-                   friction=0.0) -> SurfaceStress:
+def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson=None,
+                   friction=None) -> SurfaceStress:
     """Surface displacements and stresses of an elastic layer (``thickness=np.inf``:
-    half-space) under the prescribed pressure (S; 1D for a line, ``(ny, nx)`` for a surface,
-    x = axis 1) and the shear ``friction * p`` along x, without solving a contact problem.
-    ``period`` is one length or, for a surface, a pair ``(period_x, period_y)``."""
+    half-space, the default) under the prescribed pressure (S; 1D for a line, ``(ny, nx)``
+    for a surface, x = axis 1) and the shear ``friction * p`` along x, without solving a
+    contact problem. ``period`` is one length or, for a surface, a pair ``(period_x,
+    period_y)``; the keywords and their defaults are those of :func:`solve_areal`."""
     p = np.asarray(pressure, dtype=np.float64)
     if p.ndim == 1:
-        lx = float(period) if np.ndim(period) == 0 else float(period[0])
+        lx = period if np.ndim(period) == 0 else float(period[0])
         ux, sxx = surface_fields(p, period=lx, thickness=thickness, young=young, poisson=poisson,
                                  friction=friction)
         return SurfaceStress(displacement_x=ux, stress_xx=sxx)
     if p.ndim != 2:
         raise ValueError(f"pressure must be 1D (line) or (ny, nx) (surface); got shape {p.shape}")
-    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
     ny, nx = p.shape
-    fields, stat, errmsg = _core.py_surface_stress(np.ascontiguousarray(p).ravel(), nx, lx, ly, float(thickness),
-                                                   float(young), float(poisson), float(friction))
-    _check(stat, errmsg)
+    scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
+    fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction)
     ux, uy, sxx, syy, sxy = (fields[:, k].reshape(ny, nx).copy() for k in range(5))
     return SurfaceStress(displacement_x=ux, stress_xx=sxx, displacement_y=uy, stress_yy=syy, stress_xy=sxy)
 
@@ -519,6 +569,13 @@ def _profile(f):
     return f["profile/height"][()] if "profile" in f else None
 
 
+def _periods(attrs) -> tuple[float, float]:
+    """(period, period_y) of a result file's /input (period_y not set: the period)."""
+    lx = float(attrs["period"])
+    ly = float(attrs["period_y"]) if "period_y" in attrs and float(attrs["period_y"]) > 0 else lx
+    return lx, ly
+
+
 def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResult | ArealResult:
     """Read a result file written by the executable or :func:`run` (a :class:`LineResult`,
     or an :class:`ArealResult` for an areal scene); the frictionless companion run stored
@@ -526,60 +583,22 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
     .false.`` has no maps: the fields and ``height`` are then None."""
     import h5py
 
-    def one(f, base) -> LineResult:
-        r = dict(base["results"].attrs)
-        fields = _maps(base)
-        spots = (np.column_stack([base["spots/trailing_edge"][()], base["spots/leading_edge"][()]])
-                 if "spots" in base else np.zeros((0, 2)))
-        names = set(_SCALARS) - {"history_length", "solver"}
-        values = {k: (int(r[k]) if k in _INTEGERS else float(r[k])) for k in names if k in r}
-        solver = r.get("solver", "")
-        values["solver"] = solver.decode() if isinstance(solver, bytes) else str(solver)
-        values["converged"] = bool(r["converged"])
-        values["monotone"] = bool(r.get("monotone", 1))
-        return LineResult(
-            pressure=fields.get("pressure"), gap=fields.get("gap"), displacement_z=fields.get("displacement_z"),
-            displacement_x=fields.get("displacement_x"), shear=fields.get("shear"),
-            stress_xx=fields.get("stress_xx"), height=_profile(f),
-            spot_max_tension=base["spots/max_tension"][()] if "spots/max_tension" in base else None,
-            spot_tension_offset=base["spots/max_tension_offset"][()] if "spots/max_tension_offset" in base else None,
-            spot_max_tension_grid=(base["spots/max_tension_grid"][()] if "spots/max_tension_grid" in base
-                                   else None),
-            period=float(f["input"].attrs["period"]), friction=float(r["friction"]), spots=spots,
-            residual_history=base["convergence/residual"][()],
-            a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values,
-        )
-
-    def one_areal(f, base) -> ArealResult:
-        r = dict(base["results"].attrs)
-        values = {k: (int(r[k]) if k in _INTEGERS else float(r[k])) for k in _AREAL_SCALARS
-                  if k in r and k not in ("solver",)}
-        solver = r.get("solver", "")
-        values["solver"] = solver.decode() if isinstance(solver, bytes) else str(solver)
-        values["converged"] = bool(r["converged"])
-        values["monotone"] = bool(r.get("monotone", 1))
-        attrs = f["input"].attrs
-        lx = float(attrs["period"])
-        ly = float(attrs["period_y"]) if float(attrs["period_y"]) > 0 else lx
-        fields = _maps(base)
-        patches = (np.column_stack([base["patches/area"][()], base["patches/perimeter"][()]])
-                   if "patches" in base else np.zeros((0, 2)))
-        return ArealResult(
-            pressure=fields.get("pressure"), gap=fields.get("gap"), displacement_z=fields.get("displacement_z"),
-            displacement_x=fields.get("displacement_x"), displacement_y=fields.get("displacement_y"),
-            stress_xx=fields.get("stress_xx"), stress_yy=fields.get("stress_yy"), stress_xy=fields.get("stress_xy"),
-            height=_profile(f), period=(lx, ly), friction=float(r["friction"]), patches=patches,
-            residual_history=base["convergence/residual"][()],
-            leakage=CoreLeakage.from_attributes(base["leakage"].attrs) if "leakage" in base else None,
-            a_over_a0=float(r["a_over_a0"]) if "a_over_a0" in r else None, **values)
+    def one(f, base, builder):
+        spots = next((base[name] for name in ("spots", "patches") if name in base), {})
+        result = builder(scalars=dict(base["results"].attrs), fields=_maps(base),
+                         spots={name: spots[name][()] for name in spots}, history=base["convergence/residual"][()],
+                         height=_profile(f), period=_periods(f["input"].attrs))
+        if "leakage" in base:
+            result.leakage = CoreLeakage.from_attributes(base["leakage"].attrs)
+        return result
 
     with h5py.File(filename, "r") as f:
         geometry = f.attrs.get("geometry", b"line")
         geometry = geometry.decode() if isinstance(geometry, bytes) else str(geometry)
-        reader = one_areal if geometry == "areal" else one
-        result = reader(f, f)
+        builder = _areal_result if geometry == "areal" else _line_result
+        result = one(f, f, builder)
         if companion and "companion" in f:
-            result.companion = reader(f, f["companion"])
+            result.companion = one(f, f["companion"], builder)
         return result
 
 

@@ -13,11 +13,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .api import _CONSTANTS, _check, _namelist
 from .native import core as _core
 
-_FORMS = {"relaxation": 0, "creep": 1}
 #: Largest number of Prony terms (the library's max_prony_terms).
-MAX_TERMS = 64
+MAX_TERMS = int(_CONSTANTS["max_prony_terms"])
 
 
 @dataclass(frozen=True)
@@ -31,8 +31,9 @@ class StandardLinearSolid:
     e_inf: float
     tau: float
 
-    def _codes(self):
-        return 1, 0, float(self.e0), float(self.e_inf), float(self.tau), -1.0, np.ones(1), np.ones(1)
+    def _namelist(self) -> dict:
+        """The &material variables of this law."""
+        return {"model": "sls", "e0": float(self.e0), "e_inf": float(self.e_inf), "tau": float(self.tau)}
 
 
 @dataclass(frozen=True)
@@ -48,42 +49,35 @@ class Prony:
     source: str = field(default="", compare=False)
 
     def __post_init__(self):
-        if self.form not in _FORMS:
-            raise ValueError(f"&material: prony_form = {self.form!r} is not allowed; allowed: {sorted(_FORMS)}")
         object.__setattr__(self, "times", tuple(float(t) for t in np.atleast_1d(self.times)))
         object.__setattr__(self, "values", tuple(float(v) for v in np.atleast_1d(self.values)))
-        if not 1 <= len(self.times) <= MAX_TERMS or len(self.times) != len(self.values):
-            raise ValueError(f"&material: prony_times/prony_values = {len(self.times)} times, {len(self.values)} "
-                             f"values is not allowed; allowed: the same number, 1 to {MAX_TERMS}")
+        # the library's checks of &material (form, number of terms, signs, order)
+        # (room for one more entry than given: the library takes no empty arrays)
+        room = max(len(self.times), len(self.values)) + 1
+        times, values = np.zeros(room), np.zeros(room)
+        times[: len(self.times)], values[: len(self.values)] = self.times, self.values
+        _check(*_core.py_check_prony(str(self.form), float(self.equilibrium), len(self.times), len(self.values),
+                                     times, values))
 
     @classmethod
     def from_file(cls, path: str | os.PathLike, equilibrium: float, form: str = "relaxation") -> "Prony":
-        """Terms from a text file of two columns ``tau_i value_i`` ('#' comments)."""
-        data = np.loadtxt(path, comments=("#", "!"), ndmin=2)
-        if data.shape[1] != 2:
-            raise ValueError(f"{path}: expected two columns 'tau_i value_i', got {data.shape[1]}")
-        return cls(tuple(data[:, 0]), tuple(data[:, 1]), equilibrium, form, source=os.fspath(path))
+        """Terms from a text file of two columns ``tau_i value_i`` (comments after '#' or
+        '!'), read by the library's reader of ``&material prony_file``."""
+        times, values, count, stat, errmsg = _core.py_read_prony_file(os.fspath(path), MAX_TERMS)
+        _check(stat, errmsg)
+        return cls(tuple(times[:count]), tuple(values[:count]), equilibrium, form, source=os.fspath(path))
 
-    def _codes(self):
-        times = np.asarray(self.times, dtype=np.float64)
-        values = np.asarray(self.values, dtype=np.float64)
-        return 2, _FORMS[self.form], -1.0, -1.0, -1.0, float(self.equilibrium), times, values
-
-
-def material_codes(material, young: float):
-    """(model, form, young, e0, e_inf, tau, equilibrium, times, values) for the wrappers."""
-    if material is None:
-        return 0, 0, float(young), -1.0, -1.0, -1.0, -1.0, np.ones(1), np.ones(1)
-    model, form, e0, e_inf, tau, eq, times, values = material._codes()
-    return model, form, float(young), e0, e_inf, tau, eq, times, values
+    def _namelist(self) -> dict:
+        """The &material variables of this law."""
+        return {"model": "prony", "prony_form": self.form, "prony_equilibrium": float(self.equilibrium),
+                "prony_times": self.times, "prony_values": self.values}
 
 
 def creep_compliance(material, omega) -> np.ndarray:
-    """``J*(k)`` of seed Eq. (14) at ``omega = k V`` (1/S), vectorised over ``omega``."""
-    from .api import _check
-
+    """``J*(k)`` of seed Eq. (14) at ``omega = k V`` (1/S), vectorised over ``omega``;
+    ``material`` None: the elastic layer of the default ``young``."""
     w = np.ascontiguousarray(np.atleast_1d(np.asarray(omega, dtype=np.float64)))
-    model, form, young, e0, e_inf, tau, eq, times, values = material_codes(material, 1.0)
-    j, stat, errmsg = _core.py_creep_compliance(w, model, form, young, e0, e_inf, tau, eq, times, values)
+    text = _namelist({"material": material._namelist() if material is not None else {}})
+    j, stat, errmsg = _core.py_creep_compliance(text, w)
     _check(stat, errmsg)
     return j

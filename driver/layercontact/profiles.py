@@ -13,7 +13,7 @@ import os
 import numpy as np
 
 from .native import core as _core
-from .api import NOT_SET, LayercontactError, _check
+from .api import _CONSTANTS, NOT_SET, LayercontactError, _check, _namelist
 
 # Length of the Fortran scene's file-name fields (lc_scene max_string).
 _MAX_STRING = 512
@@ -23,39 +23,43 @@ _DEFAULT_DATASET = "/profile/height"
 
 def self_affine_profile(
     n: int,
-    hurst: float = 0.8,
+    hurst: float | None = None,
     *,
-    period: float = 1.0,
-    seed: int = 1,
+    period: float | None = None,
+    seed: int | None = None,
     rolloff_wavelength: float | None = None,
     short_wavelength: float | None = None,
     rms_gradient: float | None = None,
     rms_height: float | None = None,
 ) -> np.ndarray:
-    """Seeded self-affine line profile of ``n`` heights on one ``period``.
+    """Seeded self-affine line profile of ``n`` heights on one ``period``: the heights of
+    ``&profile kind='self_affine'``, made by the same routine from the same variables (a
+    keyword not given takes the namelist default: hurst 0.8, seed 1, period 1).
 
-    Power spectrum flat below the roll-off wavenumber, ``~ q^(-1-2H)`` up to the short
-    cutoff (default: ``period/128``), zero beyond; random phases from SplitMix64 seeded
-    with ``seed``; scaled to exactly ``rms_gradient`` or ``rms_height`` (give one; default
-    rms_gradient = 0.1). Same arguments, same heights as ``&profile kind='self_affine'``.
+    Power spectrum flat below the roll-off wavenumber (default: the period), ``~ q^(-1-2H)``
+    up to the short cutoff (default: ``period/128``), zero beyond; random phases from
+    SplitMix64 seeded with ``seed``; scaled to exactly ``rms_gradient`` or ``rms_height``
+    (give at most one; neither: rms_gradient 0.1). Raises LayercontactError with the
+    namelist's message for a value it does not allow.
     """
-    if rms_gradient is None and rms_height is None:
-        rms_gradient = 0.1
-    height, stat, errmsg = _core.py_self_affine_profile(
-        int(n), float(period), float(hurst), int(seed),
-        NOT_SET if rolloff_wavelength is None else float(rolloff_wavelength),
-        NOT_SET if short_wavelength is None else float(short_wavelength),
-        NOT_SET if rms_gradient is None else float(rms_gradient),
-        NOT_SET if rms_height is None else float(rms_height),
-    )
+    text = _namelist({"scene": {"n": int(n), "period": period},
+                      "profile": {"kind": "self_affine", "hurst": hurst, "seed": seed,
+                                  "rolloff_wavelength": rolloff_wavelength, "short_wavelength": short_wavelength,
+                                  "rms_gradient": rms_gradient, "rms_height": rms_height}})
+    height, stat, errmsg = _core.py_make_profile(text, int(n))
     _check(stat, errmsg)
     return height
 
 
-def sinusoid_profile(n: int, amplitude: float, *, mode: int = 1, period: float = 1.0) -> np.ndarray:
-    """``amplitude * cos(2 pi mode x/period)`` on ``n`` points of one period."""
-    x = np.arange(n) * (period / n)
-    return amplitude * np.cos(2 * np.pi * mode * x / period)
+def sinusoid_profile(n: int, amplitude: float, *, mode: int | None = None, period: float | None = None) -> np.ndarray:
+    """``amplitude * cos(2 pi mode x/period)`` on ``n`` points of one period, the heights
+    of ``&profile kind='sinusoid'`` (``mode`` default 1, ``1 <= mode <= (n-1)/2``;
+    ``period`` default 1; raises LayercontactError otherwise)."""
+    text = _namelist({"scene": {"n": int(n), "period": period},
+                      "profile": {"kind": "sinusoid", "amplitude": amplitude, "mode": mode}})
+    height, stat, errmsg = _core.py_make_profile(text, int(n))
+    _check(stat, errmsg)
+    return height
 
 
 def load_profile(path: str | os.PathLike, dataset: str = "/profile/height") -> np.ndarray:
@@ -105,9 +109,9 @@ def _surface_grid(n, period, nx, ny) -> tuple[int, int, float, float]:
 
 def self_affine_surface(
     n: int = 512,
-    hurst: float = 0.8,
+    hurst: float | None = None,
     *,
-    seed: int = 1,
+    seed: int | None = None,
     short_wavelength: float | None = 1 / 64,
     rms_gradient: float | None = None,
     rms_height: float | None = None,
@@ -123,16 +127,18 @@ def self_affine_surface(
     ----------
     n : int
         Grid points along x and y (unless ``nx``, ``ny`` are given; each >= 4).
-    hurst : float
-        Hurst exponent H, 0 < H < 1: power spectrum ``C(q) ~ |q|^(-2-2H)``.
-    seed : int
-        SplitMix64 seed (>= 0); the phase of mode (mx, my) depends on the seed and the mode
+    hurst : float, optional
+        Hurst exponent H, 0 < H < 1: power spectrum ``C(q) ~ |q|^(-2-2H)``; default that of
+        ``&profile`` (0.8).
+    seed : int, optional
+        SplitMix64 seed (>= 0; default that of ``&profile``, 1); the phase of mode (mx, my) depends on the seed and the mode
         only, so a finer grid at the same ``short_wavelength`` gives the same surface.
     short_wavelength : float or None
         Shortest wavelength (L); None: ``min(lx, ly)/128``. Modes shorter than the grid
         allows are left out along with it (a round cut, keeping the surface isotropic).
     rms_gradient, rms_height : float, optional
-        Scale target, met exactly on the grid; give at most one (default rms_gradient 0.1).
+        Scale target, met exactly on the grid; give at most one (neither: the rms_gradient
+        of ``&profile``, 0.1).
     period : float or (float, float)
         Period (L), or the pair ``(lx, ly)``.
     rolloff_wavelength : float, optional
@@ -149,8 +155,11 @@ def self_affine_surface(
         ``(ny, nx)`` heights (L), zero mean.
     """
     nx, ny, lx, ly = _surface_grid(n, period, nx, ny)
+    # the defaults of &profile (lc_scene's profile_spec)
+    hurst = float(_CONSTANTS["profile/hurst"]) if hurst is None else hurst
+    seed = int(_CONSTANTS["profile/seed"]) if seed is None else seed
     if rms_gradient is None and rms_height is None:
-        rms_gradient = 0.1
+        rms_gradient = float(_CONSTANTS["profile/rms_gradient"])
     height, stat, errmsg = _core.py_self_affine_surface(
         nx,
         ny,
@@ -205,32 +214,44 @@ def sinusoid_surface(
     n: int,
     amplitude: float,
     *,
-    mode: int = 1,
-    mode_y: int = 0,
-    period: float | tuple[float, float] = 1.0,
+    mode: int | None = None,
+    mode_y: int | None = None,
+    period: float | tuple[float, float] | None = None,
     nx: int | None = None,
     ny: int | None = None,
 ) -> np.ndarray:
     """``amplitude * cos(2 pi (mode x/lx + mode_y y/ly))`` on an ``(ny, nx)`` grid, the
-    heights of ``&profile kind='sinusoid'`` on an areal scene (``0 <= mode <= (nx-1)/2``,
-    ``|mode_y| <= (ny-1)/2``, not both zero; raises LayercontactError otherwise)."""
-    nx, ny, lx, ly = _surface_grid(n, period, nx, ny)
-    return _make_surface("sinusoid", nx, ny, lx, ly, amplitude=amplitude, mode=mode, mode_y=mode_y)
+    heights of ``&profile kind='sinusoid'`` on an areal scene (``mode`` default 1,
+    ``mode_y`` default 0; ``0 <= mode <= (nx-1)/2``, ``|mode_y| <= (ny-1)/2``, not both
+    zero; raises LayercontactError otherwise)."""
+    return _areal_profile(n, period, nx, ny, {"kind": "sinusoid", "amplitude": amplitude, "mode": mode,
+                                              "mode_y": mode_y})
 
 
 def spherical_cap(
     n: int,
     radius: float,
     *,
-    period: float | tuple[float, float] = 1.0,
+    period: float | tuple[float, float] | None = None,
     nx: int | None = None,
     ny: int | None = None,
 ) -> np.ndarray:
     """Spherical cap of ``radius`` R with its apex (height 0, the maximum) at the grid
     point ``(ix, iy) = (nx//2, ny//2)``: ``sqrt(R^2 - rho^2) - R`` within the distance R of
     the apex, ``-R`` beyond; the heights of ``&profile kind='sphere'``."""
-    nx, ny, lx, ly = _surface_grid(n, period, nx, ny)
-    return _make_surface("sphere", nx, ny, lx, ly, radius=radius)
+    return _areal_profile(n, period, nx, ny, {"kind": "sphere", "radius": radius})
+
+
+def _areal_profile(n, period, nx, ny, profile: dict) -> np.ndarray:
+    """The heights of an areal scene's &profile variables ``profile`` (the library's
+    make_profile, from namelist text: its defaults and checks), ``(ny, nx)``."""
+    nx, ny = int(n if nx is None else nx), int(n if ny is None else ny)
+    lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    text = _namelist({"scene": {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly},
+                      "profile": profile})
+    height, stat, errmsg = _core.py_make_profile(text, nx * ny)
+    _check(stat, errmsg)
+    return height.reshape(ny, nx)
 
 
 def read_surface(

@@ -24,7 +24,7 @@ module lc_greens_viscoelastic
    use lc_strings, only: to_string
    implicit none (type, external)
    private
-   public :: material_law, creep_compliance, static_modulus, check_material, max_prony_terms, make_material_law
+   public :: material_law, creep_compliance, static_modulus, check_material, max_prony_terms
 
    !> The value of a parameter that was not given.
    real(wp), parameter :: unset = -1.0_wp
@@ -88,28 +88,6 @@ contains
          j = 1.0_wp/law%young
       end select
    end function creep_compliance
-
-   !> A law from plain values (for the Python wrappers): model 0 elastic, 1 sls, 2 prony;
-   !> form 0 relaxation, 1 creep.
-   pure function make_material_law(model, form, young, e0, e_inf, tau, equilibrium, times, values) result(law)
-      integer, intent(in) :: model, form
-      real(wp), intent(in) :: young, e0, e_inf, tau, equilibrium, times(:), values(:)
-      type(material_law) :: law
-      character(len=8), parameter :: models(0:2) = [character(len=8) :: 'elastic', 'sls', 'prony']
-      character(len=10), parameter :: forms(0:1) = [character(len=10) :: 'relaxation', 'creep']
-      law%model = models(max(0, min(2, model)))
-      law%form = forms(max(0, min(1, form)))
-      law%young = young
-      law%e0 = e0
-      law%e_inf = e_inf
-      law%tau = tau
-      law%equilibrium = equilibrium
-      if (trim(law%model) == 'prony') then
-         allocate (law%times(size(times)), law%values(size(values)))
-         law%times = times
-         law%values = values
-      end if
-   end function make_material_law
 
    !> The low-frequency (V -> 0) modulus: the elastic limit used for normalisations (S).
    pure real(wp) function static_modulus(law)

@@ -30,7 +30,7 @@ module lc_io_hdf5
    use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
    use lc_strings, only: to_string, lower_case
    use lc_scene, only: scene_type, is_areal
-   use lc_result, only: contact_result
+   use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_leakage_reynolds, only: leakage_result
    use lc_version, only: build_isa
    implicit none (type, external)
@@ -42,12 +42,6 @@ module lc_io_hdf5
    character(len=*), parameter :: units_note = "lengths in the input's length unit L, " // &
       & 'pressures/moduli in its stress unit S'
    character(len=*), parameter :: overwrite_hint = 'set &output overwrite = .true.'
-   !> The unit of every /results attribute (L and S: the input's length and stress units).
-   character(len=*), parameter :: results_units = 'mean_pressure S; penetration L; contact_length L; ' // &
-      & 'mean_gap L; leak_rate L^3 (<g^3>/12); pressure_shift L; summit_shift L; max_tension S; ' // &
-      & 'max_tension_grid S; max_principal_stress S; max_tension_x L; max_tension_y L; max_tension_offset L; ' // &
-      & 'max_principal_x L; max_principal_y L; dissipated_power S L/T; wall_time s; ' // &
-      & 'the others are dimensionless (fractions, friction coefficients, residuals, normalised values) or counts'
    character(len=*), parameter :: leakage_units = 'k_eff_x L^3; k_eff_y L^3 (12 eta times the mean flux per ' // &
       & 'unit width per unit mean pressure gradient: g^3 for a uniform gap g); wall_time s; ' // &
       & 'the others are dimensionless (fractions, residuals, tolerances, flags 0/1) or counts'
@@ -386,6 +380,8 @@ contains
       !> contact area relative to the frictionless companion's
       real(wp), intent(in), optional :: a_over_a0
       integer(hid_t) :: group
+      type(result_scalar), allocatable :: table(:)
+      integer :: i
 
       if (scene%fields) then
          call create_group(loc, 'fields', group, st)
@@ -431,47 +427,21 @@ contains
       end if
 
       call create_group(loc, 'results', group, st)
-      call write_attr_string(group, 'units', results_units, st)
-      call write_attr_real(group, 'mean_pressure', res%mean_pressure, st)
-      call write_attr_real(group, 'penetration', res%penetration, st)
-      call write_attr_real(group, 'contact_fraction', res%contact_fraction, st)
-      call write_attr_real(group, 'delta_mu', res%delta_mu, st)
-      call write_attr_real(group, 'delta_mu_spectral', res%delta_mu_spectral, st)
-      call write_attr_real(group, 'delta_mu_energy', res%delta_mu_energy, st)
-      call write_attr_real(group, 'delta_mu_profile', res%delta_mu_profile, st)
-      call write_attr_real(group, 'total_friction', res%friction + res%delta_mu, st)
-      call write_attr_real(group, 'dissipated_power', res%dissipated_power, st)
-      call write_attr_real(group, 'pressure_shift', res%pressure_shift, st)
-      call write_attr_real(group, 'summit_shift', res%summit_shift, st)
-      call write_attr_int(group, 'monotone', merge(1, 0, res%monotone), st)
-      call write_attr_int(group, 'converged', merge(1, 0, res%converged), st)
-      call write_attr_int(group, 'iterations', res%iterations, st)
-      call write_attr_int(group, 'outer_iterations', res%outer_iterations, st)
-      call write_attr_string(group, 'solver', trim(res%solver), st)
-      call write_attr_int(group, 'fft_pairs', res%fft_pairs, st)
-      call write_attr_real(group, 'residual', res%residual, st)
-      call write_attr_real(group, 'gap_resolution', res%gap_resolution, st)
-      call write_attr_real(group, 'wall_time', res%wall_time, st)
-      call write_attr_real(group, 'friction', res%friction, st)
-      call write_attr_int(group, 'n_spots', res%n_spots, st)
-      call write_attr_real(group, 'contact_length', res%contact_length, st)
-      call write_attr_real(group, 'mean_gap', res%mean_gap, st)
-      call write_attr_real(group, 'leak_rate', res%leak_rate, st)
-      if (allocated(res%stress_xx)) then
-         call write_attr_real(group, 'max_tension', res%max_tension, st)
-         call write_attr_real(group, 'max_tension_grid', res%max_tension_grid, st)
-         call write_attr_real(group, 'max_tension_x', res%max_tension_x, st)
-         call write_attr_real(group, 'max_tension_offset', res%max_tension_offset, st)
-         if (is_areal(scene)) then
-            call write_attr_real(group, 'max_tension_y', res%max_tension_y, st)
-            call write_attr_real(group, 'max_principal_stress', res%max_principal_stress, st)
-            call write_attr_real(group, 'max_principal_x', res%max_principal_x, st)
-            call write_attr_real(group, 'max_principal_y', res%max_principal_y, st)
-         end if
+      if (present(a_over_a0)) then
+         table = result_scalars(res, is_areal(scene), a_over_a0)
+      else
+         table = result_scalars(res, is_areal(scene))
       end if
-      call write_attr_real(group, 'normalised_pressure', res%normalised_pressure, st)
-      call write_attr_real(group, 'normalised_thickness', res%normalised_thickness, st)
-      if (present(a_over_a0)) call write_attr_real(group, 'a_over_a0', a_over_a0, st)
+      call write_attr_string(group, 'units', results_units(table), st)
+      do i = 1, size(table)
+         if (table(i)%is_text) then
+            call write_attr_string(group, trim(table(i)%name), trim(table(i)%text), st)
+         else if (table(i)%is_integer) then
+            call write_attr_int(group, trim(table(i)%name), nint(table(i)%value), st)
+         else
+            call write_attr_real(group, trim(table(i)%name), table(i)%value, st)
+         end if
+      end do
       call close_group(group, st)
 
       if (allocated(res%leakage)) call write_leakage(loc, res%leakage, st)
@@ -512,6 +482,20 @@ contains
       call write_attr_real(group, 'wall_time', leakage%wall_time, st)
       call close_group(group, st)
    end subroutine write_leakage
+
+   !> The /results@units text: the unit of every dimensional attribute (L and S: the input's
+   !> length and stress units), then a word on the others.
+   pure function results_units(table) result(units)
+      type(result_scalar), intent(in) :: table(:)
+      character(len=:), allocatable :: units
+      integer :: i
+      units = ''
+      do i = 1, size(table)
+         if (trim(table(i)%unit) /= '1') units = units // trim(table(i)%name) // ' ' // trim(table(i)%unit) // '; '
+      end do
+      units = units // 'the others are dimensionless (fractions, friction coefficients, residuals, ' // &
+         & 'normalised values) or counts'
+   end function results_units
 
    !> Fields must match the profile's grid (a mismatch is a bug in the caller).
    subroutine check_sizes(res, n, label, error)

@@ -15,7 +15,7 @@ module lc_io_namelist
    use lc_greens_viscoelastic, only: max_prony_terms
    implicit none (type, external)
    private
-   public :: read_scene, read_scene_text, write_scene_namelist
+   public :: read_scene, read_scene_text, write_scene_namelist, read_prony_file
 
    integer, parameter :: n_groups = 8
    character(len=*), parameter :: group_names(n_groups) = [character(len=8) :: &

@@ -1,12 +1,14 @@
 !> Unit tests of the input/output modules: namelist parsing and its error messages,
-!> the namelist echo round trip, the output pre-check, the HDF5 writer and profile reader.
+!> the namelist echo round trip, the output pre-check, the HDF5 writer and profile reader,
+!> the result's scalars by name and scenes solved from namelist text (the Python route).
 !> Run in a scratch directory: files are created under ./test_io_scratch/.
 program test_io
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, code_input, code_io
-   use lc_scene, only: scene_type, not_set
-   use lc_result, only: contact_result
+   use lc_scene, only: scene_type, not_set, companion_of
+   use lc_result, only: contact_result, result_scalar, result_scalars
+   use lc_scene_text, only: solve_scene_text
    use lc_io_namelist, only: read_scene, read_scene_text, write_scene_namelist
    use lc_io_hdf5, only: check_output, write_results
    use lc_profiles_measured, only: measured_heights
@@ -24,6 +26,9 @@ program test_io
    call test_round_trip()
    call test_check_output()
    call test_write_and_read()
+   call test_result_scalars()
+   call test_companion_of()
+   call test_solve_scene_text()
    if (failures > 0) then
       write (*, '(i0, a)') failures, ' check(s) failed'
       error stop 1
@@ -340,6 +345,66 @@ contains
       ! the extension picks the format: a namelist is text, and not numbers
       call check_error(error, code_input, [character(len=40) :: 'valid.nml', 'is not a number'], 'not heights')
    end subroutine test_write_and_read
+
+   subroutine test_result_scalars()
+      type(contact_result) :: result
+      type(result_scalar), allocatable :: table(:)
+      integer :: i
+      call fake_result(16, 0.2_wp, 0.5_wp, result)
+      table = result_scalars(result, .false.)
+      call check(all([(count(table%name == table(i)%name) == 1, i = 1, size(table))]), 'every scalar name once')
+      call check(.not. any(table%name == 'max_tension'), 'no stress scalars without the stress')
+      call check(.not. any(table%name == 'a_over_a0'), 'no a_over_a0 without a companion')
+      call check(any(table%name == 'mean_pressure' .and. table%value == 0.1_wp .and. table%unit == 'S'), &
+         & 'mean_pressure by name, with its unit')
+      call check(any(table%name == 'iterations' .and. table%is_integer .and. table%value == 3), 'a count')
+      allocate (result%stress_xx(16))
+      table = result_scalars(result, .true., 0.9_wp)
+      call check(any(table%name == 'max_tension') .and. any(table%name == 'max_principal_stress'), &
+         & 'the stress scalars of a surface')
+      call check(table(size(table))%name == 'a_over_a0' .and. table(size(table))%value == 0.9_wp, 'a_over_a0 last')
+   end subroutine test_result_scalars
+
+   subroutine test_companion_of()
+      type(scene_type) :: scene, companion
+      scene%mean_pressure = 0.25_wp
+      companion = companion_of(scene, 0.2500001_wp)
+      call check(companion%mean_pressure == 0.25_wp, 'under load control the companion keeps the load')
+      scene%control = 'displacement'
+      scene%mean_pressure = not_set
+      scene%penetration = 0.01_wp
+      companion = companion_of(scene, 0.3_wp)
+      call check(trim(companion%control) == 'load' .and. companion%mean_pressure == 0.3_wp .and. &
+         & companion%penetration == not_set, 'under displacement control, the load found')
+   end subroutine test_companion_of
+
+   subroutine test_solve_scene_text()
+      integer, parameter :: n = 64
+      real(wp) :: height(n), fields(n, 6, 2), spots(n/2 + 1, 5, 2), history(100, 2)
+      character(len=8192) :: table
+      type(error_type), allocatable :: error
+      integer :: j
+      height = [(0.01_wp*cos(8*atan(1.0_wp)*j/n), j=0, n - 1)]
+      call solve_scene_text('&scene' // nl // ' n = 64' // nl // '/' // nl // '&friction' // nl // &
+         & ' coefficient = 0.3' // nl // ' companion = .true.' // nl // '/' // nl // '&layer' // nl // &
+         & ' thickness = 0.2' // nl // '/' // nl // '&loading' // nl // ' mean_pressure = 1e-3' // nl // '/' // nl, &
+         & height, fields, spots, history, table, error)
+      call check(.not. allocated(error), 'solve_scene_text succeeds')
+      if (allocated(error)) write (*, '(a)') error%message
+      call check(index(table, 'input/period = 1.0') > 0, 'the period, resolved')
+      call check(index(table, nl // 'results/mean_pressure = 1.00000000000000002E-003 S' // nl) > 0, &
+         & 'mean_pressure by name, all its digits and its unit')
+      call check(index(table, nl // 'fields = pressure gap displacement_z displacement_x shear stress_xx' // nl) > 0, &
+         & 'the field columns by name')
+      call check(index(table, nl // 'companion/results/friction = 0.') > 0, 'the frictionless companion')
+      call check(index(table, 'results/a_over_a0 = ') > 0, 'a/a0')
+      call check(all(fields(:, 1, 1) >= 0) .and. abs(sum(fields(:, 1, 1))/n - 1.0e-3_wp) < 1.0e-15_wp, &
+         & 'the pressure carries the load')
+      call solve_scene_text('&layer' // nl // ' poisson = 0.7' // nl // '/' // nl, height, fields, spots, history, &
+         & table, error)
+      call check_error(error, code_input, [character(len=60) :: '&layer: poisson = 7.00000E-01 is not allowed'], &
+         & 'a bad value in the text: the namelist message')
+   end subroutine test_solve_scene_text
 
    !> A made-up result with recognisable values (no solver involved).
    subroutine fake_result(n, friction, fraction, res)
