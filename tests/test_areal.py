@@ -716,3 +716,23 @@ def test_partial_contact_residual_recomputed(nx, ny, ly, thickness, nu, mu, visc
         else:
             assert res.delta_mu_energy == pytest.approx(res.delta_mu, rel=1e-12)
             assert res.dissipated_power == 0
+
+
+def test_large_grids_transform_in_two_passes_like_the_2d_plan():
+    """Grids of at least 800 000 points are transformed rows first, then blocks of columns
+    (lc_fft_plans): the surface stresses of a pressure made of two oblique modes on
+    1024 x 1000 points (two-pass, 513 columns: the last block has one) equal those of the
+    same modes on 64 x 50 points (the 2D plan) at the common points, to rounding: the
+    fields of a band-limited pressure are exact on both grids."""
+    def fields(nx, ny):
+        x = np.arange(nx) / nx
+        y = np.arange(ny)[:, None] * (0.8 / ny)
+        p = 1 + 0.5 * np.cos(2 * np.pi * (3 * x + 5 * y / 0.8)) + 0.3 * np.sin(2 * np.pi * (-7 * x + 2 * y / 0.8))
+        f = lc.surface_stress(p, period=(1.0, 0.8), thickness=0.3, poisson=0.3, friction=0.5)
+        return np.array([f.displacement_x, f.displacement_y, f.stress_xx, f.stress_yy, f.stress_xy])
+
+    big = fields(1024, 1000)[:, ::20, ::16]
+    small = fields(64, 50)
+    scale = np.abs(small).max(axis=(1, 2), keepdims=True)
+    assert np.abs(big - small).max() <= 1e-12 * scale.max()
+    assert np.all(np.abs(big - small) <= 1e-12 * scale)
