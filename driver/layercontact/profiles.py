@@ -112,7 +112,7 @@ def self_affine_surface(
     hurst: float | None = None,
     *,
     seed: int | None = None,
-    short_wavelength: float | None = 1 / 64,
+    short_wavelength: float | None = None,
     rms_gradient: float | None = None,
     rms_height: float | None = None,
     period: float | tuple[float, float] = 1.0,
@@ -133,9 +133,10 @@ def self_affine_surface(
     seed : int, optional
         SplitMix64 seed (>= 0; default that of ``&profile``, 1); the phase of mode (mx, my) depends on the seed and the mode
         only, so a finer grid at the same ``short_wavelength`` gives the same surface.
-    short_wavelength : float or None
-        Shortest wavelength (L); None: ``min(lx, ly)/128``. Modes shorter than the grid
-        allows are left out along with it (a round cut, keeping the surface isotropic).
+    short_wavelength : float, optional
+        Shortest wavelength (L); default that of ``&profile``, ``min(lx, ly)/128``. Modes
+        shorter than the grid allows are left out along with it (a round cut, keeping the
+        surface isotropic).
     rms_gradient, rms_height : float, optional
         Scale target, met exactly on the grid; give at most one (neither: the rms_gradient
         of ``&profile``, 0.1).
