@@ -50,8 +50,9 @@ contains
       type(contact_result) :: result, companion
       character(len=:), allocatable :: description
 
-      fields = 0
-      spots = 0
+      ! fields and spots are filled after the solve, only as far as they are described: sized
+      ! for the most a scene can return (a patch per two points), their untouched pages stay
+      ! out of memory, and the solve's peak is not raised by them
       history = 0
       table = ''
       call read_scene_text(text, source, scene, error)
