@@ -63,16 +63,24 @@ contains
             & scene%profile%boundary, scene%n, scene%ny, error)
          if (allocated(error)) return
          call check_scene(scene, error)
-         if (allocated(error)) return
+         if (allocated(error)) then
+            error%message = "&profile: file = '" // trim(scene%profile%file) // "' sets the grid (no &scene n, " // &
+               & 'nx or ny given), and ' // error%message
+            return
+         end if
       end if
-      call check_output(output_file, scene%overwrite, error)
-      if (allocated(error)) return
       if (scene%solver%target_error /= not_set) then
          call choose_resolution(scene, error)
+         if (allocated(error)) return
+         ! (the grid chosen must be one the scene may have)
+         call check_scene(scene, error)
          if (allocated(error)) return
       end if
       allocate (height(scene%n*scene%ny))
       call make_profile(scene, height, error)
+      if (allocated(error)) return
+      ! bad input in the profile (a file's content) is found before anything is created
+      call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
 
       call solve_contact(scene, height, scene%friction, result, error)

@@ -84,6 +84,11 @@ def test_every_input_runs_the_same_in_fortran_and_python(nml, tmp_path, monkeypa
 
 
 BAD = [
+    ("&profile\n kindd = 'sinusoid'\n/\n", "allowed variables in &profile: kind, hurst, seed, rolloff_wavelength, "
+     "short_wavelength, rms_gradient, rms_height, amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, "
+     "resample"),
+    ("&output\n file = 'bad.h5'\n leakag = .true.\n/\n",
+     "allowed variables in &output: file, overwrite, stress, gap_bins, fields, leakage, leakage_tol"),
     ("&layer\n thickness = -1.0\n/\n", "&layer: thickness"),
     ("&layer\n poisson = 0.7\n/\n", "-1 < poisson <= 0.5"),
     ("&layr\n thickness = 1.0\n/\n", "line 1: unknown namelist group '&layr'"),

@@ -236,7 +236,9 @@ def test_bad_measured_input_exits_2_and_writes_nothing(tmp_path, name, content, 
     else:
         np.save(path, content)
     nml = tmp_path / "bad.nml"
-    nml.write_text(SCENE.format(nx=32, ny=24, file=path, profile=profile, output=tmp_path / "bad.h5"))
+    # the result would go to directories that do not exist yet: none may be created
+    output = tmp_path / "new" / "sub" / "bad.h5"
+    nml.write_text(SCENE.format(nx=32, ny=24, file=path, profile=profile, output=output))
     from test_inputs import run_exe
 
     proc = run_exe(nml, tmp_path)
@@ -244,7 +246,23 @@ def test_bad_measured_input_exits_2_and_writes_nothing(tmp_path, name, content, 
     for word in words:
         assert word in proc.stderr, proc.stderr
     assert "&profile" in proc.stderr and "allowed" in proc.stderr
-    assert not (tmp_path / "bad.h5").exists() and not list(tmp_path.glob("*.tmp"))
+    assert not (tmp_path / "new").exists() and not list(tmp_path.rglob("*.tmp"))
+
+
+def test_a_file_that_sets_the_grid_is_named_when_its_size_is_refused(tmp_path):
+    """Without &scene n the file's size is the grid: a surface of one row is refused
+    naming the file, not a variable the scene does not set."""
+    path = tmp_path / "row.txt"
+    path.write_text(" ".join(["0.5"] * 64) + "\n")
+    nml = tmp_path / "bad.nml"
+    nml.write_text(f"&scene\n geometry = 'areal'\n/\n&profile\n kind = 'file'\n file = '{path}'\n/\n"
+                   f"&loading\n mean_pressure = 0.01\n/\n&output\n file = '{tmp_path / 'new' / 'bad.h5'}'\n/\n")
+    from test_inputs import run_exe
+
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert f"&profile: file = '{path}' sets the grid" in proc.stderr and "ny (or n) = 1" in proc.stderr
+    assert not (tmp_path / "new").exists()
 
 
 def test_treatments_of_measured_heights_are_refused_for_generated_profiles(tmp_path):

@@ -21,7 +21,7 @@ module lc_io_namelist
    character(len=*), parameter :: group_names(n_groups) = [character(len=8) :: &
       & 'scene', 'layer', 'material', 'friction', 'profile', 'loading', 'solver', 'output']
    !> Variables allowed in each group, in the order of `group_names` (for messages).
-   character(len=*), parameter :: group_variables(n_groups) = [character(len=128) :: &
+   character(len=*), parameter :: group_variables(n_groups) = [character(len=192) :: &
       & 'geometry, title, period, n, period_x, period_y, nx, ny', &
       & 'thickness, young, poisson', &
       & 'model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, prony_values, prony_file', &
@@ -30,7 +30,7 @@ module lc_io_namelist
       & 'amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, resample', &
       & 'control, mean_pressure, normalised_pressure, penetration', &
       & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose', &
-      & 'file, overwrite, stress, gap_bins, fields']
+      & 'file, overwrite, stress, gap_bins, fields, leakage, leakage_tol']
 
    character(len=*), parameter :: newline = new_line('a')
    !> The status of a string variable too long for the scene (not an iostat value: those

@@ -20,8 +20,9 @@ static int hypre_started = 0;
 /* Loading Debian's hypre loads SuperLU_DIST, whose initialisation turns off glibc's mmap for
  * large blocks and the trimming of the heap (mallopt M_MMAP_MAX 0, M_TRIM_THRESHOLD -1): every
  * array then comes from the heap and stays there when freed, and a coupled 2048^2 solve
- * peaked 140 MiB (4.4 doubles per grid point) higher. glibc's defaults are put back when
- * this library is loaded (after its dependencies) and again after MPI and hypre start;
+ * peaked 140 MiB higher (docs/decisions/006). Both are set back to glibc's default values
+ * (which also fixes the mmap threshold at its default of 128 KiB instead of letting it grow)
+ * when this library is loaded (after its dependencies) and again after MPI and hypre start;
  * nothing here needs the other setting. */
 static void malloc_defaults(void) {
     mallopt(M_MMAP_MAX, 65536);
@@ -30,8 +31,11 @@ static void malloc_defaults(void) {
 
 __attribute__((constructor)) static void malloc_defaults_at_load(void) { malloc_defaults(); }
 
+void lc_hypre_free(void);
+
 static void finish_at_exit(void) {
     int finalized = 0;
+    lc_hypre_free();
     if (hypre_started) HYPRE_Finalize();
     MPI_Finalized(&finalized);
     if (mpi_started_here && !finalized) MPI_Finalize();

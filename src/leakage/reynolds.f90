@@ -114,11 +114,13 @@ contains
       same = all(active_x .eqv. active_y)
       prepared = .false.
       call solve_direction(1, active_x, result%x)
-      if (allocated(error)) return
-      if (.not. same) prepared = .false.
-      call solve_direction(2, active_y, result%y)
-      if (allocated(error)) return
+      if (.not. allocated(error)) then
+         if (.not. same) prepared = .false.
+         call solve_direction(2, active_y, result%y)
+      end if
+      ! (hypre's matrix, vectors and hierarchy are freed on every path)
       call lc_hypre_free()
+      if (allocated(error)) return
       call system_clock(finish)
       result%wall_time = real(finish - start, wp)/real(rate, wp)
 
@@ -295,7 +297,8 @@ contains
 
       allocate (r(n_free), z(n_free), q(n_free), decreases(max_iter))
       r = b
-      status = lc_hypre_apply(r, z)
+      call precondition(r, z)
+      if (allocated(error)) return
       p = z
       rho = sum(r*z)
       bound = dissipation(phi)
@@ -322,7 +325,8 @@ contains
                end if
             end if
          end if
-         status = lc_hypre_apply(r, z)
+         call precondition(r, z)
+         if (allocated(error)) return
          rho_next = sum(r*z)
          p = z + (rho_next/rho)*p
          rho = rho_next
@@ -332,6 +336,16 @@ contains
       flow%residual = sqrt(sum((b - q)**2))/b_norm
 
    contains
+
+      !> z = one V-cycle of BoomerAMG on r (an error if hypre reports a failure).
+      subroutine precondition(r, z)
+         real(wp), intent(in) :: r(:)
+         real(wp), intent(out) :: z(:)
+         if (lc_hypre_apply(r, z) /= 0) then
+            z = 0.0_wp
+            call fatal_error(error, 'leakage: hypre''s BoomerAMG failed to apply its V-cycle', code_internal)
+         end if
+      end subroutine precondition
 
       !> The right-hand side on the free cells: the divergence of the face fluxes of the
       !> imposed jump.
