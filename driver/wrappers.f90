@@ -313,44 +313,11 @@ subroutine py_self_affine_surface(nx, ny, lx, ly, hurst, seed, rolloff, short, r
    call status_of(error, stat, errmsg)
 end subroutine py_self_affine_surface
 
-!> The surface of an areal scene's &profile (kind = sinusoid | sphere | file) on an
-!> nx x ny grid, made by make_profile exactly as a namelist run makes it; heights flat with
-!> x fastest. Not-given amplitude and radius are passed as -1.
-subroutine py_make_surface(profile_kind, nx, ny, lx, ly, amplitude, mode, mode_y, radius, filename, dataset, height, &
-      & stat, errmsg)
-   use lc_errors, only: error_type, status_of
-   use lc_scene, only: scene_type
-   use lc_profiles_profile, only: make_profile
-   implicit none (type, external)
-   character(len=*), intent(in) :: profile_kind, filename, dataset
-   integer, intent(in) :: nx, ny, mode, mode_y
-   real(8), intent(in) :: lx, ly, amplitude, radius
-   real(8), intent(out) :: height(nx*ny)
-   integer, intent(out) :: stat
-   character(len=1024), intent(out) :: errmsg
-   type(error_type), allocatable :: error
-   type(scene_type) :: scene
-   scene%geometry = 'areal'
-   scene%n = nx
-   scene%ny = ny
-   scene%period = lx
-   scene%period_y = ly
-   scene%profile%kind = profile_kind
-   scene%profile%amplitude = amplitude
-   scene%profile%mode = mode
-   scene%profile%mode_y = mode_y
-   scene%profile%radius = radius
-   scene%profile%file = filename
-   scene%profile%dataset = dataset
-   call make_profile(scene, height, error)
-   call status_of(error, stat, errmsg)
-end subroutine py_make_surface
-
 !> Sizes of the heights in a file (&profile file, dataset), read by the reader of
 !> &profile kind = 'file' (lc_profiles_height_file): nx x ny with x fastest, (n, 1) for a
 !> 1D array.
 subroutine py_height_file_shape(filename, dataset, nx, ny, stat, errmsg)
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_profiles_height_file, only: read_height_file
    implicit none (type, external)
    character(len=*), intent(in) :: filename, dataset
@@ -359,16 +326,11 @@ subroutine py_height_file_shape(filename, dataset, nx, ny, stat, errmsg)
    character(len=1024), intent(out) :: errmsg
    type(error_type), allocatable :: error
    real(8), allocatable :: height(:, :)
-   stat = 0
-   errmsg = ''
    nx = 0
    ny = 0
    call read_height_file(filename, dataset, height, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
+   call status_of(error, stat, errmsg)
+   if (allocated(error)) return
    nx = size(height, 1)
    ny = size(height, 2)
 end subroutine py_height_file_shape
@@ -376,7 +338,7 @@ end subroutine py_height_file_shape
 !> The heights of a file as the reader of &profile kind = 'file' reads them, flat with x
 !> fastest; nx x ny from py_height_file_shape (a file of another size now is an error).
 subroutine py_read_height_file(filename, dataset, nx, ny, height, stat, errmsg)
-   use lc_errors, only: error_type, fatal_error, code_io
+   use lc_errors, only: error_type, fatal_error, code_io, status_of
    use lc_profiles_height_file, only: read_height_file, named
    implicit none (type, external)
    character(len=*), intent(in) :: filename, dataset
@@ -386,19 +348,14 @@ subroutine py_read_height_file(filename, dataset, nx, ny, height, stat, errmsg)
    character(len=1024), intent(out) :: errmsg
    type(error_type), allocatable :: error
    real(8), allocatable :: read_back(:, :)
-   stat = 0
-   errmsg = ''
    height = 0
    call read_height_file(filename, dataset, read_back, error)
    if (.not. allocated(error)) then
       if (size(read_back, 1) /= nx .or. size(read_back, 2) /= ny) &
          & call fatal_error(error, named(filename) // ' changed while it was read', code_io)
    end if
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
+   call status_of(error, stat, errmsg)
+   if (allocated(error)) return
    height = reshape(read_back, [nx*ny])
 end subroutine py_read_height_file
 
@@ -406,7 +363,7 @@ end subroutine py_read_height_file
 !> boundary, resample), as &profile kind = 'file' makes them; areal = 0: a line of nx
 !> points (ny = 1).
 subroutine py_measured_heights(filename, dataset, areal, detrend, boundary, resample, nx, ny, height, stat, errmsg)
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_profiles_measured, only: measured_heights
    implicit none (type, external)
    character(len=*), intent(in) :: filename, dataset, detrend, boundary, resample
@@ -415,19 +372,14 @@ subroutine py_measured_heights(filename, dataset, areal, detrend, boundary, resa
    integer, intent(out) :: stat
    character(len=1024), intent(out) :: errmsg
    type(error_type), allocatable :: error
-   stat = 0
-   errmsg = ''
    call measured_heights(filename, dataset, areal /= 0, detrend, boundary, resample, nx, ny, height, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-   end if
+   call status_of(error, stat, errmsg)
 end subroutine py_measured_heights
 
 !> Detrend, boundary and resample (lc_profiles_measured) of heights raw (mx x n/mx, x
 !> fastest) onto an nx x ny grid; areal = 0: a line (ny = 1).
 subroutine py_prepare_heights(n, raw, mx, areal, detrend, boundary, resample, nx, ny, height, stat, errmsg)
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_profiles_measured, only: prepare_heights
    implicit none (type, external)
    integer, intent(in) :: n, mx, areal, nx, ny
@@ -438,22 +390,18 @@ subroutine py_prepare_heights(n, raw, mx, areal, detrend, boundary, resample, nx
    character(len=1024), intent(out) :: errmsg
    !f2py intent(hide) :: n
    type(error_type), allocatable :: error
-   stat = 0
-   errmsg = ''
    height = 0
    call prepare_heights(reshape(raw, [mx, n/mx]), areal /= 0, detrend, boundary, resample, nx, ny, height, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-   end if
+   call status_of(error, stat, errmsg)
 end subroutine py_prepare_heights
 
 !> Reynolds leakage of a gap (nx*ny, x fastest) by the core: k_eff along x and y and the
-!> diagnostics (lc_leakage_reynolds). closed(j) /= 0 marks contact. values = [k_eff_x, k_eff_y, connected_fraction_x, connected_fraction_y,
-!> fluid_fraction, residual_x, residual_y, wall_time]; counts = [percolating_x, percolating_y,
+!> diagnostics (lc_leakage_reynolds). closed(j) /= 0 marks contact. values = [k_eff_x,
+!> k_eff_y, connected_fraction_x, connected_fraction_y, fluid_fraction, residual_x,
+!> residual_y, wall_time]; counts = [percolating_x, percolating_y,
 !> iterations_x, iterations_y, unknowns_x, unknowns_y, converged_x, converged_y].
 subroutine py_reynolds_leakage(n, gap, closed, nx, lx, ly, tol, max_iter, values, counts, stat, errmsg)
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, status_of
    use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
    implicit none (type, external)
    integer, intent(in) :: n, nx, max_iter
@@ -466,16 +414,11 @@ subroutine py_reynolds_leakage(n, gap, closed, nx, lx, ly, tol, max_iter, values
    !f2py intent(hide) :: n
    type(error_type), allocatable :: error
    type(leakage_result) :: res
-   stat = 0
-   errmsg = ''
    values = 0
    counts = 0
    call reynolds_leakage(gap, closed /= 0, nx, n/nx, lx, ly, tol, max_iter, res, error)
-   if (allocated(error)) then
-      stat = error%code
-      errmsg = error%message
-      return
-   end if
+   call status_of(error, stat, errmsg)
+   if (allocated(error)) return
    values = [res%x%k_eff, res%y%k_eff, res%x%connected_fraction, res%y%connected_fraction, &
       & res%fluid_fraction, res%x%residual, res%y%residual, res%wall_time]
    counts = [merge(1, 0, res%x%percolating), merge(1, 0, res%y%percolating), res%x%iterations, &

@@ -10,7 +10,7 @@ module lc_run
    use lc_errors, only: error_type, fatal_error, code_input
    use lc_scene, only: scene_type, not_set, is_areal, check_scene, grid_of, companion_of
    use lc_grid, only: grid_type
-   use lc_leakage_reynolds, only: reynolds_leakage
+   use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
@@ -123,9 +123,6 @@ contains
       type(contact_result), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
       type(grid_type) :: grid
-      ! a CG that has not met tol by then is reported as not converged (k_eff is then an
-      ! upper bound); 16-40 iterations were measured near percolation up to 2048^2
-      integer, parameter :: leakage_max_iter = 500
       grid = grid_of(scene)
       allocate (result%leakage)
       call reynolds_leakage(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &

@@ -14,6 +14,7 @@ module lc_scene
    use lc_greens_viscoelastic, only: material_law, check_material, static_modulus
    use lc_grid, only: grid_type, line_grid, surface_grid
    use lc_greens_kernel, only: layer_kernel, make_kernel
+   use lc_leakage_reynolds, only: leakage_tol_allowed, leakage_tol_range
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
@@ -363,8 +364,8 @@ contains
          else if (scene%leakage .and. .not. is_areal(scene)) then
             call input_error(error, 'output', 'leakage', '.true.', &
                & ".false. with geometry = 'line' (the Reynolds leakage needs the gap of an areal contact)")
-         else if (.not. (scene%leakage_tol >= 1.0e-14_wp .and. scene%leakage_tol <= 1.0e-2_wp)) then
-            call input_error(error, 'output', 'leakage_tol', to_string(scene%leakage_tol), '1e-14 <= leakage_tol <= 1e-2')
+         else if (.not. leakage_tol_allowed(scene%leakage_tol)) then
+            call input_error(error, 'output', 'leakage_tol', to_string(scene%leakage_tol), leakage_tol_range)
          else if (scene%gap_bins < 0 .or. scene%gap_bins > 100000) then
             call input_error(error, 'output', 'gap_bins', to_string(scene%gap_bins), '0 <= gap_bins <= 100000')
          else if (s%max_iter < 1 .or. s%max_iter > max_iterations) then

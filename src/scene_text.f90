@@ -19,6 +19,7 @@ module lc_scene_text
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_observables_surface, only: surface_fields
    use lc_observables_stress, only: surface_stress
+   use lc_leakage_reynolds, only: leakage_max_iter, leakage_solver
    implicit none (type, external)
    private
    public :: solve_scene_text, profile_of_text, material_of_text, surface_stress_of_text, tensor_of_text, &
@@ -172,7 +173,11 @@ contains
    pure function library_constants() result(text)
       character(len=:), allocatable :: text
       type(profile_spec) :: profile
+      type(scene_type) :: scene
       text = 'max_prony_terms = ' // to_string(max_prony_terms) // newline // &
+         & 'output/leakage_tol = ' // real_text(scene%leakage_tol) // newline // &
+         & 'leakage/max_iter = ' // to_string(leakage_max_iter) // newline // &
+         & 'leakage/solver = ' // leakage_solver // newline // &
          & 'not_set = ' // real_text(not_set) // newline // &
          & 'profile/hurst = ' // real_text(profile%hurst) // newline // &
          & 'profile/seed = ' // to_string(profile%seed) // newline // &

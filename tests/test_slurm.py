@@ -502,5 +502,7 @@ def test_a_leakage_scene_runs_in_a_slurm_array_task(slurm_cluster, tmp_path, mon
         gap_result = lc.read_result(tmp_path / result_file)
         ref = lc.reynolds_leakage(gap_result.gap, period=gap_result.period, contact=gap_result.pressure > 0,
                                   method="direct")
+        # the task's k_eff meets leakage_tol 1e-6 (an upper bound); 2e-6 leaves the rounding
+        # of the direct solve its share
         assert k == pytest.approx(ref.k_eff, rel=2e-6)
     assert summary["leakage_k_eff_x"][0] > summary["leakage_k_eff_x"][1] > 0

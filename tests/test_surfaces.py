@@ -291,9 +291,10 @@ def bad_files(tmp_path, surface):
         "\n".join(" ".join(["1.0"] * 20) for _ in range(11)) + "\n1.0 x" + " 1" * 18
     )
     cases.append(("word.txt", None, 2, "line 12: 'x' is not a number"))
-    cases.append(("missing.npy", None, 4, "cannot be opened"))
-    cases.append(("missing.txt", None, 4, "cannot be opened"))
-    cases.append(("missing.h5", None, 4, "cannot be opened as HDF5"))
+    # a file that is not there is bad input (2), from Python as in a run
+    cases.append(("missing.npy", None, 2, "is not found"))
+    cases.append(("missing.txt", None, 2, "is not found"))
+    cases.append(("missing.h5", None, 2, "is not found"))
     return cases
 
 

@@ -647,8 +647,8 @@ def core_leakage(
     period=1.0,
     *,
     contact=None,
-    tol: float = 1e-6,
-    max_iter: int = 500,
+    tol: float | None = None,
+    max_iter: int | None = None,
 ) -> CoreLeakage:
     """The Reynolds leakage along x and along y of ``gap`` by the compiled core, as a run
     with ``&output leakage = .true.`` computes it (:class:`CoreLeakage`).
@@ -661,23 +661,26 @@ def core_leakage(
         Period (L), or the pair ``(lx, ly)``.
     contact : array_like of bool, optional
         ``(ny, nx)`` contact mask; cells with ``gap <= 1e-6 max(gap)`` are closed as well.
-    tol : float
-        Relative accuracy of ``k_eff`` at which CG stops (energy-error estimate).
-    max_iter : int
-        Largest number of CG iterations per direction.
+    tol : float, optional
+        Relative accuracy of ``k_eff`` at which CG stops (energy-error estimate); default
+        that of ``&output leakage_tol`` (1e-6), the same range.
+    max_iter : int, optional
+        Largest number of CG iterations per direction; default that of a run (500).
     """
+    from .api import _CONSTANTS, _check
     from .native import core
+
+    tol = float(_CONSTANTS["output/leakage_tol"]) if tol is None else float(tol)
+    max_iter = int(_CONSTANTS["leakage/max_iter"]) if max_iter is None else int(max_iter)
 
     g = np.array(gap, dtype=np.float64)
     if g.ndim != 2 or min(g.shape) < 4:
-        raise ValueError(f"gap must be a (ny, nx) array with nx, ny >= 4; got shape {g.shape}")
+        raise ValueError(f"gap must be a (ny, nx) array with nx, ny >= 4 (an areal grid); got shape {g.shape}")
     if not np.all(np.isfinite(g)):
         raise ValueError("gap must be finite")
     lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else tuple(float(p) for p in period)
     if not (lx > 0 and ly > 0 and np.isfinite(lx) and np.isfinite(ly)):
         raise ValueError(f"period must be positive and finite; got {(lx, ly)}")
-    if not (1e-14 <= tol <= 1e-2) or max_iter < 1:
-        raise ValueError("tol must be in [1e-14, 1e-2] and max_iter >= 1")
     closed = np.zeros(g.shape, dtype=np.int32) if contact is None else np.asarray(contact, dtype=np.int32)
     if closed.shape != g.shape:
         raise ValueError(f"contact has shape {closed.shape}, the gap {g.shape}")
@@ -685,8 +688,7 @@ def core_leakage(
         np.ascontiguousarray(g.ravel()), np.ascontiguousarray(closed.ravel()), g.shape[1], lx, ly, tol,
         max_iter,
     )
-    if stat != 0:
-        raise RuntimeError(errmsg.decode().strip() if isinstance(errmsg, bytes) else str(errmsg).strip())
+    _check(stat, errmsg)
     return CoreLeakage(
         k_eff_x=float(values[0]), k_eff_y=float(values[1]),
         percolating_x=bool(counts[0]), percolating_y=bool(counts[1]),
@@ -696,6 +698,6 @@ def core_leakage(
         iterations_x=int(counts[2]), iterations_y=int(counts[3]),
         residual_x=float(values[5]), residual_y=float(values[6]),
         converged=bool(counts[6] and counts[7]), tol=tol,
-        solver="cg + hypre BoomerAMG",
+        solver=_CONSTANTS["leakage/solver"],
         wall_time=float(values[7]),
     )

@@ -177,40 +177,6 @@ def self_affine_surface(
     return height.reshape(ny, nx)
 
 
-def _make_surface(
-    kind: str,
-    nx: int,
-    ny: int,
-    lx: float,
-    ly: float,
-    *,
-    amplitude=NOT_SET,
-    mode=1,
-    mode_y=0,
-    radius=NOT_SET,
-    path="",
-    dataset=_DEFAULT_DATASET,
-) -> np.ndarray:
-    """The surface of an areal scene's &profile, made by the library's make_profile."""
-    if len(path) > _MAX_STRING or len(dataset) > _MAX_STRING:
-        raise ValueError(f"file and dataset names are limited to {_MAX_STRING} characters")
-    height, stat, errmsg = _core.py_make_surface(
-        kind,
-        int(nx),
-        int(ny),
-        float(lx),
-        float(ly),
-        float(amplitude),
-        int(mode),
-        int(mode_y),
-        float(radius),
-        path,
-        dataset,
-    )
-    _check(stat, errmsg)
-    return height.reshape(ny, nx)
-
-
 def sinusoid_surface(
     n: int,
     amplitude: float,

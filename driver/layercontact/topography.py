@@ -131,20 +131,21 @@ def scene_lines(topography: Topography, file: str) -> str:
     h = np.asarray(topography.height)
     factor = 1 if topography.periodic else 2
     unit = f"({topography.unit})" if topography.unit else "(the file's length unit)"
-    if not np.all(np.isfinite(topography.size)):
-        unit = "(the file states no size: give the period in the heights' unit)"
+    sized = bool(np.all(np.isfinite(topography.size)))
+
+    def period(name: str, length: float, note: str = "") -> str:
+        # a file that states no size gets no period line (a NaN would be bad input), only a note
+        if not sized:
+            return f"   ! {name} = ? (the file states no size: give it in the heights' unit)"
+        return f"   {name} = {factor * length!r}" + (f"   ! {note}" if note else "")
+
     lines = ["&scene"]
     if h.ndim == 2:
         ny, nx = h.shape
-        lines += [
-            "   geometry = 'areal'",
-            f"   nx = {factor * nx}",
-            f"   ny = {factor * ny}",
-            f"   period = {factor * topography.size[0]!r}   ! {unit}",
-            f"   period_y = {factor * topography.size[1]!r}",
-        ]
+        lines += ["   geometry = 'areal'", f"   nx = {factor * nx}", f"   ny = {factor * ny}",
+                  period("period", topography.size[0], unit), period("period_y", topography.size[1])]
     else:
-        lines += [f"   n = {factor * h.size}", f"   period = {factor * topography.size[0]!r}   ! {unit}"]
+        lines += [f"   n = {factor * h.size}", period("period", topography.size[0], unit)]
     lines += ["/", "&profile", "   kind = 'file'", f"   file = '{file}'"]
     if not topography.periodic:
         lines += ["   boundary = 'mirror'   ! a measured patch: it and its mirror images make the period"]

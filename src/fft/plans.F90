@@ -27,8 +27,8 @@ module lc_fft_plans
    !> lines. Measured per r2c + c2r pair (bench/fft_plans.c, FFTW 3.3.10, one thread):
    !> 1000^2 9.4 -> 7.2 ms, 1024^2 10.0 -> 7.3 ms, 2048^2 61 -> 42 ms, where FFTW_MEASURE
    !> (0.5-0.8 s of planning, and a plan that may differ from run to run) reaches 6.2 and
-   !> 33 ms; from 640^2 to 768^2 the two are equal, and below the 2D plan was as fast or
-   !> faster in another run.
+   !> 33 ms; from 640^2 to 768^2 the two are equal. Below, the gain is not steady: 512^2
+   !> took 1.06 against 1.44 ms on a quiet machine, 640^2 3.3 against 2.2 ms under load.
    integer, parameter :: split_points = 800000
    integer, parameter :: column_block = 8
 

@@ -369,6 +369,11 @@ contains
       end associate
       call write_attr_string(loc, 'output_file', trim(scene%output_file), st)
       call write_attr_int(loc, 'overwrite', merge(1, 0, scene%overwrite), st)
+      call write_attr_int(loc, 'stress', merge(1, 0, scene%stress), st)
+      call write_attr_int(loc, 'gap_bins', scene%gap_bins, st)
+      call write_attr_int(loc, 'fields', merge(1, 0, scene%fields), st)
+      call write_attr_int(loc, 'leakage', merge(1, 0, scene%leakage), st)
+      call write_attr_real(loc, 'leakage_tol', scene%leakage_tol, st)
    end subroutine write_scene_attrs
 
    !> fields/, results (attributes) and convergence/ of one solve, under `loc`.

@@ -50,7 +50,16 @@ contains
       real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
       integer :: ix, iy
+      logical :: found
 
+      ! a file that is not there is bad input (exit 2), from every route; one that is there
+      ! but cannot be read is an I/O failure (4)
+      inquire (file=filename, exist=found)
+      if (.not. found) then
+         call fatal_error(error, named(filename) // ' is not found; allowed: an existing file (HDF5, .npy or ' // &
+            & 'text), relative to the working directory', code_input)
+         return
+      end if
       if (ends_with(filename, '.h5') .or. ends_with(filename, '.hdf5')) then
          call read_hdf5(filename, dataset, height, error)
       else if (ends_with(filename, '.npy')) then

@@ -13,7 +13,7 @@
 !>   differing only in the rounding of the cosine's argument (up to ~2 pi (mode+mode_y)).
 program test_profiles
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, code_input, code_io
+   use lc_errors, only: error_type, code_input
    use lc_scene, only: scene_type, not_set, check_scene
    use lc_fft_plans, only: fft_plan
    use lc_profiles_random, only: splitmix64, splitmix64_uniform
@@ -471,7 +471,7 @@ contains
       call measured_heights('/nonexistent/surface.npy', '', .true., 'auto', 'periodic', 'none', nx, ny, read_back, &
          & error)
       call report(allocated(error), 'missing .npy surface file is an error')
-      if (allocated(error)) call report(error%code == code_io, 'its code is code_io: ' // error%message)
+      if (allocated(error)) call report(error%code == code_input, 'its code is code_input (bad input): ' // error%message)
    end subroutine check_surface_text_file
 
    !> Detrending, mirroring and resampling of measured heights against closed forms.
