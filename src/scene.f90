@@ -15,6 +15,7 @@ module lc_scene
    use lc_grid, only: grid_type, line_grid, surface_grid
    use lc_greens_kernel, only: layer_kernel, make_kernel
    use lc_leakage_reynolds, only: leakage_tol_allowed, leakage_tol_range
+   use lc_profiles_measured, only: check_treatments
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
@@ -310,13 +311,8 @@ contains
             if (len_trim(p%file) == 0) then
                call input_error(error, 'profile', 'file', "''", &
                   & 'the name of a file holding the heights (.h5/.hdf5, .npy or text)')
-            else if (.not. one_of(p%detrend, [character(len=16) :: 'auto', 'none', 'mean', 'plane', 'curvature'])) then
-               call input_error(error, 'profile', 'detrend', "'" // trim(p%detrend) // "'", &
-                  & "'auto', 'none', 'mean', 'plane' or 'curvature'")
-            else if (.not. one_of(p%boundary, [character(len=16) :: 'periodic', 'mirror'])) then
-               call input_error(error, 'profile', 'boundary', "'" // trim(p%boundary) // "'", "'periodic' or 'mirror'")
-            else if (.not. one_of(p%resample, [character(len=16) :: 'none', 'fourier'])) then
-               call input_error(error, 'profile', 'resample', "'" // trim(p%resample) // "'", "'none' or 'fourier'")
+            else
+               call check_treatments(p%detrend, p%boundary, p%resample, error)
             end if
          end select
          if (allocated(error)) return

@@ -32,7 +32,7 @@ module lc_profiles_measured
    implicit none (type, external)
    private
    public :: measured_heights, measured_grid, prepare_heights, detrend_heights, mirror_heights, resample_heights
-   public :: detrend_modes, boundary_modes, resample_modes
+   public :: detrend_modes, boundary_modes, resample_modes, check_treatments
 
    !> Allowed values of &profile detrend, boundary and resample, for checks and messages.
    character(len=*), parameter :: detrend_modes = "'auto', 'none', 'mean', 'plane' or 'curvature'"
@@ -107,6 +107,24 @@ contains
       end if
    end subroutine measured_grid
 
+   !> The values of &profile detrend, boundary and resample (the namelist check and the
+   !> Python route both ask here).
+   subroutine check_treatments(detrend, boundary, resample, error)
+      character(len=*), intent(in) :: detrend, boundary, resample
+      type(error_type), allocatable, intent(out) :: error
+      select case (trim(detrend))
+      case ('auto', 'none', 'mean', 'plane', 'curvature')
+      case default
+         call input_error(error, 'profile', 'detrend', "'" // trim(detrend) // "'", detrend_modes)
+         return
+      end select
+      if (trim(boundary) /= 'periodic' .and. trim(boundary) /= 'mirror') then
+         call input_error(error, 'profile', 'boundary', "'" // trim(boundary) // "'", boundary_modes)
+      else if (trim(resample) /= 'none' .and. trim(resample) /= 'fourier') then
+         call input_error(error, 'profile', 'resample', "'" // trim(resample) // "'", resample_modes)
+      end if
+   end subroutine check_treatments
+
    !> Steps 2 to 4 of the module header on heights raw(mx, my) (my = 1 for a line): the
    !> heights on an nx x ny grid. Messages of the grid's size start with 'holds'.
    subroutine prepare_heights(raw, areal, detrend, boundary, resample, nx, ny, height, error)
@@ -120,22 +138,10 @@ contains
       character(len=:), allocatable :: mode
 
       height = 0.0_wp
+      call check_treatments(detrend, boundary, resample, error)
+      if (allocated(error)) return
       mode = trim(detrend)
       if (mode == 'auto') mode = merge('plane', 'none ', trim(boundary) == 'mirror')
-      select case (mode)
-      case ('none', 'mean', 'plane', 'curvature')
-      case default
-         call input_error(error, 'profile', 'detrend', "'" // trim(detrend) // "'", detrend_modes)
-         return
-      end select
-      if (trim(boundary) /= 'periodic' .and. trim(boundary) /= 'mirror') then
-         call input_error(error, 'profile', 'boundary', "'" // trim(boundary) // "'", boundary_modes)
-         return
-      end if
-      if (trim(resample) /= 'none' .and. trim(resample) /= 'fourier') then
-         call input_error(error, 'profile', 'resample', "'" // trim(resample) // "'", resample_modes)
-         return
-      end if
 
       ! a polynomial of degree d needs d + 1 points along each axis it varies along
       select case (mode)
