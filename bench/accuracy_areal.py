@@ -97,8 +97,8 @@ LEAK_TOL = 1e-8
 # mean patch size 2 A / P (contact area over half the perimeter, in lambda_s; a line spot's
 # length) from a pilot solve at ppw 4, tol 1e-4; tol = the largest of TOLS <= (eps/12)^1.5.
 # It covers every observable but the max tension: the largest grid value of sigma_xx
-# converges at order ~1/2 (a square-root cusp at the trailing edges, not resolved sub-grid
-# on surfaces), so it is reported, not targeted.
+# converges at order 0.75-0.95 (a square-root cusp at the trailing edges, not resolved
+# sub-grid on surfaces), so it is reported, not targeted.
 RULE_SPOT = 0.3
 PILOT = dict(ppw=4, tol=1e-4)
 # ---------------------------------------------------------------------------------------
