@@ -84,6 +84,8 @@ def test_every_input_runs_the_same_in_fortran_and_python(nml, tmp_path, monkeypa
 
 
 BAD = [
+    ("&material\n model = 'prony'\n prony_equilibrium = 1.0\n prony_file = 'absent_terms.txt'\n/\n",
+     "&material: prony_file = 'absent_terms.txt' is not allowed; allowed: an existing text file"),
     ("&profile\n kindd = 'sinusoid'\n/\n", "allowed variables in &profile: kind, hurst, seed, rolloff_wavelength, "
      "short_wavelength, rms_gradient, rms_height, amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, "
      "resample"),

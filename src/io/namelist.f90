@@ -9,7 +9,7 @@ module lc_io_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input, code_io
+   use lc_errors, only: error_type, fatal_error, input_error, code_input, code_io
    use lc_strings, only: to_string, lower_case
    use lc_scene, only: scene_type, check_scene, not_set, max_string
    use lc_greens_viscoelastic, only: max_prony_terms
@@ -468,8 +468,17 @@ contains
       character(len=1024) :: line, msg
       real(wp) :: pair(2), extra
       integer :: unit, stat, lineno, cut
+      logical :: found
 
       allocate (times(0), values(0))
+      ! a file that is not there is bad input (as for &profile file); one that is there but
+      ! cannot be opened an I/O failure
+      inquire (file=filename, exist=found)
+      if (.not. found) then
+         call input_error(error, 'material', 'prony_file', "'" // filename // "'", &
+            & 'an existing text file of tau_i value_i lines, relative to the working directory')
+         return
+      end if
       open (newunit=unit, file=filename, status='old', action='read', iostat=stat, iomsg=msg)
       if (stat /= 0) then
          call fatal_error(error, "&material: cannot open prony_file '" // filename // "': " // trim(msg), code_io)
