@@ -30,7 +30,7 @@ fi
 # Rebuild the package only when a source file changed since the last install.
 stamp=.venv/.layercontact-installed
 if [ ! -f "$stamp" ] || [ -n "$(find src app driver meson.build meson.options pyproject.toml -newer "$stamp" -print -quit)" ]; then
-  echo "bootstrap: building and installing layercontact into .venv (about a minute)"
+  echo "bootstrap: building and installing layercontact into .venv (about a minute once downloaded)"
   .venv/bin/pip install -q ".[test]" meson ninja
   touch "$stamp"
 fi
