@@ -335,30 +335,6 @@ subroutine py_height_file_shape(filename, dataset, nx, ny, stat, errmsg)
    ny = size(height, 2)
 end subroutine py_height_file_shape
 
-!> The heights of a file as the reader of &profile kind = 'file' reads them, flat with x
-!> fastest; nx x ny from py_height_file_shape (a file of another size now is an error).
-subroutine py_read_height_file(filename, dataset, nx, ny, height, stat, errmsg)
-   use lc_errors, only: error_type, fatal_error, code_io, status_of
-   use lc_profiles_height_file, only: read_height_file, named
-   implicit none (type, external)
-   character(len=*), intent(in) :: filename, dataset
-   integer, intent(in) :: nx, ny
-   real(8), intent(out) :: height(nx*ny)
-   integer, intent(out) :: stat
-   character(len=1024), intent(out) :: errmsg
-   type(error_type), allocatable :: error
-   real(8), allocatable :: read_back(:, :)
-   height = 0
-   call read_height_file(filename, dataset, read_back, error)
-   if (.not. allocated(error)) then
-      if (size(read_back, 1) /= nx .or. size(read_back, 2) /= ny) &
-         & call fatal_error(error, named(filename) // ' changed while it was read', code_io)
-   end if
-   call status_of(error, stat, errmsg)
-   if (allocated(error)) return
-   height = reshape(read_back, [nx*ny])
-end subroutine py_read_height_file
-
 !> Heights of a file on a scene's grid (lc_profiles_measured: the shape rule, detrend,
 !> boundary, resample), as &profile kind = 'file' makes them; areal = 0: a line of nx
 !> points (ny = 1).

@@ -71,18 +71,13 @@ def load_profile(path: str | os.PathLike, dataset: str = "/profile/height") -> n
     line of numbers (blank lines and ``#`` comments skipped). Every height must be finite.
     Raises ValueError for content that breaks these rules and OSError for unreadable files.
     """
-    h = _read_heights(path, dataset)
-    if h.shape[0] != 1 and h.shape[1] != 1:
-        raise ValueError(
-            f"&profile: file = '{os.fspath(path)}' holds shape {h.shape}; "
-            "allowed: one row or one column of heights for a line profile"
-        )
-    return h.ravel()
+    return _as_read(path, dataset, areal=False)
 
 
-def _read_heights(path: str | os.PathLike, dataset: str | None) -> np.ndarray:
-    """The heights of a file by the library's reader, as a (ny, nx) array ((1, n) for a
-    1D array); its errors as ValueError (bad content) or OSError (unreadable file)."""
+def _as_read(path: str | os.PathLike, dataset: str | None, *, areal: bool) -> np.ndarray:
+    """The heights of a file as the library takes them for a line (1D) or a surface
+    ((ny, nx)) at the file's own size, untreated (its shape rules and messages); its errors
+    as ValueError (bad content) or OSError (unreadable file)."""
     path = os.fspath(path)
     dataset = _DEFAULT_DATASET if dataset is None else dataset
     if len(path) > _MAX_STRING or len(dataset) > _MAX_STRING:
@@ -90,12 +85,13 @@ def _read_heights(path: str | os.PathLike, dataset: str | None) -> np.ndarray:
     try:
         nx, ny, stat, errmsg = _core.py_height_file_shape(path, dataset)
         _check(stat, errmsg)
-        height, stat, errmsg = _core.py_read_height_file(path, dataset, nx, ny)
-        _check(stat, errmsg)
+        if not areal:
+            nx, ny = nx * ny, 1
+        height = _measured(path, dataset, areal, "none", "periodic", "none", nx, ny)
     except LayercontactError as error:
         kind = OSError if error.code == 4 else ValueError
         raise kind(str(error)) from None
-    return height.reshape(ny, nx)
+    return height.reshape(ny, nx) if areal else height
 
 
 def _surface_grid(n, period, nx, ny) -> tuple[int, int, float, float]:
@@ -333,10 +329,4 @@ def load_surface(path: str | os.PathLike, dataset: str | None = None) -> np.ndar
     (blank lines and ``#`` comments skipped). Every height must be finite. Raises
     ValueError for content that breaks these rules and OSError for unreadable files.
     """
-    h = _read_heights(path, dataset)
-    if h.shape[0] < 2 or h.shape[1] < 2:
-        raise ValueError(
-            f"&profile: file = '{os.fspath(path)}' holds shape {h.shape}; "
-            "allowed: a 2D array (ny, nx) of at least 2 x 2 heights for a surface"
-        )
-    return h
+    return _as_read(path, dataset, areal=True)
