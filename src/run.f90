@@ -7,7 +7,7 @@
 module lc_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_errors, only: error_type
    use lc_scene, only: scene_type, not_set, is_areal, check_scene, grid_of, companion_of
    use lc_grid, only: grid_type
    use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
@@ -39,7 +39,6 @@ contains
       real(wp), allocatable :: height(:)
       type(run_record) :: run
       integer(i8) :: start, finish, rate
-      logical :: found
 
       converged = .false.
       call system_clock(start, rate)
@@ -48,15 +47,6 @@ contains
       call read_scene(input, scene, text, error)
       if (allocated(error)) return
       output_file = trim(scene%output_file)
-      ! a profile file that is not there is bad input, found before anything is created
-      if (trim(scene%profile%kind) == 'file') then
-         inquire (file=trim(scene%profile%file), exist=found)
-         if (.not. found) then
-            call fatal_error(error, "&profile: file = '" // trim(scene%profile%file) // "' is not found; allowed: " // &
-               & 'an existing file (HDF5, .npy or text), relative to the working directory', code_input)
-            return
-         end if
-      end if
       ! without &scene n (nx, ny) a profile file sets the grid: its own size
       if (trim(scene%profile%kind) == 'file' .and. .not. scene%grid_given) then
          call measured_grid(trim(scene%profile%file), trim(scene%profile%dataset), is_areal(scene), &

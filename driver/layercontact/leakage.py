@@ -149,6 +149,23 @@ class LeakageResult:
     wall_time: float
 
 
+def _cell(gap, period, contact, *, smallest: int) -> tuple[np.ndarray, tuple[float, float], np.ndarray]:
+    """The gap as a finite ``(ny, nx)`` array (each side >= ``smallest``), the periods
+    ``(lx, ly)`` and the contact mask (False where not given), checked."""
+    g = np.array(gap, dtype=np.float64)
+    if g.ndim != 2 or min(g.shape) < smallest:
+        raise ValueError(f"gap must be a (ny, nx) array with nx, ny >= {smallest}; got shape {g.shape}")
+    if not np.all(np.isfinite(g)):
+        raise ValueError("gap must be finite")
+    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else tuple(float(p) for p in period)
+    if not (lx > 0 and ly > 0 and np.isfinite(lx) and np.isfinite(ly)):
+        raise ValueError(f"period must be positive and finite; got {(lx, ly)}")
+    closed = np.zeros(g.shape, dtype=bool) if contact is None else np.asarray(contact, dtype=bool)
+    if closed.shape != g.shape:
+        raise ValueError(f"contact has shape {closed.shape}, the gap {g.shape}")
+    return g, (lx, ly), closed
+
+
 def reynolds_leakage(
     gap,
     period=1.0,
@@ -208,14 +225,7 @@ def reynolds_leakage(
     LeakageResult
     """
     start = time.perf_counter()
-    g = np.array(gap, dtype=np.float64)
-    if g.ndim != 2 or min(g.shape) < 1:
-        raise ValueError(f"gap must be a (ny, nx) array; got shape {g.shape}")
-    if not np.all(np.isfinite(g)):
-        raise ValueError("gap must be finite")
-    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else tuple(float(p) for p in period)
-    if not (lx > 0 and ly > 0 and np.isfinite(lx) and np.isfinite(ly)):
-        raise ValueError(f"period must be positive and finite; got {(lx, ly)}")
+    g, (lx, ly), closed = _cell(gap, period, contact, smallest=1)
     if direction not in ("x", "y"):
         raise ValueError(f"direction must be 'x' or 'y'; got {direction!r}")
     if face not in ("harmonic", "arithmetic"):
@@ -225,11 +235,6 @@ def reynolds_leakage(
     if not (viscosity > 0 and pressure_gradient >= 0):
         raise ValueError("viscosity must be > 0 and pressure_gradient >= 0")
 
-    closed = np.zeros(g.shape, dtype=bool)
-    if contact is not None:
-        closed = np.asarray(contact, dtype=bool)
-        if closed.shape != g.shape:
-            raise ValueError(f"contact has shape {closed.shape}, the gap {g.shape}")
     if contact_threshold is None:
         contact_threshold = _CONTACT_THRESHOLD_RELATIVE * max(float(g.max()), 0.0)
     if np.any(g[~closed] < -contact_threshold):
@@ -673,19 +678,11 @@ def core_leakage(
     tol = float(_CONSTANTS["output/leakage_tol"]) if tol is None else float(tol)
     max_iter = int(_CONSTANTS["leakage/max_iter"]) if max_iter is None else int(max_iter)
 
-    g = np.array(gap, dtype=np.float64)
-    if g.ndim != 2 or min(g.shape) < 4:
-        raise ValueError(f"gap must be a (ny, nx) array with nx, ny >= 4 (an areal grid); got shape {g.shape}")
-    if not np.all(np.isfinite(g)):
-        raise ValueError("gap must be finite")
-    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else tuple(float(p) for p in period)
-    if not (lx > 0 and ly > 0 and np.isfinite(lx) and np.isfinite(ly)):
-        raise ValueError(f"period must be positive and finite; got {(lx, ly)}")
-    closed = np.zeros(g.shape, dtype=np.int32) if contact is None else np.asarray(contact, dtype=np.int32)
-    if closed.shape != g.shape:
-        raise ValueError(f"contact has shape {closed.shape}, the gap {g.shape}")
+    # (nx, ny >= 4: an areal grid, as the core's run has)
+    g, (lx, ly), closed = _cell(gap, period, contact, smallest=4)
     values, counts, stat, errmsg = core.py_reynolds_leakage(
-        np.ascontiguousarray(g.ravel()), np.ascontiguousarray(closed.ravel()), g.shape[1], lx, ly, tol,
+        np.ascontiguousarray(g.ravel()), np.ascontiguousarray(closed.ravel(), dtype=np.int32), g.shape[1], lx, ly,
+        tol,
         max_iter,
     )
     _check(stat, errmsg)
