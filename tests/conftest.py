@@ -45,7 +45,7 @@ def contact_violation(res: lc.LineResult, thickness: float, young: float, poisso
     }
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def rough_profile():
     """A self-affine profile used by several tests (n = 4096, H = 0.8, seed 1)."""
     return lc.self_affine_profile(4096, 0.8, seed=1, short_wavelength=1 / 64, rms_gradient=0.1)
@@ -63,9 +63,9 @@ def _free_ports(count: int) -> list[int]:
             s.close()
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def slurm_cluster():
-    """A private single-node Slurm for this pytest run (tools/local_slurm.sh): Debian's
+    """A private single-node Slurm for the tests of a module (tools/local_slurm.sh): Debian's
     slurm-wlm and munge are installed when missing, then munged, slurmctld and slurmd start
     as root with every path under a temporary directory and free ports. Yields the path of
     its slurm.conf (for SLURM_CONF); the daemons are stopped by PID afterwards, and by a
