@@ -66,9 +66,10 @@ module lc_result
       logical :: converged = .false.
       integer :: iterations = 0               !< CG or GCR iterations (all inner CG solves for anderson)
       integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for cg and gcr
-      !> the solver that ran: 'cg', 'gcr', 'anderson', or 'gcr+anderson' (gcr stalled and the
-      !> Anderson outer iteration went on from its best iterate)
-      character(len=16) :: solver = ''
+      !> the solver that ran: 'cg', 'gcr', 'anderson', 'gfmd' or 'gcr+anderson' (gcr stalled
+      !> and the Anderson outer iteration went on from its best iterate); '+newton' when the
+      !> dense Newton method finished a small grid the iterative solver left unconverged
+      character(len=24) :: solver = ''
       integer :: fft_pairs = 0                !< FFT r2c+c2r pairs spent
       real(wp) :: residual = huge(1.0_wp)     !< final dimensionless complementarity residual
       !> an upper bound of the rounding of w - r relative to the profile's peak-to-valley:
@@ -88,7 +89,7 @@ module lc_result
       character(len=8) :: unit = '1'
       logical :: is_integer = .false.
       logical :: is_text = .false.
-      character(len=16) :: text = ''
+      character(len=24) :: text = ''
    end type result_scalar
 
 contains

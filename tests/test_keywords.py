@@ -31,7 +31,7 @@ def namelist_message(tmp_path, groups: str) -> str:
     (dict(poisson=0.7), "&layer\n poisson = 0.7\n/\n"),
     (dict(young=0.0), "&layer\n young = 0.0\n/\n"),
     (dict(friction=11.0), "&friction\n coefficient = 11.0\n/\n"),
-    (dict(method="newton"), "&solver\n method = 'newton'\n/\n"),
+    (dict(method="dense"), "&solver\n method = 'dense'\n/\n"),
     (dict(tol=0.5), "&solver\n tol = 0.5\n/\n"),
     (dict(max_iter=0), "&solver\n max_iter = 0\n/\n"),
     (dict(memory=101), "&solver\n memory = 101\n/\n"),

@@ -353,6 +353,87 @@ def test_dense_newton_agrees(case):
     assert np.count_nonzero(res.pressure > bound) == np.count_nonzero(p > bound)
 
 
+@pytest.mark.parametrize("n, profile, thickness, friction, factor", [
+    (9, "rough", 1e-4, 0.5, 0.3), (9, "sinusoid", 1e-4, 1.0, 0.03), (8, "bump", 1e-4, 0.5, 0.3)])
+def test_dense_newton_finishes_what_the_iterative_solvers_leave(n, profile, thickness, friction, factor):
+    """Thin incompressible layers with strong friction on a few points: G_eff is nearly skew
+    there, GCR and the Anderson iteration stall (method 'gcr' alone says so), and under
+    'auto' the dense Newton method finishes the solve from their last iterate. Its solution
+    equals the independent numpy solver's (tests/dense_reference.py) to the bound the
+    tolerance allows (see test_dense_newton_agrees)."""
+    r = extremes_grid.profiles(n)[profile]
+    g = g_eff(n, 1.0, thickness, 1.0, 0.5, friction)
+    assert np.all(g.real >= 0)  # monotone: the solution is unique
+    pm = factor * extremes_grid.full_contact_pressure(r, thickness, 0.5, friction)
+    tol = 1e-9
+    kw = dict(thickness=thickness, poisson=0.5, friction=friction, mean_pressure=pm, tol=tol, stress=False)
+    alone = lc.solve_line(r, method="gcr", **kw)
+    assert not alone.converged
+    res = lc.solve_line(r, **kw)
+    assert res.converged and res.residual <= tol and res.solver.endswith("+newton")
+    p, s, residual = solve_dense(r, g, pm)
+    assert residual <= 1e-13
+    bound = tol * np.ptp(r) * np.max(1 / np.abs(g[1:]))
+    assert np.abs(res.pressure - p).max() <= bound
+
+
+def test_dense_newton_respects_the_budget(rough_profile):
+    """A run stopped by max_iter stays stopped: the dense method only finishes solves that
+    stalled with budget left, and its steps count as iterations."""
+    res = lc.solve_line(rough_profile, thickness=0.01, friction=1.0, mean_pressure=rough_profile.max() * 16,
+                        max_iter=5)
+    assert not res.converged and res.iterations == 5 and "newton" not in res.solver
+
+
+@pytest.mark.parametrize("case", ["glassy half-space near full contact", "lossy layer with friction",
+                                  "thin coupled elastic"])
+def test_newton_method_agrees(case):
+    """method = 'newton' alone (the dense semismooth Newton method, from the coarse start)
+    against the independent numpy solver of tests/dense_reference.py: the same solution to
+    the bound the tolerance allows (see test_dense_newton_agrees)."""
+    n = 256
+    r = extremes_grid.profiles(n)["rough"]
+    thickness, nu, friction, material, speed = {
+        "glassy half-space near full contact": (np.inf, 0.5, 0.0, lc.StandardLinearSolid(1.0, 100.0, 1.0), 0.01),
+        "lossy layer with friction": (0.16, 0.3, 0.5, lc.StandardLinearSolid(1.0, 10.0, 1.0), 1.0),
+        "thin coupled elastic": (0.01, 0.49, 1.0, None, 0.0),
+    }[case]
+    g = g_eff(n, 1.0, thickness, 1.0, nu, friction, material, speed)
+    pm = 0.3 * extremes_grid.full_contact_pressure(r, thickness, nu, friction, material, speed)
+    tol = 1e-11
+    res = lc.solve_line(r, thickness=thickness, poisson=nu, friction=friction, material=material, speed=speed,
+                        mean_pressure=pm, tol=tol, stress=False, method="newton")
+    assert res.converged and res.solver == "newton" and 1 <= res.iterations <= 200
+    p, s, residual = solve_dense(r, g, pm)
+    bound = tol * np.ptp(r) * np.max(1 / np.abs(g[1:]))
+    assert np.abs(res.pressure - p).max() <= bound
+    assert res.contact_fraction == np.count_nonzero(p > bound) / n
+
+
+@pytest.mark.parametrize("friction", [0.0, 1.0])
+def test_newton_method_under_displacement_control(friction):
+    """Displacement control (the penetration given, the load found): the dense Newton
+    method and the iterative solvers reach the same pressure and load on a finite
+    compressible layer, symmetric (CG) and coupled (GCR)."""
+    rough_profile = lc.self_affine_profile(1024, 0.8, seed=1, short_wavelength=1 / 64, rms_gradient=0.1)
+    kw = dict(thickness=0.16, poisson=0.3, friction=friction, penetration=0.3 * np.ptp(rough_profile), tol=1e-11,
+              stress=False)
+    newton = lc.solve_line(rough_profile, method="newton", **kw)
+    iterative = lc.solve_line(rough_profile, **kw)
+    assert newton.converged and iterative.converged and newton.solver == "newton"
+    e_star = 1 / (1 - 0.3**2)
+    bound = 1e-11 * np.ptp(rough_profile) * e_star * np.pi * rough_profile.size / 2
+    assert np.abs(newton.pressure - iterative.pressure).max() <= 2 * bound
+    assert newton.mean_pressure == pytest.approx(iterative.mean_pressure, rel=1e-9)
+
+
+def test_newton_method_refuses_large_grids():
+    h = lc.self_affine_profile(4096, 0.8, seed=1, short_wavelength=1 / 64, rms_gradient=0.1)
+    with pytest.raises(lc.LayercontactError, match="method = 'newton' \\(dense\\) needs a grid of at most 2048") as err:
+        lc.solve_line(h, method="newton", stress=False)
+    assert err.value.code == 2
+
+
 def test_progress_lines_name_every_level_and_the_final_count(capfd):
     """progress=True: one line per grid level of the coarse start (512 .. n points), the
     finest with the iterations and residual the result reports; silent by default."""

@@ -132,8 +132,10 @@ class LineResult:
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
     ``solver`` names the method that ran: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled
     scenes), ``'anderson'``, or ``'gcr+anderson'`` (GCR stalled and the Anderson outer
-    iteration went on from its best iterate). ``iterations`` counts CG or GCR iterations
-    (all inner CG iterations for Anderson). ``residual_history`` holds the residual per
+    iteration went on from its best iterate); ``'+newton'`` is appended when the dense
+    Newton method finished a grid of at most 2048 points that the iterative solver left
+    unconverged. ``iterations`` counts CG or GCR iterations (all inner CG iterations for
+    Anderson, plus the Newton steps). ``residual_history`` holds the residual per
     iteration (per outer iteration for Anderson); from :func:`solve_line`, the last
     ``HISTORY_CAPACITY`` (10000) of them.
     """
@@ -242,8 +244,9 @@ def solve_line(
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
     and the surface stress ``stress_xx`` (one more FFT pair).
     ``method``: ``'auto'`` (constrained CG for symmetric scenes, constrained GCR for coupled
-    ones, going on with Anderson if GCR stalls), ``'cg'``, ``'gcr'``, ``'anderson'`` or
-    ``'gfmd'``. ``precondition`` applies the Fourier stiffness 1/M to the residual on the
+    ones, going on with Anderson if GCR stalls; grids of at most 2048 points that stall are
+    finished by the dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'`` or
+    ``'newton'`` (dense semismooth Newton, grids of at most 2048 points). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
     in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard

@@ -21,6 +21,7 @@ module lc_contact_solve
    use lc_contact_solver_anderson, only: anderson_coupled, anderson_outcome
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
+   use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -156,9 +157,11 @@ contains
       type(gcr_outcome) :: gcr
       type(anderson_outcome) :: outer
       type(gfmd_outcome) :: dynamics
+      type(newton_outcome) :: newton
       real(wp), allocatable :: history(:), p_gcr(:), w_gcr(:), gap_gcr(:)
       real(wp) :: uniform, s_gcr, plain
       integer :: coarse_pairs
+      type(contact_result) :: before
 
       coarse_pairs = 0
       if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid)) then
@@ -179,37 +182,57 @@ contains
       ! only the first `iterations` entries are written and read (not zeroed: the budget may
       ! be 1e7 entries, and untouched pages cost nothing)
       allocate (history(scene%solver%max_iter))
-      if (trim(scene%solver%method) == 'gfmd') then
+      if (trim(scene%solver%method) == 'newton') then
+         if (grid%points() > dense_points) then
+            call fatal_error(error, "&solver: method = 'newton' (dense) needs a grid of at most " // &
+               & to_string(dense_points) // ' points; this one has ' // to_string(grid%points()) // &
+               & "; allowed here: 'auto', 'cg', 'gcr', 'anderson' or 'gfmd'", code_input)
+            return
+         end if
+         call dense_newton(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, &
+            & gap, newton, progress)
+         call record_solve(result, 'newton', newton%converged, newton%steps, 1, newton%fft_pairs, newton%residual, &
+            & [newton%residual])
+      else if (trim(scene%solver%method) == 'gfmd') then
          call gfmd(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
             & dynamics, history, progress)
          call record_solve(result, 'gfmd', dynamics%converged, dynamics%iterations, 1, dynamics%fft_pairs, &
             & dynamics%residual, history(1:min(dynamics%checks, size(history))))
       else if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
-         ! constrained GCR; under 'auto' a solve that stalls goes on with the Anderson outer
-         ! iteration from GCR's best iterate, with the budget left
+         ! constrained GCR; under 'auto' a solve that stalls goes on, with the budget left,
+         ! with the dense Newton method where that applies (dense_applies; it is cheaper
+         ! than the Anderson iteration on such grids) and otherwise, or if it fails, with
+         ! the Anderson outer iteration from the best iterate
          call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history, progress)
          call record_solve(result, 'gcr', gcr%converged, gcr%iterations, 1, gcr%fft_pairs, gcr%residual, &
             & history(1:gcr%iterations))
          if (.not. gcr%converged .and. trim(scene%solver%method) == 'auto' .and. &
             & gcr%iterations < scene%solver%max_iter) then
-            ! (GCR's best iterate is kept in case the Anderson iteration ends worse)
-            p_gcr = p
-            w_gcr = w
-            gap_gcr = gap
-            s_gcr = s
-            call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
-               & scene%solver%max_iter - gcr%iterations, scene%solver%memory, scene%solver%precondition, p, w, gap, &
-               & outer, history, error, progress)
-            if (allocated(error)) return
-            call record_solve(result, 'gcr+anderson', outer%converged, gcr%iterations + outer%cg_iterations, &
-               & 1 + outer%outer_iterations, gcr%fft_pairs + outer%fft_pairs, min(outer%residual, gcr%residual), &
-               & [result%residual_history, history(1:outer%outer_iterations)])
-            if (outer%residual > gcr%residual) then
-               p = p_gcr
-               w = w_gcr
-               gap = gap_gcr
-               s = s_gcr
+            if (dense_applies(scene, grid, op)) call finish_dense(op, height, load_control, pm, g_ref, &
+               & scene%solver%tol, min(newton_step_limit, scene%solver%max_iter - result%iterations), p, w, gap, &
+               & s, result, progress)
+            if (.not. result%converged .and. result%iterations < scene%solver%max_iter) then
+               ! (the best iterate so far is kept in case the Anderson iteration ends worse)
+               p_gcr = p
+               w_gcr = w
+               gap_gcr = gap
+               s_gcr = s
+               before = result
+               call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
+                  & scene%solver%max_iter - before%iterations, scene%solver%memory, scene%solver%precondition, p, w, &
+                  & gap, outer, history, error, progress)
+               if (allocated(error)) return
+               call record_solve(result, trim(before%solver) // '+anderson', outer%converged, &
+                  & before%iterations + outer%cg_iterations, 1 + outer%outer_iterations, &
+                  & before%fft_pairs + outer%fft_pairs, min(outer%residual, before%residual), &
+                  & [before%residual_history, history(1:outer%outer_iterations)])
+               if (outer%residual > before%residual) then
+                  p = p_gcr
+                  w = w_gcr
+                  gap = gap_gcr
+                  s = s_gcr
+               end if
             end if
          end if
       else if (op%coupled) then
@@ -224,6 +247,10 @@ contains
          call record_solve(result, 'cg', cg%converged, cg%iterations, 1, cg%fft_pairs, cg%residual, &
             & history(1:cg%iterations))
       end if
+      if (.not. result%converged .and. dense_applies(scene, grid, op) .and. index(result%solver, 'newton') == 0 &
+         & .and. result%iterations < scene%solver%max_iter) &
+         & call finish_dense(op, height, load_control, pm, g_ref, scene%solver%tol, &
+         & min(newton_step_limit, scene%solver%max_iter - result%iterations), p, w, gap, s, result, progress)
       result%fft_pairs = result%fft_pairs + coarse_pairs
       ! The solvers stop when the residual, with gaps below the rounding floor of w - r
       ! counted as zero, reaches tol: no iteration resolves such gaps. At loads so large that
@@ -244,6 +271,54 @@ contains
       w = w + uniform*pm
       s = s + uniform*pm
    end subroutine solve_on_grid
+
+   !> Whether the dense Newton method may finish a solve that stalled: under method 'auto',
+   !> on a grid of at most dense_points points, for a monotone operator (Re G_eff >= 0 on
+   !> every mode), where the solution is unique and the method converges from any start.
+   !> (Elsewhere it may wander for its whole step limit at ~(2/3) n^3 a step.)
+   pure logical function dense_applies(scene, grid, op)
+      type(scene_type), intent(in) :: scene
+      type(grid_type), intent(in) :: grid
+      type(compliance_operator), intent(in) :: op
+      dense_applies = trim(scene%solver%method) == 'auto' .and. grid%points() <= dense_points .and. op%monotone
+   end function dense_applies
+
+   !> A small grid that the iterative solvers left unconverged before the budget ran out
+   !> (they stopped on stagnation) is solved by the dense semismooth Newton method from
+   !> their last iterate (lc_contact_solver_newton), with the steps left in the budget; the
+   !> better of the two is kept. The solver is reported as, e.g., 'gcr+anderson+newton'.
+   subroutine finish_dense(op, height, load_control, pm, g_ref, tol, budget, p, w, gap, s, result, progress)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: height(:), pm, g_ref, tol
+      integer, intent(in) :: budget
+      logical, intent(in) :: load_control
+      real(wp), intent(inout) :: p(:), w(:), gap(:), s
+      type(contact_result), intent(inout) :: result
+      type(progress_log), intent(inout) :: progress
+      type(newton_outcome) :: newton
+      real(wp), allocatable :: p_iterative(:), w_iterative(:), gap_iterative(:)
+      real(wp) :: s_iterative
+      allocate (p_iterative, source=p)
+      allocate (w_iterative, source=w)
+      allocate (gap_iterative, source=gap)
+      s_iterative = s
+      progress%offset = result%iterations
+      call dense_newton(op, height, load_control, pm, s, g_ref, tol, budget, p, w, gap, newton, progress)
+      progress%offset = 0
+      result%solver = trim(result%solver) // '+newton'
+      result%iterations = result%iterations + newton%steps
+      result%fft_pairs = result%fft_pairs + newton%fft_pairs
+      result%residual_history = [result%residual_history, newton%residual]
+      if (newton%residual <= result%residual) then
+         result%converged = newton%converged
+         result%residual = newton%residual
+      else
+         p = p_iterative
+         w = w_iterative
+         gap = gap_iterative
+         s = s_iterative
+      end if
+   end subroutine finish_dense
 
    !> The solver statistics of `result`: which method ran and what it did.
    pure subroutine record_solve(result, solver, converged, iterations, outer_iterations, fft_pairs, residual, history)
