@@ -4,7 +4,7 @@ residual below the tolerance or says it did not, and no output is NaN or Inf.
 Grid (tests/extremes_grid.py): rough, sinusoid and narrow-bump profiles x h/lambda 1e-4 ..
 1e3 and the half-space x nu in {-0.9, 0, 0.3, 0.49, 0.5} x mu_c in {0, 0.5, 1, 1.5} x loads
 p_m/p_full = 1e-6 .. 2 (p_full: the scene's own full-contact pressure), on n = 8, 9, 63
-and 1024: 2100 runs per n, 8400 in all (~5 s; the viscoelastic grid ~100 s, most of it the
+and 1024: 2100 runs per n, 8400 in all (~5 s; the viscoelastic grid ~33 s, half of it the
 dense Newton solves of its 31 glassy runs at n = 1024).
 The measured contact fraction spans one node (1/1024 ~ 0.1 %) to full contact for every
 profile.
@@ -15,7 +15,7 @@ at the heaviest loads: gap_resolution > tol) reports the residual without the fl
 not converged (the one at n = 1024). Coupled scenes (mu_c > 0) on thin incompressible layers
 (h/lambda <= 1e-3), where the operator is nearly skew (|mu_c c|/(1-A) ~ 1.5 mu_c/(kh) at the
 fundamental), stall on tiny grids in GCR and in the outer Anderson iteration; the dense
-Newton method finishes them from the stalled iterate (the better of the two is returned).
+Newton method finishes them from the Anderson iterate (the better of the two is returned).
 `.venv/bin/python bench/extremes.py --list` prints the runs that do not converge; its tables
 of iteration counts are in docs/performance.md.
 

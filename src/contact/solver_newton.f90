@@ -31,9 +31,8 @@ module lc_contact_solver_newton
    !> Newton steps at most when the method finishes a stalled iterative solve (the budget
    !> left permitting). A monotone problem converges from any start, but a glassy layer
    !> near full contact (E_inf/E0 = 1000, 70 % contact, n = 1024) takes 114 steps from a
-   !> uniform start and up to 260 from the coarse start or a stalled GCR iterate; the
-   !> Armijo steps stay short while many points change sides. (0.03-0.08 s a step at
-   !> n = 1024.)
+   !> uniform start and up to 260 from the coarse start or a stalled iterate; the Armijo
+   !> steps stay short while many points change sides. (0.01-0.08 s a step at n = 1024.)
    integer, parameter :: newton_step_limit = 400
    !> Smallest Armijo step tried before the iteration gives up.
    real(wp), parameter :: smallest_step = 1.0e-12_wp
