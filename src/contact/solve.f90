@@ -270,7 +270,7 @@ contains
 
    !> Whether the dense Newton method may finish a solve that stalled: under method 'auto',
    !> on a grid of at most dense_points points, for a monotone operator (Re G_eff >= 0 on
-   !> every mode), where the solution is unique and the method converges from any start.
+   !> every mode), where the solution is unique and the merit has no other stationary point.
    !> (Elsewhere it may wander for its whole step limit at ~(2/3) n^3 a step.)
    pure logical function dense_applies(scene, grid, op)
       type(scene_type), intent(in) :: scene

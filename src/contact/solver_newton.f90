@@ -9,7 +9,9 @@
 !> Each step solves the (n+1) x (n+1) Newton system with LAPACK (LU with partial
 !> pivoting) and takes an Armijo step on |Phi|^2; the gap is linear in (p, s), so a trial
 !> step costs no product with G. For a monotone operator (Re G_eff >= 0) the solution is
-!> unique and the iteration converges from any start; near it, quadratically.
+!> unique and the merit |Phi|^2 has no stationary point but the solution, so the damped
+!> iteration does not get stuck on the way (every monotone run of the test grids converges);
+!> near the solution it converges quadratically.
 !>
 !> The cost is that of the factorisation, ~(2/3) n^3 per step, and 2 n^2 doubles: it is
 !> for grids where the iterative solvers stall (glassy viscoelastic layers near full
@@ -29,7 +31,7 @@ module lc_contact_solver_newton
    !> at 2048 points) and a step ~(2/3) n^3 flops (~0.3 s at 2048 points on one core).
    integer, parameter :: dense_points = 2048
    !> Newton steps at most when the method finishes a stalled iterative solve (the budget
-   !> left permitting). A monotone problem converges from any start, but a glassy layer
+   !> left permitting). A monotone problem converges from any start tried, but a glassy layer
    !> near full contact (E_inf/E0 = 1000, 70 % contact, n = 1024) takes 114 steps from a
    !> uniform start and up to 260 from the coarse start or a stalled iterate; the Armijo
    !> steps stay short while many points change sides. (0.01-0.08 s a step at n = 1024.)
