@@ -75,7 +75,7 @@ contains
       real(wp), allocatable :: g(:, :), jacobian(:, :), phi(:), step(:), dgap(:), a_grad(:), b_grad(:)
       real(wp), allocatable :: p_trial(:), gap_trial(:), phi_trial(:)
       integer, allocatable :: pivots(:)
-      real(wp) :: p_scale, merit, t, s_step, floor
+      real(wp) :: p_scale, merit, t, s_step, floor, shift
       integer :: n, m, j, info, step_count, max_steps
 
       n = size(p)
@@ -101,8 +101,12 @@ contains
          p_scale = max(sum(p)/n, g_ref/max(maxval(abs(g)), tiny(1.0_wp)))
       end if
       gap = matmul(g, p) - b - s
-      if (load_control) s = s + sum(gap)/n   ! a start with the gap's mean at zero
-      if (load_control) gap = matmul(g, p) - b - s
+      if (load_control) then
+         ! a start with the gap's mean at zero
+         shift = sum(gap)/n
+         s = s + shift
+         gap = gap - shift
+      end if
 
       do step_count = 0, max_steps
          outcome%steps = step_count
@@ -112,14 +116,16 @@ contains
          if (step_count == max_steps) exit
          call fischer_burmeister(p, gap, phi, a_grad, b_grad)
          merit = dot_product(phi, phi)
-         ! Newton system: d phi_j = a_grad_j dp_j/p_scale + b_grad_j (G dp - ds)_j/g_ref;
+         ! Newton system: d phi_j = a_grad_j dp_j/p_scale + b_grad_j (G dp - ds)_j/g_ref
+         ! (b_grad divided by g_ref once, below);
          ! load control adds the row mean(dp)/p_scale = -(mean(p)/p_scale - 1)
+         b_grad = b_grad/g_ref
          do j = 1, n
-            jacobian(1:n, j) = (b_grad/g_ref)*g(:, j)
+            jacobian(1:n, j) = b_grad*g(:, j)
             jacobian(j, j) = jacobian(j, j) + a_grad(j)/p_scale
          end do
          if (load_control) then
-            jacobian(1:n, m) = -b_grad/g_ref
+            jacobian(1:n, m) = -b_grad
             jacobian(m, 1:n) = 1.0_wp/(n*p_scale)
             jacobian(m, m) = 0.0_wp
          end if
