@@ -45,7 +45,7 @@ def table(title: str, key: str, labels, rows) -> None:
         conv = [r for r in sel if r["converged"]]
         failed = [r for r in sel if not r["converged"]]
         odd = sum(not r["monotone"] for r in failed)
-        fallback = sum(r["solver"] == "gcr+anderson" for r in sel)
+        fallback = sum("anderson" in r["solver"] and r["solver"] != "anderson" for r in sel)
         pairs = [r["pairs"] for r in conv]
         pair_stats = f"{int(np.median(pairs))} | {max(pairs)}" if pairs else "– | –"
         name = "inf" if label == np.inf else f"{label:g}" if isinstance(label, float) else label

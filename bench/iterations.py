@@ -51,7 +51,7 @@ def main() -> None:
                                   tol=args.tol, stress=False, **settings)
                 t = time.perf_counter() - t
                 flag = "" if r.converged else " NOT CONVERGED"
-                fallback = " +a" if r.solver == "gcr+anderson" else ""
+                fallback = " +a" if r.solver.startswith("gcr+") and "anderson" in r.solver else ""
                 cells.append(f"{r.iterations}{fallback}{flag} | {r.fft_pairs} | {t * 1e3:.0f}")
             print(f"| {name if n == sizes[0] else ''} | {n} | " + " | ".join(cells) + " |")
 

@@ -34,9 +34,10 @@ from extremes_grid import (PROFILES, SIZES, TOL, MAX_ITER, VISCO_SIZES, coupled,
 # different rounding (FFTW codelets, libm) tipping a marginal stagnation; not a target.
 CONVERGED_AT_LEAST = {8: 2095, 9: 2095, 63: 2095, 1024: 2094}
 RUNS_PER_SIZE = 3 * 7 * 5 * 4 * 5
-# The same for the viscoelastic grid (measured: 1268 and 1267 of 1296 converge; every monotone
-# run does, 31 of them at n = 1024 finished by the dense Newton method)
-VISCO_CONVERGED_AT_LEAST = {63: 1263, 1024: 1262}
+# The same for the viscoelastic grid (measured: 1271 and 1271 of 1296 converge; every monotone
+# run does; at n = 1024 34 of them after the GCR with its history kept across clips, 32 finished
+# by the dense Newton method)
+VISCO_CONVERGED_AT_LEAST = {63: 1266, 1024: 1266}
 VISCO_MONOTONE_FAILED_AT_MOST = {63: 0, 1024: 2}
 VISCO_RUNS_PER_SIZE = 2 * 3 * 4 * 3 * 2 * 3 * 3
 
