@@ -66,9 +66,11 @@ module lc_result
       logical :: converged = .false.
       integer :: iterations = 0               !< CG or GCR iterations (all inner CG solves for anderson)
       integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for cg and gcr
-      !> the solver that ran: 'cg', 'gcr', 'anderson', 'gfmd' or 'gcr+anderson' (gcr stalled
-      !> and the Anderson outer iteration went on from its best iterate); '+newton' when the
-      !> dense Newton method finished a small grid the iterative solver left unconverged
+      !> the solver that ran: 'cg', 'gcr', 'anderson', 'gfmd', 'newton', 'gcr+kept' (gcr
+      !> stalled and went on keeping its history across clips) or 'gcr+kept+anderson' (that
+      !> stalled too and the Anderson outer iteration went on from its best iterate);
+      !> '+newton' when the dense Newton method finished a small grid the iterative solver
+      !> left unconverged
       character(len=24) :: solver = ''
       integer :: fft_pairs = 0                !< FFT r2c+c2r pairs spent
       real(wp) :: residual = huge(1.0_wp)     !< final dimensionless complementarity residual

@@ -131,8 +131,9 @@ class LineResult:
     (``spot_max_tension_grid``) is the largest grid value.
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
     ``solver`` names the method that ran: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled
-    scenes), ``'anderson'``, or ``'gcr+anderson'`` (GCR stalled and the Anderson outer
-    iteration went on from its best iterate); ``'+newton'`` is appended when the dense
+    scenes), ``'anderson'``, ``'gcr+kept'`` (GCR stalled and went on from its best iterate
+    keeping its history across clips) or ``'gcr+kept+anderson'`` (that stalled too and the
+    Anderson outer iteration went on); ``'+newton'`` is appended when the dense
     Newton method finished a grid of at most 2048 points that the iterative solver left
     unconverged. ``iterations`` counts CG or GCR iterations (all inner CG iterations for
     Anderson, plus the Newton steps). ``residual_history`` holds the residual per

@@ -299,7 +299,7 @@ contains
    !> A small grid that the iterative solvers left unconverged before the budget ran out
    !> (they stopped on stagnation) is solved by the dense semismooth Newton method from
    !> their last iterate (lc_contact_solver_newton), with the steps left in the budget; the
-   !> better of the two is kept. The solver is reported as, e.g., 'gcr+anderson+newton'.
+   !> better of the two is kept. The solver is reported as, e.g., 'gcr+kept+anderson+newton'.
    subroutine finish_dense(op, height, load_control, pm, g_ref, tol, budget, p, w, gap, s, result, progress)
       type(compliance_operator), intent(inout) :: op
       real(wp), intent(in) :: height(:), pm, g_ref, tol
