@@ -219,8 +219,9 @@ contains
             call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
                & scene%solver%max_iter - gcr%iterations - reserve, scene%solver%memory, scene%solver%precondition, &
                & p, w, gap, kept, history(gcr%iterations + 1:), progress, keep_clipped=.true.)
+            ! (its first iterate is GCR's best, so its best is no worse)
             call record_solve(result, 'gcr+kept', kept%converged, gcr%iterations + kept%iterations, 1, &
-               & gcr%fft_pairs + kept%fft_pairs, min(kept%residual, gcr%residual), &
+               & gcr%fft_pairs + kept%fft_pairs, kept%residual, &
                & history(1:gcr%iterations + kept%iterations))
          end if
          if (.not. result%converged .and. trim(scene%solver%method) == 'auto' .and. &
