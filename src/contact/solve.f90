@@ -190,8 +190,8 @@ contains
             allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
             if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
             call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
-               & '; it solves frictionless lines on an elastic half-space or compressible layer; allowed here: ' // &
-               & allowed, code_input)
+               & '; it solves frictionless lines on an elastic half-space or layer (nu <= 0.47, or h/lambda >~ 0.07); ' &
+               & // 'allowed here: ' // allowed, code_input)
             return
          end if
       end if
