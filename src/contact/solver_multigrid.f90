@@ -131,25 +131,6 @@ module lc_contact_solver_multigrid
       real(wp) :: p_scale = 1.0_wp, g_scale = 1.0_wp, floor = 0.0_wp
    end type residual_scales
 
-   interface
-      !> LAPACK: Cholesky factorisation of a symmetric positive definite matrix.
-      subroutine dpotrf(uplo, n, a, lda, info)
-         import :: wp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, lda
-         real(wp), intent(inout) :: a(lda, *)
-         integer, intent(out) :: info
-      end subroutine dpotrf
-      !> LAPACK: solve A X = B with the Cholesky factor of dpotrf.
-      subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
-         import :: wp
-         character, intent(in) :: uplo
-         integer, intent(in) :: n, nrhs, lda, ldb
-         real(wp), intent(in) :: a(lda, *)
-         real(wp), intent(inout) :: b(ldb, *)
-         integer, intent(out) :: info
-      end subroutine dpotrs
-   end interface
 
 contains
 
@@ -186,6 +167,7 @@ contains
       real(wp) :: lowest
       integer :: k
       rise = 1.0_wp
+      if (op%nk < 3) return
       lowest = op%metric(2)
       do k = 3, op%nk
          lowest = min(lowest, op%metric(k))
@@ -462,11 +444,9 @@ contains
    recursive subroutine vcycle(h, t)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
-      integer :: info, m
       if (t == h%coarsest) then
-         m = h%level(t)%n
          h%level(t)%x = h%level(t)%rhs
-         call dpotrs('L', m, 1, h%dense, m, h%level(t)%x, m, info)
+         call cholesky_solve(h%dense, h%level(t)%x)
          return
       end if
       associate (lv => h%level(t))
@@ -665,8 +645,7 @@ contains
       shift = 0.0_wp
       do attempt = 1, 10
          call fill_dense(h, shift)
-         m = h%level(h%coarsest)%n
-         call dpotrf('L', m, h%dense, m, info)
+         call cholesky_factor(h%dense, info)
          if (info == 0) exit
          ! numerically singular (a rounding-level null space): shift the diagonal slightly;
          ! the V-cycle only preconditions, and the Newton direction only needs descent
@@ -679,11 +658,13 @@ contains
    pure subroutine fill_dense(h, shift)
       type(hierarchy), intent(inout) :: h
       real(wp), intent(in) :: shift
-      integer :: i, m, next
+      integer :: i, r, m, next
       associate (lv => h%level(h%coarsest), a => h%dense)
       m = lv%n
       do i = 1, m
-         a(:, i) = cshift(h%coarse_column, -(i - 1))
+         do r = 1, m
+            a(r, i) = h%coarse_column(modulo(r - i, m) + 1)
+         end do
       end do
       if (h%top == h%coarsest) then
          do i = 1, m
@@ -706,6 +687,42 @@ contains
       end do
       end associate
    end subroutine fill_dense
+
+   !> The lower Cholesky factor L of the symmetric positive definite a (its lower triangle),
+   !> in place; info = the column where a pivot was not positive (0: factorised). (Written
+   !> out rather than LAPACK's dpotrf: for the few hundred points of the coarsest grid a
+   !> threaded BLAS spent more time waking and parking its threads than factorising.)
+   pure subroutine cholesky_factor(a, info)
+      real(wp), contiguous, intent(inout) :: a(:, :)
+      integer, intent(out) :: info
+      integer :: j, k
+      info = 0
+      do j = 1, size(a, 2)
+         do k = 1, j - 1
+            a(j:, j) = a(j:, j) - a(j, k)*a(j:, k)
+         end do
+         if (.not. a(j, j) > 0.0_wp) then
+            info = j
+            return
+         end if
+         a(j:, j) = a(j:, j)/sqrt(a(j, j))
+      end do
+   end subroutine cholesky_factor
+
+   !> x <- (L L^T)^-1 x with the factor of cholesky_factor.
+   pure subroutine cholesky_solve(l, x)
+      real(wp), contiguous, intent(in) :: l(:, :)
+      real(wp), contiguous, intent(inout) :: x(:)
+      integer :: j, m
+      m = size(x)
+      do j = 1, m
+         x(j) = x(j)/l(j, j)
+         x(j + 1:) = x(j + 1:) - x(j)*l(j + 1:, j)
+      end do
+      do j = m, 1, -1
+         x(j) = (x(j) - dot_product(l(j + 1:, j), x(j + 1:)))/l(j, j)
+      end do
+   end subroutine cholesky_solve
 
    !> uf (on grid j) = the spectral interpolation of uc (on grid j + 1).
    subroutine interpolate(h, j, uc, uf)
