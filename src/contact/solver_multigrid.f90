@@ -106,6 +106,7 @@ module lc_contact_solver_multigrid
       type(fft_plan) :: fft
       real(wp) :: inv_n = 1.0_wp
       real(wp), allocatable :: symbol(:)       !< circulant part, half spectrum (n/2 + 1)
+      real(wp), allocatable :: multiplier(:)   !< symbol/n, as applied after an unscaled r2c
       real(wp) :: circulant_diagonal = 0.0_wp
       !> tridiagonal penalty: diagonal, and off(i) coupling i and i + 1 (periodic)
       real(wp), allocatable :: penalty_diagonal(:), penalty_off(:)
@@ -386,9 +387,9 @@ contains
       real(wp), intent(in), optional :: tol
       logical, intent(out), optional :: finished
       real(wp), intent(out), optional :: residual
-      real(wp) :: rz, rz_old, b_norm, dkd, a
+      real(wp) :: rz, rz_old, b_norm, r_norm, dkd, a
       logical :: violated
-      integer :: it, m
+      integer :: it, m, j
 
       m = size(u)
       c = 0.0_wp
@@ -406,9 +407,14 @@ contains
          dkd = dot_product(d, kd)
          if (.not. dkd > 0.0_wp) exit
          a = rz/dkd
-         c = c + a*d
-         kc = kc + a*kd
-         r = r - a*free*kd
+         r_norm = 0.0_wp
+         !$omp simd reduction(+:r_norm)
+         do j = 1, m
+            c(j) = c(j) + a*d(j)
+            kc(j) = kc(j) + a*kd(j)
+            r(j) = r(j) - a*free(j)*kd(j)
+            r_norm = r_norm + r(j)**2
+         end do
          if (present(scales)) then
             call check_finish(u, o, p, c, kc, free, scales, residual, violated)
             if (violated) exit
@@ -416,7 +422,7 @@ contains
                finished = .true.
                exit
             end if
-         else if (norm2(r) <= reduction*b_norm) then
+         else if (sqrt(r_norm) <= reduction*b_norm) then
             exit
          end if
          if (it == max_steps) exit
@@ -505,7 +511,7 @@ contains
       associate (lv => h%level(t))
       call lv%fft%forward_unscaled()
       do k = 1, size(lv%symbol)
-         lv%fft%spectrum(k) = lv%fft%spectrum(k)*(lv%symbol(k)*lv%inv_n)
+         lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%multiplier(k)
       end do
       call lv%fft%backward()
       h%pairs = h%pairs + real(lv%n, wp)/h%n_fine
@@ -568,7 +574,7 @@ contains
          lv%inv_n = 1.0_wp/m
          call lv%fft%init(m, 1, 1, error)
          if (allocated(error)) return
-         allocate (lv%symbol(m/2 + 1), lv%penalty_diagonal(m), lv%penalty_off(m), lv%jacobi(m), lv%rhs(m), &
+         allocate (lv%symbol(m/2 + 1), lv%multiplier(m/2 + 1), lv%penalty_diagonal(m), lv%penalty_off(m), lv%jacobi(m), lv%rhs(m), &
             & lv%x(m), lv%residual(m))
          lv%penalty_diagonal = 0.0_wp
          lv%penalty_off = 0.0_wp
@@ -603,11 +609,12 @@ contains
          ! (1/n) sum over the whole spectrum: the Nyquist mode of an even grid counts once
          lv%circulant_diagonal = (lv%symbol(1) + 2*sum(lv%symbol(2:)) &
             & - merge(lv%symbol(size(lv%symbol)), 0.0_wp, mod(lv%n, 2) == 0))*lv%inv_n
+         lv%multiplier = lv%symbol*lv%inv_n
          end associate
       end do
       h%level(top)%jacobi = omega/h%level(top)%circulant_diagonal
       associate (lv => h%level(h%coarsest))
-      lv%fft%spectrum = cmplx(lv%symbol*lv%inv_n, 0.0_wp, kind=wp)
+      lv%fft%spectrum = cmplx(lv%multiplier, 0.0_wp, kind=wp)
       call lv%fft%backward()
       h%coarse_column = lv%fft%real_buffer
       end associate
