@@ -5,7 +5,7 @@ for the two families of rough surfaces that a solver must handle.
     .venv/bin/python bench/scaling.py --geometry line --sizes 1024 16384 262144 1048576
     .venv/bin/python bench/scaling.py --geometry areal                # 256^2 .. 1024^2 (~2 min)
     .venv/bin/python bench/scaling.py --geometry areal --sizes 256 512 1024 2048 --points 8
-    .venv/bin/python bench/scaling.py --geometry line --scenes 1 --method multigrid   # frictionless lines only
+    .venv/bin/python bench/scaling.py --geometry line --scenes 1 --method multigrid  # frictionless only
 
 Surfaces: self-affine, Hurst exponent 0.8, rms gradient 0.1, seed 1, on a unit period
 (``layercontact.self_affine_profile`` / ``self_affine_surface``: the phases depend on the

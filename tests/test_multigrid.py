@@ -57,7 +57,8 @@ def test_westergaard(n, ratio):
 
     h0 = 0.01
     pm = ratio * np.pi * E_STAR * h0
-    res = lc.solve_line(lc.sinusoid_profile(n, h0), poisson=0.5, mean_pressure=pm, tol=1e-12, method="multigrid")
+    h = lc.sinusoid_profile(n, h0)
+    res = lc.solve_line(h, poisson=0.5, mean_pressure=pm, tol=1e-12, method="multigrid")
     assert res.converged and res.solver == "multigrid"
     assert abs(res.contact_fraction - 2 * westergaard_half_width(pm, E_STAR, h0, 1.0)) <= 2 / n
     gap_tol = 1e-5 if n == 1024 else 2e-7
@@ -77,7 +78,8 @@ def test_thin_compressible_layer_agrees_with_cg(rough_profile, control):
     stiffness, and the same load."""
     h = rough_profile
     thickness, poisson = 0.01, 0.3
-    control_kw = {"load": dict(mean_pressure=16 * h.max()), "displacement": dict(penetration=0.5 * np.ptp(h))}[control]
+    loads = {"load": dict(mean_pressure=16 * h.max()), "displacement": dict(penetration=0.5 * np.ptp(h))}
+    control_kw = loads[control]
     kw = dict(thickness=thickness, poisson=poisson, stress=False, **control_kw)
     cg = lc.solve_line(h, method="cg", tol=TOL_CG, **kw)
     mg = lc.solve_line(h, method="multigrid", tol=TOL, **kw)
@@ -95,13 +97,16 @@ def test_thin_compressible_layer_agrees_with_cg(rough_profile, control):
         (dict(thickness=0.16, friction=0.5), "friction couples the normal and tangential fields"),
         (dict(thickness=0.16, material=lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0), speed=0.1),
          "the layer is viscoelastic and sliding"),
-        (dict(thickness=0.01, poisson=0.5), "the compliance rises with \\|q\\| over the grid by a factor 123.0 \\(a thin, nearly incompressible layer; pointwise smoothing needs at most 4.0\\)"),
+        (dict(thickness=0.01, poisson=0.5),
+         "the compliance rises with \\|q\\| over the grid by a factor 123.0 "
+         "\\(a thin, nearly incompressible layer; pointwise smoothing needs at most 4.0\\)"),
     ],
 )
 def test_refuses_scenes_it_does_not_solve(rough_profile, kw, reason):
     """Coupled, viscoelastic and thin incompressible scenes are bad input (code 2) for the
     method, with a message that names it, says why and what is allowed."""
-    with pytest.raises(lc.InputError, match="&solver: method = 'multigrid' cannot solve this scene: " + reason) as err:
+    message = "&solver: method = 'multigrid' cannot solve this scene: " + reason
+    with pytest.raises(lc.InputError, match=message) as err:
         lc.solve_line(rough_profile, method="multigrid", mean_pressure=0.01, stress=False, **kw)
     assert err.value.code == 2
     assert "allowed here: 'auto'" in str(err.value)

@@ -249,8 +249,9 @@ def solve_line(
     finished by the dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'``,
     ``'newton'`` (dense semismooth Newton, grids of at most 2048 points) or ``'multigrid'``
     (nonsmooth Newton multigrid: frictionless lines on an elastic half-space or a layer with
-    ``poisson <= 0.47``, or an incompressible one from ``thickness ~ 0.07 period``; ``iterations`` counts its fine-grid iterations; ``coarse_start`` and
-    ``precondition`` do not apply). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
+    ``poisson <= 0.47``, or an incompressible one from ``thickness ~ 0.07 period``;
+    ``iterations`` counts its fine-grid iterations; ``coarse_start`` and ``precondition``
+    do not apply). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
     in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard
