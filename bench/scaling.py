@@ -5,6 +5,7 @@ for the two families of rough surfaces that a solver must handle.
     .venv/bin/python bench/scaling.py --geometry line --sizes 1024 16384 262144 1048576
     .venv/bin/python bench/scaling.py --geometry areal                # 256^2 .. 1024^2 (~2 min)
     .venv/bin/python bench/scaling.py --geometry areal --sizes 256 512 1024 2048 --points 8
+    .venv/bin/python bench/scaling.py --geometry line --scenes 1 --method multigrid  # frictionless only
 
 Surfaces: self-affine, Hurst exponent 0.8, rms gradient 0.1, seed 1, on a unit period
 (``layercontact.self_affine_profile`` / ``self_affine_surface``: the phases depend on the
@@ -26,7 +27,8 @@ dimensionless complementarity residual), one thread. "it.": CG or GCR iterations
 finest grid (plus the inner CG iterations after an Anderson fallback, marked +a);
 "pairs": FFT pairs in units of the finest grid's (coarse levels included); "ms": the
 library's solve time (``wall_time``). The last table gives max/min of the iterations and
-of the pairs over n per family and scene.
+of the pairs over n per family and scene. ``--method`` sets ``&solver method`` (for
+'multigrid', scene 1 is the only one it solves).
 """
 
 from __future__ import annotations
@@ -57,10 +59,10 @@ def heights(geometry: str, n: int, short_wavelength: float) -> np.ndarray:
     return lc.self_affine_surface(n=n, hurst=0.8, seed=1, short_wavelength=short_wavelength, rms_gradient=0.1)
 
 
-def solve(geometry: str, h: np.ndarray, scene: dict, tol: float):
+def solve(geometry: str, h: np.ndarray, scene: dict, tol: float, method: str = "auto"):
     solver = lc.solve_line if geometry == "line" else lc.solve_areal
     return solver(h, thickness=scene["thickness"], poisson=0.5, friction=scene["friction"],
-                  mean_pressure=scene["pressure"] * CONTACT_MODULUS, tol=tol, threads=1,
+                  mean_pressure=scene["pressure"] * CONTACT_MODULUS, tol=tol, threads=1, method=method,
                   material=scene.get("material"), speed=scene.get("speed", 0.0), stress=False)
 
 
@@ -73,6 +75,7 @@ def main() -> None:
     parser.add_argument("--scenes", type=int, nargs="+", help="scene numbers (1-4; default all)")
     parser.add_argument("--no-physical", action="store_true", help="family (b) only")
     parser.add_argument("--tol", type=float, default=1e-8)
+    parser.add_argument("--method", default="auto", help="&solver method (default 'auto')")
     args = parser.parse_args()
     sizes = args.sizes or DEFAULT_SIZES[args.geometry]
     scenes = list(SCENES.items())
@@ -82,7 +85,8 @@ def main() -> None:
     for k in args.points:
         families[f"(b) {k} points"] = lambda n, k=k: k / n
     start = time.perf_counter()
-    print(f"layercontact {lc.__version__} ({lc.BUILD} build); {args.geometry}; tol {args.tol:g}; one thread\n")
+    print(f"layercontact {lc.__version__} ({lc.BUILD} build); {args.geometry}; tol {args.tol:g}; "
+          f"method {args.method}; one thread\n")
     print("| family | scene | n | contact fraction | solver | it. | pairs | ms |")
     print("|---|---|---:|---:|---|---:|---:|---:|")
     spread = []
@@ -90,7 +94,7 @@ def main() -> None:
         for name, scene in scenes:
             iterations, pairs = [], []
             for n in sizes:
-                r = solve(args.geometry, heights(args.geometry, n, shortest(n)), scene, args.tol)
+                r = solve(args.geometry, heights(args.geometry, n, shortest(n)), scene, args.tol, args.method)
                 flag = "" if r.converged else " NOT CONVERGED"
                 fallback = " +a" if "anderson" in r.solver else ""
                 iterations.append(r.iterations)

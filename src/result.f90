@@ -64,10 +64,11 @@ module lc_result
       real(wp) :: max_tension_x = 0.0_wp      !< where it sits (L)
       real(wp) :: max_tension_offset = 0.0_wp !< its offset from the nearest spot's trailing edge (L)
       logical :: converged = .false.
-      integer :: iterations = 0               !< CG or GCR iterations (all inner CG solves for anderson)
+      !> CG or GCR iterations (all inner CG solves for anderson; fine-grid ones for multigrid)
+      integer :: iterations = 0
       integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for cg and gcr
-      !> the solver that ran: 'cg', 'gcr', 'anderson', 'gfmd', 'newton', 'gcr+kept' (gcr
-      !> stalled and went on keeping its history across clips) or 'gcr+kept+anderson' (that
+      !> the solver that ran: 'cg', 'gcr', 'anderson', 'gfmd', 'newton', 'multigrid', 'gcr+kept'
+      !> (gcr stalled and went on keeping its history across clips) or 'gcr+kept+anderson' (that
       !> stalled too and the Anderson outer iteration went on from its best iterate);
       !> '+newton' when the dense Newton method finished a small grid the iterative solver
       !> left unconverged

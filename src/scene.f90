@@ -353,9 +353,10 @@ contains
          else if (trim(scene%control) == 'displacement' .and. .not. positive_finite(scene%penetration)) then
             call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
                & "> 0 and finite with control = 'displacement'")
-         else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton'])) then
+         else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton', &
+            & 'multigrid'])) then
             call input_error(error, 'solver', 'method', trim(s%method), &
-               & "'auto', 'cg', 'gcr', 'anderson', 'gfmd' or 'newton'")
+               & "'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton' or 'multigrid'")
          else if (.not. (s%tol >= 1.0e-14_wp .and. s%tol <= 1.0e-2_wp)) then
             call input_error(error, 'solver', 'tol', to_string(s%tol), '1e-14 <= tol <= 1e-2')
          else if (scene%leakage .and. .not. is_areal(scene)) then

@@ -103,7 +103,7 @@ BAD = [
     ("&profile\n rms_gradient = -1.0\n/\n", "&profile: rms_gradient"),
     ("&loading\n mean_pressure = -1.0\n/\n", "&loading: mean_pressure"),
     ("&profile\n short_wavelength = -1.0\n/\n", "&profile: short_wavelength"),
-    ("&solver\n method = 'gmres'\n/\n", "'auto', 'cg', 'gcr', 'anderson', 'gfmd' or 'newton'"),
+    ("&solver\n method = 'gmres'\n/\n", "'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton' or 'multigrid'"),
     ("&loading\n control = 'displacement'\n penetration = 1e-3\n/\n", "needs a finite layer"),
     ("&loading\n normalised_pressure = 1.0\n penetration = 1e-3\n/\n", "&loading: penetration"),
     ("&profile\n kind = 'sinusoid'\n amplitude = 0.1\n mode = 2000000000\n/\n", "&profile: mode"),

@@ -131,9 +131,9 @@ class LineResult:
     (``spot_max_tension_grid``) is the largest grid value.
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
     ``solver`` names the method that ran: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled
-    scenes), ``'anderson'``, ``'gcr+kept'`` (GCR stalled and went on from its best iterate
-    keeping its history across clips) or ``'gcr+kept+anderson'`` (that stalled too and the
-    Anderson outer iteration went on); ``'+newton'`` is appended when the dense
+    scenes), ``'anderson'``, ``'multigrid'``, ``'gcr+kept'`` (GCR stalled and went on from its
+    best iterate keeping its history across clips) or ``'gcr+kept+anderson'`` (that stalled
+    too and the Anderson outer iteration went on); ``'+newton'`` is appended when the dense
     Newton method finished a grid of at most 2048 points that the iterative solver left
     unconverged. ``iterations`` counts CG or GCR iterations (all inner CG iterations for
     Anderson, plus the Newton steps). ``residual_history`` holds the residual per
@@ -246,8 +246,12 @@ def solve_line(
     and the surface stress ``stress_xx`` (one more FFT pair).
     ``method``: ``'auto'`` (constrained CG for symmetric scenes, constrained GCR for coupled
     ones, going on with Anderson if GCR stalls; grids of at most 2048 points that stall are
-    finished by the dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'`` or
-    ``'newton'`` (dense semismooth Newton, grids of at most 2048 points). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
+    finished by the dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'``,
+    ``'newton'`` (dense semismooth Newton, grids of at most 2048 points) or ``'multigrid'``
+    (nonsmooth Newton multigrid: frictionless lines on an elastic half-space or a layer with
+    ``poisson <= 0.47``, or an incompressible one from ``thickness ~ 0.07 period``;
+    ``iterations`` counts its fine-grid iterations; ``coarse_start`` and ``precondition``
+    do not apply). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
     in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard

@@ -22,6 +22,7 @@ module lc_contact_solve
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
+   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -158,12 +159,17 @@ contains
       type(anderson_outcome) :: outer
       type(gfmd_outcome) :: dynamics
       type(newton_outcome) :: newton
+      type(multigrid_outcome) :: nested
       real(wp), allocatable :: history(:), p_gcr(:), w_gcr(:), gap_gcr(:)
+      character(len=:), allocatable :: reason, allowed
       real(wp) :: uniform, s_gcr, plain, before
       integer :: coarse_pairs, reserve
 
       coarse_pairs = 0
-      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid)) then
+      ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
+      ! on the displacement, where this start solves each coarse grid to coarse_tol)
+      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
+         & trim(scene%solver%method) /= 'multigrid') then
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
             & progress, error)
          if (allocated(error)) return
@@ -178,6 +184,17 @@ contains
             & "and tangential fields and the operator is not symmetric; allowed: 'auto', 'gcr' or 'anderson'", code_input)
          return
       end if
+      if (trim(scene%solver%method) == 'multigrid') then
+         reason = multigrid_refusal(op)
+         if (len(reason) > 0) then
+            allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
+            if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
+            call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
+               & '; it solves frictionless lines on an elastic half-space or layer (nu <= 0.47, or h/lambda >~ 0.07); ' &
+               & // 'allowed here: ' // allowed, code_input)
+            return
+         end if
+      end if
       ! only the first `iterations` entries are written and read (not zeroed: the budget may
       ! be 1e7 entries, and untouched pages cost nothing)
       allocate (history(scene%solver%max_iter))
@@ -185,13 +202,19 @@ contains
          if (grid%points() > dense_points) then
             call fatal_error(error, "&solver: method = 'newton' (dense) needs a grid of at most " // &
                & to_string(dense_points) // ' points; this one has ' // to_string(grid%points()) // &
-               & "; allowed here: 'auto', 'cg', 'gcr', 'anderson' or 'gfmd'", code_input)
+               & "; allowed here: 'auto', 'cg', 'gcr', 'anderson', 'gfmd' or 'multigrid'", code_input)
             return
          end if
          call dense_newton(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, &
             & gap, newton, progress)
          call record_solve(result, 'newton', newton%converged, newton%steps, 1, newton%fft_pairs, newton%residual, &
             & [newton%residual])
+      else if (trim(scene%solver%method) == 'multigrid') then
+         call multigrid(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
+            & nested, history, progress, error)
+         if (allocated(error)) return
+         call record_solve(result, 'multigrid', nested%converged, nested%iterations, 1, nested%fft_pairs, &
+            & nested%residual, history(1:min(nested%iterations, size(history))))
       else if (trim(scene%solver%method) == 'gfmd') then
          call gfmd(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
             & dynamics, history, progress)

@@ -1,0 +1,138 @@
+"""The multigrid solver (&solver method = 'multigrid', src/contact/solver_multigrid.f90)
+against the constrained CG, Westergaard's closed form and its own contact conditions, and
+its refusal of the scenes it does not solve."""
+
+import numpy as np
+import pytest
+
+import layercontact as lc
+from conftest import contact_violation, g_eff
+
+E_STAR = 4 / 3  # E = 1, nu = 0.5
+TOL = 1e-10
+TOL_CG = 1e-12
+
+
+def profile(n: int, family: str) -> np.ndarray:
+    """The two families of bench/scaling.py: spectrum fixed in physical wavenumbers, or
+    shortest wavelength 8 grid points (broadband: more scales and spots on finer grids)."""
+    short = 1 / 64 if family == "physical" else 8 / n
+    return lc.self_affine_profile(n, 0.8, seed=1, short_wavelength=short, rms_gradient=0.1)
+
+
+def max_stiffness(n: int, thickness: float, poisson: float) -> float:
+    """The largest stiffness 1/|G_eff(k)| on the grid (k > 0): a gap residual tol * ptp(h)
+    on the contact set allows pressure differences up to this times tol * ptp(h)."""
+    g = g_eff(n, 1.0, thickness, 1.0, poisson, 0.0)
+    return np.max(1 / np.abs(g[1:]))
+
+
+@pytest.mark.parametrize("n", [4096, 65536])
+@pytest.mark.parametrize("family", ["physical", "broadband"])
+def test_agrees_with_constrained_cg(n, family):
+    """Two methods to the same fixed point: the pressure to the bound the two tolerances
+    allow (their sum, times ptp(h), times the largest stiffness |k_max| E*/2), the same
+    contact set and penetration; and far fewer transforms than the CG on broadband lines."""
+    h = profile(n, family)
+    kw = dict(thickness=np.inf, poisson=0.5, mean_pressure=0.0125 * E_STAR, stress=False)
+    cg = lc.solve_line(h, method="cg", tol=TOL_CG, **kw)
+    mg = lc.solve_line(h, method="multigrid", tol=TOL, **kw)
+    assert cg.converged and mg.converged and mg.solver == "multigrid"
+    assert mg.residual <= TOL and len(mg.residual_history) == mg.iterations
+    bound = (TOL + TOL_CG) * np.ptp(h) * max_stiffness(n, np.inf, 0.5)
+    assert np.abs(mg.pressure - cg.pressure).max() <= bound
+    assert np.array_equal(mg.pressure > 0, cg.pressure > 0)
+    assert mg.penetration == pytest.approx(cg.penetration, abs=(TOL + TOL_CG) * np.ptp(h))
+    # measured: 2-5 fine-grid iterations and 46-74 pairs from n = 1024 to 262144
+    assert mg.iterations <= 8 and mg.fft_pairs <= 120
+
+
+@pytest.mark.parametrize("n", [1024, 8192])
+@pytest.mark.parametrize("ratio", [0.05, 0.25, 0.7])
+def test_westergaard(n, ratio):
+    """Frictionless sinusoid on a half-space against Westergaard's solution, with the
+    discretisation tolerances of test_solver.py::test_westergaard (the same collocation
+    problem: only the solver differs)."""
+    from analytic import westergaard_half_width, westergaard_mean_gap, westergaard_pressure
+
+    h0 = 0.01
+    pm = ratio * np.pi * E_STAR * h0
+    h = lc.sinusoid_profile(n, h0)
+    res = lc.solve_line(h, poisson=0.5, mean_pressure=pm, tol=1e-12, method="multigrid")
+    assert res.converged and res.solver == "multigrid"
+    assert abs(res.contact_fraction - 2 * westergaard_half_width(pm, E_STAR, h0, 1.0)) <= 2 / n
+    gap_tol = 1e-5 if n == 1024 else 2e-7
+    assert abs((h0 - res.penetration) - westergaard_mean_gap(pm, E_STAR, h0, 1.0)) <= gap_tol * h0
+    p_ref = westergaard_pressure(res.x, pm, E_STAR, h0, 1.0)
+    a = westergaard_half_width(pm, E_STAR, h0, 1.0)
+    xc = np.where(res.x > 0.5, res.x - 1, res.x)
+    interior = np.abs(xc) < 0.8 * a
+    assert np.abs(res.pressure - p_ref)[interior].max() <= (3e-4 if n == 1024 else 2e-6) * p_ref.max()
+
+
+@pytest.mark.parametrize("control", ["load", "displacement"])
+def test_thin_compressible_layer_agrees_with_cg(rough_profile, control):
+    """A thin compressible layer (h/lambda = 0.01, nu = 0.3: the stiffness is flat, ~M/h, up
+    to |k| h ~ 1, dipping by 2 %, and rises beyond, so Jacobi still smooths) under load and
+    displacement control: the CG's pressure to the bound of the tolerances with the layer's largest
+    stiffness, and the same load."""
+    h = rough_profile
+    thickness, poisson = 0.01, 0.3
+    loads = {"load": dict(mean_pressure=16 * h.max()), "displacement": dict(penetration=0.5 * np.ptp(h))}
+    control_kw = loads[control]
+    kw = dict(thickness=thickness, poisson=poisson, stress=False, **control_kw)
+    cg = lc.solve_line(h, method="cg", tol=TOL_CG, **kw)
+    mg = lc.solve_line(h, method="multigrid", tol=TOL, **kw)
+    assert cg.converged and mg.converged
+    assert 0.05 < mg.contact_fraction < 0.95
+    bound = (TOL + TOL_CG) * np.ptp(h) * max_stiffness(h.size, thickness, poisson)
+    assert np.abs(mg.pressure - cg.pressure).max() <= bound
+    assert mg.mean_pressure == pytest.approx(cg.mean_pressure, rel=1e-8)
+    assert mg.penetration == pytest.approx(cg.penetration, abs=(TOL + TOL_CG) * np.ptp(h))
+
+
+@pytest.mark.parametrize(
+    "kw, reason",
+    [
+        (dict(thickness=0.16, friction=0.5), "friction couples the normal and tangential fields"),
+        (dict(thickness=0.16, material=lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0), speed=0.1),
+         "the layer is viscoelastic and sliding"),
+        (dict(thickness=0.01, poisson=0.5),
+         "the compliance rises with \\|q\\| over the grid by a factor 123.0 "
+         "\\(a thin, nearly incompressible layer; pointwise smoothing needs at most 4.0\\)"),
+    ],
+)
+def test_refuses_scenes_it_does_not_solve(rough_profile, kw, reason):
+    """Coupled, viscoelastic and thin incompressible scenes are bad input (code 2) for the
+    method, with a message that names it, says why and what is allowed."""
+    message = "&solver: method = 'multigrid' cannot solve this scene: " + reason
+    with pytest.raises(lc.InputError, match=message) as err:
+        lc.solve_line(rough_profile, method="multigrid", mean_pressure=0.01, stress=False, **kw)
+    assert err.value.code == 2
+    assert "allowed here: 'auto'" in str(err.value)
+
+
+def test_refuses_surfaces_and_sizes_without_a_small_coarsest_grid():
+    s = lc.self_affine_surface(n=64, hurst=0.8, seed=1, short_wavelength=1 / 16, rms_gradient=0.1)
+    with pytest.raises(lc.InputError, match="it solves lines, and this scene is a surface"):
+        lc.solve_areal(s, method="multigrid", mean_pressure=0.01)
+    h = profile(4095, "physical")
+    with pytest.raises(lc.InputError, match="n = 4095 halves to an odd grid of 4095 points"):
+        lc.solve_line(h, method="multigrid", mean_pressure=0.01, stress=False)
+
+
+@pytest.mark.parametrize("n", [100, 1000, 4096])
+def test_load_is_exact_and_contact_conditions_hold(n):
+    """p >= 0, the load to rounding, and the contact conditions recomputed with numpy's FFT
+    to the tolerance, on sizes with and without coarse grids (100: one dense grid; 1000:
+    coarsest 125 points)."""
+    h = profile(n, "broadband")
+    pm = 0.0125 * E_STAR
+    res = lc.solve_line(h, method="multigrid", mean_pressure=pm, tol=TOL)
+    assert res.converged
+    assert np.all(res.pressure >= 0)
+    assert res.mean_pressure == pytest.approx(pm, rel=1e-13)
+    assert res.gap.min() >= -res.gap_resolution * np.ptp(h)
+    v = contact_violation(res, np.inf, 1.0, 0.5)
+    assert v["overlap"] <= 2 * TOL and v["gap_in_contact"] <= 2 * TOL
+    assert v["w_error"] <= 1e-12
