@@ -244,9 +244,11 @@ def solve_line(
     problem at the load of this one (its computed mean pressure, whatever the control) and
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
     and the surface stress ``stress_xx`` (one more FFT pair).
-    ``method``: ``'auto'`` (constrained CG for symmetric scenes, constrained GCR for coupled
-    ones, going on with Anderson if GCR stalls; grids of at most 2048 points that stall are
-    finished by the dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'``,
+    ``method``: ``'auto'`` (the multigrid method for the frictionless elastic lines it
+    applies to from 4096 points on, constrained CG for other symmetric scenes, constrained
+    GCR for coupled ones, going on with its history kept across clips and then with
+    Anderson if GCR stalls; grids of at most 2048 points that stall are finished by the
+    dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'``,
     ``'newton'`` (dense semismooth Newton, grids of at most 2048 points) or ``'multigrid'``
     (nonsmooth Newton multigrid: frictionless lines on an elastic half-space or a layer with
     ``poisson <= 0.47``, or an incompressible one from ``thickness ~ 0.07 period``;

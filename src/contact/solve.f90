@@ -39,6 +39,12 @@ module lc_contact_solve
    !> grid of coarse_tol_size points along x, coarse_tol coarse_tol_size/nx beyond.
    real(wp), parameter :: coarse_tol = 1.0e-4_wp
    integer, parameter :: coarse_tol_size = 8192
+   !> Under method 'auto' the multigrid solver takes the frictionless elastic lines it
+   !> applies to (multigrid_refusal) from this many points on: there it costs 0.5-1x the
+   !> time of the constrained CG on a spectrum fixed in physical wavenumbers and 0.05-0.5x
+   !> on broadband roughness (bench/scaling.py --method); at n = 1024 the CG's 0.64 ms
+   !> against 0.94 ms on the physical family.
+   integer, parameter :: multigrid_points = 4096
 
 contains
 
@@ -162,29 +168,22 @@ contains
       type(multigrid_outcome) :: nested
       real(wp), allocatable :: history(:), p_gcr(:), w_gcr(:), gap_gcr(:)
       character(len=:), allocatable :: reason, allowed
+      character(len=len(scene%solver%method)) :: method
       real(wp) :: uniform, s_gcr, plain, before
       integer :: coarse_pairs, reserve
 
       coarse_pairs = 0
-      ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
-      ! on the displacement, where this start solves each coarse grid to coarse_tol)
-      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
-         & trim(scene%solver%method) /= 'multigrid') then
-         call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
-            & progress, error)
-         if (allocated(error)) return
-      end if
-      call progress%begin_level(grid%nx, grid%ny)
+      ! (the operator first: which solver runs depends on it, and refusals come before any
+      ! coarse solve)
       call build_operator(op, grid, kernel, friction, scene%solver%threads, error)
       if (allocated(error)) return
-      uniform = 0.0_wp
-      if (load_control) call op%drop_uniform_mode(uniform)
       if (op%coupled .and. trim(scene%solver%method) == 'cg') then
          call fatal_error(error, "&solver: method = 'cg' cannot solve this scene: friction couples the normal " // &
             & "and tangential fields and the operator is not symmetric; allowed: 'auto', 'gcr' or 'anderson'", code_input)
          return
       end if
-      if (trim(scene%solver%method) == 'multigrid') then
+      method = scene%solver%method
+      if (method == 'multigrid') then
          reason = multigrid_refusal(op)
          if (len(reason) > 0) then
             allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
@@ -194,7 +193,19 @@ contains
                & // 'allowed here: ' // allowed, code_input)
             return
          end if
+      else if (method == 'auto' .and. grid%points() >= multigrid_points) then
+         if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
       end if
+      ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
+      ! on the displacement, where this start solves each coarse grid to coarse_tol)
+      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. method /= 'multigrid') then
+         call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
+            & progress, error)
+         if (allocated(error)) return
+      end if
+      call progress%begin_level(grid%nx, grid%ny)
+      uniform = 0.0_wp
+      if (load_control) call op%drop_uniform_mode(uniform)
       ! only the first `iterations` entries are written and read (not zeroed: the budget may
       ! be 1e7 entries, and untouched pages cost nothing)
       allocate (history(scene%solver%max_iter))
@@ -209,7 +220,7 @@ contains
             & gap, newton, progress)
          call record_solve(result, 'newton', newton%converged, newton%steps, 1, newton%fft_pairs, newton%residual, &
             & [newton%residual])
-      else if (trim(scene%solver%method) == 'multigrid') then
+      else if (method == 'multigrid') then
          call multigrid(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
             & nested, history, progress, error)
          if (allocated(error)) return
