@@ -139,7 +139,8 @@ def test_not_converged_is_reported_honestly(rough_profile):
     assert np.all(np.isfinite(res.pressure))
     # the fields written for a stopped run belong together
     assert contact_violation(res, 0.01, 1.0, 0.5)["w_error"] <= 1e-12
-    sym = lc.solve_line(rough_profile, thickness=0.16, mean_pressure=rough_profile.max(), max_iter=7, method="cg")
+    sym = lc.solve_line(rough_profile, thickness=0.16, mean_pressure=rough_profile.max(), max_iter=7,
+                        method="cg")
     assert not sym.converged and contact_violation(sym, 0.16, 1.0, 0.5)["w_error"] <= 1e-12
     nested = lc.solve_line(rough_profile, thickness=0.16, mean_pressure=rough_profile.max(), max_iter=1)
     assert nested.solver == "multigrid" and not nested.converged and nested.iterations == 1
