@@ -23,16 +23,18 @@ from layercontact.native import core as _core
 SLS = lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0)
 # name: (settings, the scene it is compared with)
 SCENES = {
-    "half-space, mu_c = 0, plain CG": (dict(thickness=np.inf, pressure=0.3, precondition=False, coarse_start=False),
-                                       None),
-    "half-space, mu_c = 0": (dict(thickness=np.inf, pressure=0.3), None),
-    "h/lambda = 0.16, mu_c = 0": (dict(thickness=0.16, pressure=3.0), None),
+    "half-space, mu_c = 0, plain CG": (dict(thickness=np.inf, pressure=0.3, precondition=False, coarse_start=False,
+                                            method="cg"), None),
+    "half-space, mu_c = 0": (dict(thickness=np.inf, pressure=0.3, method="cg"), None),
+    "half-space, mu_c = 0, multigrid": (dict(thickness=np.inf, pressure=0.3), "half-space, mu_c = 0"),
+    "h/lambda = 0.16, mu_c = 0": (dict(thickness=0.16, pressure=3.0, method="cg"), None),
+    "h/lambda = 0.16, mu_c = 0, multigrid": (dict(thickness=0.16, pressure=3.0), "h/lambda = 0.16, mu_c = 0"),
     "h/lambda = 0.16, mu_c = 0.5": (dict(thickness=0.16, friction=0.5, pressure=3.0), "h/lambda = 0.16, mu_c = 0"),
     "h/lambda = 0.01, mu_c = 0": (dict(thickness=0.01, pressure=30.0), None),
     "h/lambda = 0.01, mu_c = 0.5": (dict(thickness=0.01, friction=0.5, pressure=30.0), "h/lambda = 0.01, mu_c = 0"),
     "h/lambda = 0.01, mu_c = 0.5, anderson": (dict(thickness=0.01, friction=0.5, pressure=30.0, method="anderson"),
                                               "h/lambda = 0.01, mu_c = 0"),
-    "h/lambda = 0.16, elastic E0": (dict(thickness=0.16, pressure=1.0), None),
+    "h/lambda = 0.16, elastic E0": (dict(thickness=0.16, pressure=1.0, method="cg"), None),
     "h/lambda = 0.16, SLS, V = 0.1": (dict(thickness=0.16, pressure=1.0, material=SLS, speed=0.1),
                                       "h/lambda = 0.16, elastic E0"),
     "h/lambda = 0.16, SLS, V = 0.1, anderson": (dict(thickness=0.16, pressure=1.0, material=SLS, speed=0.1,
@@ -65,7 +67,8 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", default=[1024, 8192, 65536])
     parser.add_argument("--no-marginal", action="store_true", help="skip the table of the cost of one iteration")
     args = parser.parse_args()
-    print(f"core: {lc.BUILD} build; tol 1e-8; method 'auto' (preconditioned CG or GCR) with coarse start unless said otherwise; nu = 0.5; "
+    print(f"core: {lc.BUILD} build; tol 1e-8; frictionless rows: method 'cg' (preconditioned, coarse start), "
+          "'multigrid' rows method 'auto'; coupled rows: method 'auto' (GCR) unless said otherwise; nu = 0.5; "
           "SLS: E0 = 1, E_inf = 10, tau = 1 (loss peak near V = 0.1 for the roughness here); times: best of 5; "
           "it.: CG or GCR iterations on the finest grid (all inner CG iterations for anderson); FFT pair: the bare "
           "FFTW r2c + c2r pair\n")
