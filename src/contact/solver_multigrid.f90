@@ -152,14 +152,24 @@ contains
             & '(f0.1)') // ' (a thin, nearly incompressible layer; pointwise smoothing needs at most ' // &
             & formatted(allowed_rise, '(f0.1)') // ')'
       else
-         m = op%grid%nx
-         do while (mod(m, 2) == 0 .and. m/2 >= coarsest_points)
-            m = m/2
-         end do
+         m = op%grid%nx/2**halvings(op%grid%nx, coarsest_points)
          if (m > coarsest_limit) reason = 'n = ' // to_string(op%grid%nx) // ' halves to an odd grid of ' // &
             & to_string(m) // ' points; it needs n = m 2^k with m <= ' // to_string(coarsest_limit)
       end if
    end function multigrid_refusal
+
+   !> How many times a grid of n points halves while the result stays even-sized and
+   !> at least `smallest` points long (n/2**k with k the count is the coarsest grid).
+   pure integer function halvings(n, smallest) result(k)
+      integer, intent(in) :: n, smallest
+      integer :: m
+      k = 0
+      m = n
+      do while (mod(m, 2) == 0 .and. m/2 >= smallest)
+         m = m/2
+         k = k + 1
+      end do
+   end function halvings
 
    !> The largest factor by which the normal compliance M(q) on the grid's modes exceeds its
    !> value at a longer wave: 1 where it falls with |q| (op%metric_falls).
@@ -217,12 +227,7 @@ contains
       if (load_control) stiffness(1) = 0.0_wp
       f = merge(mean_pressure, 0.0_wp, load_control)
 
-      nested = 0
-      m = n
-      do while (mod(m, 2) == 0 .and. m/2 >= nested_coarsest)
-         m = m/2
-         nested = nested + 1
-      end do
+      nested = halvings(n, nested_coarsest)
       do j = nested, 0, -1
          m = h%level(j)%n
          call set_grid(h, j, stiffness(1:m/2 + 1))
@@ -557,12 +562,8 @@ contains
       integer, intent(in) :: n
       type(error_type), allocatable, intent(out) :: error
       integer :: t, m, levels
-      levels = 1
-      m = n
-      do while (mod(m, 2) == 0 .and. m/2 >= coarsest_points)
-         m = m/2
-         levels = levels + 1
-      end do
+      levels = 1 + halvings(n, coarsest_points)
+      m = n/2**(levels - 1)
       h%n_fine = n
       h%coarsest = levels - 1
       allocate (h%level(0:h%coarsest), h%free(n), h%dense(m, m), h%coarse_column(m))
