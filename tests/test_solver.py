@@ -261,20 +261,22 @@ def test_threads_need_an_openmp_build(rough_profile):
     assert err.value.code == 2
 
 
+@pytest.mark.parametrize("method", ["cg", "multigrid"])
 @pytest.mark.parametrize("n", [1024, 8192])
 @pytest.mark.parametrize("ratio", [0.05, 0.25, 0.7])
-def test_westergaard(n, ratio):
+def test_westergaard(n, ratio, method):
     """Frictionless sinusoid on a half-space against Westergaard's solution
     (tests/analytic.py). Point collocation resolves the contact edge to one grid step, so
     2a/lambda is within 2/n; the mean gap and the interior pressure converge much faster
     (measured worst over the three loads: mean gap 8e-7 h0 at n = 1024 and 2e-8 h0 at
-    8192; pressure within 0.8 a, 3e-5 and 2e-7 of the peak). Tolerances: 10x those."""
+    8192; pressure within 0.8 a, 3e-5 and 2e-7 of the peak). Tolerances: 10x those. The
+    constrained CG and the multigrid solver solve the same collocation problem."""
     from analytic import westergaard_half_width, westergaard_mean_gap, westergaard_pressure
 
     h0, estar = 0.01, 4 / 3
     pm = ratio * np.pi * estar * h0
-    res = lc.solve_line(lc.sinusoid_profile(n, h0), poisson=0.5, mean_pressure=pm, tol=1e-12)
-    assert res.converged
+    res = lc.solve_line(lc.sinusoid_profile(n, h0), poisson=0.5, mean_pressure=pm, tol=1e-12, method=method)
+    assert res.converged and res.solver == method
     assert abs(res.contact_fraction - 2 * westergaard_half_width(pm, estar, h0, 1.0)) <= 2 / n
     gap_tol = 1e-5 if n == 1024 else 2e-7
     assert abs((h0 - res.penetration) - westergaard_mean_gap(pm, estar, h0, 1.0)) <= gap_tol * h0
