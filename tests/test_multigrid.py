@@ -7,6 +7,7 @@ import pytest
 
 import layercontact as lc
 from conftest import contact_violation, g_eff
+from test_areal import g_eff_grid, independent_areal_residual
 
 E_STAR = 4 / 3  # E = 1, nu = 0.5
 TOL = 1e-10
@@ -89,13 +90,13 @@ def test_refuses_scenes_it_does_not_solve(rough_profile, kw, reason):
     assert "allowed here: 'auto'" in str(err.value)
 
 
-def test_refuses_surfaces_and_sizes_without_a_small_coarsest_grid():
-    s = lc.self_affine_surface(n=64, hurst=0.8, seed=1, short_wavelength=1 / 16, rms_gradient=0.1)
-    with pytest.raises(lc.InputError, match="it solves lines, and this scene is a surface"):
-        lc.solve_areal(s, method="multigrid", mean_pressure=0.01)
+def test_refuses_sizes_without_a_small_coarsest_grid():
     h = profile(4095, "physical")
     with pytest.raises(lc.InputError, match="n = 4095 halves to an odd grid of 4095 points"):
         lc.solve_line(h, method="multigrid", mean_pressure=0.01, stress=False)
+    s = lc.self_affine_surface(n=100, hurst=0.8, seed=1, short_wavelength=8 / 100, rms_gradient=0.1)
+    with pytest.raises(lc.InputError, match="the 100 x 100 grid halves to one of 25 x 25 points"):
+        lc.solve_areal(s, method="multigrid", mean_pressure=0.01)
 
 
 @pytest.mark.parametrize("n", [100, 1000, 4096])
@@ -113,3 +114,57 @@ def test_load_is_exact_and_contact_conditions_hold(n):
     v = contact_violation(res, np.inf, 1.0, 0.5)
     assert v["overlap"] <= 2 * TOL and v["gap_in_contact"] <= 2 * TOL
     assert v["w_error"] <= 1e-12
+
+
+# --- surfaces --------------------------------------------------------------------------------
+
+def surface(nx: int, ny: int, lx: float = 1.0, ly: float = 1.0) -> np.ndarray:
+    """A broadband self-affine surface: shortest wavelength 8 grid points of the longer axis."""
+    return lc.self_affine_surface(nx=nx, ny=ny, period=(lx, ly), hurst=0.8, seed=1,
+                                  short_wavelength=8 * max(lx / nx, ly / ny), rms_gradient=0.1)
+
+
+@pytest.mark.parametrize(
+    "nx, ny, lx, ly, thickness, poisson, control",
+    [
+        (128, 128, 1.0, 1.0, np.inf, 0.5, "load"),
+        # a rectangular cell on a layer (nx != ny and lx != ly: the axes cannot be swapped)
+        (128, 64, 2.0, 0.5, 0.5, 0.3, "load"),
+        (64, 64, 1.0, 1.0, 0.3, 0.3, "displacement"),
+    ],
+)
+def test_surface_agrees_with_constrained_cg(nx, ny, lx, ly, thickness, poisson, control):
+    """Surfaces: the CG's fixed point to the bound the two tolerances allow (their sum,
+    times ptp(h), times the largest stiffness 1/|G_eff| on the grid, from the closed-form
+    tensor of areal_reference.py), the same contact set and penetration, in a few
+    iterations (measured: 3-4 and 45-48 pairs)."""
+    h = surface(nx, ny, lx, ly)
+    loads = {"load": dict(mean_pressure=0.0125 * E_STAR), "displacement": dict(penetration=0.4 * np.ptp(h))}
+    kw = dict(period=(lx, ly), thickness=thickness, poisson=poisson, stress=False, **loads[control])
+    cg = lc.solve_areal(h, method="cg", tol=TOL_CG, **kw)
+    mg = lc.solve_areal(h, method="multigrid", tol=TOL, **kw)
+    assert cg.converged and mg.converged and mg.solver == "multigrid"
+    assert 0.05 < mg.contact_fraction < 0.95
+    g = g_eff_grid(nx, ny, lx, ly, thickness, 1.0, poisson, 0.0)
+    bound = (TOL + TOL_CG) * np.ptp(h) / np.abs(g[g != 0]).min()
+    assert np.abs(mg.pressure - cg.pressure).max() <= bound
+    assert np.array_equal(mg.pressure > 0, cg.pressure > 0)
+    assert mg.mean_pressure == pytest.approx(cg.mean_pressure, rel=1e-8)
+    assert mg.penetration == pytest.approx(cg.penetration, abs=(TOL + TOL_CG) * np.ptp(h))
+    assert mg.iterations <= 8 and mg.fft_pairs <= 80
+
+
+@pytest.mark.parametrize("n", [8, 16, 256])
+def test_surface_contact_conditions_hold(n):
+    """p >= 0, the load to rounding, and the complementarity residual recomputed with numpy's
+    FFT and the closed-form tensor within 2 tol (rounding of w - r lies far below tol), on
+    sizes with a dense grid only (8 x 8), one coarse grid (16 x 16 -> 8 x 8) and a nested
+    iteration with five levels (256 x 256)."""
+    h = surface(n, n)
+    pm = 0.0125 * E_STAR
+    res = lc.solve_areal(h, method="multigrid", mean_pressure=pm, tol=TOL, stress=False)
+    assert res.converged
+    assert np.all(res.pressure >= 0)
+    assert res.mean_pressure == pytest.approx(pm, rel=1e-13)
+    residual, _ = independent_areal_residual(res, g_eff_grid(n, n, 1.0, 1.0, np.inf, 1.0, 0.5, 0.0))
+    assert residual <= 2 * TOL

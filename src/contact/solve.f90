@@ -189,11 +189,12 @@ contains
             allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
             if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
             call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
-               & '; it solves frictionless lines on an elastic half-space or layer (nu <= 0.47, or h/lambda >~ 0.07); ' &
+               & '; it solves frictionless lines and surfaces on an elastic half-space or layer (nu <= 0.47, ' // &
+               & 'or h/lambda >~ 0.07); ' &
                & // 'allowed here: ' // allowed, code_input)
             return
          end if
-      else if (method == 'auto' .and. grid%points() >= multigrid_points) then
+      else if (method == 'auto' .and. grid%is_line() .and. grid%points() >= multigrid_points) then
          if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
       end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid

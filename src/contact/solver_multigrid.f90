@@ -1,5 +1,5 @@
-!> Truncated nonsmooth Newton multigrid (TNNMG) for the frictionless contact of a line on an
-!> elastic half-space or layer: Graeser and Kornhuber, "Multigrid methods for obstacle
+!> Truncated nonsmooth Newton multigrid (TNNMG) for the frictionless contact of a line or a
+!> surface on an elastic half-space or layer: Graeser and Kornhuber, "Multigrid methods for obstacle
 !> problems" (J. Comput. Math., 2009), and "Nonsmooth Newton methods for set-valued saddle
 !> point problems" (SIAM J. Numer. Anal., 2009).
 !>
@@ -20,11 +20,12 @@
 !> contact set in few iterations. Once the set has settled, a finishing CG phase solves the
 !> linear problem on it and checks the complementarity residual at every iteration.
 !>
-!> V-cycle (for K_II): linear interpolation P, restriction P^T; on the grid being solved the
-!> exactly truncated operator I K I (one transform pair), on the coarser ones the Galerkin
-!> product of the penalised operator K + d D_A (D_A the indicator of the contact set, d the
-!> diagonal of K): a Galerkin circulant (a transform on the coarse grid; its symbol does not
-!> depend on the contact set) plus a tridiagonal part rebuilt in O(n) when the set changes.
+!> V-cycle (for K_II): linear interpolation P (bilinear on a surface: both axes are halved),
+!> restriction P^T; on the grid being solved the exactly truncated operator I K I (one
+!> transform pair), on the coarser ones the Galerkin product of the penalised operator
+!> K + d D_A (D_A the indicator of the contact set, d the diagonal of K): a Galerkin
+!> circulant (a transform on the coarse grid; its symbol does not depend on the contact set)
+!> plus a 3-point (line) or 9-point (surface) stencil rebuilt in O(n) when the set changes.
 !> The penalty stands in for the truncated Galerkin operator P^T I K I P, whose application
 !> would cost a transform of the finest grid. Damped Jacobi smoothing; a dense Cholesky
 !> solve on the coarsest grid (at most coarsest_limit points). The Newton direction needs
@@ -39,7 +40,8 @@
 !>
 !> Applies where pointwise Jacobi smooths, i.e. the stiffness rises with |q| (the
 !> operator's metric_falls, or nearly: allowed_rise), to symmetric (not coupled), elastic
-!> lines: multigrid_refusal.
+!> lines and surfaces: multigrid_refusal. Fields are stored as the rest of the library
+!> stores them: nx x ny points, x fastest; spectra on the half spectrum (nx/2 + 1) x ny.
 module lc_contact_solver_multigrid
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
@@ -64,8 +66,10 @@ module lc_contact_solver_multigrid
    !> up to 31; 6 iterations but 300-1200 pairs at 16.5 (h/lambda = 0.001, nu = 0.495), no
    !> convergence in 300 iterations at 123 (h/lambda = 0.01, nu = 0.5).)
    real(wp), parameter :: allowed_rise = 4.0_wp
-   !> The V-cycle coarsens while the next grid has at least this many points ...
+   !> The V-cycle coarsens while the next grid has at least this many points (and, on a
+   !> surface, at least shortest_side points along each axis) ...
    integer, parameter :: coarsest_points = 64
+   integer, parameter :: shortest_side = 4
    !> ... and its coarsest grid (solved densely) may have at most this many.
    integer, parameter :: coarsest_limit = 256
    !> The nested iteration starts on the coarsest grid of at least this many points.
@@ -99,27 +103,33 @@ module lc_contact_solver_multigrid
       integer :: vcycles = 0   !< V-cycles started on the grid being solved, all grids
    end type multigrid_outcome
 
-   !> One grid of n/2^t points: its plan, the operator on it for the current hierarchy, and
-   !> the V-cycle's work arrays.
+   !> One grid of nx/2^t x ny/2^t points (ny = 1 on a line): its plan, the operator on it
+   !> for the current hierarchy, and the V-cycle's work arrays.
    type :: grid_level
-      integer :: n = 0
+      integer :: nx = 0, ny = 1, n = 0
       type(fft_plan) :: fft
       real(wp) :: inv_n = 1.0_wp
-      real(wp), allocatable :: symbol(:)       !< circulant part, half spectrum (n/2 + 1)
+      real(wp), allocatable :: symbol(:)       !< circulant part, half spectrum (nx/2 + 1) x ny
       real(wp), allocatable :: multiplier(:)   !< symbol/n, as applied after an unscaled r2c
       real(wp) :: circulant_diagonal = 0.0_wp
-      !> tridiagonal penalty: diagonal, and off(i) coupling i and i + 1 (periodic)
-      real(wp), allocatable :: penalty_diagonal(:), penalty_off(:)
+      !> the penalty's stencil (coarse grids): penalty(ex, ey, i) couples point i with its
+      !> neighbour i + (ex, ey), periodic (ey = 0 only on a line)
+      real(wp), allocatable :: penalty(:, :, :)
       real(wp), allocatable :: jacobi(:)       !< omega over the diagonal of the operator
       real(wp), allocatable :: rhs(:), x(:), residual(:)
+      !> a surface's transfers work axis by axis: the field on the next grid's x and this ny
+      real(wp), allocatable :: halfway(:)
+      real(wp), allocatable :: stencil_halfway(:, :, :)
    end type grid_level
 
-   !> The grids n/2^t, t = 0..coarsest (one plan per size, shared by the nested grids), the
+   !> The grids of every 2^t-th point, t = 0..coarsest (one plan per size, shared by the
+   !> nested grids), the
    !> grid being solved (`top`: its operator is I K I, the coarser ones are the V-cycle's)
    !> and the transform count.
    type :: hierarchy
       type(grid_level), allocatable :: level(:)
       integer :: top = 0, coarsest = 0, n_fine = 0
+      logical :: surface = .false.   !< both axes are halved
       real(wp), allocatable :: free(:)           !< 1 off the contact set, 0 on it (top grid)
       real(wp), allocatable :: dense(:, :)       !< Cholesky factor of the coarsest operator
       real(wp), allocatable :: coarse_column(:)  !< real-space column of its circulant part
@@ -139,11 +149,9 @@ contains
    function multigrid_refusal(op) result(reason)
       type(compliance_operator), intent(in) :: op
       character(len=:), allocatable :: reason
-      integer :: m
+      integer :: m, k
       reason = ''
-      if (op%grid%ny /= 1) then
-         reason = 'it solves lines, and this scene is a surface'
-      else if (op%kernel%viscoelastic) then
+      if (op%kernel%viscoelastic) then
          reason = 'the layer is viscoelastic and sliding (its compliance is complex)'
       else if (op%coupled) then
          reason = 'friction couples the normal and tangential fields and the operator is not symmetric'
@@ -152,41 +160,77 @@ contains
             & '(f0.1)') // ' (a thin, nearly incompressible layer; pointwise smoothing needs at most ' // &
             & formatted(allowed_rise, '(f0.1)') // ')'
       else
-         m = op%grid%nx/2**halvings(op%grid%nx, coarsest_points)
-         if (m > coarsest_limit) reason = 'n = ' // to_string(op%grid%nx) // ' halves to an odd grid of ' // &
-            & to_string(m) // ' points; it needs n = m 2^k with m <= ' // to_string(coarsest_limit)
+         k = halvings(op%grid%nx, op%grid%ny, coarsest_points)
+         m = op%grid%points()/2**(k*merge(1, 2, op%grid%is_line()))
+         if (m > coarsest_limit) then
+            if (op%grid%is_line()) then
+               reason = 'n = ' // to_string(op%grid%nx) // ' halves to an odd grid of ' // to_string(m) // &
+                  & ' points; it needs n = m 2^k with m <= ' // to_string(coarsest_limit)
+            else
+               reason = 'the ' // to_string(op%grid%nx) // ' x ' // to_string(op%grid%ny) // ' grid halves to one of ' &
+                  & // to_string(op%grid%nx/2**k) // ' x ' // to_string(op%grid%ny/2**k) // ' points; it needs ' // &
+                  & 'nx, ny = mx 2^k, my 2^k with mx my <= ' // to_string(coarsest_limit)
+            end if
+         end if
       end if
    end function multigrid_refusal
 
-   !> How many times a grid of n points halves while the result stays even-sized and
-   !> at least `smallest` points long (n/2**k with k the count is the coarsest grid).
-   pure integer function halvings(n, smallest) result(k)
-      integer, intent(in) :: n, smallest
-      integer :: m
+   !> How many times a grid of nx x ny points (ny = 1: a line) halves along every axis
+   !> longer than 1 while the result has at least `smallest` points (and at least
+   !> shortest_side along each axis of a surface): the coarsest grid is nx/2**k x ny/2**k.
+   pure integer function halvings(nx, ny, smallest) result(k)
+      integer, intent(in) :: nx, ny, smallest
+      integer :: mx, my
       k = 0
-      m = n
-      do while (mod(m, 2) == 0 .and. m/2 >= smallest)
-         m = m/2
+      mx = nx
+      my = ny
+      do while (mod(mx, 2) == 0 .and. (mx/2)*max(my/2, 1) >= smallest)
+         if (my > 1) then
+            if (mod(my, 2) /= 0 .or. min(mx, my)/2 < shortest_side) exit
+            my = my/2
+         end if
+         mx = mx/2
          k = k + 1
       end do
    end function halvings
 
    !> The largest factor by which the normal compliance M(q) on the grid's modes exceeds its
-   !> value at a longer wave: 1 where it falls with |q| (op%metric_falls).
+   !> value at a longer wave: 1 where it falls with |q| (op%metric_falls). The modes are
+   !> gathered in bins of |q| one fundamental wide (on a line, one mode a bin: exact; on a
+   !> surface, modes within a bin count as equally long).
    pure real(wp) function compliance_rise(op) result(rise)
       type(compliance_operator), intent(in) :: op
-      real(wp) :: lowest
-      integer :: k
+      real(wp), parameter :: pi = acos(-1.0_wp)
+      real(wp), allocatable :: low(:), high(:)
+      real(wp) :: qx, qy, q_unit, q_max, lowest
+      integer :: i, bin
       rise = 1.0_wp
       if (op%nk < 3) return
-      lowest = op%metric(2)
-      do k = 3, op%nk
-         lowest = min(lowest, op%metric(k))
-         rise = max(rise, op%metric(k)/lowest)
+      if (op%grid%is_line()) then
+         q_unit = 2*pi/op%grid%lx
+         q_max = pi*op%grid%nx/op%grid%lx
+      else
+         q_unit = 2*pi/max(op%grid%lx, op%grid%ly)
+         q_max = pi*hypot(op%grid%nx/op%grid%lx, op%grid%ny/op%grid%ly)
+      end if
+      allocate (low(ceiling(q_max/q_unit) + 1), high(ceiling(q_max/q_unit) + 1))
+      low = huge(1.0_wp)
+      high = 0.0_wp
+      do i = 2, op%nk
+         call op%grid%wavevector(i, qx, qy)
+         bin = nint(hypot(qx, qy)/q_unit)
+         low(bin) = min(low(bin), op%metric(i))
+         high(bin) = max(high(bin), op%metric(i))
+      end do
+      lowest = huge(1.0_wp)
+      do bin = 1, size(low)
+         if (high(bin) == 0.0_wp) cycle
+         lowest = min(lowest, low(bin))
+         rise = max(rise, high(bin)/lowest)
       end do
    end function compliance_rise
 
-   !> Solve the frictionless contact of a line: w = M p, gap = w - b - s >= 0, p >= 0,
+   !> Solve the frictionless contact of a line or surface: w = M p, gap = w - b - s >= 0, p >= 0,
    !> p gap = 0, under load control (mean(p) = p_m, s found) or displacement control (s
    !> given). p: out the solution (the guess on entry is not used: the nested iteration makes
    !> its own); w = M p; gap. history(1:outcome%iterations) receives the residual of each
@@ -209,35 +253,36 @@ contains
       type(hierarchy) :: h
       real(wp), allocatable :: stiffness(:), u(:), o(:)
       real(wp) :: f, target
-      integer :: n, j, nested, m, steps, tightened
+      integer :: n, j, nested, m, mc, steps, tightened
       logical :: converged
 
       n = size(p)
-      call build_hierarchy(h, n, error)
+      call build_hierarchy(h, op%grid%nx, op%grid%ny, error)
       if (allocated(error)) return
-      ! K = 1/M on the modes k = 0..n/2; a coarser grid of the nested iteration samples the
-      ! same wavenumbers, so its symbol is the first m/2 + 1 of these. (M(0) = 0 under load
-      ! control, the uniform mode being dropped: K(0) = 0.)
-      allocate (stiffness(n/2 + 1), u(n), o(n))
-      where (op%metric(1:n/2 + 1) > 0.0_wp)
-         stiffness = 1.0_wp/op%metric(1:n/2 + 1)
+      ! K = 1/M on the half spectrum; a coarser grid of the nested iteration samples the
+      ! same wavevectors (level_symbol). (M(0) = 0 under load control, the uniform mode
+      ! being dropped: K(0) = 0.)
+      allocate (stiffness(op%nk), u(n), o(n))
+      where (op%metric > 0.0_wp)
+         stiffness = 1.0_wp/op%metric
       elsewhere
          stiffness = 0.0_wp
       end where
       if (load_control) stiffness(1) = 0.0_wp
       f = merge(mean_pressure, 0.0_wp, load_control)
 
-      nested = halvings(n, nested_coarsest)
+      nested = halvings(op%grid%nx, op%grid%ny, nested_coarsest)
       do j = nested, 0, -1
          m = h%level(j)%n
-         call set_grid(h, j, stiffness(1:m/2 + 1))
-         o(1:m) = b(1:n:2**j)
+         call set_grid(h, j, level_symbol(stiffness, h%level(0), h%level(j)))
+         call sample(b, h%level(0)%nx, h%level(0)%ny, 2**j, o(1:m))
          if (.not. load_control) o(1:m) = o(1:m) + s
          if (j == nested) then
             u(1:m) = o(1:m)
          else
-            gap(1:m/2) = u(1:m/2)   ! (a copy: the interpolation writes over u)
-            call interpolate(h, j, gap(1:m/2), u(1:m))
+            mc = h%level(j + 1)%n
+            gap(1:mc) = u(1:mc)   ! (a copy: the interpolation writes over u)
+            call interpolate(h, j, gap(1:mc), u(1:m))
          end if
          if (j == 0) exit
          ! the coarsest grid to tol, the others one iteration each
@@ -463,12 +508,12 @@ contains
       associate (lv => h%level(t))
       lv%x = lv%jacobi*lv%rhs
       call level_residual(h, t)
-      call restrict(lv%residual, h%level(t + 1)%rhs)
+      call restrict(h, t, lv%residual, h%level(t + 1)%rhs)
       call vcycle(h, t + 1)
       if (t == h%top) then
-         call prolong_add(h%level(t + 1)%x, lv%x, h%free(1:lv%n))
+         call prolong_add(h, t, h%level(t + 1)%x, lv%x, h%free(1:lv%n))
       else
-         call prolong_add(h%level(t + 1)%x, lv%x)
+         call prolong_add(h, t, h%level(t + 1)%x, lv%x)
       end if
       call level_residual(h, t)
       lv%x = lv%x + lv%jacobi*lv%residual
@@ -479,7 +524,7 @@ contains
    subroutine level_residual(h, t)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
-      integer :: i, m
+      integer :: m
       associate (lv => h%level(t))
       m = lv%n
       lv%fft%real_buffer = lv%x
@@ -487,16 +532,32 @@ contains
       if (t == h%top) then
          lv%residual = lv%rhs - h%free(1:m)*lv%fft%real_buffer
       else
-         associate (x => lv%x, dg => lv%penalty_diagonal, off => lv%penalty_off)
-         lv%residual(1) = lv%rhs(1) - lv%fft%real_buffer(1) - dg(1)*x(1) - off(1)*x(2) - off(m)*x(m)
-         do i = 2, m - 1
-            lv%residual(i) = lv%rhs(i) - lv%fft%real_buffer(i) - dg(i)*x(i) - off(i)*x(i + 1) - off(i - 1)*x(i - 1)
-         end do
-         lv%residual(m) = lv%rhs(m) - lv%fft%real_buffer(m) - dg(m)*x(m) - off(m)*x(1) - off(m - 1)*x(m - 1)
-         end associate
+         lv%residual = lv%rhs - lv%fft%real_buffer
+         call subtract_stencil(lv%penalty, lv%x, lv%residual, lv%nx, lv%ny)
       end if
       end associate
    end subroutine level_residual
+
+   !> r <- r - S x for the 9-point (3-point on a line, ny = 1) periodic stencil S:
+   !> (S x)(i) = sum over (ex, ey) of s(ex, ey, i) x(i + (ex, ey)).
+   pure subroutine subtract_stencil(s, x, r, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: s(-1:1, -1:1, 0:nx - 1, 0:ny - 1), x(0:nx - 1, 0:ny - 1)
+      real(wp), intent(inout) :: r(0:nx - 1, 0:ny - 1)
+      integer :: ix, iy, xm, xp, ym, yp
+      do iy = 0, ny - 1
+         ym = modulo(iy - 1, ny)
+         yp = modulo(iy + 1, ny)
+         do ix = 0, nx - 1
+            xm = merge(nx - 1, ix - 1, ix == 0)
+            xp = merge(0, ix + 1, ix == nx - 1)
+            r(ix, iy) = r(ix, iy) - (s(-1, 0, ix, iy)*x(xm, iy) + s(0, 0, ix, iy)*x(ix, iy) + s(1, 0, ix, iy)*x(xp, iy))
+            if (ny > 1) r(ix, iy) = r(ix, iy) &
+               & - (s(-1, -1, ix, iy)*x(xm, ym) + s(0, -1, ix, iy)*x(ix, ym) + s(1, -1, ix, iy)*x(xp, ym)) &
+               & - (s(-1, 1, ix, iy)*x(xm, yp) + s(0, 1, ix, iy)*x(ix, yp) + s(1, 1, ix, iy)*x(xp, yp))
+         end do
+      end do
+   end subroutine subtract_stencil
 
    !> y = K x on the grid being solved (one transform pair).
    subroutine apply_stiffness(h, x, y)
@@ -523,93 +584,231 @@ contains
       end associate
    end subroutine transform
 
-   !> Coarse = P^T fine (P: linear interpolation, periodic).
-   pure subroutine restrict(fine, coarse)
+   !> coarse (level t + 1) = P^T fine (level t); P: linear interpolation, periodic, along x
+   !> and (a surface) along y.
+   subroutine restrict(h, t, fine, coarse)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
       real(wp), contiguous, intent(in) :: fine(:)
       real(wp), contiguous, intent(out) :: coarse(:)
-      integer :: i, m
-      m = size(coarse)
-      coarse(1) = fine(1) + 0.5_wp*(fine(2) + fine(2*m))
-      do i = 2, m
-         coarse(i) = fine(2*i - 1) + 0.5_wp*(fine(2*i) + fine(2*i - 2))
-      end do
+      associate (lv => h%level(t))
+      if (h%surface) then
+         call restrict_x(fine, lv%halfway, lv%nx, lv%ny)
+         call restrict_y(lv%halfway, coarse, lv%nx/2, lv%ny)
+      else
+         call restrict_x(fine, coarse, lv%nx, 1)
+      end if
+      end associate
    end subroutine restrict
 
-   !> fine <- fine + P coarse (linear interpolation, periodic), masked by `free` if given.
-   pure subroutine prolong_add(coarse, fine, free)
+   !> fine (level t) <- fine + P coarse (level t + 1), masked by `free` if given.
+   subroutine prolong_add(h, t, coarse, fine, free)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
       real(wp), contiguous, intent(in) :: coarse(:)
       real(wp), contiguous, intent(inout) :: fine(:)
       real(wp), contiguous, intent(in), optional :: free(:)
-      integer :: i, m
-      m = size(coarse)
-      if (present(free)) then
-         do i = 1, m
-            fine(2*i - 1) = fine(2*i - 1) + free(2*i - 1)*coarse(i)
-            fine(2*i) = fine(2*i) + free(2*i)*0.5_wp*(coarse(i) + coarse(mod(i, m) + 1))
-         end do
+      associate (lv => h%level(t))
+      if (h%surface) then
+         call prolong_y(coarse, lv%halfway, lv%nx/2, lv%ny)
+         call prolong_x_add(lv%halfway, fine, lv%nx, lv%ny, free)
       else
-         do i = 1, m
-            fine(2*i - 1) = fine(2*i - 1) + coarse(i)
-            fine(2*i) = fine(2*i) + 0.5_wp*(coarse(i) + coarse(mod(i, m) + 1))
-         end do
+         call prolong_x_add(coarse, fine, lv%nx, 1, free)
       end if
+      end associate
    end subroutine prolong_add
 
-   !> The grids n, n/2, ... while the next has at least coarsest_points points, with their
-   !> plans and work arrays (allocated once, for all the nested grids).
-   subroutine build_hierarchy(h, n, error)
+   !> Along x, row by row: coarse(i) = fine(2i - 1) + (fine(2i) + fine(2i - 2))/2.
+   pure subroutine restrict_x(fine, coarse, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: fine(nx, ny)
+      real(wp), intent(out) :: coarse(nx/2, ny)
+      integer :: i, j, m
+      m = nx/2
+      do j = 1, ny
+         coarse(1, j) = fine(1, j) + 0.5_wp*(fine(2, j) + fine(2*m, j))
+         do i = 2, m
+            coarse(i, j) = fine(2*i - 1, j) + 0.5_wp*(fine(2*i, j) + fine(2*i - 2, j))
+         end do
+      end do
+   end subroutine restrict_x
+
+   !> Along y: the same for the rows.
+   pure subroutine restrict_y(fine, coarse, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: fine(nx, ny)
+      real(wp), intent(out) :: coarse(nx, ny/2)
+      integer :: j, m
+      m = ny/2
+      coarse(:, 1) = fine(:, 1) + 0.5_wp*(fine(:, 2) + fine(:, 2*m))
+      do j = 2, m
+         coarse(:, j) = fine(:, 2*j - 1) + 0.5_wp*(fine(:, 2*j) + fine(:, 2*j - 2))
+      end do
+   end subroutine restrict_y
+
+   !> Along x, row by row: fine <- fine + P coarse, masked by `free` if given.
+   pure subroutine prolong_x_add(coarse, fine, nx, ny, free)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: coarse(nx/2, ny)
+      real(wp), intent(inout) :: fine(nx, ny)
+      real(wp), intent(in), optional :: free(nx, ny)
+      integer :: i, j, m
+      m = nx/2
+      if (present(free)) then
+         do j = 1, ny
+            do i = 1, m
+               fine(2*i - 1, j) = fine(2*i - 1, j) + free(2*i - 1, j)*coarse(i, j)
+               fine(2*i, j) = fine(2*i, j) + free(2*i, j)*0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
+            end do
+         end do
+      else
+         do j = 1, ny
+            do i = 1, m
+               fine(2*i - 1, j) = fine(2*i - 1, j) + coarse(i, j)
+               fine(2*i, j) = fine(2*i, j) + 0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
+            end do
+         end do
+      end if
+   end subroutine prolong_x_add
+
+   !> Along y: fine = P coarse (assigned).
+   pure subroutine prolong_y(coarse, fine, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: coarse(nx, ny/2)
+      real(wp), intent(out) :: fine(nx, ny)
+      integer :: j, m
+      m = ny/2
+      do j = 1, m
+         fine(:, 2*j - 1) = coarse(:, j)
+         fine(:, 2*j) = 0.5_wp*(coarse(:, j) + coarse(:, mod(j, m) + 1))
+      end do
+   end subroutine prolong_y
+
+   !> The grids of every 2^t-th point while the next has at least coarsest_points points
+   !> (halvings), with their plans and work arrays (allocated once, for all the nested grids).
+   subroutine build_hierarchy(h, nx, ny, error)
       type(hierarchy), intent(out) :: h
-      integer, intent(in) :: n
+      integer, intent(in) :: nx, ny
       type(error_type), allocatable, intent(out) :: error
-      integer :: t, m, levels
-      levels = 1 + halvings(n, coarsest_points)
-      m = n/2**(levels - 1)
-      h%n_fine = n
-      h%coarsest = levels - 1
-      allocate (h%level(0:h%coarsest), h%free(n), h%dense(m, m), h%coarse_column(m))
+      integer :: t, m
+      h%surface = ny > 1
+      h%coarsest = halvings(nx, ny, coarsest_points)
+      h%n_fine = nx*ny
+      allocate (h%level(0:h%coarsest), h%free(nx*ny))
       h%free = 1.0_wp
       do t = 0, h%coarsest
-         m = n/2**t
          associate (lv => h%level(t))
-         lv%n = m
+         lv%nx = nx/2**t
+         lv%ny = merge(ny/2**t, 1, h%surface)
+         lv%n = lv%nx*lv%ny
+         m = lv%n
          lv%inv_n = 1.0_wp/m
-         call lv%fft%init(m, 1, 1, error)
+         call lv%fft%init(lv%nx, lv%ny, 1, error)
          if (allocated(error)) return
-         allocate (lv%symbol(m/2 + 1), lv%multiplier(m/2 + 1), lv%penalty_diagonal(m), lv%penalty_off(m), lv%jacobi(m), lv%rhs(m), &
+         allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier((lv%nx/2 + 1)*lv%ny), lv%jacobi(m), lv%rhs(m), &
             & lv%x(m), lv%residual(m))
-         lv%penalty_diagonal = 0.0_wp
-         lv%penalty_off = 0.0_wp
+         if (t > 0) allocate (lv%penalty(-1:1, -1:1, m))
+         if (h%surface .and. t < h%coarsest) allocate (lv%halfway(m/2))
+         if (h%surface .and. t > 0 .and. t < h%coarsest) allocate (lv%stencil_halfway(-1:1, -1:1, m/2))
          end associate
       end do
+      m = h%level(h%coarsest)%n
+      allocate (h%dense(m, m), h%coarse_column(m))
    end subroutine build_hierarchy
 
-   !> Make grid `top` the one being solved, with the stiffness symbol K(0..m/2) on it: the
-   !> Galerkin circulants P^T C P below it (their symbols in closed form: a coarse mode k
-   !> gathers the fine modes k and m_c - k with the weights 2 alpha^2 and 2 beta^2,
-   !> alpha, beta = (1 +- cos(pi k/m_c))/2), their diagonals, and the real-space column of
-   !> the coarsest one.
+   !> The flat index on the half spectrum of an nx x ny grid of the mode (kx, ky), any
+   !> integers: periodic, and a mode outside the half spectrum is read at its mirror image
+   !> -(kx, ky) (the symbols here are real and even).
+   pure integer function mode_index(nx, ny, kx, ky) result(i)
+      integer, intent(in) :: nx, ny, kx, ky
+      integer :: mx, my
+      mx = modulo(kx, nx)
+      my = modulo(ky, ny)
+      if (2*mx > nx) then
+         mx = nx - mx
+         my = modulo(-my, ny)
+      end if
+      i = mx + (nx/2 + 1)*my + 1
+   end function mode_index
+
+   !> The symbol on grid `coarse` of the nested iteration from the one on the finest grid
+   !> `fine`: the coarse grid's wavevectors are among the fine grid's (its Nyquist modes
+   !> read at +pi/dx: the symbol is even in each component, |q| being all it depends on).
+   pure function level_symbol(symbol, fine, coarse) result(sampled)
+      real(wp), intent(in) :: symbol(:)
+      type(grid_level), intent(in) :: fine, coarse
+      real(wp) :: sampled((coarse%nx/2 + 1)*coarse%ny)
+      integer :: kx, ky, my
+      do ky = 0, coarse%ny - 1
+         my = merge(ky, ky - coarse%ny, 2*ky <= coarse%ny)
+         do kx = 0, coarse%nx/2
+            sampled(kx + (coarse%nx/2 + 1)*ky + 1) = symbol(mode_index(fine%nx, fine%ny, kx, my))
+         end do
+      end do
+   end function level_symbol
+
+   !> f (nx x ny) at every step-th point along each axis longer than 1.
+   pure subroutine sample(f, nx, ny, step, fc)
+      integer, intent(in) :: nx, ny, step
+      real(wp), intent(in) :: f(nx, ny)
+      real(wp), intent(out) :: fc(nx/step, max(ny/step, 1))
+      if (ny > 1) then
+         fc = f(1:nx:step, 1:ny:step)
+      else
+         fc = f(1:nx:step, :)
+      end if
+   end subroutine sample
+
+   !> Make grid `top` the one being solved, with the stiffness symbol K on its half spectrum:
+   !> the Galerkin circulants P^T C P below it (their symbols in closed form: along each
+   !> halved axis a coarse mode k gathers the fine modes k and k + m_c with the weights
+   !> 2 alpha^2 and 2 beta^2, alpha, beta = (1 +- cos(pi k/m_c))/2; on a surface the products
+   !> of the two axes' weights over the four fine modes), their diagonals, and the real-space
+   !> column of the coarsest one.
    subroutine set_grid(h, top, symbol)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: top
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), parameter :: pi = acos(-1.0_wp)
-      real(wp) :: alpha, beta
-      integer :: t, k, mc
+      real(wp) :: ax, bx, ay, by
+      integer :: t, kx, ky, nkx, row, first, last
       h%top = top
       h%level(top)%symbol = symbol
       do t = top + 1, h%coarsest
-         mc = h%level(t)%n
-         do k = 0, mc/2
-            alpha = 0.5_wp*(1.0_wp + cos(pi*k/mc))
-            beta = 0.5_wp*(1.0_wp - cos(pi*k/mc))
-            h%level(t)%symbol(k + 1) = 2*alpha**2*h%level(t - 1)%symbol(k + 1) + 2*beta**2*h%level(t - 1)%symbol(mc - k + 1)
+         associate (c => h%level(t), f => h%level(t - 1))
+         nkx = c%nx/2 + 1
+         do ky = 0, c%ny - 1
+            do kx = 0, c%nx/2
+               ax = 0.5_wp*(1.0_wp + cos(pi*kx/c%nx))
+               bx = 0.5_wp*(1.0_wp - cos(pi*kx/c%nx))
+               if (h%surface) then
+                  ay = 0.5_wp*(1.0_wp + cos(pi*ky/c%ny))
+                  by = 0.5_wp*(1.0_wp - cos(pi*ky/c%ny))
+                  c%symbol(kx + nkx*ky + 1) = &
+                     & 2*ax**2*(2*ay**2*f%symbol(mode_index(f%nx, f%ny, kx, ky)) &
+                     &          + 2*by**2*f%symbol(mode_index(f%nx, f%ny, kx, ky + c%ny))) &
+                     & + 2*bx**2*(2*ay**2*f%symbol(mode_index(f%nx, f%ny, kx + c%nx, ky)) &
+                     &            + 2*by**2*f%symbol(mode_index(f%nx, f%ny, kx + c%nx, ky + c%ny)))
+               else
+                  c%symbol(kx + 1) = 2*ax**2*f%symbol(kx + 1) + 2*bx**2*f%symbol(mode_index(f%nx, 1, kx + c%nx, 0))
+               end if
+            end do
          end do
+         end associate
       end do
       do t = top, h%coarsest
          associate (lv => h%level(t))
-         ! (1/n) sum over the whole spectrum: the Nyquist mode of an even grid counts once
-         lv%circulant_diagonal = (lv%symbol(1) + 2*sum(lv%symbol(2:)) &
-            & - merge(lv%symbol(size(lv%symbol)), 0.0_wp, mod(lv%n, 2) == 0))*lv%inv_n
+         ! (1/n) sum over the whole spectrum, row by row of the half spectrum: the modes of a
+         ! row stand for two, but for its mx = 0 and (even nx) Nyquist ones
+         nkx = lv%nx/2 + 1
+         lv%circulant_diagonal = 0.0_wp
+         do row = 1, lv%ny
+            first = (row - 1)*nkx + 1
+            last = row*nkx
+            lv%circulant_diagonal = lv%circulant_diagonal + (lv%symbol(first) + 2*sum(lv%symbol(first + 1:last)) &
+               & - merge(lv%symbol(last), 0.0_wp, mod(lv%nx, 2) == 0))
+         end do
+         lv%circulant_diagonal = lv%circulant_diagonal*lv%inv_n
          lv%multiplier = lv%symbol*lv%inv_n
          end associate
       end do
@@ -622,30 +821,24 @@ contains
    end subroutine set_grid
 
    !> The coarse operators for the contact set of h%free: the Galerkin products of the
-   !> penalty d D_A (tridiagonal on every coarser grid, by the recursion below), the Jacobi
-   !> weights, and the Cholesky factor of the coarsest operator.
+   !> penalty d D_A (a 3- or 9-point stencil on every coarser grid), the
+   !> Jacobi weights, and the Cholesky factor of the coarsest operator.
    subroutine set_contact(h)
       type(hierarchy), intent(inout) :: h
-      integer :: t, i, m, info, attempt
+      integer :: t, info, attempt
       real(wp) :: shift
       do t = h%top + 1, h%coarsest
-         m = h%level(t)%n
-         associate (dg => h%level(t - 1)%penalty_diagonal, off => h%level(t - 1)%penalty_off, &
-            & cdg => h%level(t)%penalty_diagonal, coff => h%level(t)%penalty_off)
+         associate (c => h%level(t), f => h%level(t - 1))
          if (t == h%top + 1) then
-            dg = (1.0_wp - h%free(1:2*m))*penalty*h%level(h%top)%circulant_diagonal
-            off = 0.0_wp
+            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, f%ny, c%penalty)
+         else if (h%surface) then
+            ! (axis by axis: P = Px Py)
+            call coarsen_x(f%penalty, f%nx, f%ny, f%stencil_halfway)
+            call coarsen_y(f%stencil_halfway, f%nx/2, f%ny, c%penalty)
+         else
+            call coarsen_x(f%penalty, f%nx, 1, c%penalty)
          end if
-         ! energy sum dg f^2 + 2 off f_i f_i+1 with f = P c, f(2i-1) = c(i),
-         ! f(2i) = (c(i) + c(i+1))/2
-         cdg(1) = dg(1) + 0.25_wp*(dg(2) + dg(2*m)) + off(1) + off(2*m)
-         do i = 2, m
-            cdg(i) = dg(2*i - 1) + 0.25_wp*(dg(2*i) + dg(2*i - 2)) + off(2*i - 1) + off(2*i - 2)
-         end do
-         do i = 1, m
-            coff(i) = 0.25_wp*dg(2*i) + 0.5_wp*(off(2*i - 1) + off(2*i))
-         end do
-         h%level(t)%jacobi = omega/(h%level(t)%circulant_diagonal + cdg)
+         c%jacobi = omega/(c%circulant_diagonal + c%penalty(0, 0, :))
          end associate
       end do
       ! the coarsest operator, dense: circulant plus penalty (on the grid being solved, when
@@ -661,17 +854,115 @@ contains
       end do
    end subroutine set_contact
 
+   !> The Galerkin products below use that the fine point 2I + k of an axis (zero-based,
+   !> k = -2..2 from the coarse point I) takes the values of the coarse points I + to(1:2, k)
+   !> with the weights of(1:2, k) under linear interpolation (a weight 0: no second point).
+   pure subroutine interpolation_weights(to, of)
+      integer, intent(out) :: to(2, -2:2)
+      real(wp), intent(out) :: of(2, -2:2)
+      to = reshape([-1, 0, -1, 0, 0, 0, 0, 1, 1, 0], [2, 5])
+      of = reshape([1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp], [2, 5])
+   end subroutine interpolation_weights
+
+   !> coarse = P^T D P for the fine nx x ny grid's diagonal D = `weight` on the contact set
+   !> (free = 0) and 0 off it, P linear interpolation along x and (ny > 1) along y: a 3 x 3
+   !> stencil (3 x 1 on a line).
+   pure subroutine galerkin_diagonal(free, weight, nx, ny, coarse)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: free(0:nx - 1, 0:ny - 1), weight
+      real(wp), intent(out) :: coarse(-1:1, -1:1, 0:nx/2 - 1, 0:max(ny/2, 1) - 1)
+      integer :: to(2, -2:2), cx, cy, kx, ky, ky_reach, a, b, ix, iy
+      real(wp) :: of(2, -2:2), v
+      call interpolation_weights(to, of)
+      ky_reach = merge(1, 0, ny > 1)
+      coarse = 0.0_wp
+      do cy = 0, max(ny/2, 1) - 1
+         do cx = 0, nx/2 - 1
+            do ky = -ky_reach, ky_reach
+               iy = merge(modulo(2*cy + ky, ny), 0, ny > 1)
+               do kx = -1, 1
+                  ix = modulo(2*cx + kx, nx)
+                  if (free(ix, iy) /= 0.0_wp) cycle
+                  ! (P(i, I) = of(1, k) for the point I itself: 1 at k = 0, 1/2 at k = +-1)
+                  v = weight*of(1, kx)*merge(of(1, ky), 1.0_wp, ny > 1)
+                  do b = 1, merge(2, 1, ny > 1)
+                     do a = 1, 2
+                        associate (dy => merge(to(b, ky), 0, ny > 1), wy => merge(of(b, ky), 1.0_wp, ny > 1))
+                        coarse(to(a, kx), dy, cx, cy) = coarse(to(a, kx), dy, cx, cy) + v*of(a, kx)*wy
+                        end associate
+                     end do
+                  end do
+               end do
+            end do
+         end do
+      end do
+   end subroutine galerkin_diagonal
+
+   !> b = Px^T a Px for the 3 x 3 stencil `a` of the fine nx x ny grid, Px linear
+   !> interpolation along x only: the stencil of the (nx/2) x ny grid.
+   pure subroutine coarsen_x(a, nx, ny, b)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: a(-1:1, -1:1, 0:nx - 1, 0:ny - 1)
+      real(wp), intent(out) :: b(-1:1, -1:1, 0:nx/2 - 1, 0:ny - 1)
+      integer :: to(2, -2:2), cx, iy, k, e, ix, j, reach
+      real(wp) :: of(2, -2:2)
+      call interpolation_weights(to, of)
+      reach = merge(1, 0, ny > 1)
+      b = 0.0_wp
+      do iy = 0, ny - 1
+         do cx = 0, nx/2 - 1
+            do k = -1, 1
+               ix = modulo(2*cx + k, nx)
+               do e = -1, 1
+                  do j = 1, 2
+                     b(to(j, k + e), -reach:reach, cx, iy) = b(to(j, k + e), -reach:reach, cx, iy) &
+                        & + (of(1, k)*of(j, k + e))*a(e, -reach:reach, ix, iy)
+                  end do
+               end do
+            end do
+         end do
+      end do
+   end subroutine coarsen_x
+
+   !> c = Py^T b Py for the 3 x 3 stencil `b` of the fine nx x ny grid, Py linear
+   !> interpolation along y only: the stencil of the nx x (ny/2) grid.
+   pure subroutine coarsen_y(b, nx, ny, c)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: b(-1:1, -1:1, 0:nx - 1, 0:ny - 1)
+      real(wp), intent(out) :: c(-1:1, -1:1, 0:nx - 1, 0:ny/2 - 1)
+      integer :: to(2, -2:2), cy, ix, k, e, iy, j
+      real(wp) :: of(2, -2:2)
+      call interpolation_weights(to, of)
+      c = 0.0_wp
+      do cy = 0, ny/2 - 1
+         do k = -1, 1
+            iy = modulo(2*cy + k, ny)
+            do e = -1, 1
+               do j = 1, 2
+                  do ix = 0, nx - 1
+                     c(:, to(j, k + e), ix, cy) = c(:, to(j, k + e), ix, cy) + (of(1, k)*of(j, k + e))*b(:, e, ix, iy)
+                  end do
+               end do
+            end do
+         end do
+      end do
+   end subroutine coarsen_y
+
    !> The dense matrix of the coarsest grid's operator (see set_contact), its diagonal
    !> shifted by `shift`.
    pure subroutine fill_dense(h, shift)
       type(hierarchy), intent(inout) :: h
       real(wp), intent(in) :: shift
-      integer :: i, r, m, next
+      integer :: i, j, m, ix, iy, jx, jy, ex, ey
       associate (lv => h%level(h%coarsest), a => h%dense)
       m = lv%n
       do i = 1, m
-         do r = 1, m
-            a(r, i) = h%coarse_column(modulo(r - i, m) + 1)
+         ix = mod(i - 1, lv%nx)
+         iy = (i - 1)/lv%nx
+         do j = 1, m
+            jx = mod(j - 1, lv%nx)
+            jy = (j - 1)/lv%nx
+            a(j, i) = h%coarse_column(modulo(jx - ix, lv%nx) + lv%nx*modulo(jy - iy, lv%ny) + 1)
          end do
       end do
       if (h%top == h%coarsest) then
@@ -683,11 +974,17 @@ contains
             end if
          end do
       else
+         ! row i: sum over the stencil of penalty(ex, ey, i) x(i + (ex, ey))
          do i = 1, m
-            next = mod(i, m) + 1
-            a(i, i) = a(i, i) + lv%penalty_diagonal(i)
-            a(next, i) = a(next, i) + lv%penalty_off(i)
-            a(i, next) = a(i, next) + lv%penalty_off(i)
+            ix = mod(i - 1, lv%nx)
+            iy = (i - 1)/lv%nx
+            do ey = -1, 1
+               do ex = -1, 1
+                  if (lv%penalty(ex, ey, i) == 0.0_wp) cycle
+                  j = modulo(ix + ex, lv%nx) + lv%nx*modulo(iy + ey, lv%ny) + 1
+                  a(i, j) = a(i, j) + lv%penalty(ex, ey, i)
+               end do
+            end do
          end do
       end if
       do i = 1, m
@@ -732,25 +1029,39 @@ contains
       end do
    end subroutine cholesky_solve
 
-   !> uf (on grid j) = the spectral interpolation of uc (on grid j + 1).
+   !> uf (on grid j) = the spectral interpolation of uc (on grid j + 1): its Fourier
+   !> coefficients, zero-padded.
    subroutine interpolate(h, j, uc, uf)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: j
       real(wp), contiguous, intent(in) :: uc(:)
       real(wp), contiguous, intent(out) :: uf(:)
-      integer :: mc
-      mc = size(uc)
-      associate (coarse => h%level(j + 1)%fft, fine => h%level(j)%fft)
-      coarse%real_buffer = uc
-      call coarse%forward()
-      fine%spectrum = (0.0_wp, 0.0_wp)
-      fine%spectrum(1:mc/2 + 1) = coarse%spectrum
-      ! the coarse Nyquist mode is a cosine: on the fine grid half of it is its mirror image
-      if (mod(mc, 2) == 0) fine%spectrum(mc/2 + 1) = 0.5_wp*fine%spectrum(mc/2 + 1)
-      call fine%backward()
-      uf = fine%real_buffer
+      complex(wp) :: value
+      integer :: kx, ky, fy, nkc, nkf
+      associate (coarse => h%level(j + 1), fine => h%level(j))
+      nkc = coarse%nx/2 + 1
+      nkf = fine%nx/2 + 1
+      coarse%fft%real_buffer = uc
+      call coarse%fft%forward()
+      fine%fft%spectrum = (0.0_wp, 0.0_wp)
+      do ky = 0, coarse%ny - 1
+         ! (rows of negative ky move to the end of the longer fine axis)
+         fy = merge(ky, ky + fine%ny - coarse%ny, 2*ky <= coarse%ny)
+         do kx = 0, coarse%nx/2
+            value = coarse%fft%spectrum(kx + nkc*ky + 1)
+            ! a coarse Nyquist mode is a cosine: on the fine grid half of it is its mirror image
+            if (2*kx == coarse%nx) value = 0.5_wp*value
+            if (h%surface .and. 2*ky == coarse%ny) then
+               value = 0.5_wp*value
+               fine%fft%spectrum(kx + nkf*(fine%ny - ky) + 1) = value
+            end if
+            fine%fft%spectrum(kx + nkf*fy + 1) = value
+         end do
+      end do
+      call fine%fft%backward()
+      uf = fine%fft%real_buffer
+      h%pairs = h%pairs + 0.5_wp*(coarse%n + fine%n)/h%n_fine
       end associate
-      h%pairs = h%pairs + 0.5_wp*(3*mc)/h%n_fine
    end subroutine interpolate
 
    !> p_ref (p_m, or the mean pressure under displacement control), g_ref and the rounding
