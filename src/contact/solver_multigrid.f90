@@ -137,6 +137,12 @@ module lc_contact_solver_multigrid
       integer :: vcycles = 0
    end type hierarchy
 
+   !> The work arrays of the iterations, allocated once for the finest grid (the nested
+   !> grids use their first points).
+   type :: workspace
+      real(wp), allocatable :: c(:), kc(:), v(:), kv(:), previous(:), cg(:, :)
+   end type workspace
+
    !> The scales of the residual, from the last full evaluation of the state.
    type :: residual_scales
       real(wp) :: p_scale = 1.0_wp, g_scale = 1.0_wp, floor = 0.0_wp
@@ -251,6 +257,7 @@ contains
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
       type(hierarchy) :: h
+      type(workspace) :: work
       real(wp), allocatable :: stiffness(:), u(:), o(:)
       real(wp) :: f, target
       integer :: n, j, nested, m, mc, steps, tightened
@@ -262,7 +269,8 @@ contains
       ! K = 1/M on the half spectrum; a coarser grid of the nested iteration samples the
       ! same wavevectors (level_symbol). (M(0) = 0 under load control, the uniform mode
       ! being dropped: K(0) = 0.)
-      allocate (stiffness(op%nk), u(n), o(n))
+      allocate (stiffness(op%nk), u(n), o(n), work%c(n), work%kc(n), work%v(n), work%kv(n), work%previous(n), &
+         & work%cg(n, 3))
       where (op%metric > 0.0_wp)
          stiffness = 1.0_wp/op%metric
       elsewhere
@@ -286,7 +294,7 @@ contains
          end if
          if (j == 0) exit
          ! the coarsest grid to tol, the others one iteration each
-         call tnnmg(h, op, u(1:m), o(1:m), f, load_control, g_ref, tol, merge(max_iter, 1, j == nested), &
+         call tnnmg(h, work, op, u(1:m), o(1:m), f, load_control, g_ref, tol, merge(max_iter, 1, j == nested), &
             & p(1:m), steps, converged)
       end do
 
@@ -294,7 +302,7 @@ contains
       target = tol
       tightened = 0
       do
-         call tnnmg(h, op, u, o, f, load_control, g_ref, target, max_iter - outcome%iterations, p, steps, &
+         call tnnmg(h, work, op, u, o, f, load_control, g_ref, target, max_iter - outcome%iterations, p, steps, &
             & converged, history(outcome%iterations + 1:), progress)
          outcome%iterations = outcome%iterations + steps
          call returned_fields(op, u, o, b, load_control, mean_pressure, g_ref, p, w, gap, s, outcome%residual)
@@ -312,8 +320,9 @@ contains
    !> TNNMG iterations on the grid h%top from u until the residual on (K u + f, u - o) is at
    !> most tol or max_steps ran; p = K u + f on exit. steps: iterations run. history and
    !> progress (the finest grid): the residual of each iteration.
-   subroutine tnnmg(h, op, u, o, f, load_control, g_ref, tol, max_steps, p, steps, converged, history, progress)
+   subroutine tnnmg(h, work, op, u, o, f, load_control, g_ref, tol, max_steps, p, steps, converged, history, progress)
       type(hierarchy), intent(inout) :: h
+      type(workspace), intent(inout), target :: work
       type(compliance_operator), intent(in) :: op
       real(wp), contiguous, intent(inout) :: u(:)
       real(wp), contiguous, intent(in) :: o(:)
@@ -325,15 +334,14 @@ contains
       logical, intent(out) :: converged
       real(wp), contiguous, intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
-      ! (allocated once per grid: the iterations below allocate nothing)
-      real(wp), allocatable :: c(:), kc(:), v(:), kv(:), previous(:), work(:, :)
       type(residual_scales) :: scales
       real(wp) :: residual, diagonal, alpha, vkv, b_max, contact
       integer :: m, step, changed, j
       logical :: settled, finished, clipped, tension
 
       m = size(u)
-      allocate (c(m), kc(m), v(m), kv(m), previous(m), work(m, 3))
+      associate (c => work%c(1:m), kc => work%kc(1:m), v => work%v(1:m), kv => work%kv(1:m), &
+         & previous => work%previous(1:m), cg_work => work%cg(1:m, :))
       previous = 1.0_wp
       diagonal = h%level(h%top)%circulant_diagonal
       b_max = maxval(abs(o))
@@ -349,8 +357,9 @@ contains
          call apply_stiffness(h, u, p)
          p = p + f
          scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest)
-         residual = residual_of(u, p, o, scales)
-         contact = count(u <= o)/real(m, wp)
+         ! (the free points and how many changed are found in the same pass: the
+         ! truncated problem below needs them)
+         call examine(u, p, o, scales, h%free(1:m), previous, residual, contact, changed, tension)
          call record(step, residual, contact)
          if (residual <= tol) then
             converged = .true.
@@ -364,21 +373,14 @@ contains
          end if
          ! the truncated problem on the free points; the finishing phase once the contact set
          ! has settled
-         changed = 0
-         tension = .false.
-         do j = 1, m
-            h%free(j) = merge(1.0_wp, 0.0_wp, u(j) > o(j))
-            if (h%free(j) /= previous(j)) changed = changed + 1
-            if (h%free(j) == 0.0_wp .and. p(j) < 0.0_wp) tension = .true.
-         end do
          settled = step > 1 .and. changed <= settled_fraction*contact*m .and. .not. tension
-         previous = h%free(1:m)
-         call set_contact(h)
+         ! (the coarse operators depend on the set only)
+         if (changed > 0 .or. step == 1) call set_contact(h)
          finished = .false.
          if (settled) then
-            call truncated_cg(h, u, o, p, finish_iterations, 0.0_wp, c, kc, work, scales, tol, finished, residual)
+            call truncated_cg(h, u, o, p, finish_iterations, 0.0_wp, c, kc, cg_work, scales, tol, finished, residual)
          else
-            call truncated_cg(h, u, o, p, newton_iterations, newton_reduction, c, kc, work)
+            call truncated_cg(h, u, o, p, newton_iterations, newton_reduction, c, kc, cg_work)
          end if
          if (finished) then
             u = u + c
@@ -407,6 +409,7 @@ contains
          u = u + alpha*v
          p = p + alpha*kv
       end do
+      end associate
    contains
       subroutine record(step, residual, contact)
          integer, intent(in) :: step
@@ -483,20 +486,28 @@ contains
       end do
       end associate
    contains
-      !> z = the V-cycle applied to r on the grid being solved
+      !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse
+      !> correction added (not one after the other: no transform on the grid being solved;
+      !> symmetric, as CG needs), V the V-cycle of the next grid; the dense solve where the
+      !> grid being solved is the coarsest.
       subroutine precondition(r, z)
          real(wp), contiguous, intent(in) :: r(:)
          real(wp), contiguous, intent(inout) :: z(:)
-         h%level(h%top)%rhs = r
          h%vcycles = h%vcycles + 1
-         call vcycle(h, h%top)
-         z = h%level(h%top)%x
+         z = r
+         if (h%top == h%coarsest) then
+            call cholesky_solve(h%dense, z)
+            return
+         end if
+         call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
+         call vcycle(h, h%top + 1)
+         z = (omega/h%level(h%top)%circulant_diagonal)*r
+         call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)))
       end subroutine precondition
    end subroutine truncated_cg
 
-   !> One V(1,1)-cycle on level t: x ~ A_t^-1 rhs, with A the truncated I K I on the grid
-   !> being solved (h%top; x stays 0 on the contact set) and the penalised Galerkin
-   !> operators below; the coarsest grid is solved exactly.
+   !> One V(1,1)-cycle on the coarse level t > h%top: x ~ A_t^-1 rhs with the penalised
+   !> Galerkin operators; the coarsest grid is solved exactly.
    recursive subroutine vcycle(h, t)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
@@ -510,31 +521,21 @@ contains
       call level_residual(h, t)
       call restrict(h, t, lv%residual, h%level(t + 1)%rhs)
       call vcycle(h, t + 1)
-      if (t == h%top) then
-         call prolong_add(h, t, h%level(t + 1)%x, lv%x, h%free(1:lv%n))
-      else
-         call prolong_add(h, t, h%level(t + 1)%x, lv%x)
-      end if
+      call prolong_add(h, t, h%level(t + 1)%x, lv%x)
       call level_residual(h, t)
       lv%x = lv%x + lv%jacobi*lv%residual
       end associate
    end subroutine vcycle
 
-   !> residual = rhs - A_t x on level t (one transform pair of that grid).
+   !> residual = rhs - A_t x on the coarse level t (one transform pair of that grid).
    subroutine level_residual(h, t)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
-      integer :: m
       associate (lv => h%level(t))
-      m = lv%n
       lv%fft%real_buffer = lv%x
       call transform(h, t)
-      if (t == h%top) then
-         lv%residual = lv%rhs - h%free(1:m)*lv%fft%real_buffer
-      else
-         lv%residual = lv%rhs - lv%fft%real_buffer
-         call subtract_stencil(lv%penalty, lv%x, lv%residual, lv%nx, lv%ny)
-      end if
+      lv%residual = lv%rhs - lv%fft%real_buffer
+      call subtract_stencil(lv%penalty, lv%x, lv%residual, lv%nx, lv%ny)
       end associate
    end subroutine level_residual
 
@@ -544,19 +545,26 @@ contains
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: s(-1:1, -1:1, 0:nx - 1, 0:ny - 1), x(0:nx - 1, 0:ny - 1)
       real(wp), intent(inout) :: r(0:nx - 1, 0:ny - 1)
-      integer :: ix, iy, xm, xp, ym, yp
+      integer :: iy, ey, row
       do iy = 0, ny - 1
-         ym = modulo(iy - 1, ny)
-         yp = modulo(iy + 1, ny)
-         do ix = 0, nx - 1
-            xm = merge(nx - 1, ix - 1, ix == 0)
-            xp = merge(0, ix + 1, ix == nx - 1)
-            r(ix, iy) = r(ix, iy) - (s(-1, 0, ix, iy)*x(xm, iy) + s(0, 0, ix, iy)*x(ix, iy) + s(1, 0, ix, iy)*x(xp, iy))
-            if (ny > 1) r(ix, iy) = r(ix, iy) &
-               & - (s(-1, -1, ix, iy)*x(xm, ym) + s(0, -1, ix, iy)*x(ix, ym) + s(1, -1, ix, iy)*x(xp, ym)) &
-               & - (s(-1, 1, ix, iy)*x(xm, yp) + s(0, 1, ix, iy)*x(ix, yp) + s(1, 1, ix, iy)*x(xp, yp))
+         do ey = merge(-1, 0, ny > 1), merge(1, 0, ny > 1)
+            row = modulo(iy + ey, ny)
+            call subtract_row(s(:, :, :, iy), ey, x(:, row), r(:, iy), nx)
          end do
       end do
+   contains
+      !> rr <- rr - the stencil's row ey applied to the row xr, periodic
+      pure subroutine subtract_row(a, ey, xr, rr, n)
+         integer, intent(in) :: n, ey
+         real(wp), intent(in) :: a(-1:1, -1:1, 0:n - 1), xr(0:n - 1)
+         real(wp), intent(inout) :: rr(0:n - 1)
+         integer :: i
+         rr(0) = rr(0) - (a(-1, ey, 0)*xr(n - 1) + a(0, ey, 0)*xr(0) + a(1, ey, 0)*xr(1))
+         do i = 1, n - 2
+            rr(i) = rr(i) - (a(-1, ey, i)*xr(i - 1) + a(0, ey, i)*xr(i) + a(1, ey, i)*xr(i + 1))
+         end do
+         rr(n - 1) = rr(n - 1) - (a(-1, ey, n - 1)*xr(n - 2) + a(0, ey, n - 1)*xr(n - 1) + a(1, ey, n - 1)*xr(0))
+      end subroutine subtract_row
    end subroutine subtract_stencil
 
    !> y = K x on the grid being solved (one transform pair).
@@ -705,11 +713,11 @@ contains
          lv%inv_n = 1.0_wp/m
          call lv%fft%init(lv%nx, lv%ny, 1, error)
          if (allocated(error)) return
-         allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier((lv%nx/2 + 1)*lv%ny), lv%jacobi(m), lv%rhs(m), &
-            & lv%x(m), lv%residual(m))
-         if (t > 0) allocate (lv%penalty(-1:1, -1:1, m))
+         allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier((lv%nx/2 + 1)*lv%ny))
+         ! (the finest grid is never a coarse one of the V-cycle)
+         if (t > 0) allocate (lv%penalty(-1:1, -1:1, m), lv%jacobi(m), lv%rhs(m), lv%x(m), lv%residual(m))
          if (h%surface .and. t < h%coarsest) allocate (lv%halfway(m/2))
-         if (h%surface .and. t > 0 .and. t < h%coarsest) allocate (lv%stencil_halfway(-1:1, -1:1, m/2))
+         if (h%surface .and. t < h%coarsest) allocate (lv%stencil_halfway(-1:1, -1:1, m/2))
          end associate
       end do
       m = h%level(h%coarsest)%n
@@ -812,7 +820,6 @@ contains
          lv%multiplier = lv%symbol*lv%inv_n
          end associate
       end do
-      h%level(top)%jacobi = omega/h%level(top)%circulant_diagonal
       associate (lv => h%level(h%coarsest))
       lv%fft%spectrum = cmplx(lv%multiplier, 0.0_wp, kind=wp)
       call lv%fft%backward()
@@ -829,8 +836,11 @@ contains
       real(wp) :: shift
       do t = h%top + 1, h%coarsest
          associate (c => h%level(t), f => h%level(t - 1))
-         if (t == h%top + 1) then
-            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, f%ny, c%penalty)
+         if (t == h%top + 1 .and. h%surface) then
+            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, f%ny, f%stencil_halfway)
+            call coarsen_y(f%stencil_halfway, f%nx/2, f%ny, c%penalty)
+         else if (t == h%top + 1) then
+            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, 1, c%penalty)
          else if (h%surface) then
             ! (axis by axis: P = Px Py)
             call coarsen_x(f%penalty, f%nx, f%ny, f%stencil_halfway)
@@ -864,36 +874,25 @@ contains
       of = reshape([1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp], [2, 5])
    end subroutine interpolation_weights
 
-   !> coarse = P^T D P for the fine nx x ny grid's diagonal D = `weight` on the contact set
-   !> (free = 0) and 0 off it, P linear interpolation along x and (ny > 1) along y: a 3 x 3
-   !> stencil (3 x 1 on a line).
-   pure subroutine galerkin_diagonal(free, weight, nx, ny, coarse)
+   !> b = Px^T D Px for the fine nx x ny grid's diagonal D = `weight` on the contact set
+   !> (free = 0) and 0 off it, Px linear interpolation along x only: the 3-point stencil
+   !> (ey = 0) of the (nx/2) x ny grid. (On a surface coarsen_y completes P^T D P.)
+   pure subroutine galerkin_diagonal(free, weight, nx, ny, b)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: free(0:nx - 1, 0:ny - 1), weight
-      real(wp), intent(out) :: coarse(-1:1, -1:1, 0:nx/2 - 1, 0:max(ny/2, 1) - 1)
-      integer :: to(2, -2:2), cx, cy, kx, ky, ky_reach, a, b, ix, iy
-      real(wp) :: of(2, -2:2), v
-      call interpolation_weights(to, of)
-      ky_reach = merge(1, 0, ny > 1)
-      coarse = 0.0_wp
-      do cy = 0, max(ny/2, 1) - 1
+      real(wp), intent(out) :: b(-1:1, -1:1, 0:nx/2 - 1, 0:ny - 1)
+      real(wp) :: left, centre, right
+      integer :: cx, iy
+      b = 0.0_wp
+      do iy = 0, ny - 1
          do cx = 0, nx/2 - 1
-            do ky = -ky_reach, ky_reach
-               iy = merge(modulo(2*cy + ky, ny), 0, ny > 1)
-               do kx = -1, 1
-                  ix = modulo(2*cx + kx, nx)
-                  if (free(ix, iy) /= 0.0_wp) cycle
-                  ! (P(i, I) = of(1, k) for the point I itself: 1 at k = 0, 1/2 at k = +-1)
-                  v = weight*of(1, kx)*merge(of(1, ky), 1.0_wp, ny > 1)
-                  do b = 1, merge(2, 1, ny > 1)
-                     do a = 1, 2
-                        associate (dy => merge(to(b, ky), 0, ny > 1), wy => merge(of(b, ky), 1.0_wp, ny > 1))
-                        coarse(to(a, kx), dy, cx, cy) = coarse(to(a, kx), dy, cx, cy) + v*of(a, kx)*wy
-                        end associate
-                     end do
-                  end do
-               end do
-            end do
+            ! the fine points 2 cx - 1, 2 cx, 2 cx + 1 (weights 1/2, 1, 1/2 from cx)
+            left = weight*(1.0_wp - free(modulo(2*cx - 1, nx), iy))
+            centre = weight*(1.0_wp - free(2*cx, iy))
+            right = weight*(1.0_wp - free(2*cx + 1, iy))
+            b(0, 0, cx, iy) = centre + 0.25_wp*(left + right)
+            b(-1, 0, cx, iy) = 0.25_wp*left
+            b(1, 0, cx, iy) = 0.25_wp*right
          end do
       end do
    end subroutine galerkin_diagonal
@@ -1071,31 +1070,59 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(in) :: f, g_ref, b_max, largest
       type(residual_scales) :: scales
-      real(wp) :: p_ref
-      p_ref = merge(f, sum(p)/size(p), load_control)
+      real(wp) :: p_ref, u_max, p_max, p_sum
+      integer :: j
+      u_max = 0.0_wp
+      p_max = -huge(1.0_wp)
+      p_sum = 0.0_wp
+      !$omp simd reduction(max:u_max, p_max) reduction(+:p_sum)
+      do j = 1, size(u)
+         u_max = max(u_max, abs(u(j)))
+         p_max = max(p_max, p(j))
+         p_sum = p_sum + p(j)
+      end do
+      p_ref = merge(f, p_sum/size(p), load_control)
       scales%p_scale = 1.0_wp/max(p_ref, tiny(1.0_wp))
       scales%g_scale = 1.0_wp/g_ref
-      scales%floor = rounding_floor(maxval(abs(u)), b_max, maxval(p), largest)
+      scales%floor = rounding_floor(u_max, b_max, p_max, largest)
    end function scales_of
 
-   !> The complementarity residual of (p, u - o): gaps within the floor count as zero, and a
-   !> tension (p < 0) there counts in full.
-   pure real(wp) function residual_of(u, p, o, scales) result(residual)
+   !> The complementarity residual of (p, u - o) (gaps within the floor count as zero, and a
+   !> tension (p < 0) there counts in full) and the contact fraction (u <= o); the free
+   !> points (1 where u > o), how many changed from `previous` (then set to them), and
+   !> whether a contact point carries tension.
+   pure subroutine examine(u, p, o, scales, free, previous, residual, contact, changed, tension)
       real(wp), contiguous, intent(in) :: u(:), p(:), o(:)
       type(residual_scales), intent(in) :: scales
-      real(wp) :: g, check
+      real(wp), contiguous, intent(out) :: free(:)
+      real(wp), contiguous, intent(inout) :: previous(:)
+      real(wp), intent(out) :: residual, contact
+      integer, intent(out) :: changed
+      logical, intent(out) :: tension
+      real(wp) :: g, check, touching, moved, pulled
       integer :: j
       residual = 0.0_wp
       check = 0.0_wp
-      !$omp simd reduction(max:residual) reduction(+:check) private(g)
+      touching = 0.0_wp
+      moved = 0.0_wp
+      pulled = 0.0_wp
+      !$omp simd reduction(max:residual) reduction(+:check, touching, moved, pulled) private(g)
       do j = 1, size(u)
          g = u(j) - o(j)
          residual = max(residual, merge(abs(min(p(j)*scales%p_scale, g*scales%g_scale)), &
             & max(-p(j)*scales%p_scale, 0.0_wp), g > scales%floor))
          check = check + g + p(j)
+         free(j) = merge(1.0_wp, 0.0_wp, g > 0.0_wp)
+         touching = touching + (1.0_wp - free(j))
+         moved = moved + abs(free(j) - previous(j))
+         pulled = pulled + merge(1.0_wp, 0.0_wp, free(j) == 0.0_wp .and. p(j) < 0.0_wp)
+         previous(j) = free(j)
       end do
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
-   end function residual_of
+      contact = touching/size(u)
+      changed = nint(moved)
+      tension = pulled > 0.0_wp
+   end subroutine examine
 
    !> The finishing phase's check of (u + c, p + kc): its residual, and whether a point
    !> left the feasible set (a gap below zero off the contact set, a tension on it).
