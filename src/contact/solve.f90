@@ -39,12 +39,14 @@ module lc_contact_solve
    !> grid of coarse_tol_size points along x, coarse_tol coarse_tol_size/nx beyond.
    real(wp), parameter :: coarse_tol = 1.0e-4_wp
    integer, parameter :: coarse_tol_size = 8192
-   !> Under method 'auto' the multigrid solver takes the frictionless elastic lines it
-   !> applies to (multigrid_refusal) from this many points on: there it costs 0.5-1x the
-   !> time of the constrained CG on a spectrum fixed in physical wavenumbers and 0.05-0.5x
-   !> on broadband roughness (bench/scaling.py --method); at n = 1024 the CG's 0.64 ms
-   !> against 0.94 ms on the physical family.
-   integer, parameter :: multigrid_points = 4096
+   !> Under method 'auto' the multigrid solver takes the frictionless elastic scenes it
+   !> applies to (multigrid_refusal) from this many points on, lines and surfaces
+   !> (bench/scaling.py --scenes 1 --method multigrid --against cg, tol 1e-8): on lines
+   !> from 4096 points, where the constrained CG takes 1.35-3.4x its time on broadband
+   !> roughness (5.6-15x at 65536) and 0.74-0.91x on a spectrum fixed in physical
+   !> wavenumbers; on surfaces from 1024^2, where the CG takes 1.4-2.2x its time broadband
+   !> and 1.2x physical (at 512^2 0.75-1.36x: a multigrid pair costs 2-3x a CG pair there).
+   integer, parameter :: multigrid_points = 4096, multigrid_surface_points = 1024**2
 
 contains
 
@@ -194,7 +196,8 @@ contains
                & // 'allowed here: ' // allowed, code_input)
             return
          end if
-      else if (method == 'auto' .and. grid%is_line() .and. grid%points() >= multigrid_points) then
+      else if (method == 'auto' .and. grid%points() >= merge(multigrid_points, multigrid_surface_points, &
+         & grid%is_line())) then
          if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
       end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid

@@ -119,7 +119,8 @@ module lc_contact_solver_multigrid
       real(wp), allocatable :: rhs(:), x(:), residual(:)
       !> a surface's transfers work axis by axis: the field on the next grid's x and this ny
       real(wp), allocatable :: halfway(:)
-      real(wp), allocatable :: stencil_halfway(:, :, :)
+      !> the stencils of three rows coarsened along x, for the next grid's rows in turn
+      real(wp), allocatable :: window(:, :, :, :)
    end type grid_level
 
    !> The grids of every 2^t-th point, t = 0..coarsest (one plan per size, shared by the
@@ -717,7 +718,7 @@ contains
          ! (the finest grid is never a coarse one of the V-cycle)
          if (t > 0) allocate (lv%penalty(-1:1, -1:1, m), lv%jacobi(m), lv%rhs(m), lv%x(m), lv%residual(m))
          if (h%surface .and. t < h%coarsest) allocate (lv%halfway(m/2))
-         if (h%surface .and. t < h%coarsest) allocate (lv%stencil_halfway(-1:1, -1:1, m/2))
+         if (h%surface .and. t < h%coarsest) allocate (lv%window(-1:1, -1:1, lv%nx/2, -1:1))
          end associate
       end do
       m = h%level(h%coarsest)%n
@@ -836,17 +837,12 @@ contains
       real(wp) :: shift
       do t = h%top + 1, h%coarsest
          associate (c => h%level(t), f => h%level(t - 1))
-         if (t == h%top + 1 .and. h%surface) then
-            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, f%ny, f%stencil_halfway)
-            call coarsen_y(f%stencil_halfway, f%nx/2, f%ny, c%penalty)
+         if (h%surface) then
+            call coarsen_surface(h, t)
          else if (t == h%top + 1) then
-            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, 1, c%penalty)
-         else if (h%surface) then
-            ! (axis by axis: P = Px Py)
-            call coarsen_x(f%penalty, f%nx, f%ny, f%stencil_halfway)
-            call coarsen_y(f%stencil_halfway, f%nx/2, f%ny, c%penalty)
+            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, c%penalty)
          else
-            call coarsen_x(f%penalty, f%nx, 1, c%penalty)
+            call coarsen_x(f%penalty, f%nx, 0, c%penalty)
          end if
          c%jacobi = omega/(c%circulant_diagonal + c%penalty(0, 0, :))
          end associate
@@ -864,6 +860,53 @@ contains
       end do
    end subroutine set_contact
 
+   !> The penalty stencil of the surface's level t = P^T A P, A that of level t - 1 (on the
+   !> grid being solved the diagonal d D_A), P = Px Py: row by row of level t, from the three
+   !> rows of level t - 1 that reach it, coarsened along x (galerkin_diagonal, coarsen_x)
+   !> into the window, then along y (coarsen_y_row). (A row between two coarse ones is
+   !> coarsened twice: the window holds 3 rows, not a whole grid coarsened along x.)
+   subroutine coarsen_surface(h, t)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      integer :: cy, k, row, nx
+      associate (f => h%level(t - 1), c => h%level(t))
+      nx = f%nx
+      do cy = 0, c%ny - 1
+         do k = -1, 1
+            row = modulo(2*cy + k, f%ny)
+            if (t == h%top + 1) then
+               call galerkin_diagonal(h%free(row*nx + 1:(row + 1)*nx), penalty*f%circulant_diagonal, nx, &
+                  & f%window(:, :, :, k))
+            else
+               call coarsen_x(f%penalty(:, :, row*nx + 1:(row + 1)*nx), nx, 1, f%window(:, :, :, k))
+            end if
+         end do
+         call coarsen_y_row(f%window, c%nx, c%penalty(:, :, cy*c%nx + 1:(cy + 1)*c%nx))
+      end do
+      end associate
+   end subroutine coarsen_surface
+
+   !> b = Px^T D Px for a row of nx points with the diagonal D = `weight` on the contact set
+   !> (free = 0) and 0 off it, Px linear interpolation: the 3-point stencil (ey = 0) of the
+   !> row of nx/2 points.
+   pure subroutine galerkin_diagonal(free, weight, nx, b)
+      integer, intent(in) :: nx
+      real(wp), intent(in) :: free(0:nx - 1), weight
+      real(wp), intent(out) :: b(-1:1, -1:1, 0:nx/2 - 1)
+      real(wp) :: left, centre, right
+      integer :: cx
+      b = 0.0_wp
+      do cx = 0, nx/2 - 1
+         ! the fine points 2 cx - 1, 2 cx, 2 cx + 1 (weights 1/2, 1, 1/2 from cx)
+         left = weight*(1.0_wp - free(modulo(2*cx - 1, nx)))
+         centre = weight*(1.0_wp - free(2*cx))
+         right = weight*(1.0_wp - free(2*cx + 1))
+         b(0, 0, cx) = centre + 0.25_wp*(left + right)
+         b(-1, 0, cx) = 0.25_wp*left
+         b(1, 0, cx) = 0.25_wp*right
+      end do
+   end subroutine galerkin_diagonal
+
    !> The Galerkin products below use that the fine point 2I + k of an axis (zero-based,
    !> k = -2..2 from the coarse point I) takes the values of the coarse points I + to(1:2, k)
    !> with the weights of(1:2, k) under linear interpolation (a weight 0: no second point).
@@ -874,78 +917,50 @@ contains
       of = reshape([1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp], [2, 5])
    end subroutine interpolation_weights
 
-   !> b = Px^T D Px for the fine nx x ny grid's diagonal D = `weight` on the contact set
-   !> (free = 0) and 0 off it, Px linear interpolation along x only: the 3-point stencil
-   !> (ey = 0) of the (nx/2) x ny grid. (On a surface coarsen_y completes P^T D P.)
-   pure subroutine galerkin_diagonal(free, weight, nx, ny, b)
-      integer, intent(in) :: nx, ny
-      real(wp), intent(in) :: free(0:nx - 1, 0:ny - 1), weight
-      real(wp), intent(out) :: b(-1:1, -1:1, 0:nx/2 - 1, 0:ny - 1)
-      real(wp) :: left, centre, right
-      integer :: cx, iy
-      b = 0.0_wp
-      do iy = 0, ny - 1
-         do cx = 0, nx/2 - 1
-            ! the fine points 2 cx - 1, 2 cx, 2 cx + 1 (weights 1/2, 1, 1/2 from cx)
-            left = weight*(1.0_wp - free(modulo(2*cx - 1, nx), iy))
-            centre = weight*(1.0_wp - free(2*cx, iy))
-            right = weight*(1.0_wp - free(2*cx + 1, iy))
-            b(0, 0, cx, iy) = centre + 0.25_wp*(left + right)
-            b(-1, 0, cx, iy) = 0.25_wp*left
-            b(1, 0, cx, iy) = 0.25_wp*right
-         end do
-      end do
-   end subroutine galerkin_diagonal
-
-   !> b = Px^T a Px for the 3 x 3 stencil `a` of the fine nx x ny grid, Px linear
-   !> interpolation along x only: the stencil of the (nx/2) x ny grid.
-   pure subroutine coarsen_x(a, nx, ny, b)
-      integer, intent(in) :: nx, ny
-      real(wp), intent(in) :: a(-1:1, -1:1, 0:nx - 1, 0:ny - 1)
-      real(wp), intent(out) :: b(-1:1, -1:1, 0:nx/2 - 1, 0:ny - 1)
-      integer :: to(2, -2:2), cx, iy, k, e, ix, j, reach
+   !> b = Px^T a Px for the 3 x 3 stencil `a` of a row of nx points, Px linear interpolation
+   !> along x: the stencil of the row of nx/2 points. `reach`: 1 if the stencil couples rows
+   !> (a surface), 0 on a line (ey = 0 only).
+   pure subroutine coarsen_x(a, nx, reach, b)
+      integer, intent(in) :: nx, reach
+      real(wp), intent(in) :: a(-1:1, -1:1, 0:nx - 1)
+      real(wp), intent(out) :: b(-1:1, -1:1, 0:nx/2 - 1)
+      integer :: to(2, -2:2), cx, k, e, ix, j
       real(wp) :: of(2, -2:2)
       call interpolation_weights(to, of)
-      reach = merge(1, 0, ny > 1)
       b = 0.0_wp
-      do iy = 0, ny - 1
-         do cx = 0, nx/2 - 1
-            do k = -1, 1
-               ix = modulo(2*cx + k, nx)
-               do e = -1, 1
-                  do j = 1, 2
-                     b(to(j, k + e), -reach:reach, cx, iy) = b(to(j, k + e), -reach:reach, cx, iy) &
-                        & + (of(1, k)*of(j, k + e))*a(e, -reach:reach, ix, iy)
-                  end do
+      do cx = 0, nx/2 - 1
+         do k = -1, 1
+            ix = modulo(2*cx + k, nx)
+            do e = -1, 1
+               do j = 1, 2
+                  b(to(j, k + e), -reach:reach, cx) = b(to(j, k + e), -reach:reach, cx) &
+                     & + (of(1, k)*of(j, k + e))*a(e, -reach:reach, ix)
                end do
             end do
          end do
       end do
    end subroutine coarsen_x
 
-   !> c = Py^T b Py for the 3 x 3 stencil `b` of the fine nx x ny grid, Py linear
-   !> interpolation along y only: the stencil of the nx x (ny/2) grid.
-   pure subroutine coarsen_y(b, nx, ny, c)
-      integer, intent(in) :: nx, ny
-      real(wp), intent(in) :: b(-1:1, -1:1, 0:nx - 1, 0:ny - 1)
-      real(wp), intent(out) :: c(-1:1, -1:1, 0:nx - 1, 0:ny/2 - 1)
-      integer :: to(2, -2:2), cy, ix, k, e, iy, j
+   !> c = the row of Py^T b Py from the three rows rows(:, :, :, k) = b's rows 2 cy + k
+   !> (k = -1, 0, 1) of nx points, Py linear interpolation along y.
+   pure subroutine coarsen_y_row(rows, nx, c)
+      integer, intent(in) :: nx
+      real(wp), intent(in) :: rows(-1:1, -1:1, 0:nx - 1, -1:1)
+      real(wp), intent(out) :: c(-1:1, -1:1, 0:nx - 1)
+      integer :: to(2, -2:2), ix, k, e, j
       real(wp) :: of(2, -2:2)
       call interpolation_weights(to, of)
       c = 0.0_wp
-      do cy = 0, ny/2 - 1
-         do k = -1, 1
-            iy = modulo(2*cy + k, ny)
-            do e = -1, 1
-               do j = 1, 2
-                  do ix = 0, nx - 1
-                     c(:, to(j, k + e), ix, cy) = c(:, to(j, k + e), ix, cy) + (of(1, k)*of(j, k + e))*b(:, e, ix, iy)
-                  end do
+      do k = -1, 1
+         do e = -1, 1
+            do j = 1, 2
+               do ix = 0, nx - 1
+                  c(:, to(j, k + e), ix) = c(:, to(j, k + e), ix) + (of(1, k)*of(j, k + e))*rows(:, e, ix, k)
                end do
             end do
          end do
       end do
-   end subroutine coarsen_y
+   end subroutine coarsen_y_row
 
    !> The dense matrix of the coarsest grid's operator (see set_contact), its diagonal
    !> shifted by `shift`.
