@@ -347,16 +347,14 @@ contains
       diagonal = h%level(h%top)%circulant_diagonal
       b_max = maxval(abs(o))
       u = max(u, o)
-      call apply_stiffness(h, u, p)
-      p = p + f
+      call apply_stiffness(h, u, p, shift=f)
       converged = .false.
       steps = 0
       do step = 1, max_steps
          steps = step
          ! nonlinear smoother: projected damped Jacobi
          u = max(o, u - (omega/diagonal)*p)
-         call apply_stiffness(h, u, p)
-         p = p + f
+         call apply_stiffness(h, u, p, shift=f)
          scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest)
          ! (the free points and how many changed are found in the same pass: the
          ! truncated problem below needs them)
@@ -400,11 +398,11 @@ contains
             end if
          end do
          if (clipped) then
-            call apply_stiffness(h, v, kv)
+            call apply_stiffness(h, v, kv, xy=vkv)
          else
             kv = kc
+            vkv = dot_product(v, kv)
          end if
-         vkv = dot_product(v, kv)
          if (.not. vkv > 0.0_wp) cycle
          alpha = min(1.0_wp, max(0.0_wp, -dot_product(p, v)/vkv))
          u = u + alpha*v
@@ -457,27 +455,26 @@ contains
       rz = dot_product(r, d)
       do it = 1, max_steps
          ! (d is zero on the contact set, as the V-cycle's output: d.I K d = d.K d)
-         call apply_stiffness(h, d, kd)
-         dkd = dot_product(d, kd)
+         call apply_stiffness(h, d, kd, xy=dkd)
          if (.not. dkd > 0.0_wp) exit
          a = rz/dkd
-         r_norm = 0.0_wp
-         !$omp simd reduction(+:r_norm)
-         do j = 1, m
-            c(j) = c(j) + a*d(j)
-            kc(j) = kc(j) + a*kd(j)
-            r(j) = r(j) - a*free(j)*kd(j)
-            r_norm = r_norm + r(j)**2
-         end do
          if (present(scales)) then
-            call check_finish(u, o, p, c, kc, free, scales, residual, violated)
+            call step_and_check(u, o, p, a, d, kd, free, c, kc, r, scales, residual, violated)
             if (violated) exit
             if (residual <= tol) then
                finished = .true.
                exit
             end if
-         else if (sqrt(r_norm) <= reduction*b_norm) then
-            exit
+         else
+            r_norm = 0.0_wp
+            !$omp simd reduction(+:r_norm)
+            do j = 1, m
+               c(j) = c(j) + a*d(j)
+               kc(j) = kc(j) + a*kd(j)
+               r(j) = r(j) - a*free(j)*kd(j)
+               r_norm = r_norm + r(j)**2
+            end do
+            if (sqrt(r_norm) <= reduction*b_norm) exit
          end if
          if (it == max_steps) exit
          rz_old = rz
@@ -495,15 +492,15 @@ contains
          real(wp), contiguous, intent(in) :: r(:)
          real(wp), contiguous, intent(inout) :: z(:)
          h%vcycles = h%vcycles + 1
-         z = r
          if (h%top == h%coarsest) then
+            z = r
             call cholesky_solve(h%dense, z)
             return
          end if
          call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
          call vcycle(h, h%top + 1)
-         z = (omega/h%level(h%top)%circulant_diagonal)*r
-         call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)))
+         call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), r, &
+            & omega/h%level(h%top)%circulant_diagonal)
       end subroutine precondition
    end subroutine truncated_cg
 
@@ -568,14 +565,29 @@ contains
       end subroutine subtract_row
    end subroutine subtract_stencil
 
-   !> y = K x on the grid being solved (one transform pair).
-   subroutine apply_stiffness(h, x, y)
+   !> y = K x (+ shift) on the grid being solved (one transform pair), and x.K x.
+   subroutine apply_stiffness(h, x, y, shift, xy)
       type(hierarchy), intent(inout) :: h
       real(wp), contiguous, intent(in) :: x(:)
       real(wp), contiguous, intent(out) :: y(:)
+      real(wp), intent(in), optional :: shift   !< added to y
+      real(wp), intent(out), optional :: xy     !< x.y (without the shift)
+      real(wp) :: f, dot
+      integer :: j
       h%level(h%top)%fft%real_buffer = x
       call transform(h, h%top)
-      y = h%level(h%top)%fft%real_buffer
+      ! (the shift and the product in the pass that reads the result out)
+      f = 0.0_wp
+      if (present(shift)) f = shift
+      dot = 0.0_wp
+      associate (buffer => h%level(h%top)%fft%real_buffer)
+      !$omp simd reduction(+:dot)
+      do j = 1, size(x)
+         dot = dot + x(j)*buffer(j)
+         y(j) = buffer(j) + f
+      end do
+      end associate
+      if (present(xy)) xy = dot
    end subroutine apply_stiffness
 
    !> The buffer of level t times its circulant, counted in pairs of the finest grid.
@@ -610,19 +622,22 @@ contains
       end associate
    end subroutine restrict
 
-   !> fine (level t) <- fine + P coarse (level t + 1), masked by `free` if given.
-   subroutine prolong_add(h, t, coarse, fine, free)
+   !> fine (level t) <- fine + P coarse (level t + 1), masked by `free` if given; with
+   !> `base` fine <- scale base + P coarse masked (the grid being solved: its Jacobi step
+   !> and coarse correction in one pass).
+   subroutine prolong_add(h, t, coarse, fine, free, base, scale)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
       real(wp), contiguous, intent(in) :: coarse(:)
       real(wp), contiguous, intent(inout) :: fine(:)
-      real(wp), contiguous, intent(in), optional :: free(:)
+      real(wp), contiguous, intent(in), optional :: free(:), base(:)
+      real(wp), intent(in), optional :: scale
       associate (lv => h%level(t))
       if (h%surface) then
          call prolong_y(coarse, lv%halfway, lv%nx/2, lv%ny)
-         call prolong_x_add(lv%halfway, fine, lv%nx, lv%ny, free)
+         call prolong_x_add(lv%halfway, fine, lv%nx, lv%ny, free, base, scale)
       else
-         call prolong_x_add(coarse, fine, lv%nx, 1, free)
+         call prolong_x_add(coarse, fine, lv%nx, 1, free, base, scale)
       end if
       end associate
    end subroutine prolong_add
@@ -655,15 +670,24 @@ contains
       end do
    end subroutine restrict_y
 
-   !> Along x, row by row: fine <- fine + P coarse, masked by `free` if given.
-   pure subroutine prolong_x_add(coarse, fine, nx, ny, free)
+   !> Along x, row by row: fine <- fine + P coarse, masked by `free` if given; with `base`
+   !> (and free), fine <- scale base + free P coarse.
+   pure subroutine prolong_x_add(coarse, fine, nx, ny, free, base, scale)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: coarse(nx/2, ny)
       real(wp), intent(inout) :: fine(nx, ny)
-      real(wp), intent(in), optional :: free(nx, ny)
+      real(wp), intent(in), optional :: free(nx, ny), base(nx, ny)
+      real(wp), intent(in), optional :: scale
       integer :: i, j, m
       m = nx/2
-      if (present(free)) then
+      if (present(base)) then
+         do j = 1, ny
+            do i = 1, m
+               fine(2*i - 1, j) = scale*base(2*i - 1, j) + free(2*i - 1, j)*coarse(i, j)
+               fine(2*i, j) = scale*base(2*i, j) + free(2*i, j)*0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
+            end do
+         end do
+      else if (present(free)) then
          do j = 1, ny
             do i = 1, m
                fine(2*i - 1, j) = fine(2*i - 1, j) + free(2*i - 1, j)*coarse(i, j)
@@ -1139,10 +1163,13 @@ contains
       tension = pulled > 0.0_wp
    end subroutine examine
 
-   !> The finishing phase's check of (u + c, p + kc): its residual, and whether a point
-   !> left the feasible set (a gap below zero off the contact set, a tension on it).
-   pure subroutine check_finish(u, o, p, c, kc, free, scales, residual, violated)
-      real(wp), contiguous, intent(in) :: u(:), o(:), p(:), c(:), kc(:), free(:)
+   !> The finishing phase's CG step (c += a d, kc += a kd, r -= a I kd) and its check of
+   !> (u + c, p + kc), in one pass: the residual, and whether a point left the feasible set
+   !> (a gap below zero off the contact set, a tension on it).
+   pure subroutine step_and_check(u, o, p, a, d, kd, free, c, kc, r, scales, residual, violated)
+      real(wp), contiguous, intent(in) :: u(:), o(:), p(:), d(:), kd(:), free(:)
+      real(wp), intent(in) :: a
+      real(wp), contiguous, intent(inout) :: c(:), kc(:), r(:)
       type(residual_scales), intent(in) :: scales
       real(wp), intent(out) :: residual
       logical, intent(out) :: violated
@@ -1153,6 +1180,9 @@ contains
       check = 0.0_wp
       !$omp simd reduction(max:residual) reduction(+:bad, check) private(g, pt)
       do j = 1, size(u)
+         c(j) = c(j) + a*d(j)
+         kc(j) = kc(j) + a*kd(j)
+         r(j) = r(j) - a*free(j)*kd(j)
          g = u(j) + c(j) - o(j)
          pt = p(j) + kc(j)
          bad = bad + merge(1.0_wp, 0.0_wp, (free(j) > 0.0_wp .and. g < 0.0_wp) .or. (free(j) == 0.0_wp .and. pt < 0.0_wp))
@@ -1162,7 +1192,7 @@ contains
       end do
       violated = bad > 0.0_wp
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
-   end subroutine check_finish
+   end subroutine step_and_check
 
    !> The fields the other solvers return, from the displacement form's (u, p = K u + f):
    !> the pressure kept where the gap is the smaller term of the residual (p/p_ref >=
