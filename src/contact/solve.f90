@@ -103,8 +103,11 @@ contains
             & ' NaN or infinite values; allowed: finite heights', code_input)
          return
       end if
-      ! a grid too large for this machine (or job) ends here, with how much it needs
-      call check_memory(n, kernel%coupled(friction), scene%solver%memory, scene%stress .and. grid%ny > 1, error)
+      ! a grid too large for this machine (or job) ends here, with how much it needs (the
+      ! multigrid's coarse grids if the scene may go to it: refusals need the operator)
+      call check_memory(n, kernel%coupled(friction), scene%solver%memory, scene%stress .and. grid%ny > 1, &
+         & .not. kernel%coupled(friction) .and. (scene%solver%method == 'multigrid' .or. (scene%solver%method == &
+         & 'auto' .and. n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))), error)
       if (allocated(error)) return
       lambda_max = maxval(height)
       g_ref = maxval(height) - minval(height)

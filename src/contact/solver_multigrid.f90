@@ -107,7 +107,9 @@ module lc_contact_solver_multigrid
    !> for the current hierarchy, and the V-cycle's work arrays.
    type :: grid_level
       integer :: nx = 0, ny = 1, n = 0
-      type(fft_plan) :: fft
+      !> the plan: the operator's own on the finest grid, `plan` on the coarser ones
+      type(fft_plan), pointer :: fft => null()
+      type(fft_plan), allocatable :: plan
       real(wp) :: inv_n = 1.0_wp
       real(wp), allocatable :: symbol(:)       !< circulant part, half spectrum (nx/2 + 1) x ny
       real(wp), allocatable :: multiplier(:)   !< symbol/n, as applied after an unscaled r2c
@@ -139,9 +141,10 @@ module lc_contact_solver_multigrid
    end type hierarchy
 
    !> The work arrays of the iterations, allocated once for the finest grid (the nested
-   !> grids use their first points).
+   !> grids use their first points): the Newton direction c and K c, and the CG's three
+   !> (which the projected line search reuses).
    type :: workspace
-      real(wp), allocatable :: c(:), kc(:), v(:), kv(:), previous(:), cg(:, :)
+      real(wp), allocatable :: c(:), kc(:), cg(:, :)
    end type workspace
 
    !> The scales of the residual, from the last full evaluation of the state.
@@ -244,7 +247,7 @@ contains
    !> fine-grid iteration. The scene must pass multigrid_refusal.
    subroutine multigrid(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, history, &
          & progress, error)
-      type(compliance_operator), intent(inout) :: op
+      type(compliance_operator), intent(inout), target :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
       real(wp), intent(in) :: mean_pressure   !< p_m (load control; ignored otherwise)
@@ -257,35 +260,27 @@ contains
       real(wp), contiguous, intent(inout) :: history(:)
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
-      type(hierarchy) :: h
+      type(hierarchy), target :: h
       type(workspace) :: work
-      real(wp), allocatable :: stiffness(:), u(:), o(:)
+      real(wp), allocatable :: u(:)
       real(wp) :: f, target
       integer :: n, j, nested, m, mc, steps, tightened
       logical :: converged
 
       n = size(p)
-      call build_hierarchy(h, op%grid%nx, op%grid%ny, error)
+      call build_hierarchy(h, op, error)
       if (allocated(error)) return
-      ! K = 1/M on the half spectrum; a coarser grid of the nested iteration samples the
-      ! same wavevectors (level_symbol). (M(0) = 0 under load control, the uniform mode
-      ! being dropped: K(0) = 0.)
-      allocate (stiffness(op%nk), u(n), o(n), work%c(n), work%kc(n), work%v(n), work%kv(n), work%previous(n), &
-         & work%cg(n, 3))
-      where (op%metric > 0.0_wp)
-         stiffness = 1.0_wp/op%metric
-      elsewhere
-         stiffness = 0.0_wp
-      end where
-      if (load_control) stiffness(1) = 0.0_wp
+      allocate (u(n), work%c(n), work%kc(n), work%cg(n, 3))
       f = merge(mean_pressure, 0.0_wp, load_control)
 
+      ! (until the fields are returned w holds the obstacle o of the grid being solved, and
+      ! gap is scratch)
+      associate (o => w)
       nested = halvings(op%grid%nx, op%grid%ny, nested_coarsest)
       do j = nested, 0, -1
          m = h%level(j)%n
-         call set_grid(h, j, level_symbol(stiffness, h%level(0), h%level(j)))
-         call sample(b, h%level(0)%nx, h%level(0)%ny, 2**j, o(1:m))
-         if (.not. load_control) o(1:m) = o(1:m) + s
+         call set_grid(h, j, level_symbol(op, load_control, h%level(j)))
+         call obstacle(j, o(1:m))
          if (j == nested) then
             u(1:m) = o(1:m)
          else
@@ -303,19 +298,30 @@ contains
       target = tol
       tightened = 0
       do
+         call obstacle(0, o)
          call tnnmg(h, work, op, u, o, f, load_control, g_ref, target, max_iter - outcome%iterations, p, steps, &
             & converged, history(outcome%iterations + 1:), progress)
          outcome%iterations = outcome%iterations + steps
-         call returned_fields(op, u, o, b, load_control, mean_pressure, g_ref, p, w, gap, s, outcome%residual)
+         call returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, o, gap, s, outcome%residual)
          h%pairs = h%pairs + 1.0_wp
          if (outcome%iterations > 0) history(min(outcome%iterations, size(history))) = outcome%residual
          if (outcome%residual <= tol .or. outcome%iterations >= max_iter .or. tightened == tightenings) exit
          target = target*tightening
          tightened = tightened + 1
       end do
+      end associate
       outcome%converged = outcome%residual <= tol
       outcome%fft_pairs = nint(h%pairs)
       outcome%vcycles = h%vcycles
+   contains
+      !> o = the obstacle on the grid of every 2^j-th point: b there (plus s under
+      !> displacement control)
+      subroutine obstacle(j, o)
+         integer, intent(in) :: j
+         real(wp), contiguous, intent(out) :: o(:)
+         call sample(b, h%level(0)%nx, h%level(0)%ny, 2**j, o)
+         if (.not. load_control) o = o + s
+      end subroutine obstacle
    end subroutine multigrid
 
    !> TNNMG iterations on the grid h%top from u until the residual on (K u + f, u - o) is at
@@ -341,9 +347,9 @@ contains
       logical :: settled, finished, clipped, tension
 
       m = size(u)
-      associate (c => work%c(1:m), kc => work%kc(1:m), v => work%v(1:m), kv => work%kv(1:m), &
-         & previous => work%previous(1:m), cg_work => work%cg(1:m, :))
-      previous = 1.0_wp
+      associate (c => work%c(1:m), kc => work%kc(1:m), cg_work => work%cg(1:m, :), v => work%cg(1:m, 1), &
+         & kv => work%cg(1:m, 2))
+      h%free(1:m) = 1.0_wp
       diagonal = h%level(h%top)%circulant_diagonal
       b_max = maxval(abs(o))
       u = max(u, o)
@@ -358,7 +364,7 @@ contains
          scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest)
          ! (the free points and how many changed are found in the same pass: the
          ! truncated problem below needs them)
-         call examine(u, p, o, scales, h%free(1:m), previous, residual, contact, changed, tension)
+         call examine(u, p, o, scales, h%free(1:m), residual, contact, changed, tension)
          call record(step, residual, contact)
          if (residual <= tol) then
             converged = .true.
@@ -719,11 +725,13 @@ contains
 
    !> The grids of every 2^t-th point while the next has at least coarsest_points points
    !> (halvings), with their plans and work arrays (allocated once, for all the nested grids).
-   subroutine build_hierarchy(h, nx, ny, error)
-      type(hierarchy), intent(out) :: h
-      integer, intent(in) :: nx, ny
+   subroutine build_hierarchy(h, op, error)
+      type(hierarchy), intent(out), target :: h
+      type(compliance_operator), intent(inout), target :: op
       type(error_type), allocatable, intent(out) :: error
-      integer :: t, m
+      integer :: t, m, nx, ny
+      nx = op%grid%nx
+      ny = op%grid%ny
       h%surface = ny > 1
       h%coarsest = halvings(nx, ny, coarsest_points)
       h%n_fine = nx*ny
@@ -736,8 +744,14 @@ contains
          lv%n = lv%nx*lv%ny
          m = lv%n
          lv%inv_n = 1.0_wp/m
-         call lv%fft%init(lv%nx, lv%ny, 1, error)
-         if (allocated(error)) return
+         if (t == 0) then
+            lv%fft => op%fft
+         else
+            allocate (lv%plan)
+            call lv%plan%init(lv%nx, lv%ny, 1, error)
+            if (allocated(error)) return
+            lv%fft => lv%plan
+         end if
          allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier((lv%nx/2 + 1)*lv%ny))
          ! (the finest grid is never a coarse one of the V-cycle)
          if (t > 0) allocate (lv%penalty(-1:1, -1:1, m), lv%jacobi(m), lv%rhs(m), lv%x(m), lv%residual(m))
@@ -764,20 +778,26 @@ contains
       i = mx + (nx/2 + 1)*my + 1
    end function mode_index
 
-   !> The symbol on grid `coarse` of the nested iteration from the one on the finest grid
-   !> `fine`: the coarse grid's wavevectors are among the fine grid's (its Nyquist modes
-   !> read at +pi/dx: the symbol is even in each component, |q| being all it depends on).
-   pure function level_symbol(symbol, fine, coarse) result(sampled)
-      real(wp), intent(in) :: symbol(:)
-      type(grid_level), intent(in) :: fine, coarse
-      real(wp) :: sampled((coarse%nx/2 + 1)*coarse%ny)
+   !> The stiffness K = 1/M on the half spectrum of grid `coarse` of the nested iteration
+   !> (K = 0 where M = 0; K(0) = 0 under load control, the uniform mode being dropped: see
+   !> drop_uniform_mode): the coarse grid's wavevectors are among the finest grid's (its
+   !> Nyquist modes read at +pi/dx: M is even in each component, |q| being all it depends on).
+   pure function level_symbol(op, load_control, coarse) result(stiffness)
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
+      type(grid_level), intent(in) :: coarse
+      real(wp) :: stiffness((coarse%nx/2 + 1)*coarse%ny)
+      real(wp) :: m
       integer :: kx, ky, my
       do ky = 0, coarse%ny - 1
          my = merge(ky, ky - coarse%ny, 2*ky <= coarse%ny)
          do kx = 0, coarse%nx/2
-            sampled(kx + (coarse%nx/2 + 1)*ky + 1) = symbol(mode_index(fine%nx, fine%ny, kx, my))
+            m = op%metric(mode_index(op%grid%nx, op%grid%ny, kx, my))
+            stiffness(kx + (coarse%nx/2 + 1)*ky + 1) = 0.0_wp
+            if (m > 0.0_wp) stiffness(kx + (coarse%nx/2 + 1)*ky + 1) = 1.0_wp/m
          end do
       end do
+      if (load_control) stiffness(1) = 0.0_wp
    end function level_symbol
 
    !> f (nx x ny) at every step-th point along each axis longer than 1.
@@ -1128,34 +1148,33 @@ contains
 
    !> The complementarity residual of (p, u - o) (gaps within the floor count as zero, and a
    !> tension (p < 0) there counts in full) and the contact fraction (u <= o); the free
-   !> points (1 where u > o), how many changed from `previous` (then set to them), and
+   !> points (free: 1 where u > o) and how many changed from the free points on entry, and
    !> whether a contact point carries tension.
-   pure subroutine examine(u, p, o, scales, free, previous, residual, contact, changed, tension)
+   pure subroutine examine(u, p, o, scales, free, residual, contact, changed, tension)
       real(wp), contiguous, intent(in) :: u(:), p(:), o(:)
       type(residual_scales), intent(in) :: scales
-      real(wp), contiguous, intent(out) :: free(:)
-      real(wp), contiguous, intent(inout) :: previous(:)
+      real(wp), contiguous, intent(inout) :: free(:)
       real(wp), intent(out) :: residual, contact
       integer, intent(out) :: changed
       logical, intent(out) :: tension
-      real(wp) :: g, check, touching, moved, pulled
+      real(wp) :: g, check, touching, moved, pulled, now
       integer :: j
       residual = 0.0_wp
       check = 0.0_wp
       touching = 0.0_wp
       moved = 0.0_wp
       pulled = 0.0_wp
-      !$omp simd reduction(max:residual) reduction(+:check, touching, moved, pulled) private(g)
+      !$omp simd reduction(max:residual) reduction(+:check, touching, moved, pulled) private(g, now)
       do j = 1, size(u)
          g = u(j) - o(j)
          residual = max(residual, merge(abs(min(p(j)*scales%p_scale, g*scales%g_scale)), &
             & max(-p(j)*scales%p_scale, 0.0_wp), g > scales%floor))
          check = check + g + p(j)
-         free(j) = merge(1.0_wp, 0.0_wp, g > 0.0_wp)
-         touching = touching + (1.0_wp - free(j))
-         moved = moved + abs(free(j) - previous(j))
-         pulled = pulled + merge(1.0_wp, 0.0_wp, free(j) == 0.0_wp .and. p(j) < 0.0_wp)
-         previous(j) = free(j)
+         now = merge(1.0_wp, 0.0_wp, g > 0.0_wp)
+         touching = touching + (1.0_wp - now)
+         moved = moved + abs(now - free(j))
+         pulled = pulled + merge(1.0_wp, 0.0_wp, now == 0.0_wp .and. p(j) < 0.0_wp)
+         free(j) = now
       end do
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
       contact = touching/size(u)
@@ -1198,20 +1217,21 @@ contains
    !> the pressure kept where the gap is the smaller term of the residual (p/p_ref >=
    !> gap/g_ref, the points in contact), 0 elsewhere (there |p| <= tol p_ref already),
    !> scaled to the load (load control); w = M p; s the mean of w - b over the contact set
-   !> (load control); gap = w - b - s; and the residual of these fields.
-   subroutine returned_fields(op, u, o, b, load_control, mean_pressure, g_ref, p, w, gap, s, residual)
+   !> (load control); gap = w - b - s; and the residual of these fields. w holds the
+   !> obstacle o on entry.
+   subroutine returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, w, gap, s, residual)
       type(compliance_operator), intent(inout) :: op
-      real(wp), contiguous, intent(in) :: u(:), o(:), b(:)
+      real(wp), contiguous, intent(in) :: u(:), b(:)
       logical, intent(in) :: load_control
       real(wp), intent(in) :: mean_pressure, g_ref
-      real(wp), contiguous, intent(inout) :: p(:)
-      real(wp), contiguous, intent(out) :: w(:), gap(:)
+      real(wp), contiguous, intent(inout) :: p(:), w(:)
+      real(wp), contiguous, intent(out) :: gap(:)
       real(wp), intent(inout) :: s
       real(wp), intent(out) :: residual
       real(wp) :: p_ref
       integer :: contact
       p_ref = merge(mean_pressure, sum(p)/size(p), load_control)
-      where (p > 0.0_wp .and. p*g_ref >= (u - o)*p_ref)
+      where (p > 0.0_wp .and. p*g_ref >= (u - w)*p_ref)
          gap = p
       elsewhere
          gap = 0.0_wp
