@@ -7,9 +7,9 @@ the same for broadband lines against Tamaas.
     .venv/bin/python bench/areal_peers.py --sizes 256 1024         # + 1024^2: ~8 min
     .venv/bin/python bench/areal_peers.py --sizes 2048 --peers tamaas --peer-tol tamaas=1e-8 \\
         --timeout 3600                                             # one Tamaas run at 2048^2 (~10-20 min)
-    .venv/bin/python bench/areal_peers.py --geometry line --peers tamaas   # n = 65536: ~15 min
-    .venv/bin/python bench/areal_peers.py --geometry line --peers tamaas --sizes 1048576 \
-        --peer-tol tamaas=1e-11 --timeout 3000                     # one Tamaas run at 2^20 (see below)
+    .venv/bin/python bench/areal_peers.py --geometry line          # lines, n = 65536: ~11 min
+    .venv/bin/python bench/areal_peers.py --geometry line --sizes 1048576 --peer-tol tamaas=1e-10 \\
+        --timeout 2400                                             # one Tamaas run at 2^20 (see below)
 
 Problem: an isotropic self-affine surface, Hurst
 exponent 0.8, spectrum from the period down to a shortest wavelength of 8 grid points, rms
@@ -50,7 +50,7 @@ control, periodic, unit period, n = 65536 by default. layercontact runs ``solve_
 its default method ('auto': the multigrid solver for these lines), Tamaas ``PolonskyKeerRey``
 on a ``basic_1d`` model; equal accuracy, reference, ladder and times exactly as above, with
 the contact error counted in points of the line (the post-processor takes the line as a grid
-of one row). The cross-check at tol 1e-12 runs up to 2^18 points (512^2 or a line of
+of one row); "p err" (bench/peers.py's criterion) is printed but not used. The cross-check at tol 1e-12 runs up to 2^18 points (512^2 or a line of
 262144) unless ``--cross-check``. A Tamaas solve takes about a minute at n = 65536 and much
 longer at 2^20, so there ``--peer-tol tamaas=TOL`` with ``--timeout`` runs one tolerance; a
 timed-out run is reported as such (its time is a lower bound). ContactMechanics is not run
