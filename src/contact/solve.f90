@@ -171,6 +171,7 @@ contains
       character(len=len(scene%solver%method)) :: method
       real(wp) :: uniform, s_gcr, plain, before
       integer :: coarse_pairs, reserve
+      logical :: started
 
       coarse_pairs = 0
       ! (the operator first: which solver runs depends on it, and refusals come before any
@@ -196,9 +197,17 @@ contains
       else if (method == 'auto' .and. grid%points() >= multigrid_points) then
          if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
       end if
+      started = .false.
+      if (op%coupled .and. method == 'auto' .and. grid%is_line() .and. experiment('LC_COUPLED_START') == 'mg' &
+         & .and. grid%points() >= experiment_size('LC_COUPLED_START_SIZE')) then
+         call frictionless_start(scene, grid, kernel, height, load_control, pm, g_ref, p, s, coarse_pairs, &
+            & progress, started, error)
+         if (allocated(error)) return
+      end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
       ! on the displacement, where this start solves each coarse grid to coarse_tol)
-      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. method /= 'multigrid') then
+      if (.not. started .and. scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
+         & method /= 'multigrid') then
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
             & progress, error)
          if (allocated(error)) return
@@ -383,6 +392,75 @@ contains
       result%residual = residual
       result%residual_history = history
    end subroutine record_solve
+
+   !> (experiment) the value of an environment variable
+   function experiment(name) result(value)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: value
+      character(len=64) :: buffer
+      integer :: length, stat
+      call get_environment_variable(name, buffer, length, stat)
+      value = ''
+      if (stat == 0) value = trim(buffer)
+   end function experiment
+
+   integer function experiment_size(name) result(value)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: text
+      integer :: stat
+      text = experiment(name)
+      value = 0
+      if (len(text) > 0) read (text, *, iostat=stat) value
+   end function experiment_size
+
+   real(wp) function experiment_real(name, default) result(value)
+      character(len=*), intent(in) :: name
+      real(wp), intent(in) :: default
+      character(len=:), allocatable :: text
+      integer :: stat
+      text = experiment(name)
+      value = default
+      if (len(text) > 0) read (text, *, iostat=stat) value
+   end function experiment_real
+
+   !> Start a coupled elastic line (or a sliding viscoelastic one, with its relaxed modulus)
+   !> from the frictionless solution by the multigrid solver, where it applies to the
+   !> frictionless counterpart; started says whether it did.
+   subroutine frictionless_start(scene, grid, kernel, height, load_control, pm, g_ref, p, s, pairs, progress, &
+         & started, error)
+      type(scene_type), intent(in) :: scene
+      type(grid_type), intent(in) :: grid
+      type(layer_kernel), intent(in) :: kernel
+      real(wp), intent(in) :: height(:), pm, g_ref
+      logical, intent(in) :: load_control
+      real(wp), intent(inout) :: p(:), s
+      integer, intent(out) :: pairs
+      type(progress_log), intent(inout) :: progress
+      logical, intent(out) :: started
+      type(error_type), allocatable, intent(out) :: error
+      type(layer_kernel) :: static
+      type(compliance_operator) :: op0
+      type(multigrid_outcome) :: outcome
+      real(wp), allocatable :: w0(:), gap0(:), history(:)
+      real(wp) :: uniform, s0
+      started = .false.
+      pairs = 0
+      static = kernel
+      static%speed = 0.0_wp
+      static%viscoelastic = .false.
+      call build_operator(op0, grid, static, 0.0_wp, scene%solver%threads, error)
+      if (allocated(error)) return
+      if (len(multigrid_refusal(op0)) > 0) return
+      if (load_control) call op0%drop_uniform_mode(uniform)
+      allocate (w0(size(p)), gap0(size(p)), history(1000))
+      s0 = s
+      call multigrid(op0, height, load_control, pm, s0, g_ref, experiment_real('LC_COUPLED_START_TOL', 1.0e-4_wp), &
+         & 1000, p, w0, gap0, outcome, history, progress, error)
+      if (allocated(error)) return
+      if (load_control) s = s0
+      pairs = outcome%fft_pairs
+      started = .true.
+   end subroutine frictionless_start
 
    !> Replace the guess p (and s) by the solution on the grid of every second point,
    !> interpolated linearly (which keeps p >= 0). The coarse solve needs only the accuracy
