@@ -22,7 +22,7 @@ module lc_contact_solve
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
-   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal
+   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -171,7 +171,7 @@ contains
       character(len=len(scene%solver%method)) :: method
       real(wp) :: uniform, s_gcr, plain, before
       integer :: coarse_pairs, reserve
-      logical :: started
+      logical :: started, outer_multigrid
 
       coarse_pairs = 0
       ! (the operator first: which solver runs depends on it, and refusals come before any
@@ -198,6 +198,10 @@ contains
          if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
       end if
       started = .false.
+      outer_multigrid = op%coupled .and. method == 'auto' .and. grid%is_line() .and. &
+         & experiment('LC_COUPLED') == 'anderson_mg' .and. grid%points() >= experiment_size('LC_COUPLED_SIZE')
+      if (outer_multigrid) outer_multigrid = len(metric_refusal(op)) == 0
+      if (outer_multigrid .and. experiment('LC_COUPLED_NESTED') /= 'yes') started = .true.
       if (op%coupled .and. method == 'auto' .and. grid%is_line() .and. experiment('LC_COUPLED_START') == 'mg' &
          & .and. grid%points() >= experiment_size('LC_COUPLED_START_SIZE')) then
          call frictionless_start(scene, grid, kernel, height, load_control, pm, g_ref, p, s, coarse_pairs, &
@@ -240,6 +244,13 @@ contains
             & dynamics, history, progress)
          call record_solve(result, 'gfmd', dynamics%converged, dynamics%iterations, 1, dynamics%fft_pairs, &
             & dynamics%residual, history(1:min(dynamics%checks, size(history))))
+      else if (outer_multigrid) then
+         call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+            & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error, progress, &
+            & inner_multigrid=.true., warm_start=coarse_pairs > 0)
+         if (allocated(error)) return
+         call record_solve(result, 'anderson+multigrid', outer%converged, outer%cg_iterations, &
+            & outer%outer_iterations, outer%fft_pairs, outer%residual, history(1:outer%outer_iterations))
       else if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
          ! constrained GCR; under 'auto' a solve that stalls goes on with the GCR from its best
          ! iterate, now keeping its history across clips (on broadband fine grids the

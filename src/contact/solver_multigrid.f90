@@ -52,6 +52,7 @@ module lc_contact_solver_multigrid
    implicit none (type, external)
    private
    public :: multigrid, multigrid_outcome, multigrid_refusal
+   public :: metric_refusal, multigrid_warm
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
    !> step lowers the energy monotonically; 2/3 damps the upper half of the spectrum best.
@@ -157,6 +158,85 @@ contains
             & to_string(m) // ' points; it needs n = m 2^k with m <= ' // to_string(coarsest_limit)
       end if
    end function multigrid_refusal
+
+   !> Why the method cannot solve the symmetric problem with the operator's metric
+   !> M = |G_eff| (empty if it can): multigrid_refusal without the refusal of coupled and
+   !> viscoelastic operators, for the inner solves of an outer iteration on a coupled line.
+   function metric_refusal(op) result(reason)
+      type(compliance_operator), intent(in) :: op
+      character(len=:), allocatable :: reason
+      integer :: m
+      reason = ''
+      if (op%grid%ny /= 1) then
+         reason = 'it solves lines, and this scene is a surface'
+      else if (.not. op%metric_falls .and. compliance_rise(op) > allowed_rise) then
+         reason = 'the compliance rises with |q| over the grid by a factor ' // formatted(compliance_rise(op), &
+            & '(f0.1)')
+      else
+         m = op%grid%nx/2**halvings(op%grid%nx, coarsest_points)
+         if (m > coarsest_limit) reason = 'n = m 2^k with m > ' // to_string(coarsest_limit)
+      end if
+   end function metric_refusal
+
+   !> The symmetric problem with the operator's metric M (as multigrid), iterated on the
+   !> finest grid only from the pressure p given on entry (its displacement M p, less s under
+   !> load control), without the nested iteration: for a sequence of problems whose
+   !> solutions are close (the inner solves of an outer iteration). s: in the constant of
+   !> the previous solution (load control) or the given one; out as multigrid.
+   subroutine multigrid_warm(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
+         & history, progress, error)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), contiguous, intent(in) :: b(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure
+      real(wp), intent(inout) :: s
+      real(wp), intent(in) :: g_ref, tol
+      integer, intent(in) :: max_iter
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(out) :: w(:), gap(:)
+      type(multigrid_outcome), intent(out) :: outcome
+      real(wp), contiguous, intent(inout) :: history(:)
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(hierarchy) :: h
+      real(wp), allocatable :: stiffness(:), u(:), o(:)
+      real(wp) :: f, target
+      integer :: n, steps, tightened
+      logical :: converged
+
+      n = size(p)
+      call build_hierarchy(h, n, error)
+      if (allocated(error)) return
+      allocate (stiffness(n/2 + 1), u(n), o(n))
+      where (op%metric(1:n/2 + 1) > 0.0_wp)
+         stiffness = 1.0_wp/op%metric(1:n/2 + 1)
+      elsewhere
+         stiffness = 0.0_wp
+      end where
+      if (load_control) stiffness(1) = 0.0_wp
+      f = merge(mean_pressure, 0.0_wp, load_control)
+      call set_grid(h, 0, stiffness)
+      o = b
+      if (.not. load_control) o = o + s
+      call op%apply_metric(p, u)
+      h%pairs = h%pairs + 1.0_wp
+      if (load_control) u = u - s
+      target = tol
+      tightened = 0
+      do
+         call tnnmg(h, op, u, o, f, load_control, g_ref, target, max_iter - outcome%iterations, p, steps, &
+            & converged, history(outcome%iterations + 1:), progress)
+         outcome%iterations = outcome%iterations + steps
+         call returned_fields(op, u, o, b, load_control, mean_pressure, g_ref, p, w, gap, s, outcome%residual)
+         h%pairs = h%pairs + 1.0_wp
+         if (outcome%residual <= tol .or. outcome%iterations >= max_iter .or. tightened == tightenings) exit
+         target = target*tightening
+         tightened = tightened + 1
+      end do
+      outcome%converged = outcome%residual <= tol
+      outcome%fft_pairs = nint(h%pairs)
+      outcome%vcycles = h%vcycles
+   end subroutine multigrid_warm
 
    !> How many times a grid of n points halves while the result stays even-sized and
    !> at least `smallest` points long (n/2**k with k the count is the coarsest grid).
