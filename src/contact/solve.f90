@@ -170,7 +170,7 @@ contains
       character(len=:), allocatable :: reason, allowed
       character(len=len(scene%solver%method)) :: method
       real(wp) :: uniform, s_gcr, plain, before
-      integer :: coarse_pairs, reserve
+      integer :: coarse_pairs, reserve, switch
       logical :: started, outer_multigrid
 
       coarse_pairs = 0
@@ -261,12 +261,27 @@ contains
          ! (dense_applies: an Anderson iteration costs ~1e-3 of a Newton step there, so it
          ! goes first: a glassy layer at n = 1024 converges in 97362 of them in 0.6 s, the
          ! Newton method from GCR's iterate in 3.2 s)
-         call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+         switch = 0
+         if (trim(scene%solver%method) == 'auto' .and. grid%is_line()) then
+            switch = experiment_size('LC_COUPLED_SWITCH')
+            if (switch > 0 .and. len(metric_refusal(op)) > 0) switch = 0
+         end if
+         call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
+            & merge(min(switch, scene%solver%max_iter), scene%solver%max_iter, switch > 0), &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history, progress)
          call record_solve(result, 'gcr', gcr%converged, gcr%iterations, 1, gcr%fft_pairs, gcr%residual, &
             & history(1:gcr%iterations))
-         if (.not. gcr%converged .and. trim(scene%solver%method) == 'auto' .and. &
-            & gcr%iterations < scene%solver%max_iter) then
+         if (switch > 0 .and. .not. gcr%converged .and. gcr%iterations < scene%solver%max_iter) then
+            call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
+               & scene%solver%max_iter - gcr%iterations, scene%solver%memory, scene%solver%precondition, p, w, gap, &
+               & outer, history(gcr%iterations + 1:), error, progress, inner_multigrid=.true., warm_start=.true.)
+            if (allocated(error)) return
+            call record_solve(result, 'gcr+anderson+multigrid', outer%converged, gcr%iterations + outer%cg_iterations, &
+               & 1 + outer%outer_iterations, gcr%fft_pairs + outer%fft_pairs, outer%residual, &
+               & history(1:gcr%iterations + outer%outer_iterations))
+         end if
+         if (.not. result%converged .and. trim(scene%solver%method) == 'auto' .and. &
+            & result%iterations < scene%solver%max_iter) then
             reserve = 0
             if (dense_applies(scene, grid, op)) reserve = min(newton_step_limit, &
                & (scene%solver%max_iter - gcr%iterations)/2)
