@@ -245,12 +245,30 @@ contains
          call record_solve(result, 'gfmd', dynamics%converged, dynamics%iterations, 1, dynamics%fft_pairs, &
             & dynamics%residual, history(1:min(dynamics%checks, size(history))))
       else if (outer_multigrid) then
-         call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+         call anderson_coupled(op, height, load_control, pm, s, g_ref, &
+            & max(scene%solver%tol, experiment_real('LC_COUPLED_POLISH', 0.0_wp)), scene%solver%max_iter, &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error, progress, &
             & inner_multigrid=.true., warm_start=coarse_pairs > 0)
          if (allocated(error)) return
          call record_solve(result, 'anderson+multigrid', outer%converged, outer%cg_iterations, &
             & outer%outer_iterations, outer%fft_pairs, outer%residual, history(1:outer%outer_iterations))
+         if (outer%residual > scene%solver%tol) then
+            call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
+               & max(1, experiment_size('LC_COUPLED_POLISH_BUDGET')), &
+               & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history, progress)
+            call record_solve(result, 'anderson+multigrid+gcr', gcr%converged, outer%cg_iterations + gcr%iterations, &
+               & outer%outer_iterations + 1, outer%fft_pairs + gcr%fft_pairs, gcr%residual, history(1:1))
+            if (.not. gcr%converged) then
+               reserve = result%fft_pairs
+               call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
+                  & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error, progress, &
+                  & inner_multigrid=.true., warm_start=.true.)
+               if (allocated(error)) return
+               call record_solve(result, 'anderson+multigrid+gcr+anderson', outer%converged, &
+                  & result%iterations + outer%cg_iterations, result%outer_iterations + outer%outer_iterations, &
+                  & reserve + outer%fft_pairs, outer%residual, history(1:1))
+            end if
+         end if
       else if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
          ! constrained GCR; under 'auto' a solve that stalls goes on with the GCR from its best
          ! iterate, now keeping its history across clips (on broadband fine grids the
