@@ -45,6 +45,14 @@ module lc_contact_solve
    !> on broadband roughness (bench/scaling.py --method); at n = 1024 the CG's 0.64 ms
    !> against 0.94 ms on the physical family.
    integer, parameter :: multigrid_points = 4096
+   !> Method 'multigrid' on a coupled line: the Anderson iteration with multigrid inner solves
+   !> goes to this tolerance (or the scene's, if looser), GCR from there to the scene's
+   !> tolerance within polish_budget iterations, and the Anderson iteration again where GCR
+   !> does not get there. The last outer iterations cost a multigrid solve each where GCR,
+   !> from an iterate this close, needs 10-20 iterations; from 1e-5 GCR stalled more often
+   !> (docs/decisions/010-coupled-lines-multigrid.md).
+   real(wp), parameter :: polish_tol = 1.0e-6_wp
+   integer, parameter :: polish_budget = 50
 
 contains
 
@@ -170,8 +178,7 @@ contains
       character(len=:), allocatable :: reason, allowed
       character(len=len(scene%solver%method)) :: method
       real(wp) :: uniform, s_gcr, plain, before
-      integer :: coarse_pairs, reserve, switch
-      logical :: started, outer_multigrid
+      integer :: coarse_pairs, reserve
 
       coarse_pairs = 0
       ! (the operator first: which solver runs depends on it, and refusals come before any
@@ -185,33 +192,30 @@ contains
       end if
       method = scene%solver%method
       if (method == 'multigrid') then
-         reason = multigrid_refusal(op)
+         ! (a coupled line: the multigrid solver does the Anderson iteration's inner solves,
+         ! symmetric problems with the metric |G_eff|)
+         if (op%coupled) then
+            reason = metric_refusal(op)
+         else
+            reason = multigrid_refusal(op)
+         end if
          if (len(reason) > 0) then
             allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
             if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
             call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
-               & '; it solves frictionless lines on an elastic half-space or layer (nu <= 0.47, or h/lambda >~ 0.07); ' &
-               & // 'allowed here: ' // allowed, code_input)
+               & '; it solves lines on an elastic half-space or layer (nu <= 0.47, or h/lambda >~ 0.07), with ' // &
+               & 'friction or sliding viscoelastic layers by an outer iteration around it; allowed here: ' // &
+               & allowed, code_input)
             return
          end if
       else if (method == 'auto' .and. grid%points() >= multigrid_points) then
          if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
       end if
-      started = .false.
-      outer_multigrid = op%coupled .and. method == 'auto' .and. grid%is_line() .and. &
-         & experiment('LC_COUPLED') == 'anderson_mg' .and. grid%points() >= experiment_size('LC_COUPLED_SIZE')
-      if (outer_multigrid) outer_multigrid = len(metric_refusal(op)) == 0
-      if (outer_multigrid .and. experiment('LC_COUPLED_NESTED') /= 'yes') started = .true.
-      if (op%coupled .and. method == 'auto' .and. grid%is_line() .and. experiment('LC_COUPLED_START') == 'mg' &
-         & .and. grid%points() >= experiment_size('LC_COUPLED_START_SIZE')) then
-         call frictionless_start(scene, grid, kernel, height, load_control, pm, g_ref, p, s, coarse_pairs, &
-            & progress, started, error)
-         if (allocated(error)) return
-      end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
-      ! on the displacement, where this start solves each coarse grid to coarse_tol)
-      if (.not. started .and. scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
-         & method /= 'multigrid') then
+      ! on the displacement, where this start solves each coarse grid to coarse_tol; the
+      ! outer iteration of a coupled line takes the start, whose contact set is nearly right)
+      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
+         & (method /= 'multigrid' .or. op%coupled)) then
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
             & progress, error)
          if (allocated(error)) return
@@ -233,6 +237,10 @@ contains
             & gap, newton, progress)
          call record_solve(result, 'newton', newton%converged, newton%steps, 1, newton%fft_pairs, newton%residual, &
             & [newton%residual])
+      else if (method == 'multigrid' .and. op%coupled) then
+         call coupled_multigrid(scene, op, height, load_control, pm, g_ref, coarse_pairs > 0, p, w, gap, s, history, &
+            & result, progress, error)
+         if (allocated(error)) return
       else if (method == 'multigrid') then
          call multigrid(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
             & nested, history, progress, error)
@@ -244,31 +252,6 @@ contains
             & dynamics, history, progress)
          call record_solve(result, 'gfmd', dynamics%converged, dynamics%iterations, 1, dynamics%fft_pairs, &
             & dynamics%residual, history(1:min(dynamics%checks, size(history))))
-      else if (outer_multigrid) then
-         call anderson_coupled(op, height, load_control, pm, s, g_ref, &
-            & max(scene%solver%tol, experiment_real('LC_COUPLED_POLISH', 0.0_wp)), scene%solver%max_iter, &
-            & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error, progress, &
-            & inner_multigrid=.true., warm_start=coarse_pairs > 0)
-         if (allocated(error)) return
-         call record_solve(result, 'anderson+multigrid', outer%converged, outer%cg_iterations, &
-            & outer%outer_iterations, outer%fft_pairs, outer%residual, history(1:outer%outer_iterations))
-         if (outer%residual > scene%solver%tol) then
-            call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
-               & max(1, experiment_size('LC_COUPLED_POLISH_BUDGET')), &
-               & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history, progress)
-            call record_solve(result, 'anderson+multigrid+gcr', gcr%converged, outer%cg_iterations + gcr%iterations, &
-               & outer%outer_iterations + 1, outer%fft_pairs + gcr%fft_pairs, gcr%residual, history(1:1))
-            if (.not. gcr%converged) then
-               reserve = result%fft_pairs
-               call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-                  & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error, progress, &
-                  & inner_multigrid=.true., warm_start=.true.)
-               if (allocated(error)) return
-               call record_solve(result, 'anderson+multigrid+gcr+anderson', outer%converged, &
-                  & result%iterations + outer%cg_iterations, result%outer_iterations + outer%outer_iterations, &
-                  & reserve + outer%fft_pairs, outer%residual, history(1:1))
-            end if
-         end if
       else if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
          ! constrained GCR; under 'auto' a solve that stalls goes on with the GCR from its best
          ! iterate, now keeping its history across clips (on broadband fine grids the
@@ -279,27 +262,12 @@ contains
          ! (dense_applies: an Anderson iteration costs ~1e-3 of a Newton step there, so it
          ! goes first: a glassy layer at n = 1024 converges in 97362 of them in 0.6 s, the
          ! Newton method from GCR's iterate in 3.2 s)
-         switch = 0
-         if (trim(scene%solver%method) == 'auto' .and. grid%is_line()) then
-            switch = experiment_size('LC_COUPLED_SWITCH')
-            if (switch > 0 .and. len(metric_refusal(op)) > 0) switch = 0
-         end if
-         call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
-            & merge(min(switch, scene%solver%max_iter), scene%solver%max_iter, switch > 0), &
+         call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history, progress)
          call record_solve(result, 'gcr', gcr%converged, gcr%iterations, 1, gcr%fft_pairs, gcr%residual, &
             & history(1:gcr%iterations))
-         if (switch > 0 .and. .not. gcr%converged .and. gcr%iterations < scene%solver%max_iter) then
-            call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
-               & scene%solver%max_iter - gcr%iterations, scene%solver%memory, scene%solver%precondition, p, w, gap, &
-               & outer, history(gcr%iterations + 1:), error, progress, inner_multigrid=.true., warm_start=.true.)
-            if (allocated(error)) return
-            call record_solve(result, 'gcr+anderson+multigrid', outer%converged, gcr%iterations + outer%cg_iterations, &
-               & 1 + outer%outer_iterations, gcr%fft_pairs + outer%fft_pairs, outer%residual, &
-               & history(1:gcr%iterations + outer%outer_iterations))
-         end if
-         if (.not. result%converged .and. trim(scene%solver%method) == 'auto' .and. &
-            & result%iterations < scene%solver%max_iter) then
+         if (.not. gcr%converged .and. trim(scene%solver%method) == 'auto' .and. &
+            & gcr%iterations < scene%solver%max_iter) then
             reserve = 0
             if (dense_applies(scene, grid, op)) reserve = min(newton_step_limit, &
                & (scene%solver%max_iter - gcr%iterations)/2)
@@ -373,6 +341,56 @@ contains
       s = s + uniform*pm
    end subroutine solve_on_grid
 
+   !> Method 'multigrid' on a coupled line (the operator passed metric_refusal): the Anderson
+   !> outer iteration with the symmetric inner problems solved by the multigrid method (the
+   !> first from p if `warm`, the interpolated coarse solution, else from its own nested
+   !> iteration) to polish_tol, then GCR from there, and the Anderson iteration again from
+   !> GCR's best iterate if GCR has not converged within polish_budget iterations. On
+   !> broadband lines neither the outer iterations nor the multigrid's inner ones grow with
+   !> n, where GCR's set finding does (docs/decisions/010-coupled-lines-multigrid.md).
+   subroutine coupled_multigrid(scene, op, height, load_control, pm, g_ref, warm, p, w, gap, s, history, result, &
+         & progress, error)
+      type(scene_type), intent(in) :: scene
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: height(:), pm, g_ref
+      logical, intent(in) :: load_control, warm
+      real(wp), intent(inout) :: p(:), s
+      real(wp), intent(out) :: w(:), gap(:)
+      real(wp), intent(inout) :: history(:)
+      type(contact_result), intent(inout) :: result
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(anderson_outcome) :: outer
+      type(gcr_outcome) :: gcr
+      real(wp) :: tol
+      integer :: max_iter, memory
+      logical :: precondition
+
+      tol = scene%solver%tol
+      max_iter = scene%solver%max_iter
+      memory = scene%solver%memory
+      precondition = scene%solver%precondition
+      call anderson_coupled(op, height, load_control, pm, s, g_ref, max(tol, polish_tol), max_iter, memory, &
+         & precondition, p, w, gap, outer, history, error, progress, inner_multigrid=.true., warm_start=warm)
+      if (allocated(error)) return
+      call record_solve(result, 'anderson+multigrid', outer%residual <= tol, outer%cg_iterations, &
+         & outer%outer_iterations, outer%fft_pairs, outer%residual, history(1:outer%outer_iterations))
+      if (result%converged .or. result%iterations >= max_iter) return
+      call constrained_gcr(op, height, load_control, pm, s, g_ref, tol, min(polish_budget, max_iter - result%iterations), &
+         & memory, precondition, p, w, gap, gcr, history, progress)
+      call record_solve(result, trim(result%solver) // '+gcr', gcr%converged, result%iterations + gcr%iterations, &
+         & result%outer_iterations + 1, result%fft_pairs + gcr%fft_pairs, gcr%residual, &
+         & [result%residual_history, history(1:gcr%iterations)])
+      if (result%converged .or. result%iterations >= max_iter) return
+      call anderson_coupled(op, height, load_control, pm, s, g_ref, tol, max_iter - result%iterations, memory, &
+         & precondition, p, w, gap, outer, history, error, progress, inner_multigrid=.true., warm_start=.true.)
+      if (allocated(error)) return
+      call record_solve(result, trim(result%solver) // '+anderson+multigrid', outer%converged, &
+         & result%iterations + outer%cg_iterations, result%outer_iterations + outer%outer_iterations, &
+         & result%fft_pairs + outer%fft_pairs, outer%residual, &
+         & [result%residual_history, history(1:outer%outer_iterations)])
+   end subroutine coupled_multigrid
+
    !> Whether the dense Newton method may finish a solve that stalled: under method 'auto',
    !> on a grid of at most dense_points points, for a monotone operator (Re G_eff >= 0 on
    !> every mode), where the solution is unique and the merit has no other stationary point.
@@ -436,75 +454,6 @@ contains
       result%residual = residual
       result%residual_history = history
    end subroutine record_solve
-
-   !> (experiment) the value of an environment variable
-   function experiment(name) result(value)
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: value
-      character(len=64) :: buffer
-      integer :: length, stat
-      call get_environment_variable(name, buffer, length, stat)
-      value = ''
-      if (stat == 0) value = trim(buffer)
-   end function experiment
-
-   integer function experiment_size(name) result(value)
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: text
-      integer :: stat
-      text = experiment(name)
-      value = 0
-      if (len(text) > 0) read (text, *, iostat=stat) value
-   end function experiment_size
-
-   real(wp) function experiment_real(name, default) result(value)
-      character(len=*), intent(in) :: name
-      real(wp), intent(in) :: default
-      character(len=:), allocatable :: text
-      integer :: stat
-      text = experiment(name)
-      value = default
-      if (len(text) > 0) read (text, *, iostat=stat) value
-   end function experiment_real
-
-   !> Start a coupled elastic line (or a sliding viscoelastic one, with its relaxed modulus)
-   !> from the frictionless solution by the multigrid solver, where it applies to the
-   !> frictionless counterpart; started says whether it did.
-   subroutine frictionless_start(scene, grid, kernel, height, load_control, pm, g_ref, p, s, pairs, progress, &
-         & started, error)
-      type(scene_type), intent(in) :: scene
-      type(grid_type), intent(in) :: grid
-      type(layer_kernel), intent(in) :: kernel
-      real(wp), intent(in) :: height(:), pm, g_ref
-      logical, intent(in) :: load_control
-      real(wp), intent(inout) :: p(:), s
-      integer, intent(out) :: pairs
-      type(progress_log), intent(inout) :: progress
-      logical, intent(out) :: started
-      type(error_type), allocatable, intent(out) :: error
-      type(layer_kernel) :: static
-      type(compliance_operator) :: op0
-      type(multigrid_outcome) :: outcome
-      real(wp), allocatable :: w0(:), gap0(:), history(:)
-      real(wp) :: uniform, s0
-      started = .false.
-      pairs = 0
-      static = kernel
-      static%speed = 0.0_wp
-      static%viscoelastic = .false.
-      call build_operator(op0, grid, static, 0.0_wp, scene%solver%threads, error)
-      if (allocated(error)) return
-      if (len(multigrid_refusal(op0)) > 0) return
-      if (load_control) call op0%drop_uniform_mode(uniform)
-      allocate (w0(size(p)), gap0(size(p)), history(1000))
-      s0 = s
-      call multigrid(op0, height, load_control, pm, s0, g_ref, experiment_real('LC_COUPLED_START_TOL', 1.0e-4_wp), &
-         & 1000, p, w0, gap0, outcome, history, progress, error)
-      if (allocated(error)) return
-      if (load_control) s = s0
-      pairs = outcome%fft_pairs
-      started = .true.
-   end subroutine frictionless_start
 
    !> Replace the guess p (and s) by the solution on the grid of every second point,
    !> interpolated linearly (which keeps p >= 0). The coarse solve needs only the accuracy

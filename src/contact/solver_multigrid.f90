@@ -171,10 +171,12 @@ contains
          reason = 'it solves lines, and this scene is a surface'
       else if (.not. op%metric_falls .and. compliance_rise(op) > allowed_rise) then
          reason = 'the compliance rises with |q| over the grid by a factor ' // formatted(compliance_rise(op), &
-            & '(f0.1)')
+            & '(f0.1)') // ' (a thin, nearly incompressible layer; pointwise smoothing needs at most ' // &
+            & formatted(allowed_rise, '(f0.1)') // ')'
       else
          m = op%grid%nx/2**halvings(op%grid%nx, coarsest_points)
-         if (m > coarsest_limit) reason = 'n = m 2^k with m > ' // to_string(coarsest_limit)
+         if (m > coarsest_limit) reason = 'n = ' // to_string(op%grid%nx) // ' halves to an odd grid of ' // &
+            & to_string(m) // ' points; it needs n = m 2^k with m <= ' // to_string(coarsest_limit)
       end if
    end function metric_refusal
 
