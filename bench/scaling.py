@@ -28,7 +28,7 @@ finest grid (plus the inner CG iterations after an Anderson fallback, marked +a)
 "pairs": FFT pairs in units of the finest grid's (coarse levels included); "ms": the
 library's solve time (``wall_time``). The last table gives max/min of the iterations and
 of the pairs over n per family and scene. ``--method`` sets ``&solver method`` (for
-'multigrid', scene 1 is the only one it solves).
+'multigrid', scenes 1, 2 and 4: it refuses the thin incompressible layer of scene 3).
 """
 
 from __future__ import annotations
