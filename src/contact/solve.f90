@@ -53,6 +53,15 @@ module lc_contact_solve
    !> (docs/decisions/010-coupled-lines-multigrid.md).
    real(wp), parameter :: polish_tol = 1.0e-6_wp
    integer, parameter :: polish_budget = 50
+   !> Under method 'auto' a coupled line of at least outer_multigrid_points points goes the
+   !> way of method 'multigrid' (where its metric passes metric_refusal) when the solve on
+   !> the grid of every second point needed more than hard_coarse_iterations GCR iterations
+   !> or went that way itself: GCR's iterations grow with n on broadband lines (73, 218, 448
+   !> at 16384, 65536, 262144) and are flat where the spectrum is fixed (8-42 up to 262144
+   !> on bench/scaling.py's scenes), where the outer iteration costs 1.2-9x GCR's transforms
+   !> (docs/decisions/010-coupled-lines-multigrid.md).
+   integer, parameter :: outer_multigrid_points = 8192
+   integer, parameter :: hard_coarse_iterations = 60
 
 contains
 
@@ -179,8 +188,10 @@ contains
       character(len=len(scene%solver%method)) :: method
       real(wp) :: uniform, s_gcr, plain, before
       integer :: coarse_pairs, reserve
+      logical :: coarse_hard
 
       coarse_pairs = 0
+      coarse_hard = .false.
       ! (the operator first: which solver runs depends on it, and refusals come before any
       ! coarse solve)
       call build_operator(op, grid, kernel, friction, scene%solver%threads, error)
@@ -217,8 +228,11 @@ contains
       if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
          & (method /= 'multigrid' .or. op%coupled)) then
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
-            & progress, error)
+            & coarse_hard, progress, error)
          if (allocated(error)) return
+      end if
+      if (method == 'auto' .and. op%coupled .and. coarse_hard .and. grid%points() >= outer_multigrid_points) then
+         if (len(metric_refusal(op)) == 0) method = 'multigrid'
       end if
       call progress%begin_level(grid%nx, grid%ny)
       uniform = 0.0_wp
@@ -460,7 +474,7 @@ contains
    !> of a starting guess (coarse_tol); its FFT pairs are returned in units of pairs of
    !> this grid (2 or 4 times as long each, on a line or a surface).
    recursive subroutine coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, &
-         & pairs, progress, error)
+         & pairs, hard, progress, error)
       type(scene_type), intent(in) :: scene
       type(grid_type), intent(in) :: grid
       type(layer_kernel), intent(in) :: kernel
@@ -468,6 +482,9 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: p(:), s
       integer, intent(out) :: pairs
+      !> the coarse solve needed more than hard_coarse_iterations GCR iterations, or the
+      !> outer iteration with multigrid inner solves
+      logical, intent(out) :: hard
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: coarse
@@ -492,6 +509,8 @@ contains
       if (load_control) s = sc
       ratio = grid%points()/coarse_grid%points()
       pairs = (coarse_result%fft_pairs + ratio - 1)/ratio
+      hard = index(coarse_result%solver, 'anderson+multigrid') == 1 .or. &
+         & (index(coarse_result%solver, 'gcr') == 1 .and. coarse_result%iterations > hard_coarse_iterations)
    end subroutine coarse_solution
 
    !> The values of f at every second point (along both axes of a surface).
