@@ -250,7 +250,7 @@ def solve_line(
     applies to from 4096 points on, constrained CG for other symmetric scenes, constrained
     GCR for coupled ones, going on with its history kept across clips and then with
     Anderson if GCR stalls; a coupled line of 8192 points or more whose coarse-start solve
-    needed more than 60 GCR iterations, i.e. broadband roughness, goes the way of
+    needed more than 100 GCR iterations, i.e. broadband roughness, goes the way of
     ``'multigrid'`` below where that applies; grids of at most 2048 points that stall are finished by the
     dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'``,
     ``'newton'`` (dense semismooth Newton, grids of at most 2048 points) or ``'multigrid'``

@@ -56,12 +56,13 @@ module lc_contact_solve
    !> Under method 'auto' a coupled line of at least outer_multigrid_points points goes the
    !> way of method 'multigrid' (where its metric passes metric_refusal) when the solve on
    !> the grid of every second point needed more than hard_coarse_iterations GCR iterations
-   !> or went that way itself: GCR's iterations grow with n on broadband lines (73, 218, 448
-   !> at 16384, 65536, 262144) and are flat where the spectrum is fixed (8-42 up to 262144
-   !> on bench/scaling.py's scenes), where the outer iteration costs 1.2-9x GCR's transforms
-   !> (docs/decisions/010-coupled-lines-multigrid.md).
+   !> or went that way itself. The coarse solves of bench/scaling.py's coupled scenes need
+   !> 7-14 GCR iterations where the spectrum is fixed (up to 2^20), where the outer
+   !> iteration would cost 1.2-9x GCR's transforms, and 39-75 (n = 16384) to 118-217
+   !> (65536) on broadband lines, where GCR's grow with n; with 60, the SLS at 16384 went
+   !> the outer way and cost 671 pairs against GCR's 418 (docs/decisions/010-coupled-lines-multigrid.md).
    integer, parameter :: outer_multigrid_points = 8192
-   integer, parameter :: hard_coarse_iterations = 60
+   integer, parameter :: hard_coarse_iterations = 100
 
 contains
 
