@@ -114,7 +114,7 @@ def test_coupled_lines_agree_with_gcr(n, family, scene):
     assert np.abs(mg.pressure - gcr.pressure).max() <= bound
     assert mg.mean_pressure == pytest.approx(gcr.mean_pressure, rel=1e-10)
     assert mg.penetration == pytest.approx(gcr.penetration, abs=(TOL + TOL_GCR) * np.ptp(h))
-    # measured at tol 1e-8 from n = 1024 to 2^20: 142-198 pairs (friction) and 646-850
+    # measured at tol 1e-8 from n = 1024 to 2^20: 131-265 pairs (friction) and 641-803
     # (viscoelastic) on broadband lines; tol 1e-10 here
     assert mg.fft_pairs <= 1500
 

@@ -2,7 +2,9 @@
 !>    find p >= 0, gap = G_eff p - r - s >= 0, p gap = 0 (+ load or displacement control).
 !>
 !> Outer fixed point x -> T(x): T(x) solves the symmetric problem with metric M and target
-!> b = r - N x (constrained CG, warm-started); its fixed point solves the coupled problem.
+!> b = r - N x (constrained CG, warm-started; or, with inner_multigrid, the multigrid solver
+!> of lc_contact_solver_multigrid, whose iterations do not grow with n on broadband lines);
+!> its fixed point solves the coupled problem.
 !> The outer iteration is accelerated with Anderson mixing (Walker & Ni, SIAM J. Numer.
 !> Anal. 49 (2011) 1715), which for the linearised map behaves like GMRES: with
 !> M = |G_eff| the map's eigenvalues lie on the right half of the unit circle, so the rate

@@ -181,10 +181,10 @@ contains
    end function metric_refusal
 
    !> The symmetric problem with the operator's metric M (as multigrid), iterated on the
-   !> finest grid only from the pressure p given on entry (its displacement M p, less s under
-   !> load control), without the nested iteration: for a sequence of problems whose
-   !> solutions are close (the inner solves of an outer iteration). s: in the constant of
-   !> the previous solution (load control) or the given one; out as multigrid.
+   !> finest grid only from the pressure p given on entry (its displacement M p, less, under
+   !> load control, the mean of M p - b over p's contact set), without the nested iteration:
+   !> for a sequence of problems whose solutions are close (the inner solves of an outer
+   !> iteration). s: in the given constant (displacement control); out as multigrid.
    subroutine multigrid_warm(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
          & history, progress, error)
       type(compliance_operator), intent(inout) :: op
@@ -222,6 +222,9 @@ contains
       if (.not. load_control) o = o + s
       call op%apply_metric(p, u)
       h%pairs = h%pairs + 1.0_wp
+      ! (the gap of p is zero on its contact set; the constant is not taken from the caller,
+      ! whose s may hold the uniform mode's shift)
+      if (load_control .and. any(p > 0.0_wp)) s = sum(u - b, mask=p > 0.0_wp)/count(p > 0.0_wp)
       if (load_control) u = u - s
       target = tol
       tightened = 0
