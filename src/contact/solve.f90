@@ -22,7 +22,7 @@ module lc_contact_solve
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
-   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal
+   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -47,6 +47,24 @@ module lc_contact_solve
    !> wavenumbers; on surfaces from 1024^2, where the CG takes 1.4-2.2x its time broadband
    !> and 1.2x physical (at 512^2 0.75-1.36x: a multigrid pair costs 2-3x a CG pair there).
    integer, parameter :: multigrid_points = 4096, multigrid_surface_points = 1024**2
+   !> Method 'multigrid' on a coupled line: the Anderson iteration with multigrid inner solves
+   !> goes to this tolerance (or the scene's, if looser), GCR from there to the scene's
+   !> tolerance within polish_budget iterations, and the Anderson iteration again where GCR
+   !> does not get there. The last outer iterations cost a multigrid solve each where GCR,
+   !> from an iterate this close, needs 10-20 iterations; from 1e-5 GCR stalled more often
+   !> (docs/decisions/010-coupled-lines-multigrid.md).
+   real(wp), parameter :: polish_tol = 1.0e-6_wp
+   integer, parameter :: polish_budget = 50
+   !> Under method 'auto' a coupled line of at least outer_multigrid_points points goes the
+   !> way of method 'multigrid' (where its metric passes metric_refusal) when the solve on
+   !> the grid of every second point needed more than hard_coarse_iterations GCR iterations
+   !> or went that way itself. The coarse solves of bench/scaling.py's coupled scenes need
+   !> 7-14 GCR iterations where the spectrum is fixed (up to 2^20), where the outer
+   !> iteration would cost 1.2-9x GCR's transforms, and 39-75 (n = 16384) to 118-217
+   !> (65536) on broadband lines, where GCR's grow with n; with 60, the SLS at 16384 went
+   !> the outer way and cost 671 pairs against GCR's 418 (docs/decisions/010-coupled-lines-multigrid.md).
+   integer, parameter :: outer_multigrid_points = 8192
+   integer, parameter :: hard_coarse_iterations = 100
 
 contains
 
@@ -176,8 +194,10 @@ contains
       character(len=len(scene%solver%method)) :: method
       real(wp) :: uniform, s_gcr, plain, before
       integer :: coarse_pairs, reserve
+      logical :: coarse_hard
 
       coarse_pairs = 0
+      coarse_hard = .false.
       ! (the operator first: which solver runs depends on it, and refusals come before any
       ! coarse solve)
       call build_operator(op, grid, kernel, friction, scene%solver%threads, error)
@@ -189,14 +209,23 @@ contains
       end if
       method = scene%solver%method
       if (method == 'multigrid') then
-         reason = multigrid_refusal(op)
+         ! (a coupled line: the multigrid solver does the Anderson iteration's inner solves,
+         ! symmetric problems with the metric |G_eff|)
+         if (op%coupled .and. .not. grid%is_line()) then
+            reason = 'friction couples the normal and tangential fields, and the outer iteration around it solves ' &
+               & // 'coupled lines only'
+         else if (op%coupled) then
+            reason = metric_refusal(op)
+         else
+            reason = multigrid_refusal(op)
+         end if
          if (len(reason) > 0) then
             allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
             if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
             call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
                & '; it solves frictionless lines and surfaces on an elastic half-space or layer (nu <= 0.47, ' // &
-               & 'or h/lambda >~ 0.07); ' &
-               & // 'allowed here: ' // allowed, code_input)
+               & 'or h/lambda >~ 0.07), and lines with friction or sliding viscoelastic layers by an outer ' // &
+               & 'iteration around it; allowed here: ' // allowed, code_input)
             return
          end if
       else if (method == 'auto' .and. grid%points() >= merge(multigrid_points, multigrid_surface_points, &
@@ -204,11 +233,17 @@ contains
          if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
       end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
-      ! on the displacement, where this start solves each coarse grid to coarse_tol)
-      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. method /= 'multigrid') then
+      ! on the displacement, where this start solves each coarse grid to coarse_tol; the
+      ! outer iteration of a coupled line takes the start, whose contact set is nearly right)
+      if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
+         & (method /= 'multigrid' .or. op%coupled)) then
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
-            & progress, error)
+            & coarse_hard, progress, error)
          if (allocated(error)) return
+      end if
+      if (method == 'auto' .and. op%coupled .and. coarse_hard .and. grid%is_line() .and. &
+         & grid%points() >= outer_multigrid_points) then
+         if (len(metric_refusal(op)) == 0) method = 'multigrid'
       end if
       call progress%begin_level(grid%nx, grid%ny)
       uniform = 0.0_wp
@@ -227,6 +262,10 @@ contains
             & gap, newton, progress)
          call record_solve(result, 'newton', newton%converged, newton%steps, 1, newton%fft_pairs, newton%residual, &
             & [newton%residual])
+      else if (method == 'multigrid' .and. op%coupled) then
+         call coupled_multigrid(scene, op, height, load_control, pm, g_ref, coarse_pairs > 0, p, w, gap, s, history, &
+            & result, progress, error)
+         if (allocated(error)) return
       else if (method == 'multigrid') then
          call multigrid(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
             & nested, history, progress, error)
@@ -327,6 +366,56 @@ contains
       s = s + uniform*pm
    end subroutine solve_on_grid
 
+   !> Method 'multigrid' on a coupled line (the operator passed metric_refusal): the Anderson
+   !> outer iteration with the symmetric inner problems solved by the multigrid method (the
+   !> first from p if `warm`, the interpolated coarse solution, else from its own nested
+   !> iteration) to polish_tol, then GCR from there, and the Anderson iteration again from
+   !> GCR's best iterate if GCR has not converged within polish_budget iterations. On
+   !> broadband lines neither the outer iterations nor the multigrid's inner ones grow with
+   !> n, where GCR's set finding does (docs/decisions/010-coupled-lines-multigrid.md).
+   subroutine coupled_multigrid(scene, op, height, load_control, pm, g_ref, warm, p, w, gap, s, history, result, &
+         & progress, error)
+      type(scene_type), intent(in) :: scene
+      type(compliance_operator), intent(inout) :: op
+      real(wp), intent(in) :: height(:), pm, g_ref
+      logical, intent(in) :: load_control, warm
+      real(wp), intent(inout) :: p(:), s
+      real(wp), intent(out) :: w(:), gap(:)
+      real(wp), intent(inout) :: history(:)
+      type(contact_result), intent(inout) :: result
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(anderson_outcome) :: outer
+      type(gcr_outcome) :: gcr
+      real(wp) :: tol
+      integer :: max_iter, memory
+      logical :: precondition
+
+      tol = scene%solver%tol
+      max_iter = scene%solver%max_iter
+      memory = scene%solver%memory
+      precondition = scene%solver%precondition
+      call anderson_coupled(op, height, load_control, pm, s, g_ref, max(tol, polish_tol), max_iter, memory, &
+         & precondition, p, w, gap, outer, history, error, progress, inner_multigrid=.true., warm_start=warm)
+      if (allocated(error)) return
+      call record_solve(result, 'anderson+multigrid', outer%residual <= tol, outer%cg_iterations, &
+         & outer%outer_iterations, outer%fft_pairs, outer%residual, history(1:outer%outer_iterations))
+      if (result%converged .or. result%iterations >= max_iter) return
+      call constrained_gcr(op, height, load_control, pm, s, g_ref, tol, min(polish_budget, max_iter - result%iterations), &
+         & memory, precondition, p, w, gap, gcr, history, progress)
+      call record_solve(result, trim(result%solver) // '+gcr', gcr%converged, result%iterations + gcr%iterations, &
+         & result%outer_iterations + 1, result%fft_pairs + gcr%fft_pairs, gcr%residual, &
+         & [result%residual_history, history(1:gcr%iterations)])
+      if (result%converged .or. result%iterations >= max_iter) return
+      call anderson_coupled(op, height, load_control, pm, s, g_ref, tol, max_iter - result%iterations, memory, &
+         & precondition, p, w, gap, outer, history, error, progress, inner_multigrid=.true., warm_start=.true.)
+      if (allocated(error)) return
+      call record_solve(result, trim(result%solver) // '+anderson+multigrid', outer%converged, &
+         & result%iterations + outer%cg_iterations, result%outer_iterations + outer%outer_iterations, &
+         & result%fft_pairs + outer%fft_pairs, outer%residual, &
+         & [result%residual_history, history(1:outer%outer_iterations)])
+   end subroutine coupled_multigrid
+
    !> Whether the dense Newton method may finish a solve that stalled: under method 'auto',
    !> on a grid of at most dense_points points, for a monotone operator (Re G_eff >= 0 on
    !> every mode), where the solution is unique and the merit has no other stationary point.
@@ -396,7 +485,7 @@ contains
    !> of a starting guess (coarse_tol); its FFT pairs are returned in units of pairs of
    !> this grid (2 or 4 times as long each, on a line or a surface).
    recursive subroutine coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, &
-         & pairs, progress, error)
+         & pairs, hard, progress, error)
       type(scene_type), intent(in) :: scene
       type(grid_type), intent(in) :: grid
       type(layer_kernel), intent(in) :: kernel
@@ -404,6 +493,9 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: p(:), s
       integer, intent(out) :: pairs
+      !> the coarse solve needed more than hard_coarse_iterations GCR iterations, or the
+      !> outer iteration with multigrid inner solves
+      logical, intent(out) :: hard
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: coarse
@@ -428,6 +520,8 @@ contains
       if (load_control) s = sc
       ratio = grid%points()/coarse_grid%points()
       pairs = (coarse_result%fft_pairs + ratio - 1)/ratio
+      hard = index(coarse_result%solver, 'anderson+multigrid') == 1 .or. &
+         & (index(coarse_result%solver, 'gcr') == 1 .and. coarse_result%iterations > hard_coarse_iterations)
    end subroutine coarse_solution
 
    !> The values of f at every second point (along both axes of a surface).

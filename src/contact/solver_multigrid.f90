@@ -53,7 +53,7 @@ module lc_contact_solver_multigrid
    use lc_contact_progress, only: progress_log
    implicit none (type, external)
    private
-   public :: multigrid, multigrid_outcome, multigrid_refusal
+   public :: multigrid, multigrid_warm, multigrid_outcome, multigrid_refusal, metric_refusal
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
    !> step lowers the energy monotonically; 2/3 damps the upper half of the spectrum best.
@@ -164,13 +164,24 @@ contains
    function multigrid_refusal(op) result(reason)
       type(compliance_operator), intent(in) :: op
       character(len=:), allocatable :: reason
-      integer :: m, k
-      reason = ''
       if (op%kernel%viscoelastic) then
          reason = 'the layer is viscoelastic and sliding (its compliance is complex)'
       else if (op%coupled) then
          reason = 'friction couples the normal and tangential fields and the operator is not symmetric'
-      else if (.not. op%metric_falls .and. compliance_rise(op) > allowed_rise) then
+      else
+         reason = metric_refusal(op)
+      end if
+   end function multigrid_refusal
+
+   !> Why the method cannot solve the symmetric problem with the operator's metric
+   !> M = |G_eff| (empty if it can): multigrid_refusal without the refusal of coupled and
+   !> viscoelastic operators, for the inner solves of an outer iteration on a coupled line.
+   function metric_refusal(op) result(reason)
+      type(compliance_operator), intent(in) :: op
+      character(len=:), allocatable :: reason
+      integer :: m, k
+      reason = ''
+      if (.not. op%metric_falls .and. compliance_rise(op) > allowed_rise) then
          reason = 'the compliance rises with |q| over the grid by a factor ' // formatted(compliance_rise(op), &
             & '(f0.1)') // ' (a thin, nearly incompressible layer; pointwise smoothing needs at most ' // &
             & formatted(allowed_rise, '(f0.1)') // ')'
@@ -188,7 +199,89 @@ contains
             end if
          end if
       end if
-   end function multigrid_refusal
+   end function metric_refusal
+
+   !> The symmetric problem with the operator's metric M (as multigrid), iterated on the
+   !> finest grid only from the pressure p given on entry (its displacement M p, less, under
+   !> load control, the mean of M p - b over p's contact set), without the nested iteration:
+   !> for a sequence of problems whose solutions are close (the inner solves of an outer
+   !> iteration). s: in the given constant (displacement control); out as multigrid.
+   subroutine multigrid_warm(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
+         & history, progress, error)
+      type(compliance_operator), intent(inout), target :: op
+      real(wp), contiguous, intent(in) :: b(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure
+      real(wp), intent(inout) :: s
+      real(wp), intent(in) :: g_ref, tol
+      integer, intent(in) :: max_iter
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(out) :: w(:), gap(:)
+      type(multigrid_outcome), intent(out) :: outcome
+      real(wp), contiguous, intent(inout) :: history(:)
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(hierarchy), target :: h
+      type(workspace) :: work
+      real(wp), allocatable :: u(:)
+      integer :: n
+
+      n = size(p)
+      call build_hierarchy(h, op, error)
+      if (allocated(error)) return
+      allocate (u(n), work%c(n), work%kc(n), work%cg(n, 3))
+      call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
+      call op%apply_metric(p, u)
+      h%pairs = h%pairs + 1.0_wp
+      ! (the gap of p is zero on its contact set; the constant is not taken from the caller,
+      ! whose s may hold the uniform mode's shift)
+      if (load_control .and. any(p > 0.0_wp)) s = sum(u - b, mask=p > 0.0_wp)/count(p > 0.0_wp)
+      if (load_control) u = u - s
+      call finest_iterations(h, work, op, u, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, &
+         & outcome, history, progress)
+   end subroutine multigrid_warm
+
+   !> TNNMG iterations on the finest grid from u until the fields returned (p, w, gap, s;
+   !> returned_fields) meet tol: where they miss it the iteration goes on to a smaller
+   !> tolerance, at most `tightenings` times. The outcome's counts.
+   subroutine finest_iterations(h, work, op, u, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, &
+         & outcome, history, progress)
+      type(hierarchy), intent(inout) :: h
+      type(workspace), intent(inout) :: work
+      type(compliance_operator), intent(inout) :: op
+      real(wp), contiguous, intent(inout) :: u(:)
+      real(wp), contiguous, intent(in) :: b(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure, g_ref, tol
+      real(wp), intent(inout) :: s
+      integer, intent(in) :: max_iter
+      real(wp), contiguous, intent(inout) :: p(:), w(:), gap(:)
+      type(multigrid_outcome), intent(inout) :: outcome
+      real(wp), contiguous, intent(inout) :: history(:)
+      type(progress_log), intent(inout) :: progress
+      real(wp) :: target
+      integer :: steps, tightened
+      logical :: converged
+      target = tol
+      tightened = 0
+      do
+         ! (w holds the obstacle until the fields are returned)
+         w = b
+         if (.not. load_control) w = w + s
+         call tnnmg(h, work, op, u, w, merge(mean_pressure, 0.0_wp, load_control), load_control, g_ref, target, &
+            & max_iter - outcome%iterations, p, steps, converged, history(outcome%iterations + 1:), progress)
+         outcome%iterations = outcome%iterations + steps
+         call returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, w, gap, s, outcome%residual)
+         h%pairs = h%pairs + 1.0_wp
+         if (outcome%iterations > 0) history(min(outcome%iterations, size(history))) = outcome%residual
+         if (outcome%residual <= tol .or. outcome%iterations >= max_iter .or. tightened == tightenings) exit
+         target = target*tightening
+         tightened = tightened + 1
+      end do
+      outcome%converged = outcome%residual <= tol
+      outcome%fft_pairs = nint(h%pairs)
+      outcome%vcycles = h%vcycles
+   end subroutine finest_iterations
 
    !> How many times a grid of nx x ny points (ny = 1: a line) halves along every axis
    !> longer than 1 while the result has at least `smallest` points (and at least
@@ -268,8 +361,8 @@ contains
       type(hierarchy), target :: h
       type(workspace) :: work
       real(wp), allocatable :: u(:)
-      real(wp) :: f, target
-      integer :: n, j, nested, m, mc, steps, tightened
+      real(wp) :: f
+      integer :: n, j, nested, m, mc, steps
       logical :: converged
 
       n = size(p)
@@ -298,26 +391,11 @@ contains
          call tnnmg(h, work, op, u(1:m), o(1:m), f, load_control, g_ref, tol, merge(max_iter, 1, j == nested), &
             & p(1:m), steps, converged)
       end do
+      end associate
 
       ! the finest grid, to tol on the fields returned
-      target = tol
-      tightened = 0
-      do
-         call obstacle(0, o)
-         call tnnmg(h, work, op, u, o, f, load_control, g_ref, target, max_iter - outcome%iterations, p, steps, &
-            & converged, history(outcome%iterations + 1:), progress)
-         outcome%iterations = outcome%iterations + steps
-         call returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, o, gap, s, outcome%residual)
-         h%pairs = h%pairs + 1.0_wp
-         if (outcome%iterations > 0) history(min(outcome%iterations, size(history))) = outcome%residual
-         if (outcome%residual <= tol .or. outcome%iterations >= max_iter .or. tightened == tightenings) exit
-         target = target*tightening
-         tightened = tightened + 1
-      end do
-      end associate
-      outcome%converged = outcome%residual <= tol
-      outcome%fft_pairs = nint(h%pairs)
-      outcome%vcycles = h%vcycles
+      call finest_iterations(h, work, op, u, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, &
+         & outcome, history, progress)
    contains
       !> o = the obstacle on the grid of every 2^j-th point: b there (plus s under
       !> displacement control)
