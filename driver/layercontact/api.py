@@ -247,15 +247,17 @@ def solve_line(
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
     and the surface stress ``stress_xx`` (one more FFT pair).
     ``method``: ``'auto'`` (the multigrid method for the frictionless elastic lines it
-    applies to from 4096 points on, constrained CG for other symmetric scenes, constrained
+    applies to from 4096 points on, and surfaces from 1024², constrained CG for other
+    symmetric scenes, constrained
     GCR for coupled ones, going on with its history kept across clips and then with
     Anderson if GCR stalls; a coupled line of 8192 points or more whose coarse-start solve
     needed more than 100 GCR iterations, i.e. broadband roughness, goes the way of
     ``'multigrid'`` below where that applies; grids of at most 2048 points that stall are finished by the
     dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'``,
     ``'newton'`` (dense semismooth Newton, grids of at most 2048 points) or ``'multigrid'``
-    (nonsmooth Newton multigrid: frictionless lines on an elastic half-space or a layer with
-    ``poisson <= 0.47``, or an incompressible one from ``thickness ~ 0.07 period``;
+    (nonsmooth Newton multigrid: frictionless lines and surfaces on an elastic half-space or
+    a layer with ``poisson <= 0.47``, or an incompressible one from ``thickness ~ 0.07
+    period``;
     ``iterations`` counts its fine-grid iterations; ``coarse_start`` and ``precondition``
     do not apply; on such a layer with friction, or sliding viscoelastic, the Anderson
     outer iteration with multigrid inner solves, from the coarse start, finished by GCR:
