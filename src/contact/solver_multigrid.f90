@@ -243,7 +243,8 @@ contains
 
    !> TNNMG iterations on the finest grid from u until the fields returned (p, w, gap, s;
    !> returned_fields) meet tol: where they miss it the iteration goes on to a smaller
-   !> tolerance, at most `tightenings` times. The outcome's counts.
+   !> tolerance, at most `tightenings` times and while the residual of the fields halves.
+   !> The outcome's counts.
    subroutine finest_iterations(h, work, op, u, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, &
          & outcome, history, progress)
       type(hierarchy), intent(inout) :: h
@@ -259,11 +260,12 @@ contains
       type(multigrid_outcome), intent(inout) :: outcome
       real(wp), contiguous, intent(inout) :: history(:)
       type(progress_log), intent(inout) :: progress
-      real(wp) :: target
+      real(wp) :: target, before
       integer :: steps, tightened
       logical :: converged
       target = tol
       tightened = 0
+      before = huge(1.0_wp)
       do
          ! (w holds the obstacle until the fields are returned)
          w = b
@@ -275,6 +277,10 @@ contains
          h%pairs = h%pairs + 1.0_wp
          if (outcome%iterations > 0) history(min(outcome%iterations, size(history))) = outcome%residual
          if (outcome%residual <= tol .or. outcome%iterations >= max_iter .or. tightened == tightenings) exit
+         ! (a residual that did not halve is the rescaling's, near the rounding floor: the
+         ! caller finishes)
+         if (outcome%residual > 0.5_wp*before) exit
+         before = outcome%residual
          target = target*tightening
          tightened = tightened + 1
       end do
