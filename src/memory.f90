@@ -40,18 +40,22 @@ contains
    !> Bytes a solve of `points` grid points needs: the fields, the multipliers, the FFT
    !> buffers and the solver's work arrays (doubles per point, bench/memory.py: 14.6 for a
    !> frictionless areal solve at 2048^2 by the constrained CG, 26.1 by the multigrid at
-   !> 1024^2, 30.3 for a coupled one with GCR's history of 12), plus the in-plane fields
-   !> of the stress observables.
-   pure integer(i8) function solve_bytes(points, coupled, memory, stress, multigrid) result(bytes)
+   !> 1024^2, 30.3 for a coupled one with GCR's history of 12; a line's multigrid 39, its
+   !> coarse grids halving only one axis), plus the in-plane fields of the stress
+   !> observables.
+   pure integer(i8) function solve_bytes(points, coupled, memory, stress, multigrid, line) result(bytes)
       integer, intent(in) :: points
       !> friction or a moving viscoelastic law: the GCR (or Anderson) history
       logical, intent(in) :: coupled
       integer, intent(in) :: memory   !< &solver memory (history length)
       logical, intent(in) :: stress
       logical, intent(in) :: multigrid   !< the multigrid solver and its coarse grids
+      logical, intent(in) :: line
       integer :: doubles
-      doubles = merge(27, 15, multigrid)
-      if (coupled) doubles = 6 + 2*max(memory, 1)
+      doubles = 15
+      if (multigrid) doubles = merge(40, 27, line)
+      ! (a coupled line's outer iteration holds its history and the multigrid's arrays)
+      if (coupled) doubles = 6 + 2*max(memory, 1) + merge(25, 0, multigrid)
       if (stress) doubles = doubles + 6
       bytes = 8_i8*doubles*points
    end function solve_bytes
@@ -89,13 +93,13 @@ contains
    end subroutine available_bytes
 
    !> Error code 5 if a solve of `points` grid points needs more than this process may use.
-   subroutine check_memory(points, coupled, memory, stress, multigrid, error)
+   subroutine check_memory(points, coupled, memory, stress, multigrid, line, error)
       integer, intent(in) :: points, memory
-      logical, intent(in) :: coupled, stress, multigrid
+      logical, intent(in) :: coupled, stress, multigrid, line
       type(error_type), allocatable, intent(out) :: error
       integer(i8) :: needed, available
       character(len=:), allocatable :: limit
-      needed = solve_bytes(points, coupled, memory, stress, multigrid)
+      needed = solve_bytes(points, coupled, memory, stress, multigrid, line)
       call available_bytes(available, limit)
       if (needed <= available) return
       call fatal_error(error, 'not enough memory: this scene (' // to_string(points) // ' grid points) needs about ' &

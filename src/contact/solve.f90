@@ -95,7 +95,7 @@ contains
       real(wp) :: pm, s, g_ref, lambda_max
       type(progress_log) :: progress
       integer(i8) :: start, finish, rate
-      logical :: load_control
+      logical :: load_control, may_multigrid
       integer :: n
 
       call system_clock(start, rate)
@@ -123,9 +123,15 @@ contains
       end if
       ! a grid too large for this machine (or job) ends here, with how much it needs (the
       ! multigrid's coarse grids if the scene may go to it: refusals need the operator)
+      if (kernel%coupled(friction)) then
+         may_multigrid = grid%is_line() .and. (scene%solver%method == 'multigrid' .or. &
+            & (scene%solver%method == 'auto' .and. n >= outer_multigrid_points))
+      else
+         may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
+            & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
+      end if
       call check_memory(n, kernel%coupled(friction), scene%solver%memory, scene%stress .and. grid%ny > 1, &
-         & .not. kernel%coupled(friction) .and. (scene%solver%method == 'multigrid' .or. (scene%solver%method == &
-         & 'auto' .and. n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))), error)
+         & may_multigrid, grid%is_line(), error)
       if (allocated(error)) return
       lambda_max = maxval(height)
       g_ref = maxval(height) - minval(height)

@@ -642,20 +642,20 @@ contains
    !> (S x)(i) = sum over (ex, ey) of s(ex, ey, i) x(i + (ex, ey)).
    pure subroutine subtract_stencil(s, x, r, nx, ny)
       integer, intent(in) :: nx, ny
-      real(wp), intent(in) :: s(-1:1, -1:1, 0:nx - 1, 0:ny - 1), x(0:nx - 1, 0:ny - 1)
+      real(wp), intent(in) :: s(-1:1, -min(ny - 1, 1):min(ny - 1, 1), 0:nx - 1, 0:ny - 1), x(0:nx - 1, 0:ny - 1)
       real(wp), intent(inout) :: r(0:nx - 1, 0:ny - 1)
       integer :: iy, ey, row
       do iy = 0, ny - 1
          do ey = merge(-1, 0, ny > 1), merge(1, 0, ny > 1)
             row = modulo(iy + ey, ny)
-            call subtract_row(s(:, :, :, iy), ey, x(:, row), r(:, iy), nx)
+            call subtract_row(s(:, :, :, iy), min(ny - 1, 1), ey, x(:, row), r(:, iy), nx)
          end do
       end do
    contains
       !> rr <- rr - the stencil's row ey applied to the row xr, periodic
-      pure subroutine subtract_row(a, ey, xr, rr, n)
-         integer, intent(in) :: n, ey
-         real(wp), intent(in) :: a(-1:1, -1:1, 0:n - 1), xr(0:n - 1)
+      pure subroutine subtract_row(a, reach, ey, xr, rr, n)
+         integer, intent(in) :: n, reach, ey
+         real(wp), intent(in) :: a(-1:1, -reach:reach, 0:n - 1), xr(0:n - 1)
          real(wp), intent(inout) :: rr(0:n - 1)
          integer :: i
          rr(0) = rr(0) - (a(-1, ey, 0)*xr(n - 1) + a(0, ey, 0)*xr(0) + a(1, ey, 0)*xr(1))
@@ -824,9 +824,10 @@ contains
       type(hierarchy), intent(out), target :: h
       type(compliance_operator), intent(inout), target :: op
       type(error_type), allocatable, intent(out) :: error
-      integer :: t, m, nx, ny
+      integer :: t, m, nx, ny, reach
       nx = op%grid%nx
       ny = op%grid%ny
+      reach = merge(1, 0, ny > 1)
       h%surface = ny > 1
       h%coarsest = halvings(nx, ny, coarsest_points)
       h%n_fine = nx*ny
@@ -849,7 +850,8 @@ contains
          end if
          allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier((lv%nx/2 + 1)*lv%ny))
          ! (the finest grid is never a coarse one of the V-cycle)
-         if (t > 0) allocate (lv%penalty(-1:1, -1:1, m), lv%jacobi(m), lv%rhs(m), lv%x(m), lv%residual(m))
+         ! (the stencil couples rows on a surface only)
+         if (t > 0) allocate (lv%penalty(-1:1, -reach:reach, m), lv%jacobi(m), lv%rhs(m), lv%x(m), lv%residual(m))
          if (h%surface .and. t < h%coarsest) allocate (lv%halfway(m/2))
          if (h%surface .and. t < h%coarsest) allocate (lv%window(-1:1, -1:1, lv%nx/2, -1:1))
          end associate
@@ -979,7 +981,7 @@ contains
          if (h%surface) then
             call coarsen_surface(h, t)
          else if (t == h%top + 1) then
-            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, c%penalty)
+            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, 0, c%penalty)
          else
             call coarsen_x(f%penalty, f%nx, 0, c%penalty)
          end if
@@ -1014,7 +1016,7 @@ contains
          do k = -1, 1
             row = modulo(2*cy + k, f%ny)
             if (t == h%top + 1) then
-               call galerkin_diagonal(h%free(row*nx + 1:(row + 1)*nx), penalty*f%circulant_diagonal, nx, &
+               call galerkin_diagonal(h%free(row*nx + 1:(row + 1)*nx), penalty*f%circulant_diagonal, nx, 1, &
                   & f%window(:, :, :, k))
             else
                call coarsen_x(f%penalty(:, :, row*nx + 1:(row + 1)*nx), nx, 1, f%window(:, :, :, k))
@@ -1027,11 +1029,11 @@ contains
 
    !> b = Px^T D Px for a row of nx points with the diagonal D = `weight` on the contact set
    !> (free = 0) and 0 off it, Px linear interpolation: the 3-point stencil (ey = 0) of the
-   !> row of nx/2 points.
-   pure subroutine galerkin_diagonal(free, weight, nx, b)
-      integer, intent(in) :: nx
+   !> row of nx/2 points, in a stencil array reaching `reach` rows (0 on a line).
+   pure subroutine galerkin_diagonal(free, weight, nx, reach, b)
+      integer, intent(in) :: nx, reach
       real(wp), intent(in) :: free(0:nx - 1), weight
-      real(wp), intent(out) :: b(-1:1, -1:1, 0:nx/2 - 1)
+      real(wp), intent(out) :: b(-1:1, -reach:reach, 0:nx/2 - 1)
       real(wp) :: left, centre, right
       integer :: cx
       b = 0.0_wp
@@ -1061,8 +1063,8 @@ contains
    !> (a surface), 0 on a line (ey = 0 only).
    pure subroutine coarsen_x(a, nx, reach, b)
       integer, intent(in) :: nx, reach
-      real(wp), intent(in) :: a(-1:1, -1:1, 0:nx - 1)
-      real(wp), intent(out) :: b(-1:1, -1:1, 0:nx/2 - 1)
+      real(wp), intent(in) :: a(-1:1, -reach:reach, 0:nx - 1)
+      real(wp), intent(out) :: b(-1:1, -reach:reach, 0:nx/2 - 1)
       integer :: to(2, -2:2), cx, k, e, ix, j
       real(wp) :: of(2, -2:2)
       call interpolation_weights(to, of)
@@ -1131,7 +1133,7 @@ contains
          do i = 1, m
             ix = mod(i - 1, lv%nx)
             iy = (i - 1)/lv%nx
-            do ey = -1, 1
+            do ey = lbound(lv%penalty, 2), ubound(lv%penalty, 2)
                do ex = -1, 1
                   if (lv%penalty(ex, ey, i) == 0.0_wp) cycle
                   j = modulo(ix + ex, lv%nx) + lv%nx*modulo(iy + ey, lv%ny) + 1
