@@ -1,6 +1,7 @@
-"""The multigrid solver (&solver method = 'multigrid', src/contact/solver_multigrid.f90)
-against the constrained CG, Westergaard's closed form and its own contact conditions, and
-its refusal of the scenes it does not solve."""
+"""The multigrid solver (&solver method = 'multigrid', src/contact/solver_multigrid.f90) on
+lines and surfaces against the constrained CG and its own contact conditions recomputed with
+numpy, coupled lines by the outer iteration with multigrid inner solves against GCR, the
+choice of method 'auto', and the refusal of the scenes it does not solve."""
 
 import numpy as np
 import pytest

@@ -42,10 +42,11 @@ module lc_contact_solve
    !> Under method 'auto' the multigrid solver takes the frictionless elastic scenes it
    !> applies to (multigrid_refusal) from this many points on, lines and surfaces
    !> (bench/scaling.py --scenes 1 --method multigrid --against cg, tol 1e-8): on lines
-   !> from 4096 points, where the constrained CG takes 1.35-3.4x its time on broadband
-   !> roughness (5.6-15x at 65536) and 0.74-0.91x on a spectrum fixed in physical
-   !> wavenumbers; on surfaces from 1024^2, where the CG takes 1.4-2.2x its time broadband
-   !> and 1.2x physical (at 512^2 0.75-1.36x: a multigrid pair costs 2-3x a CG pair there).
+   !> from 4096 points, where the constrained CG takes 1.1-3.4x its time on broadband
+   !> roughness (4.6-8.6x at 65536) and 0.6-0.8x on a spectrum fixed in physical
+   !> wavenumbers; on surfaces from 1024^2, where the CG takes 1.5-2.3x its time broadband
+   !> (2.1-3.4x at 2048^2) and 1.2x physical (at 512^2 0.8-1.3x: a multigrid pair costs
+   !> 2-3x a CG pair there). docs/decisions/011-multigrid-for-surfaces.md.
    integer, parameter :: multigrid_points = 4096, multigrid_surface_points = 1024**2
    !> Method 'multigrid' on a coupled line: the Anderson iteration with multigrid inner solves
    !> goes to this tolerance (or the scene's, if looser), GCR from there to the scene's

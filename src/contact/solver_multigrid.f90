@@ -1,7 +1,8 @@
 !> Truncated nonsmooth Newton multigrid (TNNMG) for the frictionless contact of a line or a
-!> surface on an elastic half-space or layer: Graeser and Kornhuber, "Multigrid methods for obstacle
-!> problems" (J. Comput. Math., 2009), and "Nonsmooth Newton methods for set-valued saddle
-!> point problems" (SIAM J. Numer. Anal., 2009).
+!> surface on an elastic half-space or layer: Graeser and Kornhuber, "Multigrid methods for
+!> obstacle problems" (J. Comput. Math., 2009), and "Nonsmooth Newton methods for set-valued
+!> saddle point problems" (SIAM J. Numer. Anal., 2009). multigrid_warm solves the symmetric
+!> inner problems of the outer iteration on coupled lines (lc_contact_solver_anderson).
 !>
 !> Displacement form. With the stiffness K = 1/M (the inverse of the operator's real normal
 !> compliance, mode by mode) and u the surface displacement seen from the rigid profile's
@@ -14,22 +15,25 @@
 !>
 !> One iteration on a grid: a projected damped Jacobi step (it releases every contact point
 !> that carries tension at once, and lowers J); the truncated Newton problem K_II c_I = -p_I
-!> (c = 0 on the contact set A), solved inexactly by at most two CG iterations preconditioned
-!> by a V-cycle; the direction projected onto u >= o and an exact line search (J is
+!> (c = 0 on the contact set A), solved inexactly by at most two preconditioned CG
+!> iterations; the direction projected onto u >= o and an exact line search (J is
 !> quadratic). Both steps lower J, hence global convergence; the Newton step finds the
 !> contact set in few iterations. Once the set has settled, a finishing CG phase solves the
-!> linear problem on it and checks the complementarity residual at every iteration.
+!> linear problem on it and checks the complementarity residual at every iteration (going
+!> on as a Newton step if a point leaves the set).
 !>
-!> V-cycle (for K_II): linear interpolation P (bilinear on a surface: both axes are halved),
-!> restriction P^T; on the grid being solved the exactly truncated operator I K I (one
-!> transform pair), on the coarser ones the Galerkin product of the penalised operator
-!> K + d D_A (D_A the indicator of the contact set, d the diagonal of K): a Galerkin
-!> circulant (a transform on the coarse grid; its symbol does not depend on the contact set)
-!> plus a 3-point (line) or 9-point (surface) stencil rebuilt in O(n) when the set changes.
-!> The penalty stands in for the truncated Galerkin operator P^T I K I P, whose application
-!> would cost a transform of the finest grid. Damped Jacobi smoothing; a dense Cholesky
-!> solve on the coarsest grid (at most coarsest_limit points). The Newton direction needs
-!> only to be a descent direction, which is what lets the coarse operators be this cheap.
+!> The CG's preconditioner: a damped Jacobi step on the free points plus the coarse
+!> correction I P V P^T I, added (no transform on the grid being solved), V a V(1,1)-cycle
+!> on the coarser grids. Linear interpolation P (bilinear on a surface: every axis longer
+!> than one is halved), restriction P^T; the coarse operators are the Galerkin products of
+!> the penalised operator K + d D_A (D_A the indicator of the contact set, d the diagonal of
+!> K): a Galerkin circulant (a transform on the coarse grid; its symbol does not depend on
+!> the contact set) plus a 3-point (line) or 9-point (surface) stencil rebuilt in O(n) when
+!> the set changes. The penalty stands in for the truncated Galerkin operator P^T I K I P,
+!> whose application would cost a transform of the finest grid. Damped Jacobi smoothing; a
+!> dense Cholesky solve on the coarsest grid (at most coarsest_limit points). The Newton
+!> direction needs only to be a descent direction, which is what lets the coarse operators
+!> be this cheap.
 !>
 !> Nested iteration: the solve starts on the grid of every 2^J-th point (the coarsest of at
 !> least nested_coarsest points), solved to tol from u = o; each finer grid starts from the
@@ -105,7 +109,7 @@ module lc_contact_solver_multigrid
       integer :: iterations = 0
       integer :: fft_pairs = 0
       real(wp) :: residual = huge(1.0_wp)
-      integer :: vcycles = 0   !< V-cycles started on the grid being solved, all grids
+      integer :: vcycles = 0   !< preconditioner applications (each a V-cycle of the coarser grids)
    end type multigrid_outcome
 
    !> One grid of nx/2^t x ny/2^t points (ny = 1 on a line): its plan, the operator on it
@@ -131,9 +135,8 @@ module lc_contact_solver_multigrid
    end type grid_level
 
    !> The grids of every 2^t-th point, t = 0..coarsest (one plan per size, shared by the
-   !> nested grids), the
-   !> grid being solved (`top`: its operator is I K I, the coarser ones are the V-cycle's)
-   !> and the transform count.
+   !> nested grids), the grid being solved (`top`: its operator is I K I, the coarser ones
+   !> are the V-cycle's) and the transform count.
    type :: hierarchy
       type(grid_level), allocatable :: level(:)
       integer :: top = 0, coarsest = 0, n_fine = 0
@@ -516,7 +519,7 @@ contains
    end subroutine tnnmg
 
    !> CG on the truncated Newton problem I K I c = -I p (c = 0 on the contact set),
-   !> preconditioned by the V-cycle, from c = 0; kc = K c (carried along at no cost).
+   !> preconditioned (precondition, below), from c = 0; kc = K c (carried along at no cost).
    !> work(:, 1:3): the residual, the direction and its image. Without `scales`: at most
    !> max_steps iterations, or until the residual fell by `reduction`. With them (the
    !> finishing phase): after every iteration the complementarity residual of
@@ -551,7 +554,7 @@ contains
       call precondition(r, d)
       rz = dot_product(r, d)
       do it = 1, max_steps
-         ! (d is zero on the contact set, as the V-cycle's output: d.I K d = d.K d)
+         ! (d is zero on the contact set, as the preconditioner's output: d.I K d = d.K d)
          call apply_stiffness(h, d, kd, xy=dkd)
          if (.not. dkd > 0.0_wp) exit
          a = rz/dkd
