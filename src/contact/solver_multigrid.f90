@@ -1068,8 +1068,8 @@ contains
       integer, intent(in) :: nx, reach
       real(wp), intent(in) :: a(-1:1, -reach:reach, 0:nx - 1)
       real(wp), intent(out) :: b(-1:1, -reach:reach, 0:nx/2 - 1)
-      integer :: to(2, -2:2), cx, k, e, ix, j
-      real(wp) :: of(2, -2:2)
+      integer :: to(2, -2:2), cx, k, e, ix, j, ey
+      real(wp) :: of(2, -2:2), w
       call interpolation_weights(to, of)
       b = 0.0_wp
       do cx = 0, nx/2 - 1
@@ -1077,8 +1077,11 @@ contains
             ix = modulo(2*cx + k, nx)
             do e = -1, 1
                do j = 1, 2
-                  b(to(j, k + e), -reach:reach, cx) = b(to(j, k + e), -reach:reach, cx) &
-                     & + (of(1, k)*of(j, k + e))*a(e, -reach:reach, ix)
+                  w = of(1, k)*of(j, k + e)
+                  if (w == 0.0_wp) cycle
+                  do ey = -reach, reach
+                     b(to(j, k + e), ey, cx) = b(to(j, k + e), ey, cx) + w*a(e, ey, ix)
+                  end do
                end do
             end do
          end do
