@@ -67,12 +67,15 @@ module lc_result
       !> CG or GCR iterations (all inner CG solves for anderson; fine-grid ones for multigrid)
       integer :: iterations = 0
       integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for cg and gcr
-      !> the solver that ran: 'cg', 'gcr', 'anderson', 'gfmd', 'newton', 'multigrid', 'gcr+kept'
+      !> the solver that ran: 'cg', 'gcr', 'anderson', 'gfmd', 'newton', 'multigrid',
+      !> 'multigrid+cg' (the CG finished the multigrid's fields), 'anderson+multigrid' (a
+      !> coupled line's outer iteration; '+gcr', '+anderson+multigrid' appended as in
+      !> solve.f90's coupled_multigrid), 'gcr+kept'
       !> (gcr stalled and went on keeping its history across clips) or 'gcr+kept+anderson' (that
       !> stalled too and the Anderson outer iteration went on from its best iterate);
       !> '+newton' when the dense Newton method finished a small grid the iterative solver
       !> left unconverged
-      character(len=24) :: solver = ''
+      character(len=48) :: solver = ''
       integer :: fft_pairs = 0                !< FFT r2c+c2r pairs spent
       real(wp) :: residual = huge(1.0_wp)     !< final dimensionless complementarity residual
       !> an upper bound of the rounding of w - r relative to the profile's peak-to-valley:
@@ -92,7 +95,7 @@ module lc_result
       character(len=8) :: unit = '1'
       logical :: is_integer = .false.
       logical :: is_text = .false.
-      character(len=24) :: text = ''
+      character(len=48) :: text = ''
    end type result_scalar
 
 contains

@@ -131,9 +131,11 @@ class LineResult:
     (``spot_max_tension_grid``) is the largest grid value.
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
     ``solver`` names the method that ran: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled
-    scenes), ``'anderson'``, ``'multigrid'``, ``'anderson+multigrid'`` (method ``'multigrid'`` on a
-    coupled line; ``'+gcr'`` when GCR finished it, ``'+gcr+anderson+multigrid'`` when the
-    outer iteration went on after GCR), ``'gcr+kept'`` (GCR stalled and went on from its
+    scenes), ``'anderson'``, ``'multigrid'``, ``'multigrid+cg'`` (the constrained CG finished
+    fields the multigrid left just above a tolerance near the rounding floor),
+    ``'anderson+multigrid'`` (method ``'multigrid'`` on a coupled line; ``'+gcr'`` when GCR
+    finished it, ``'+gcr+anderson+multigrid'`` when the outer iteration went on after GCR),
+    ``'gcr+kept'`` (GCR stalled and went on from its
     best iterate keeping its history across clips) or ``'gcr+kept+anderson'`` (that stalled
     too and the Anderson outer iteration went on); ``'+newton'`` is appended when the dense
     Newton method finished a grid of at most 2048 points that the iterative solver left
@@ -248,20 +250,19 @@ def solve_line(
     and the surface stress ``stress_xx`` (one more FFT pair).
     ``method``: ``'auto'`` (the multigrid method for the frictionless elastic lines it
     applies to from 4096 points on, and surfaces from 1024², constrained CG for other
-    symmetric scenes, constrained
-    GCR for coupled ones, going on with its history kept across clips and then with
-    Anderson if GCR stalls; a coupled line of 8192 points or more whose coarse-start solve
-    needed more than 100 GCR iterations, i.e. broadband roughness, goes the way of
-    ``'multigrid'`` below where that applies; grids of at most 2048 points that stall are finished by the
-    dense Newton method), ``'cg'``, ``'gcr'``, ``'anderson'``, ``'gfmd'``,
-    ``'newton'`` (dense semismooth Newton, grids of at most 2048 points) or ``'multigrid'``
-    (nonsmooth Newton multigrid: frictionless lines and surfaces on an elastic half-space or
-    a layer with ``poisson <= 0.47``, or an incompressible one from ``thickness ~ 0.07
-    period``;
-    ``iterations`` counts its fine-grid iterations; ``coarse_start`` and ``precondition``
-    do not apply; on such a layer with friction, or sliding viscoelastic, the Anderson
-    outer iteration with multigrid inner solves, from the coarse start, finished by GCR:
-    transform pairs that do not grow with ``n`` on broadband lines). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
+    symmetric scenes, constrained GCR for coupled ones, going on with its history kept
+    across clips and then with Anderson if GCR stalls; a coupled line of 8192 points or
+    more whose coarse-start solve needed more than 100 GCR iterations, i.e. broadband
+    roughness, goes the way of ``'multigrid'`` below where that applies; grids of at most
+    2048 points that stall are finished by the dense Newton method), ``'cg'``, ``'gcr'``,
+    ``'anderson'``, ``'gfmd'``, ``'newton'`` (dense semismooth Newton, grids of at most 2048
+    points) or ``'multigrid'`` (nonsmooth Newton multigrid: frictionless lines and surfaces
+    on an elastic half-space or a layer with ``poisson <= 0.47``, or an incompressible one
+    from ``thickness ~ 0.07 period``; ``iterations`` counts its fine-grid iterations;
+    ``coarse_start`` and ``precondition`` do not apply; on such a line with friction, or
+    sliding viscoelastic, the Anderson outer iteration with multigrid inner solves, from the
+    coarse start, finished by GCR: transform pairs that do not grow with ``n`` on broadband
+    lines). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
     in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard
