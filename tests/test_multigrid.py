@@ -116,7 +116,7 @@ def test_coupled_lines_agree_with_gcr(n, family, scene):
     assert np.abs(mg.pressure - gcr.pressure).max() <= bound
     assert mg.mean_pressure == pytest.approx(gcr.mean_pressure, rel=1e-10)
     assert mg.penetration == pytest.approx(gcr.penetration, abs=(TOL + TOL_GCR) * np.ptp(h))
-    # measured at tol 1e-8 from n = 1024 to 2^20: 131-265 pairs (friction) and 641-803
+    # measured at tol 1e-8 from n = 1024 to 2^20: 144-261 pairs (friction) and 555-717
     # (viscoelastic) on broadband lines; tol 1e-10 here
     assert mg.fft_pairs <= 1500
 
@@ -171,7 +171,7 @@ def test_surface_agrees_with_constrained_cg(nx, ny, lx, ly, thickness, poisson, 
     """Surfaces: the CG's fixed point to the bound the two tolerances allow (their sum,
     times ptp(h), times the largest stiffness 1/|G_eff| on the grid, from the closed-form
     tensor of areal_reference.py), the same contact set and penetration, in a few
-    iterations (measured: 3-4 and 45-48 pairs)."""
+    iterations (measured: 3-4 iterations and 34-40 pairs)."""
     h = surface(nx, ny, lx, ly)
     loads = {"load": dict(mean_pressure=0.0125 * E_STAR), "displacement": dict(penetration=0.4 * np.ptp(h))}
     kw = dict(period=(lx, ly), thickness=thickness, poisson=poisson, stress=False, **loads[control])
@@ -206,9 +206,9 @@ def test_surface_contact_conditions_hold(n):
 
 def test_auto_takes_the_multigrid_for_surfaces_from_1024_squared():
     """Method 'auto' sends frictionless surfaces of 1024^2 points and more to the multigrid
-    solver (where it is 1.2-2.9x faster than the constrained CG, bench/scaling.py --against
+    solver (where it is 1.2-3.4x faster than the constrained CG, bench/scaling.py --against
     cg), smaller ones and coupled ones elsewhere. A broadband 1024^2 surface: measured 5
-    iterations, 38 transform pairs (the CG needs 129)."""
+    iterations, 40 transform pairs (the CG needs 129)."""
     big = surface(1024, 1024)
     res = lc.solve_areal(big, mean_pressure=0.0125 * E_STAR, tol=1e-8, stress=False)
     assert res.converged and res.solver == "multigrid"
