@@ -19,7 +19,7 @@ module lc_contact_solver_anderson
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome, complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
-   use lc_contact_solver_multigrid, only: multigrid, multigrid_warm, multigrid_outcome
+   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome
    implicit none (type, external)
    private
    public :: anderson_coupled, anderson_outcome
@@ -116,13 +116,9 @@ contains
          b = r - nw
          tx = p   ! warm start from the previous output of T
          if (use_multigrid) then
-            if (k == 1 .and. .not. warm) then
-               call multigrid(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
-                  & max_iter - outcome%cg_iterations, tx, w, gap, nested, inner_history, quiet, error)
-            else
-               call multigrid_warm(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
-                  & max_iter - outcome%cg_iterations, tx, w, gap, nested, inner_history, quiet, error)
-            end if
+            call multigrid(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
+               & max_iter - outcome%cg_iterations, tx, w, gap, nested, inner_history, quiet, error, &
+               & warm=k > 1 .or. warm)
             if (allocated(error)) return
             outcome%cg_iterations = outcome%cg_iterations + nested%iterations
             outcome%fft_pairs = outcome%fft_pairs + nested%fft_pairs + 2

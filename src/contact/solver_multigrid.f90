@@ -1,8 +1,9 @@
 !> Truncated nonsmooth Newton multigrid (TNNMG) for the frictionless contact of a line or a
 !> surface on an elastic half-space or layer: Graeser and Kornhuber, "Multigrid methods for
 !> obstacle problems" (J. Comput. Math., 2009), and "Nonsmooth Newton methods for set-valued
-!> saddle point problems" (SIAM J. Numer. Anal., 2009). multigrid_warm solves the symmetric
-!> inner problems of the outer iteration on coupled lines (lc_contact_solver_anderson).
+!> saddle point problems" (SIAM J. Numer. Anal., 2009). Warm-started (multigrid's `warm`)
+!> it solves the symmetric inner problems of the outer iteration on coupled lines
+!> (lc_contact_solver_anderson).
 !>
 !> Displacement form. With the stiffness K = 1/M (the inverse of the operator's real normal
 !> compliance, mode by mode) and u the surface displacement seen from the rigid profile's
@@ -57,7 +58,7 @@ module lc_contact_solver_multigrid
    use lc_contact_progress, only: progress_log
    implicit none (type, external)
    private
-   public :: multigrid, multigrid_warm, multigrid_outcome, multigrid_refusal, metric_refusal
+   public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
    !> step lowers the energy monotonically; 2/3 damps the upper half of the spectrum best.
@@ -204,46 +205,6 @@ contains
       end if
    end function metric_refusal
 
-   !> The symmetric problem with the operator's metric M (as multigrid), iterated on the
-   !> finest grid only from the pressure p given on entry (its displacement M p, less, under
-   !> load control, the mean of M p - b over p's contact set), without the nested iteration:
-   !> for a sequence of problems whose solutions are close (the inner solves of an outer
-   !> iteration). s: in the given constant (displacement control); out as multigrid.
-   subroutine multigrid_warm(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
-         & history, progress, error)
-      type(compliance_operator), intent(inout), target :: op
-      real(wp), contiguous, intent(in) :: b(:)
-      logical, intent(in) :: load_control
-      real(wp), intent(in) :: mean_pressure
-      real(wp), intent(inout) :: s
-      real(wp), intent(in) :: g_ref, tol
-      integer, intent(in) :: max_iter
-      real(wp), contiguous, intent(inout) :: p(:)
-      real(wp), contiguous, intent(out) :: w(:), gap(:)
-      type(multigrid_outcome), intent(out) :: outcome
-      real(wp), contiguous, intent(inout) :: history(:)
-      type(progress_log), intent(inout) :: progress
-      type(error_type), allocatable, intent(out) :: error
-      type(hierarchy), target :: h
-      type(workspace) :: work
-      real(wp), allocatable :: u(:)
-      integer :: n
-
-      n = size(p)
-      call build_hierarchy(h, op, error)
-      if (allocated(error)) return
-      allocate (u(n), work%c(n), work%kc(n), work%cg(n, 3))
-      call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
-      call op%apply_metric(p, u)
-      h%pairs = h%pairs + 1.0_wp
-      ! (the gap of p is zero on its contact set; the constant is not taken from the caller,
-      ! whose s may hold the uniform mode's shift)
-      if (load_control .and. any(p > 0.0_wp)) s = sum(u - b, mask=p > 0.0_wp)/count(p > 0.0_wp)
-      if (load_control) u = u - s
-      call finest_iterations(h, work, op, u, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, &
-         & outcome, history, progress)
-   end subroutine multigrid_warm
-
    !> TNNMG iterations on the finest grid from u until the fields returned (p, w, gap, s;
    !> returned_fields) meet tol: where they miss it the iteration goes on to a smaller
    !> tolerance, at most `tightenings` times and while the residual of the fields halves.
@@ -349,11 +310,15 @@ contains
 
    !> Solve the frictionless contact of a line or surface: w = M p, gap = w - b - s >= 0, p >= 0,
    !> p gap = 0, under load control (mean(p) = p_m, s found) or displacement control (s
-   !> given). p: out the solution (the guess on entry is not used: the nested iteration makes
-   !> its own); w = M p; gap. history(1:outcome%iterations) receives the residual of each
-   !> fine-grid iteration. The scene must pass multigrid_refusal.
+   !> given). p: out the solution; on entry not used (the nested iteration makes its own
+   !> start), or with `warm` the start: its displacement M p (less, under load control, the
+   !> mean of M p - b over p's contact set), iterated on the finest grid only, for a sequence
+   !> of problems whose solutions are close (the inner solves of an outer iteration on a
+   !> coupled line, whose metric M = |G_eff| passed metric_refusal). w = M p; gap.
+   !> history(1:outcome%iterations) receives the residual of each fine-grid iteration. The
+   !> scene must pass multigrid_refusal (or, warm, metric_refusal).
    subroutine multigrid(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, history, &
-         & progress, error)
+         & progress, error, warm)
       type(compliance_operator), intent(inout), target :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -367,6 +332,7 @@ contains
       real(wp), contiguous, intent(inout) :: history(:)
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: warm
       type(hierarchy), target :: h
       type(workspace) :: work
       real(wp), allocatable :: u(:)
@@ -379,6 +345,20 @@ contains
       if (allocated(error)) return
       allocate (u(n), work%c(n), work%kc(n), work%cg(n, 3))
       f = merge(mean_pressure, 0.0_wp, load_control)
+      if (present(warm)) then
+         if (warm) then
+            call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
+            call op%apply_metric(p, u)
+            h%pairs = h%pairs + 1.0_wp
+            ! (the gap of p is zero on its contact set; the constant is not taken from the
+            ! caller, whose s may hold the uniform mode's shift)
+            if (load_control .and. any(p > 0.0_wp)) s = sum(u - b, mask=p > 0.0_wp)/count(p > 0.0_wp)
+            if (load_control) u = u - s
+            call finest_iterations(h, work, op, u, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, &
+               & gap, outcome, history, progress)
+            return
+         end if
+      end if
 
       ! (until the fields are returned w holds the obstacle o of the grid being solved, and
       ! gap is scratch)
