@@ -184,9 +184,12 @@ contains
       type(compliance_operator), intent(in) :: op
       character(len=:), allocatable :: reason
       integer :: m, k
+      real(wp) :: rise
       reason = ''
-      if (.not. op%metric_falls .and. compliance_rise(op) > allowed_rise) then
-         reason = 'the compliance rises with |q| over the grid by a factor ' // formatted(compliance_rise(op), &
+      rise = 1.0_wp
+      if (.not. op%metric_falls) rise = compliance_rise(op)
+      if (rise > allowed_rise) then
+         reason = 'the compliance rises with |q| over the grid by a factor ' // formatted(rise, &
             & '(f0.1)') // ' (a thin, nearly incompressible layer; pointwise smoothing needs at most ' // &
             & formatted(allowed_rise, '(f0.1)') // ')'
       else
