@@ -22,7 +22,7 @@ module lc_contact_solve
    use lc_contact_solver_gcr, only: constrained_gcr, gcr_outcome
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
-   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal
+   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_tnnmg
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -406,6 +406,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(anderson_outcome) :: outer
       type(gcr_outcome) :: gcr
+      type(multigrid_outcome) :: nested
+      character(len=16) :: env
+      integer :: stat
       real(wp) :: tol
       integer :: max_iter, memory
       logical :: precondition
@@ -414,6 +417,15 @@ contains
       max_iter = scene%solver%max_iter
       memory = scene%solver%memory
       precondition = scene%solver%precondition
+      call get_environment_variable('LC_CTNNMG', env, status=stat)
+      if (stat == 0) then
+         call coupled_tnnmg(op, height, load_control, pm, s, g_ref, tol, max_iter, p, w, gap, nested, history, &
+            & progress, error)
+         if (allocated(error)) return
+         call record_solve(result, 'tnnmg', nested%converged, nested%iterations, 1, nested%fft_pairs, &
+            & nested%residual, history(1:min(nested%iterations, size(history))))
+         return
+      end if
       call anderson_coupled(op, height, load_control, pm, s, g_ref, max(tol, polish_tol), max_iter, memory, &
          & precondition, p, w, gap, outer, history, error, progress, inner_multigrid=.true., warm_start=warm)
       if (allocated(error)) return

@@ -58,7 +58,7 @@ module lc_contact_solver_multigrid
    use lc_contact_progress, only: progress_log
    implicit none (type, external)
    private
-   public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal
+   public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_tnnmg
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
    !> step lowers the energy monotonically; 2/3 damps the upper half of the spectrum best.
@@ -101,6 +101,9 @@ module lc_contact_solver_multigrid
    !> smaller, at most `tightenings` times.
    real(wp), parameter :: tightening = 0.1_wp
    integer, parameter :: tightenings = 3
+   !> coupled_tnnmg: directions kept by the GCR on the truncated Newton problem (restarted
+   !> when full).
+   integer, parameter :: gcr_memory = 20
 
    !> What one multigrid solve did. `iterations` counts the TNNMG iterations on the finest
    !> grid (a finishing CG phase counts as one); `fft_pairs` every transform pair on every
@@ -399,6 +402,198 @@ contains
       end subroutine obstacle
    end subroutine multigrid
 
+   !> Coupled contact (friction, or a sliding viscoelastic layer) in the displacement form
+   !> with the non-symmetric stiffness K = 1/G_eff: u >= o, p = K u + f >= 0, p (u - o) = 0.
+   !> The TNNMG iteration of the symmetric solver with K in place of the symmetric stiffness:
+   !> projected damped Jacobi (d the real-space diagonal of K), the truncated Newton problem
+   !> I K I c = -I p by GCR right-preconditioned by the symmetric multigrid preconditioner of
+   !> the metric |G_eff| (the hierarchy's, whose penalty stands for the contact set), the
+   !> direction projected onto u >= o and its step from the quadratic model of the symmetric
+   !> part. p: in, the start (the coarse start's interpolated solution, or the caller's
+   !> guess); out, the solution. The metric must pass metric_refusal.
+   subroutine coupled_tnnmg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
+         & history, progress, error)
+      type(compliance_operator), intent(inout), target :: op
+      real(wp), contiguous, intent(in) :: b(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure
+      real(wp), intent(inout) :: s
+      real(wp), intent(in) :: g_ref, tol
+      integer, intent(in) :: max_iter
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(out) :: w(:), gap(:)
+      type(multigrid_outcome), intent(out) :: outcome
+      real(wp), contiguous, intent(inout) :: history(:)
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(hierarchy), target :: h
+      type(residual_scales) :: scales
+      real(wp), allocatable :: u(:), o(:), c(:), kc(:), v(:), kv(:), dirs(:, :), kdirs(:, :), r(:)
+      real(wp) :: f, d, b_max, residual, contact, vkv, alpha
+      integer :: n, step, changed, j
+      logical :: settled, finished, clipped, tension
+
+      n = size(p)
+      call build_hierarchy(h, op, error)
+      if (allocated(error)) return
+      call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
+      call op%prepare_gcr()
+      d = op%inverse_diagonal
+      allocate (u(n), o(n), c(n), kc(n), v(n), kv(n), r(n), dirs(n, gcr_memory), kdirs(n, gcr_memory))
+      f = merge(mean_pressure, 0.0_wp, load_control)
+      o = b
+      if (.not. load_control) o = o + s
+      b_max = maxval(abs(o))
+      ! the start: u = G p, less (load control) the mean of G p - b over p's contact set
+      call op%apply_full(p, u)
+      h%pairs = h%pairs + 1.0_wp
+      if (load_control .and. any(p > 0.0_wp)) then
+         s = sum(u - b, mask=p > 0.0_wp)/count(p > 0.0_wp)
+         u = u - s
+      end if
+      u = max(u, o)
+      call apply_k(u, p)
+      h%free = 1.0_wp
+      outcome%iterations = 0
+      do step = 1, max_iter
+         outcome%iterations = step
+         u = max(o, u - (omega/d)*p)
+         call apply_k(u, p)
+         scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest)
+         call examine(u, p, o, scales, h%free, residual, contact, changed, tension)
+         if (step <= size(history)) history(step) = residual
+         call progress%tick(step, residual, contact)
+         if (residual <= tol) exit
+         if (load_control .and. contact == 0.0_wp) then
+            u = u - minval(u - o)
+            cycle
+         end if
+         settled = step > 1 .and. changed <= settled_fraction*contact*n .and. .not. tension
+         if (changed > 0 .or. step == 1) call set_contact(h)
+         finished = .false.
+         if (settled) then
+            call truncated_gcr(finish_iterations, 0.0_wp, .true.)
+         else
+            call truncated_gcr(newton_iterations, newton_reduction, .false.)
+         end if
+         if (finished) then
+            u = u + c
+            p = p + kc
+            if (step <= size(history)) history(step) = residual
+            exit
+         end if
+         clipped = .false.
+         do j = 1, n
+            v(j) = c(j)
+            if (u(j) + c(j) < o(j)) then
+               v(j) = o(j) - u(j)
+               clipped = .true.
+            end if
+         end do
+         if (clipped) then
+            call apply_k(v, kv, shift=0.0_wp)
+         else
+            kv = kc
+         end if
+         vkv = dot_product(v, kv)
+         if (.not. vkv > 0.0_wp) cycle
+         alpha = min(1.0_wp, max(0.0_wp, -dot_product(p, v)/vkv))
+         u = u + alpha*v
+         p = p + alpha*kv
+      end do
+      ! the fields: p where it is the larger term of the residual, w = G p
+      w = o
+      call returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, w, gap, s, outcome%residual, full=.true.)
+      h%pairs = h%pairs + 1.0_wp
+      outcome%converged = outcome%residual <= tol
+      outcome%fft_pairs = nint(h%pairs)
+      outcome%vcycles = h%vcycles
+   contains
+      !> y = K x + shift (f by default): a transform pair of the finest grid
+      subroutine apply_k(x, y, shift)
+         real(wp), contiguous, intent(in) :: x(:)
+         real(wp), contiguous, intent(out) :: y(:)
+         real(wp), intent(in), optional :: shift
+         real(wp), pointer, contiguous :: buffer(:)
+         buffer => op%buffer()
+         buffer = x
+         call op%inverse_full_in_buffer()
+         if (present(shift)) then
+            y = buffer + shift
+         else
+            y = buffer + f
+         end if
+         h%pairs = h%pairs + 1.0_wp
+      end subroutine apply_k
+
+      !> GCR on I K I c = -I p from c = 0 (kc = K c), right-preconditioned by the multigrid
+      !> preconditioner, restarted every gcr_memory iterations; at most max_steps
+      !> iterations or a residual reduced by `reduction`. check: after every iteration the
+      !> complementarity residual of (u + c, p + kc); `finished` when it is at most tol;
+      !> once a point leaves the feasible set the checks stop and c is iterated as a Newton
+      !> step to a residual reduced by violated_reduction.
+      subroutine truncated_gcr(max_steps, reduction, check)
+         integer, intent(in) :: max_steps
+         real(wp), intent(in) :: reduction
+         logical, intent(in) :: check
+         real(wp) :: b_norm, r_norm, beta, norm, gamma, res, g, pt, bad
+         integer :: it, k, columns, jj
+         logical :: gone
+         c = 0.0_wp
+         kc = 0.0_wp
+         r = -h%free*p
+         b_norm = norm2(r)
+         if (b_norm == 0.0_wp) return
+         columns = 0
+         gone = .false.
+         do it = 1, max_steps
+            if (columns == gcr_memory) columns = 0
+            columns = columns + 1
+            associate (z => dirs(:, columns), kz => kdirs(:, columns))
+            call precondition(h, r, z)
+            call apply_k(z, kz, shift=0.0_wp)
+            ! orthogonal on the free points to the stored images
+            do k = 1, columns - 1
+               beta = sum(h%free*kz*kdirs(:, k))
+               z = z - beta*dirs(:, k)
+               kz = kz - beta*kdirs(:, k)
+            end do
+            norm = sqrt(sum(h%free*kz**2))
+            if (.not. norm > 0.0_wp) exit
+            z = z/norm
+            kz = kz/norm
+            gamma = sum(r*kz*h%free)
+            c = c + gamma*z
+            kc = kc + gamma*kz
+            r = r - gamma*h%free*kz
+            end associate
+            r_norm = norm2(r)
+            if (check .and. .not. gone) then
+               res = 0.0_wp
+               bad = 0.0_wp
+               do jj = 1, n
+                  g = u(jj) + c(jj) - o(jj)
+                  pt = p(jj) + kc(jj)
+                  if ((h%free(jj) > 0.0_wp .and. g < 0.0_wp) .or. (h%free(jj) == 0.0_wp .and. pt < 0.0_wp)) &
+                     & bad = bad + 1.0_wp
+                  res = max(res, merge(abs(min(pt*scales%p_scale, g*scales%g_scale)), &
+                     & max(-pt*scales%p_scale, 0.0_wp), g > scales%floor))
+               end do
+               if (bad > 0.0_wp) then
+                  gone = .true.
+                  if (r_norm <= violated_reduction*b_norm) exit
+               else if (res <= tol) then
+                  finished = .true.
+                  residual = res
+                  exit
+               end if
+            else if (r_norm <= merge(violated_reduction, reduction, gone)*b_norm) then
+               exit
+            end if
+         end do
+      end subroutine truncated_gcr
+   end subroutine coupled_tnnmg
+
    !> TNNMG iterations on the grid h%top from u until the residual on (K u + f, u - o) is at
    !> most tol or max_steps ran; p = K u + f on exit. steps: iterations run. history and
    !> progress (the finest grid): the residual of each iteration.
@@ -534,7 +729,7 @@ contains
       r = -free*p
       b_norm = norm2(r)
       if (b_norm == 0.0_wp) return
-      call precondition(r, d)
+      call precondition(h, r, d)
       rz = dot_product(r, d)
       do it = 1, max_steps
          ! (d is zero on the contact set, as the preconditioner's output: d.I K d = d.K d)
@@ -565,31 +760,32 @@ contains
          end if
          if (it == max_steps) exit
          rz_old = rz
-         call precondition(r, kd)
+         call precondition(h, r, kd)
          rz = dot_product(r, kd)
          d = kd + (rz/rz_old)*d
       end do
       end associate
-   contains
-      !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse
-      !> correction added (not one after the other: no transform on the grid being solved;
-      !> symmetric, as CG needs), V the V-cycle of the next grid; the dense solve where the
-      !> grid being solved is the coarsest.
-      subroutine precondition(r, z)
-         real(wp), contiguous, intent(in) :: r(:)
-         real(wp), contiguous, intent(inout) :: z(:)
-         h%vcycles = h%vcycles + 1
-         if (h%top == h%coarsest) then
-            z = r
-            call cholesky_solve(h%dense, z)
-            return
-         end if
-         call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
-         call vcycle(h, h%top + 1)
-         call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), r, &
-            & omega/h%level(h%top)%circulant_diagonal)
-      end subroutine precondition
    end subroutine truncated_cg
+
+   !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse correction
+   !> added (not one after the other: no transform on the grid being solved; symmetric, as CG
+   !> needs), V the V-cycle of the next grid; the dense solve where the grid being solved is
+   !> the coarsest. r is zero on the contact set, and so is z.
+   subroutine precondition(h, r, z)
+      type(hierarchy), intent(inout) :: h
+      real(wp), contiguous, intent(in) :: r(:)
+      real(wp), contiguous, intent(inout) :: z(:)
+      h%vcycles = h%vcycles + 1
+      if (h%top == h%coarsest) then
+         z = r
+         call cholesky_solve(h%dense, z)
+         return
+      end if
+      call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
+      call vcycle(h, h%top + 1)
+      call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), r, &
+         & omega/h%level(h%top)%circulant_diagonal)
+   end subroutine precondition
 
    !> One V(1,1)-cycle on the coarse level t > h%top: x ~ A_t^-1 rhs with the penalised
    !> Galerkin operators; the coarsest grid is solved exactly.
@@ -1305,7 +1501,7 @@ contains
    !> scaled to the load (load control); w = M p; s the mean of w - b over the contact set
    !> (load control); gap = w - b - s; and the residual of these fields. w holds the
    !> obstacle o on entry.
-   subroutine returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, w, gap, s, residual)
+   subroutine returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, w, gap, s, residual, full)
       type(compliance_operator), intent(inout) :: op
       real(wp), contiguous, intent(in) :: u(:), b(:)
       logical, intent(in) :: load_control
@@ -1314,6 +1510,7 @@ contains
       real(wp), contiguous, intent(out) :: gap(:)
       real(wp), intent(inout) :: s
       real(wp), intent(out) :: residual
+      logical, intent(in), optional :: full   !< w = G_eff p (a coupled operator)
       real(wp) :: p_ref
       integer :: contact
       p_ref = merge(mean_pressure, sum(p)/size(p), load_control)
@@ -1324,7 +1521,11 @@ contains
       end where
       p = gap
       if (load_control) call normalise(p, mean_pressure)
-      call op%apply_metric(p, w)
+      if (present(full)) then
+         call op%apply_full(p, w)
+      else
+         call op%apply_metric(p, w)
+      end if
       contact = count(p > 0.0_wp)
       if (load_control .and. contact > 0) s = sum(w - b, mask=p > 0.0_wp)/contact
       gap = w - b - s
