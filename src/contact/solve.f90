@@ -48,24 +48,12 @@ module lc_contact_solve
    !> (2.1-3.4x at 2048^2) and 1.2x physical (at 512^2 0.8-1.3x: a multigrid pair costs
    !> 2-3x a CG pair there). docs/decisions/011-multigrid-for-surfaces.md.
    integer, parameter :: multigrid_points = 4096, multigrid_surface_points = 1024**2
-   !> Method 'multigrid' on a coupled line: the Anderson iteration with multigrid inner solves
-   !> goes to this tolerance (or the scene's, if looser), GCR from there to the scene's
-   !> tolerance within polish_budget iterations, and the Anderson iteration again where GCR
-   !> does not get there. The last outer iterations cost a multigrid solve each where GCR,
-   !> from an iterate this close, needs 10-20 iterations; from 1e-5 GCR stalled more often
-   !> (docs/decisions/010-coupled-lines-multigrid.md).
-   real(wp), parameter :: polish_tol = 1.0e-6_wp
-   integer, parameter :: polish_budget = 50
-   !> Under method 'auto' a coupled line of at least outer_multigrid_points points goes the
-   !> way of method 'multigrid' (where its metric passes metric_refusal) when the solve on
-   !> the grid of every second point needed more than hard_coarse_iterations GCR iterations
-   !> or went that way itself. The coarse solves of bench/scaling.py's coupled scenes need
-   !> 7-14 GCR iterations where the spectrum is fixed (up to 2^20), where the outer
-   !> iteration would cost 1.2-9x GCR's transforms, and 39-75 (n = 16384) to 118-217
-   !> (65536) on broadband lines, where GCR's grow with n; with 60, the SLS at 16384 went
-   !> the outer way and cost 671 pairs against GCR's 418 (docs/decisions/010-coupled-lines-multigrid.md).
-   integer, parameter :: outer_multigrid_points = 8192
-   integer, parameter :: hard_coarse_iterations = 100
+   !> Under method 'auto' a coupled line of at least coupled_multigrid_points points goes to
+   !> the multigrid method (where its metric passes metric_refusal) when the solve on the grid
+   !> of every second point needed more than hard_coarse_iterations GCR iterations or went
+   !> that way itself (MEASURE).
+   integer, parameter :: coupled_multigrid_points = 16384
+   integer, parameter :: hard_coarse_iterations = 50
 
 contains
 
@@ -125,8 +113,8 @@ contains
       ! a grid too large for this machine (or job) ends here, with how much it needs (the
       ! multigrid's coarse grids if the scene may go to it: refusals need the operator)
       if (kernel%coupled(friction)) then
-         may_multigrid = grid%is_line() .and. (scene%solver%method == 'multigrid' .or. &
-            & (scene%solver%method == 'auto' .and. n >= outer_multigrid_points))
+         may_multigrid = scene%solver%method == 'multigrid' .or. &
+            & (scene%solver%method == 'auto' .and. n >= coupled_multigrid_points)
       else
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
@@ -191,16 +179,16 @@ contains
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
       type(cg_outcome) :: cg
-      type(gcr_outcome) :: gcr, kept
       type(anderson_outcome) :: outer
       type(gfmd_outcome) :: dynamics
       type(newton_outcome) :: newton
       type(multigrid_outcome) :: nested
-      real(wp), allocatable :: history(:), p_gcr(:), w_gcr(:), gap_gcr(:)
+      type(contact_result) :: previous
+      real(wp), allocatable :: history(:)
       character(len=:), allocatable :: reason, allowed
       character(len=len(scene%solver%method)) :: method
-      real(wp) :: uniform, s_gcr, plain, before
-      integer :: coarse_pairs, reserve
+      real(wp) :: uniform, plain
+      integer :: coarse_pairs
       logical :: coarse_hard
 
       coarse_pairs = 0
@@ -216,12 +204,8 @@ contains
       end if
       method = scene%solver%method
       if (method == 'multigrid') then
-         ! (a coupled line: the multigrid solver does the Anderson iteration's inner solves,
-         ! symmetric problems with the metric |G_eff|)
-         if (op%coupled .and. .not. grid%is_line()) then
-            reason = 'friction couples the normal and tangential fields, and the outer iteration around it solves ' &
-               & // 'coupled lines only'
-         else if (op%coupled) then
+         ! (a coupled scene: its preconditioner is the hierarchy of the metric |G_eff|)
+         if (op%coupled) then
             reason = metric_refusal(op)
          else
             reason = multigrid_refusal(op)
@@ -230,9 +214,9 @@ contains
             allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
             if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
             call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
-               & '; it solves frictionless lines and surfaces on an elastic half-space or layer (nu <= 0.47, ' // &
-               & 'or h/lambda >~ 0.07), and lines with friction or sliding viscoelastic layers by an outer ' // &
-               & 'iteration around it; allowed here: ' // allowed, code_input)
+               & '; it solves lines and surfaces on an elastic half-space or layer (nu <= 0.47, or ' // &
+               & 'h/lambda >~ 0.07), with friction, and lines on sliding viscoelastic layers; allowed here: ' // &
+               & allowed, code_input)
             return
          end if
       else if (method == 'auto' .and. grid%points() >= merge(multigrid_points, multigrid_surface_points, &
@@ -240,8 +224,8 @@ contains
          if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
       end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
-      ! on the displacement, where this start solves each coarse grid to coarse_tol; the
-      ! outer iteration of a coupled line takes the start, whose contact set is nearly right)
+      ! on the displacement, where this start solves each coarse grid to coarse_tol; on a
+      ! coupled scene it takes the start, whose contact set is nearly right)
       if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
          & (method /= 'multigrid' .or. op%coupled)) then
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
@@ -249,7 +233,7 @@ contains
          if (allocated(error)) return
       end if
       if (method == 'auto' .and. op%coupled .and. coarse_hard .and. grid%is_line() .and. &
-         & grid%points() >= outer_multigrid_points) then
+         & grid%points() >= coupled_multigrid_points) then
          if (len(metric_refusal(op)) == 0) method = 'multigrid'
       end if
       call progress%begin_level(grid%nx, grid%ny)
@@ -270,9 +254,19 @@ contains
          call record_solve(result, 'newton', newton%converged, newton%steps, 1, newton%fft_pairs, newton%residual, &
             & [newton%residual])
       else if (method == 'multigrid' .and. op%coupled) then
-         call coupled_multigrid(scene, op, height, load_control, pm, g_ref, coarse_pairs > 0, p, w, gap, s, history, &
-            & result, progress, error)
+         call coupled_tnnmg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, &
+            & gap, nested, history, progress, error)
          if (allocated(error)) return
+         call record_solve(result, 'multigrid', nested%converged, nested%iterations, 1, nested%fft_pairs, &
+            & nested%residual, history(1:min(nested%iterations, size(history))))
+         ! (where the non-symmetric part defeats it, strongly glassy layers, the GCR goes on
+         ! from its best iterate)
+         if (.not. nested%converged .and. nested%iterations < scene%solver%max_iter) then
+            previous = result
+            call coupled_gcr(scene, grid, op, height, load_control, pm, g_ref, p, w, gap, s, history, result, &
+               & progress, error, previous)
+            if (allocated(error)) return
+         end if
       else if (method == 'multigrid') then
          call multigrid(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, gap, &
             & nested, history, progress, error)
@@ -297,58 +291,9 @@ contains
          call record_solve(result, 'gfmd', dynamics%converged, dynamics%iterations, 1, dynamics%fft_pairs, &
             & dynamics%residual, history(1:min(dynamics%checks, size(history))))
       else if ((op%coupled .and. trim(scene%solver%method) == 'auto') .or. trim(scene%solver%method) == 'gcr') then
-         ! constrained GCR; under 'auto' a solve that stalls goes on with the GCR from its best
-         ! iterate, now keeping its history across clips (on broadband fine grids the
-         ! restarted GCR stalls while the set settles by a clip every iteration or two; the
-         ! kept history costs more per set change than it saves elsewhere), then with the
-         ! Anderson outer iteration, with the budget left, less the steps of the dense
-         ! Newton method where that finishes what the Anderson iteration leaves
-         ! (dense_applies: an Anderson iteration costs ~1e-3 of a Newton step there, so it
-         ! goes first: a glassy layer at n = 1024 converges in 97362 of them in 0.6 s, the
-         ! Newton method from GCR's iterate in 3.2 s)
-         call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
-            & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history, progress)
-         call record_solve(result, 'gcr', gcr%converged, gcr%iterations, 1, gcr%fft_pairs, gcr%residual, &
-            & history(1:gcr%iterations))
-         if (.not. gcr%converged .and. trim(scene%solver%method) == 'auto' .and. &
-            & gcr%iterations < scene%solver%max_iter) then
-            reserve = 0
-            if (dense_applies(scene, grid, op)) reserve = min(newton_step_limit, &
-               & (scene%solver%max_iter - gcr%iterations)/2)
-            call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
-               & scene%solver%max_iter - gcr%iterations - reserve, scene%solver%memory, scene%solver%precondition, &
-               & p, w, gap, kept, history(gcr%iterations + 1:), progress, keep_clipped=.true.)
-            ! (its first iterate is GCR's best, so its best is no worse)
-            call record_solve(result, 'gcr+kept', kept%converged, gcr%iterations + kept%iterations, 1, &
-               & gcr%fft_pairs + kept%fft_pairs, kept%residual, &
-               & history(1:gcr%iterations + kept%iterations))
-         end if
-         if (.not. result%converged .and. trim(scene%solver%method) == 'auto' .and. &
-            & result%iterations < scene%solver%max_iter) then
-            reserve = 0
-            if (dense_applies(scene, grid, op)) reserve = min(newton_step_limit, &
-               & (scene%solver%max_iter - result%iterations)/2)
-            ! (GCR's best iterate is kept in case the Anderson iteration ends worse)
-            before = result%residual
-            p_gcr = p
-            w_gcr = w
-            gap_gcr = gap
-            s_gcr = s
-            call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
-               & scene%solver%max_iter - result%iterations - reserve, scene%solver%memory, &
-               & scene%solver%precondition, p, w, gap, outer, history, error, progress)
-            if (allocated(error)) return
-            call record_solve(result, trim(result%solver) // '+anderson', outer%converged, &
-               & result%iterations + outer%cg_iterations, 1 + outer%outer_iterations, &
-               & result%fft_pairs + outer%fft_pairs, min(outer%residual, result%residual), &
-               & [result%residual_history, history(1:outer%outer_iterations)])
-            if (outer%residual > before) then
-               p = p_gcr
-               w = w_gcr
-               gap = gap_gcr
-               s = s_gcr
-            end if
-         end if
+         call coupled_gcr(scene, grid, op, height, load_control, pm, g_ref, p, w, gap, s, history, result, progress, &
+            & error)
+         if (allocated(error)) return
       else if (op%coupled) then
          call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, &
             & scene%solver%memory, scene%solver%precondition, p, w, gap, outer, history, error, progress)
@@ -385,67 +330,90 @@ contains
       s = s + uniform*pm
    end subroutine solve_on_grid
 
-   !> Method 'multigrid' on a coupled line (the operator passed metric_refusal): the Anderson
-   !> outer iteration with the symmetric inner problems solved by the multigrid method (the
-   !> first from p if `warm`, the interpolated coarse solution, else from its own nested
-   !> iteration) to polish_tol, then GCR from there, and the Anderson iteration again from
-   !> GCR's best iterate if GCR has not converged within polish_budget iterations. On
-   !> broadband lines neither the outer iterations nor the multigrid's inner ones grow with
-   !> n, where GCR's set finding does (docs/decisions/010-coupled-lines-multigrid.md).
-   subroutine coupled_multigrid(scene, op, height, load_control, pm, g_ref, warm, p, w, gap, s, history, result, &
-         & progress, error)
+   !> A coupled scene by the constrained GCR from p; under method 'auto' (or after the
+   !> multigrid method, `before`) a solve that stalls goes on with the GCR from its best
+   !> iterate, now keeping its history across clips (on broadband fine grids the restarted
+   !> GCR stalls while the set settles by a clip every iteration or two; the kept history
+   !> costs more per set change than it saves elsewhere), then with the Anderson outer
+   !> iteration, with the budget left, less the steps of the dense Newton method where that
+   !> finishes what the Anderson iteration leaves (dense_applies: an Anderson iteration costs
+   !> ~1e-3 of a Newton step there, so it goes first: a glassy layer at n = 1024 converges in
+   !> 97362 of them in 0.6 s, the Newton method from GCR's iterate in 3.2 s). The counts of
+   !> `before` are added to the result's.
+   subroutine coupled_gcr(scene, grid, op, height, load_control, pm, g_ref, p, w, gap, s, history, result, &
+         & progress, error, before)
       type(scene_type), intent(in) :: scene
+      type(grid_type), intent(in) :: grid
       type(compliance_operator), intent(inout) :: op
       real(wp), intent(in) :: height(:), pm, g_ref
-      logical, intent(in) :: load_control, warm
+      logical, intent(in) :: load_control
       real(wp), intent(inout) :: p(:), s
-      real(wp), intent(out) :: w(:), gap(:)
+      real(wp), intent(inout) :: w(:), gap(:)
       real(wp), intent(inout) :: history(:)
       type(contact_result), intent(inout) :: result
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
+      type(contact_result), intent(in), optional :: before
+      type(gcr_outcome) :: gcr, kept
       type(anderson_outcome) :: outer
-      type(gcr_outcome) :: gcr
-      type(multigrid_outcome) :: nested
-      character(len=16) :: env
-      integer :: stat
-      real(wp) :: tol
-      integer :: max_iter, memory
-      logical :: precondition
+      real(wp), allocatable :: p_gcr(:), w_gcr(:), gap_gcr(:)
+      character(len=:), allocatable :: prefix
+      real(wp) :: s_gcr, residual_before
+      integer :: reserve, spent, pairs_before, max_iter
+      logical :: fallback
 
-      tol = scene%solver%tol
-      max_iter = scene%solver%max_iter
-      memory = scene%solver%memory
-      precondition = scene%solver%precondition
-      call get_environment_variable('LC_CTNNMG', env, status=stat)
-      if (stat == 0) then
-         call coupled_tnnmg(op, height, load_control, pm, s, g_ref, tol, max_iter, p, w, gap, nested, history, &
-            & progress, error)
-         if (allocated(error)) return
-         call record_solve(result, 'tnnmg', nested%converged, nested%iterations, 1, nested%fft_pairs, &
-            & nested%residual, history(1:min(nested%iterations, size(history))))
-         return
+      fallback = trim(scene%solver%method) == 'auto' .or. present(before)
+      prefix = ''
+      spent = 0
+      pairs_before = 0
+      if (present(before)) then
+         prefix = trim(before%solver) // '+'
+         spent = before%iterations
+         pairs_before = before%fft_pairs
       end if
-      call anderson_coupled(op, height, load_control, pm, s, g_ref, max(tol, polish_tol), max_iter, memory, &
-         & precondition, p, w, gap, outer, history, error, progress, inner_multigrid=.true., warm_start=warm)
-      if (allocated(error)) return
-      call record_solve(result, 'anderson+multigrid', outer%residual <= tol, outer%cg_iterations, &
-         & outer%outer_iterations, outer%fft_pairs, outer%residual, history(1:outer%outer_iterations))
-      if (result%converged .or. result%iterations >= max_iter) return
-      call constrained_gcr(op, height, load_control, pm, s, g_ref, tol, min(polish_budget, max_iter - result%iterations), &
-         & memory, precondition, p, w, gap, gcr, history, progress)
-      call record_solve(result, trim(result%solver) // '+gcr', gcr%converged, result%iterations + gcr%iterations, &
-         & result%outer_iterations + 1, result%fft_pairs + gcr%fft_pairs, gcr%residual, &
-         & [result%residual_history, history(1:gcr%iterations)])
-      if (result%converged .or. result%iterations >= max_iter) return
-      call anderson_coupled(op, height, load_control, pm, s, g_ref, tol, max_iter - result%iterations, memory, &
-         & precondition, p, w, gap, outer, history, error, progress, inner_multigrid=.true., warm_start=.true.)
-      if (allocated(error)) return
-      call record_solve(result, trim(result%solver) // '+anderson+multigrid', outer%converged, &
-         & result%iterations + outer%cg_iterations, result%outer_iterations + outer%outer_iterations, &
-         & result%fft_pairs + outer%fft_pairs, outer%residual, &
-         & [result%residual_history, history(1:outer%outer_iterations)])
-   end subroutine coupled_multigrid
+      max_iter = scene%solver%max_iter - spent
+      call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, max_iter, &
+         & scene%solver%memory, scene%solver%precondition, p, w, gap, gcr, history(spent + 1:), progress)
+      call record_solve(result, prefix // 'gcr', gcr%converged, spent + gcr%iterations, 1, pairs_before + gcr%fft_pairs, &
+         & gcr%residual, history(1:spent + gcr%iterations))
+      if (.not. gcr%converged .and. fallback .and. result%iterations < scene%solver%max_iter) then
+         reserve = 0
+         if (dense_applies(scene, grid, op)) reserve = min(newton_step_limit, &
+            & (scene%solver%max_iter - result%iterations)/2)
+         call constrained_gcr(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
+            & scene%solver%max_iter - result%iterations - reserve, scene%solver%memory, scene%solver%precondition, &
+            & p, w, gap, kept, history(result%iterations + 1:), progress, keep_clipped=.true.)
+         ! (its first iterate is GCR's best, so its best is no worse)
+         call record_solve(result, trim(result%solver) // '+kept', kept%converged, result%iterations + &
+            & kept%iterations, 1, result%fft_pairs + kept%fft_pairs, kept%residual, &
+            & history(1:result%iterations + kept%iterations))
+      end if
+      if (.not. result%converged .and. fallback .and. result%iterations < scene%solver%max_iter) then
+         reserve = 0
+         if (dense_applies(scene, grid, op)) reserve = min(newton_step_limit, &
+            & (scene%solver%max_iter - result%iterations)/2)
+         ! (GCR's best iterate is kept in case the Anderson iteration ends worse)
+         residual_before = result%residual
+         p_gcr = p
+         w_gcr = w
+         gap_gcr = gap
+         s_gcr = s
+         call anderson_coupled(op, height, load_control, pm, s, g_ref, scene%solver%tol, &
+            & scene%solver%max_iter - result%iterations - reserve, scene%solver%memory, &
+            & scene%solver%precondition, p, w, gap, outer, history, error, progress)
+         if (allocated(error)) return
+         call record_solve(result, trim(result%solver) // '+anderson', outer%converged, &
+            & result%iterations + outer%cg_iterations, 1 + outer%outer_iterations, &
+            & result%fft_pairs + outer%fft_pairs, min(outer%residual, result%residual), &
+            & [result%residual_history, history(1:outer%outer_iterations)])
+         if (outer%residual > residual_before) then
+            p = p_gcr
+            w = w_gcr
+            gap = gap_gcr
+            s = s_gcr
+         end if
+      end if
+   end subroutine coupled_gcr
 
    !> Whether the dense Newton method may finish a solve that stalled: under method 'auto',
    !> on a grid of at most dense_points points, for a monotone operator (Re G_eff >= 0 on
@@ -524,8 +492,8 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: p(:), s
       integer, intent(out) :: pairs
-      !> the coarse solve needed more than hard_coarse_iterations GCR iterations, or the
-      !> outer iteration with multigrid inner solves
+      !> the coarse solve needed more than hard_coarse_iterations GCR iterations, or went to
+      !> the multigrid method
       logical, intent(out) :: hard
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
@@ -551,7 +519,7 @@ contains
       if (load_control) s = sc
       ratio = grid%points()/coarse_grid%points()
       pairs = (coarse_result%fft_pairs + ratio - 1)/ratio
-      hard = index(coarse_result%solver, 'anderson+multigrid') == 1 .or. &
+      hard = index(coarse_result%solver, 'multigrid') == 1 .or. &
          & (index(coarse_result%solver, 'gcr') == 1 .and. coarse_result%iterations > hard_coarse_iterations)
    end subroutine coarse_solution
 

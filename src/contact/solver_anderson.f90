@@ -2,9 +2,7 @@
 !>    find p >= 0, gap = G_eff p - r - s >= 0, p gap = 0 (+ load or displacement control).
 !>
 !> Outer fixed point x -> T(x): T(x) solves the symmetric problem with metric M and target
-!> b = r - N x (constrained CG, warm-started; or, with inner_multigrid, the multigrid solver
-!> of lc_contact_solver_multigrid, whose iterations do not grow with n on broadband lines);
-!> its fixed point solves the coupled problem.
+!> b = r - N x (constrained CG, warm-started); its fixed point solves the coupled problem.
 !> The outer iteration is accelerated with Anderson mixing (Walker & Ni, SIAM J. Numer.
 !> Anal. 49 (2011) 1715), which for the linearised map behaves like GMRES: with
 !> M = |G_eff| the map's eigenvalues lie on the right half of the unit circle, so the rate
@@ -19,7 +17,6 @@ module lc_contact_solver_anderson
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome, complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
-   use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome
    implicit none (type, external)
    private
    public :: anderson_coupled, anderson_outcome
@@ -56,7 +53,7 @@ contains
    !> Solve the coupled problem. p: starting guess in, solution out; w = G_eff p;
    !> gap and s as in lc_contact_solver_cg. history(k) = residual after outer iteration k.
    subroutine anderson_coupled(op, r, load_control, mean_pressure, s, g_ref, tol, max_iter, memory, &
-         & precondition, p, w, gap, outcome, history, error, progress, inner_multigrid, warm_start)
+         & precondition, p, w, gap, outcome, history, error, progress)
       type(compliance_operator), intent(inout) :: op
       real(wp), intent(in) :: r(:)
       logical, intent(in) :: load_control
@@ -71,18 +68,6 @@ contains
       real(wp), intent(inout) :: history(:)
       type(error_type), allocatable, intent(out) :: error
       type(progress_log), intent(inout), optional :: progress
-      !> solve the inner problems by the multigrid method (the first from its nested
-      !> iteration, the others warm-started from the previous output); the caller checks
-      !> that it applies to the metric (metric_refusal)
-      logical, intent(in), optional :: inner_multigrid
-      !> with inner_multigrid: the first inner solve starts from p as well (p a good guess,
-      !> e.g. the interpolated solution of a coarser grid)
-      logical, intent(in), optional :: warm_start
-      logical :: warm
-      type(multigrid_outcome) :: nested
-      type(progress_log) :: quiet
-      real(wp), allocatable :: inner_history(:)
-      logical :: use_multigrid
       real(wp), allocatable :: x(:), f(:), x_old(:), f_old(:), tx(:), dx(:, :), df(:, :), b(:), nw(:), p_best(:)
       real(wp), allocatable :: gamma(:), gram(:, :), projection(:)
       type(cg_outcome) :: inner
@@ -105,33 +90,19 @@ contains
       p_best = p
       last_progress = 0
       preconditioned = precondition
-      use_multigrid = .false.
-      if (present(inner_multigrid)) use_multigrid = inner_multigrid
-      warm = .false.
-      if (present(warm_start)) warm = warm_start
-      if (use_multigrid) allocate (inner_history(max(1, max_iter)))
 
       do k = 1, size(history)
          call op%apply_difference(x, nw)
          b = r - nw
          tx = p   ! warm start from the previous output of T
-         if (use_multigrid) then
-            call multigrid(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
-               & max_iter - outcome%cg_iterations, tx, w, gap, nested, inner_history, quiet, error, &
-               & warm=k > 1 .or. warm)
-            if (allocated(error)) return
-            outcome%cg_iterations = outcome%cg_iterations + nested%iterations
-            outcome%fft_pairs = outcome%fft_pairs + nested%fft_pairs + 2
-         else
-            if (present(progress)) progress%offset = outcome%cg_iterations
-            call constrained_cg(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
-               & max_iter - outcome%cg_iterations, preconditioned, tx, w, gap, inner, progress=progress)
-            if (present(progress)) progress%offset = 0
-            ! once the preconditioner has stalled on this operator, do not try it again
-            preconditioned = inner%preconditioned
-            outcome%cg_iterations = outcome%cg_iterations + inner%iterations
-            outcome%fft_pairs = outcome%fft_pairs + inner%fft_pairs + 2
-         end if
+         if (present(progress)) progress%offset = outcome%cg_iterations
+         call constrained_cg(op, b, load_control, mean_pressure, s_inner, g_ref, inner_tol, &
+            & max_iter - outcome%cg_iterations, preconditioned, tx, w, gap, inner, progress=progress)
+         if (present(progress)) progress%offset = 0
+         ! once the preconditioner has stalled on this operator, do not try it again
+         preconditioned = inner%preconditioned
+         outcome%cg_iterations = outcome%cg_iterations + inner%iterations
+         outcome%fft_pairs = outcome%fft_pairs + inner%fft_pairs + 2
          outcome%outer_iterations = k
          p = tx
 

@@ -1,9 +1,9 @@
 !> Truncated nonsmooth Newton multigrid (TNNMG) for the frictionless contact of a line or a
 !> surface on an elastic half-space or layer: Graeser and Kornhuber, "Multigrid methods for
 !> obstacle problems" (J. Comput. Math., 2009), and "Nonsmooth Newton methods for set-valued
-!> saddle point problems" (SIAM J. Numer. Anal., 2009). Warm-started (multigrid's `warm`)
-!> it solves the symmetric inner problems of the outer iteration on coupled lines
-!> (lc_contact_solver_anderson).
+!> saddle point problems" (SIAM J. Numer. Anal., 2009); and the same iteration for coupled
+!> scenes (friction, sliding viscoelastic layers) with the non-symmetric stiffness
+!> (coupled_tnnmg).
 !>
 !> Displacement form. With the stiffness K = 1/M (the inverse of the operator's real normal
 !> compliance, mode by mode) and u the surface displacement seen from the rigid profile's
@@ -103,7 +103,9 @@ module lc_contact_solver_multigrid
    integer, parameter :: tightenings = 3
    !> coupled_tnnmg: directions kept by the GCR on the truncated Newton problem (restarted
    !> when full).
-   integer, parameter :: gcr_memory = 20
+   integer, parameter :: gcr_memory = 10
+   !> coupled_tnnmg: iterations without the residual halving after which it stops.
+   integer, parameter :: coupled_stall = 30
 
    !> What one multigrid solve did. `iterations` counts the TNNMG iterations on the finest
    !> grid (a finishing CG phase counts as one); `fft_pairs` every transform pair on every
@@ -316,15 +318,11 @@ contains
 
    !> Solve the frictionless contact of a line or surface: w = M p, gap = w - b - s >= 0, p >= 0,
    !> p gap = 0, under load control (mean(p) = p_m, s found) or displacement control (s
-   !> given). p: out the solution; on entry not used (the nested iteration makes its own
-   !> start), or with `warm` the start: its displacement M p (less, under load control, the
-   !> mean of M p - b over p's contact set), iterated on the finest grid only, for a sequence
-   !> of problems whose solutions are close (the inner solves of an outer iteration on a
-   !> coupled line, whose metric M = |G_eff| passed metric_refusal). w = M p; gap.
-   !> history(1:outcome%iterations) receives the residual of each fine-grid iteration. The
-   !> scene must pass multigrid_refusal (or, warm, metric_refusal).
+   !> given). p: out the solution (on entry not used: the nested iteration makes its own
+   !> start); w = M p; gap. history(1:outcome%iterations) receives the residual of each
+   !> fine-grid iteration. The scene must pass multigrid_refusal.
    subroutine multigrid(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, history, &
-         & progress, error, warm)
+         & progress, error)
       type(compliance_operator), intent(inout), target :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -338,7 +336,6 @@ contains
       real(wp), contiguous, intent(inout) :: history(:)
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
-      logical, intent(in), optional :: warm
       type(hierarchy), target :: h
       type(workspace) :: work
       real(wp), allocatable :: u(:)
@@ -351,20 +348,6 @@ contains
       if (allocated(error)) return
       allocate (u(n), work%c(n), work%kc(n), work%cg(n, 3))
       f = merge(mean_pressure, 0.0_wp, load_control)
-      if (present(warm)) then
-         if (warm) then
-            call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
-            call op%apply_metric(p, u)
-            h%pairs = h%pairs + 1.0_wp
-            ! (the gap of p is zero on its contact set; the constant is not taken from the
-            ! caller, whose s may hold the uniform mode's shift)
-            if (load_control .and. any(p > 0.0_wp)) s = sum(u - b, mask=p > 0.0_wp)/count(p > 0.0_wp)
-            if (load_control) u = u - s
-            call finest_iterations(h, work, op, u, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, &
-               & gap, outcome, history, progress)
-            return
-         end if
-      end if
 
       ! (until the fields are returned w holds the obstacle o of the grid being solved, and
       ! gap is scratch)
@@ -428,9 +411,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(hierarchy), target :: h
       type(residual_scales) :: scales
-      real(wp), allocatable :: u(:), o(:), c(:), kc(:), v(:), kv(:), dirs(:, :), kdirs(:, :), r(:)
-      real(wp) :: f, d, b_max, residual, contact, vkv, alpha
-      integer :: n, step, changed, j
+      real(wp), allocatable :: u(:), o(:), c(:), kc(:), v(:), kv(:), dirs(:, :), kdirs(:, :), r(:), u_best(:)
+      real(wp) :: f, d, b_max, residual, contact, vkv, alpha, best, best_residual
+      integer :: n, step, changed, j, last_progress
       logical :: settled, finished, clipped, tension
 
       n = size(p)
@@ -439,7 +422,7 @@ contains
       call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
       call op%prepare_gcr()
       d = op%inverse_diagonal
-      allocate (u(n), o(n), c(n), kc(n), v(n), kv(n), r(n), dirs(n, gcr_memory), kdirs(n, gcr_memory))
+      allocate (u(n), o(n), c(n), kc(n), v(n), kv(n), r(n), u_best(n), dirs(n, gcr_memory), kdirs(n, gcr_memory))
       f = merge(mean_pressure, 0.0_wp, load_control)
       o = b
       if (.not. load_control) o = o + s
@@ -455,6 +438,9 @@ contains
       call apply_k(u, p)
       h%free = 1.0_wp
       outcome%iterations = 0
+      best = huge(1.0_wp)
+      best_residual = huge(1.0_wp)
+      last_progress = 0
       do step = 1, max_iter
          outcome%iterations = step
          u = max(o, u - (omega/d)*p)
@@ -464,6 +450,20 @@ contains
          if (step <= size(history)) history(step) = residual
          call progress%tick(step, residual, contact)
          if (residual <= tol) exit
+         if (residual < best_residual) then
+            best_residual = residual
+            u_best = u
+         end if
+         if (residual < 0.5_wp*best) then
+            best = residual
+            last_progress = step
+         else if (step - last_progress > coupled_stall) then
+            ! (the non-symmetric part defeats the iteration: strongly glassy layers; the
+            ! caller goes on from the best iterate)
+            u = u_best
+            call apply_k(u, p)
+            exit
+         end if
          if (load_control .and. contact == 0.0_wp) then
             u = u - minval(u - o)
             cycle
@@ -549,25 +549,45 @@ contains
          do it = 1, max_steps
             if (columns == gcr_memory) columns = 0
             columns = columns + 1
-            associate (z => dirs(:, columns), kz => kdirs(:, columns))
+            associate (z => dirs(:, columns), kz => kdirs(:, columns), free => h%free)
             call precondition(h, r, z)
             call apply_k(z, kz, shift=0.0_wp)
-            ! orthogonal on the free points to the stored images
+            ! orthogonal on the free points to the stored images (modified Gram-Schmidt)
             do k = 1, columns - 1
-               beta = sum(h%free*kz*kdirs(:, k))
-               z = z - beta*dirs(:, k)
-               kz = kz - beta*kdirs(:, k)
+               beta = 0.0_wp
+               !$omp simd reduction(+:beta)
+               do jj = 1, n
+                  beta = beta + free(jj)*kz(jj)*kdirs(jj, k)
+               end do
+               !$omp simd
+               do jj = 1, n
+                  z(jj) = z(jj) - beta*dirs(jj, k)
+                  kz(jj) = kz(jj) - beta*kdirs(jj, k)
+               end do
             end do
-            norm = sqrt(sum(h%free*kz**2))
+            norm = 0.0_wp
+            gamma = 0.0_wp
+            !$omp simd reduction(+:norm, gamma)
+            do jj = 1, n
+               norm = norm + free(jj)*kz(jj)**2
+               gamma = gamma + free(jj)*r(jj)*kz(jj)
+            end do
+            norm = sqrt(norm)
             if (.not. norm > 0.0_wp) exit
-            z = z/norm
-            kz = kz/norm
-            gamma = sum(r*kz*h%free)
-            c = c + gamma*z
-            kc = kc + gamma*kz
-            r = r - gamma*h%free*kz
+            ! (the minimal-residual step along z, and z, kz scaled to a unit image, in one pass)
+            gamma = gamma/norm**2
+            r_norm = 0.0_wp
+            !$omp simd reduction(+:r_norm)
+            do jj = 1, n
+               c(jj) = c(jj) + gamma*z(jj)
+               kc(jj) = kc(jj) + gamma*kz(jj)
+               r(jj) = r(jj) - gamma*free(jj)*kz(jj)
+               z(jj) = z(jj)/norm
+               kz(jj) = kz(jj)/norm
+               r_norm = r_norm + r(jj)**2
+            end do
             end associate
-            r_norm = norm2(r)
+            r_norm = sqrt(r_norm)
             if (check .and. .not. gone) then
                res = 0.0_wp
                bad = 0.0_wp
