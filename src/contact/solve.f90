@@ -51,9 +51,16 @@ module lc_contact_solve
    !> Under method 'auto' a coupled line of at least coupled_multigrid_points points goes to
    !> the multigrid method (where its metric passes metric_refusal) when the solve on the grid
    !> of every second point needed more than hard_coarse_iterations GCR iterations or went
-   !> that way itself (MEASURE).
-   integer, parameter :: coupled_multigrid_points = 16384
-   integer, parameter :: hard_coarse_iterations = 50
+   !> that way itself. Measured on bench/scaling.py's coupled scenes (friction, SLS): those
+   !> coarse solves need 4-14 GCR iterations where the spectrum is fixed (n = 8192 to 65536),
+   !> where GCR takes 0.5-0.7x the multigrid's time, and 15-340 on broadband lines, where it
+   !> takes 0.6-1.2x at 8192 (the multigrid faster from about 30 coarse iterations on),
+   !> 1.1-2.1x at 16384, 1.8-3.5x at 32768 and 2.5-7x from 65536 on
+   !> (docs/decisions/012-coupled-multigrid.md). Coupled surfaces stay on GCR: the multigrid
+   !> method is faster only from 2048^2 on broadband roughness (1.1-1.5x), and slower on a
+   !> spectrum fixed in physical wavenumbers (0.4-0.6x).
+   integer, parameter :: coupled_multigrid_points = 8192
+   integer, parameter :: hard_coarse_iterations = 20
 
 contains
 
@@ -114,7 +121,7 @@ contains
       ! multigrid's coarse grids if the scene may go to it: refusals need the operator)
       if (kernel%coupled(friction)) then
          may_multigrid = scene%solver%method == 'multigrid' .or. &
-            & (scene%solver%method == 'auto' .and. n >= coupled_multigrid_points)
+            & (scene%solver%method == 'auto' .and. grid%is_line() .and. n >= coupled_multigrid_points)
       else
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))

@@ -536,9 +536,9 @@ contains
          integer, intent(in) :: max_steps
          real(wp), intent(in) :: reduction
          logical, intent(in) :: check
-         real(wp) :: b_norm, r_norm, beta, norm, gamma, res, g, pt, bad
+         real(wp) :: b_norm, r_norm, beta, norm, gamma, res
          integer :: it, k, columns, jj
-         logical :: gone
+         logical :: gone, violated
          c = 0.0_wp
          kc = 0.0_wp
          r = -h%free*p
@@ -574,32 +574,15 @@ contains
             end do
             norm = sqrt(norm)
             if (.not. norm > 0.0_wp) exit
-            ! (the minimal-residual step along z, and z, kz scaled to a unit image, in one pass)
+            ! the minimal-residual step along z (z and kz then scaled to a unit image)
             gamma = gamma/norm**2
-            r_norm = 0.0_wp
-            !$omp simd reduction(+:r_norm)
-            do jj = 1, n
-               c(jj) = c(jj) + gamma*z(jj)
-               kc(jj) = kc(jj) + gamma*kz(jj)
-               r(jj) = r(jj) - gamma*free(jj)*kz(jj)
-               z(jj) = z(jj)/norm
-               kz(jj) = kz(jj)/norm
-               r_norm = r_norm + r(jj)**2
-            end do
-            end associate
-            r_norm = sqrt(r_norm)
             if (check .and. .not. gone) then
-               res = 0.0_wp
-               bad = 0.0_wp
-               do jj = 1, n
-                  g = u(jj) + c(jj) - o(jj)
-                  pt = p(jj) + kc(jj)
-                  if ((h%free(jj) > 0.0_wp .and. g < 0.0_wp) .or. (h%free(jj) == 0.0_wp .and. pt < 0.0_wp)) &
-                     & bad = bad + 1.0_wp
-                  res = max(res, merge(abs(min(pt*scales%p_scale, g*scales%g_scale)), &
-                     & max(-pt*scales%p_scale, 0.0_wp), g > scales%floor))
-               end do
-               if (bad > 0.0_wp) then
+               call step_and_check(u, o, p, gamma, z, kz, free, c, kc, r, scales, res, violated)
+               z = z/norm
+               kz = kz/norm
+               r_norm = norm2(r)
+               if (violated) then
+                  ! the set is not yet the final one: go on as a Newton step
                   gone = .true.
                   if (r_norm <= violated_reduction*b_norm) exit
                else if (res <= tol) then
@@ -607,9 +590,20 @@ contains
                   residual = res
                   exit
                end if
-            else if (r_norm <= merge(violated_reduction, reduction, gone)*b_norm) then
-               exit
+            else
+               r_norm = 0.0_wp
+               !$omp simd reduction(+:r_norm)
+               do jj = 1, n
+                  c(jj) = c(jj) + gamma*z(jj)
+                  kc(jj) = kc(jj) + gamma*kz(jj)
+                  r(jj) = r(jj) - gamma*free(jj)*kz(jj)
+                  z(jj) = z(jj)/norm
+                  kz(jj) = kz(jj)/norm
+                  r_norm = r_norm + r(jj)**2
+               end do
+               if (sqrt(r_norm) <= merge(violated_reduction, reduction, gone)*b_norm) exit
             end if
+            end associate
          end do
       end subroutine truncated_gcr
    end subroutine coupled_tnnmg
