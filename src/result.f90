@@ -68,9 +68,9 @@ module lc_result
       integer :: iterations = 0
       integer :: outer_iterations = 0         !< outer (Anderson) iterations; 1 for cg and gcr
       !> the solver that ran: 'cg', 'gcr', 'anderson', 'gfmd', 'newton', 'multigrid',
-      !> 'multigrid+cg' (the CG finished the multigrid's fields), 'anderson+multigrid' (a
-      !> coupled line's outer iteration; '+gcr', '+anderson+multigrid' appended as in
-      !> solve.f90's coupled_multigrid), 'gcr+kept'
+      !> 'multigrid+cg' (the CG finished the multigrid's fields), 'multigrid+gcr' (GCR went
+      !> on where the multigrid stalled on a coupled scene; '+kept', '+anderson' may
+      !> follow as after 'gcr'), 'gcr+kept'
       !> (gcr stalled and went on keeping its history across clips) or 'gcr+kept+anderson' (that
       !> stalled too and the Anderson outer iteration went on from its best iterate);
       !> '+newton' when the dense Newton method finished a small grid the iterative solver

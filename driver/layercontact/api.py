@@ -133,8 +133,8 @@ class LineResult:
     ``solver`` names the method that ran: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled
     scenes), ``'anderson'``, ``'multigrid'``, ``'multigrid+cg'`` (the constrained CG finished
     fields the multigrid left just above a tolerance near the rounding floor),
-    ``'anderson+multigrid'`` (method ``'multigrid'`` on a coupled line; ``'+gcr'`` when GCR
-    finished it, ``'+gcr+anderson+multigrid'`` when the outer iteration went on after GCR),
+    ``'multigrid+gcr'`` (GCR went on where the multigrid method stalled on a coupled scene,
+    strongly glassy layers; ``'+kept'``, ``'+anderson'`` may follow as after ``'gcr'``),
     ``'gcr+kept'`` (GCR stalled and went on from its
     best iterate keeping its history across clips) or ``'gcr+kept+anderson'`` (that stalled
     too and the Anderson outer iteration went on); ``'+newton'`` is appended when the dense
@@ -252,17 +252,17 @@ def solve_line(
     applies to from 4096 points on, and surfaces from 1024², constrained CG for other
     symmetric scenes, constrained GCR for coupled ones, going on with its history kept
     across clips and then with Anderson if GCR stalls; a coupled line of 8192 points or
-    more whose coarse-start solve needed more than 100 GCR iterations, i.e. broadband
-    roughness, goes the way of ``'multigrid'`` below where that applies; grids of at most
+    more whose coarse-start solve needed more than 20 GCR iterations, i.e. broadband
+    roughness, goes to ``'multigrid'`` below where that applies; grids of at most
     2048 points that stall are finished by the dense Newton method), ``'cg'``, ``'gcr'``,
     ``'anderson'``, ``'gfmd'``, ``'newton'`` (dense semismooth Newton, grids of at most 2048
     points) or ``'multigrid'`` (nonsmooth Newton multigrid: frictionless lines and surfaces
     on an elastic half-space or a layer with ``poisson <= 0.47``, or an incompressible one
     from ``thickness ~ 0.07 period``; ``iterations`` counts its fine-grid iterations;
-    ``coarse_start`` and ``precondition`` do not apply; on such a line with friction, or
-    sliding viscoelastic, the Anderson outer iteration with multigrid inner solves, from the
-    coarse start, finished by GCR: transform pairs that do not grow with ``n`` on broadband
-    lines). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
+    ``coarse_start`` and ``precondition`` do not apply; on such a line or surface with
+    friction, or a line on a sliding viscoelastic layer, the same iteration with the
+    non-symmetric stiffness, from the coarse start, GCR going on where it stalls: transform
+    pairs that do not grow with ``n`` on broadband roughness). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
     in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard

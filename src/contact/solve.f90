@@ -54,11 +54,10 @@ module lc_contact_solve
    !> that way itself. Measured on bench/scaling.py's coupled scenes (friction, SLS): those
    !> coarse solves need 4-14 GCR iterations where the spectrum is fixed (n = 8192 to 65536),
    !> where GCR takes 0.5-0.7x the multigrid's time, and 15-340 on broadband lines, where it
-   !> takes 0.6-1.2x at 8192 (the multigrid faster from about 30 coarse iterations on),
-   !> 1.1-2.1x at 16384, 1.8-3.5x at 32768 and 2.5-7x from 65536 on
+   !> takes 0.6-1.3x at 8192, 1.2-2.2x at 16384, 1.8-3.5x at 32768 and 2.5-8x from 65536 on
    !> (docs/decisions/012-coupled-multigrid.md). Coupled surfaces stay on GCR: the multigrid
-   !> method is faster only from 2048^2 on broadband roughness (1.1-1.5x), and slower on a
-   !> spectrum fixed in physical wavenumbers (0.4-0.6x).
+   !> method is faster only at 1024^2 and 2048^2 on broadband roughness (0.7-1.6x GCR's
+   !> speed), and slower on a spectrum fixed in physical wavenumbers (0.3-0.5x).
    integer, parameter :: coupled_multigrid_points = 8192
    integer, parameter :: hard_coarse_iterations = 20
 

@@ -12,10 +12,11 @@
 !> projected on it once, a least-squares step that restores GCR's invariant) and negative
 !> pressures are clipped (the history is dropped, or, with keep_clipped, kept with the
 !> clipped points taken out of the stored directions and their images corrected). Each
-!> iteration costs two transform pairs and a few sweeps over the history. Compared with the outer fixed point of lc_contact_solver_anderson
-!> (symmetric inner solves with |G_eff|), whose rate is set by the spread of arg G_eff
-!> (thin layers with friction, lossy viscoelastic layers), the preconditioned operator
-!> here is close to the identity on a large contact set whatever arg G_eff is.
+!> iteration costs two transform pairs and a few sweeps over the history. Compared with the
+!> outer fixed point of lc_contact_solver_anderson (symmetric inner solves with |G_eff|),
+!> whose rate is set by the spread of arg G_eff (thin layers with friction, lossy
+!> viscoelastic layers), the preconditioned operator here is close to the identity on a
+!> large contact set whatever arg G_eff is.
 !>
 !> The images are stored centred on the contact set under load control: a constant added
 !> to w everywhere only moves s. w is recomputed as G_eff p to confirm convergence, so the

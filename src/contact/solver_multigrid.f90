@@ -182,9 +182,9 @@ contains
       end if
    end function multigrid_refusal
 
-   !> Why the method cannot solve the symmetric problem with the operator's metric
-   !> M = |G_eff| (empty if it can): multigrid_refusal without the refusal of coupled and
-   !> viscoelastic operators, for the inner solves of an outer iteration on a coupled line.
+   !> Why the hierarchy of the operator's metric M = |G_eff| cannot precondition the method
+   !> (empty if it can): multigrid_refusal without the refusal of coupled and viscoelastic
+   !> operators, which coupled_tnnmg solves.
    function metric_refusal(op) result(reason)
       type(compliance_operator), intent(in) :: op
       character(len=:), allocatable :: reason
