@@ -140,16 +140,30 @@ def test_coupled_surfaces_agree_with_gcr(control):
     assert mg.penetration == pytest.approx(gcr.penetration, abs=(TOL + TOL_GCR) * np.ptp(h))
 
 
-def test_a_glassy_layer_it_cannot_solve_goes_on_with_gcr(tmp_path):
-    """A strongly glassy layer (E_inf/E0 = 100) sliding where the grid's scales are glassy:
-    the non-symmetric part defeats the multigrid iteration, which stops when its residual
-    no longer halves and hands its best iterate to GCR, which converges."""
-    h = lc.self_affine_profile(1024, 0.8, seed=1, short_wavelength=1 / 64, rms_gradient=0.1)
+def test_a_glassy_layer_it_cannot_solve_goes_on_with_gcr():
+    """A strongly glassy layer (E_inf/E0 = 100) at V tau/lambda = 1 on a broadband profile,
+    lightly loaded: the non-symmetric part defeats the multigrid iteration, which stops when
+    its residual no longer halves and hands its best iterate to GCR, which converges
+    (measured: 55 iterations in all)."""
+    h = lc.self_affine_profile(1024, 0.8, seed=5, short_wavelength=4 / 1024)
     glassy = lc.StandardLinearSolid(e0=1.0, e_inf=100.0, tau=1.0)
-    res = lc.solve_line(h, method="multigrid", thickness=0.16, poisson=0.5, material=glassy, speed=0.01,
-                        mean_pressure=0.001 * E_STAR, tol=1e-9, stress=False)
+    res = lc.solve_line(h, method="multigrid", thickness=0.16, poisson=0.5, friction=0.5, material=glassy,
+                        speed=1.0, mean_pressure=0.015810609908501867, tol=1e-9, stress=False)
     assert res.converged and res.solver.startswith("multigrid+gcr")
     assert res.residual <= 1e-9
+
+
+def test_a_stiffening_layer_takes_stable_jacobi_steps():
+    """A glassy layer (E_inf/E0 = 100) sliding slowly (V tau/lambda = 1e-4): on 16384
+    points its stiffness rises with the frequency q V so steeply that Jacobi steps with the
+    mean diagonal grow the short waves (the residual grew 3x per iteration); with the bound
+    on the diagonal the method converges by itself (measured: 6 iterations, 330 pairs)."""
+    h = profile(16384, "physical")
+    glassy = lc.StandardLinearSolid(e0=1.0, e_inf=100.0, tau=1.0)
+    res = lc.solve_line(h, method="multigrid", thickness=0.16, poisson=0.5, friction=0.5, material=glassy,
+                        speed=1e-4, mean_pressure=0.03, tol=1e-8, stress=False)
+    assert res.converged and res.solver == "multigrid"
+    assert res.iterations <= 10 and res.fft_pairs <= 500
 
 
 def test_refuses_scenes_and_sizes_without_a_small_coarsest_grid():
