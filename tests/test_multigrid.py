@@ -253,7 +253,7 @@ def test_surface_contact_conditions_hold(n):
 def test_auto_takes_the_multigrid_for_surfaces_from_1024_squared():
     """Method 'auto' sends frictionless surfaces of 1024^2 points and more to the multigrid
     solver (where it is 1.2-3.4x faster than the constrained CG, bench/scaling.py --against
-    cg), smaller ones and coupled ones elsewhere. A broadband 1024^2 surface: measured 5
+    cg), smaller ones elsewhere. A broadband 1024^2 surface: measured 5
     iterations, 40 transform pairs (the CG needs 129)."""
     big = surface(1024, 1024)
     res = lc.solve_areal(big, mean_pressure=0.0125 * E_STAR, tol=1e-8, stress=False)
@@ -261,6 +261,26 @@ def test_auto_takes_the_multigrid_for_surfaces_from_1024_squared():
     assert res.iterations <= 8 and res.fft_pairs <= 60, (res.iterations, res.fft_pairs)
     small = lc.solve_areal(surface(512, 512), mean_pressure=0.0125 * E_STAR, tol=1e-8, stress=False)
     assert small.converged and small.solver == "cg"
+
+
+def test_auto_takes_the_multigrid_for_broadband_coupled_scenes():
+    """Method 'auto' sends a coupled line of 8192 points or more to the multigrid method when
+    its coarse-start solve needed more than 20 GCR iterations (broadband roughness: 39 on
+    the line of 16384 points with the shortest wavelength 8 points; a spectrum fixed in
+    physical wavenumbers: 8), and a coupled surface of 1024^2 or more when it needed more
+    than 12 (shortest wavelength 4 points: 18; physical: 6)."""
+    kw = dict(thickness=0.16, poisson=0.5, friction=0.5, tol=1e-8, stress=False)
+    broadband = lc.solve_line(profile(16384, "broadband"), mean_pressure=0.015 * E_STAR, **kw)
+    physical = lc.solve_line(profile(16384, "physical"), mean_pressure=0.015 * E_STAR, **kw)
+    assert broadband.converged and broadband.solver == "multigrid"
+    assert physical.converged and physical.solver == "gcr"
+    rough = lc.self_affine_surface(n=1024, hurst=0.8, seed=1, short_wavelength=4 / 1024, rms_gradient=0.1)
+    smooth = lc.self_affine_surface(n=1024, hurst=0.8, seed=1, short_wavelength=1 / 32, rms_gradient=0.1)
+    broadband = lc.solve_areal(rough, mean_pressure=0.015 * E_STAR, **kw)
+    physical = lc.solve_areal(smooth, mean_pressure=0.015 * E_STAR, **kw)
+    assert broadband.converged and broadband.solver == "multigrid"
+    assert broadband.fft_pairs <= 70, broadband.fft_pairs  # measured 55 (GCR: 119)
+    assert physical.converged and physical.solver == "gcr"
 
 
 def test_a_tolerance_near_the_rounding_floor_is_met_on_a_fine_surface():

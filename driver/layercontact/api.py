@@ -252,8 +252,9 @@ def solve_line(
     applies to from 4096 points on, and surfaces from 1024², constrained CG for other
     symmetric scenes, constrained GCR for coupled ones, going on with its history kept
     across clips and then with Anderson if GCR stalls; a coupled line of 8192 points or
-    more whose coarse-start solve needed more than 20 GCR iterations, i.e. broadband
-    roughness, goes to ``'multigrid'`` below where that applies; grids of at most
+    more whose coarse-start solve needed more than 20 GCR iterations, and a coupled surface
+    of 1024² or more whose coarse solve needed more than 12, i.e. broadband roughness, go to
+    ``'multigrid'`` below where that applies; grids of at most
     2048 points that stall are finished by the dense Newton method), ``'cg'``, ``'gcr'``,
     ``'anderson'``, ``'gfmd'``, ``'newton'`` (dense semismooth Newton, grids of at most 2048
     points) or ``'multigrid'`` (nonsmooth Newton multigrid: frictionless lines and surfaces

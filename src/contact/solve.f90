@@ -55,11 +55,14 @@ module lc_contact_solve
    !> coarse solves need 4-14 GCR iterations where the spectrum is fixed (n = 8192 to 65536),
    !> where GCR takes 0.5-0.7x the multigrid's time, and 15-340 on broadband lines, where it
    !> takes 0.6-1.3x at 8192, 1.2-2.2x at 16384, 1.8-3.5x at 32768 and 2.5-8x from 65536 on
-   !> (docs/decisions/012-coupled-multigrid.md). Coupled surfaces stay on GCR: the multigrid
-   !> method is faster only at 1024^2 and 2048^2 on broadband roughness (0.7-1.6x GCR's
-   !> speed), and slower on a spectrum fixed in physical wavenumbers (0.3-0.5x).
-   integer, parameter :: coupled_multigrid_points = 8192
-   integer, parameter :: hard_coarse_iterations = 20
+   !> (docs/decisions/012-coupled-multigrid.md). A coupled surface of at least 1024^2 points
+   !> goes the same way when its coarse solve needed more than 12 GCR iterations: those
+   !> coarse solves need 5-7 on the physical family (512^2 to 2048^2), where GCR takes
+   !> 0.3-0.5x the multigrid's time, and 7-28 on broadband surfaces, where it takes 1.3-1.6x
+   !> at 2048^2 with 16-28 coarse iterations, 0.9x with 9, and at 1024^2 1.3x with 18,
+   !> 0.7-0.9x with 8-12.
+   integer, parameter :: coupled_multigrid_points = 8192, coupled_multigrid_surface_points = 1024**2
+   integer, parameter :: hard_coarse_iterations = 20, hard_coarse_surface_iterations = 12
 
 contains
 
@@ -119,8 +122,8 @@ contains
       ! a grid too large for this machine (or job) ends here, with how much it needs (the
       ! multigrid's coarse grids if the scene may go to it: refusals need the operator)
       if (kernel%coupled(friction)) then
-         may_multigrid = scene%solver%method == 'multigrid' .or. &
-            & (scene%solver%method == 'auto' .and. grid%is_line() .and. n >= coupled_multigrid_points)
+         may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
+            & n >= merge(coupled_multigrid_points, coupled_multigrid_surface_points, grid%is_line()))
       else
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
@@ -238,8 +241,8 @@ contains
             & coarse_hard, progress, error)
          if (allocated(error)) return
       end if
-      if (method == 'auto' .and. op%coupled .and. coarse_hard .and. grid%is_line() .and. &
-         & grid%points() >= coupled_multigrid_points) then
+      if (method == 'auto' .and. op%coupled .and. coarse_hard .and. &
+         & grid%points() >= merge(coupled_multigrid_points, coupled_multigrid_surface_points, grid%is_line())) then
          if (len(metric_refusal(op)) == 0) method = 'multigrid'
       end if
       call progress%begin_level(grid%nx, grid%ny)
@@ -498,8 +501,8 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: p(:), s
       integer, intent(out) :: pairs
-      !> the coarse solve needed more than hard_coarse_iterations GCR iterations, or went to
-      !> the multigrid method
+      !> the coarse solve needed more than hard_coarse_iterations GCR iterations
+      !> (hard_coarse_surface_iterations on a surface), or went to the multigrid method
       logical, intent(out) :: hard
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
@@ -525,8 +528,8 @@ contains
       if (load_control) s = sc
       ratio = grid%points()/coarse_grid%points()
       pairs = (coarse_result%fft_pairs + ratio - 1)/ratio
-      hard = index(coarse_result%solver, 'multigrid') == 1 .or. &
-         & (index(coarse_result%solver, 'gcr') == 1 .and. coarse_result%iterations > hard_coarse_iterations)
+      hard = index(coarse_result%solver, 'multigrid') == 1 .or. (index(coarse_result%solver, 'gcr') == 1 .and. &
+         & coarse_result%iterations > merge(hard_coarse_iterations, hard_coarse_surface_iterations, grid%is_line()))
    end subroutine coarse_solution
 
    !> The values of f at every second point (along both axes of a surface).
