@@ -1,0 +1,751 @@
+!> The grids and coarse operators of the multigrid solvers (lc_contact_solver_multigrid):
+!> the grids of every 2^t-th point of a line or surface, and the preconditioner
+!> B = omega/d I + I P V P^T I of the truncated Newton problem I K I c = -I p (I the
+!> indicator of the free points, off the contact set A): a damped Jacobi step on the free
+!> points plus the coarse correction, added (no transform on the grid being solved), V a
+!> V(1,1)-cycle on the coarser grids. Linear interpolation P (bilinear on a surface: every
+!> axis longer than one is halved), restriction P^T; the coarse operators are the Galerkin
+!> products of the penalised operator K + d D_A (D_A the indicator of the contact set, d the
+!> diagonal of K): a Galerkin circulant (a transform on the coarse grid; its symbol does not
+!> depend on the contact set) plus a 3-point (line) or 9-point (surface) stencil rebuilt in
+!> O(n) when the set changes. The penalty stands in for the truncated Galerkin operator
+!> P^T I K I P, whose application would cost a transform of the finest grid. Damped Jacobi
+!> smoothing; a dense Cholesky solve on the coarsest grid (at most coarsest_limit points).
+!> K is real and even (a symmetric stiffness: the operator's metric inverted); the solvers
+!> only need B to approximate the truncated problem's inverse, which is what lets the
+!> coarse operators be this cheap. Fields are stored as the rest of the library stores
+!> them: nx x ny points, x fastest; spectra on the half spectrum (nx/2 + 1) x ny.
+module lc_contact_multigrid_hierarchy
+   use lc_kinds, only: wp
+   use lc_errors, only: error_type
+   use lc_fft_plans, only: fft_plan
+   use lc_contact_operator, only: compliance_operator
+   implicit none (type, external)
+   private
+   public :: grid_level, hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit
+   public :: build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate
+   public :: precondition, apply_stiffness
+
+   !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
+   !> step lowers the energy monotonically; 2/3 damps the upper half of the spectrum best.
+   real(wp), parameter :: omega = 2.0_wp/3.0_wp
+
+   !> A damped Jacobi step with the diagonal d multiplies the error's mode q by
+   !> 1 - omega K(q)/d, which grows if it exceeds 1 in modulus: where the symbol rises faster
+   !> than |q| (a viscoelastic layer stiffening with the frequency q V, whose largest K is
+   !> 3-6x the mean on a line of 16384 points at E_inf/E0 = 100, V tau/lambda = 1e-4: the
+   !> residual grew 3x per iteration) the steps take d >= jacobi_margin omega max K/2 (for a
+   !> complex K, max |K|^2/(2 Re K)) instead of the mean. K ~ |q| has max K = 2 mean on a line
+   !> (1.9 on a square surface), below the bound, and keeps the mean.
+   real(wp), parameter :: jacobi_margin = 1.1_wp
+
+   !> The V-cycle coarsens while the next grid has at least this many points (and, on a
+   !> surface, at least shortest_side points along each axis) ...
+   integer, parameter :: coarsest_points = 64
+   integer, parameter :: shortest_side = 4
+
+   !> ... and its coarsest grid (solved densely) may have at most this many.
+   integer, parameter :: coarsest_limit = 256
+
+   !> Weight of the contact-set penalty d D_A in the coarse operators (in units of the
+   !> diagonal d of K): 1 gave the fewest CG iterations on the final set against 0.5, 2, 10.
+   real(wp), parameter :: penalty = 1.0_wp
+
+   !> One grid of nx/2^t x ny/2^t points (ny = 1 on a line): its plan, the operator on it
+   !> for the current hierarchy, and the V-cycle's work arrays.
+   type :: grid_level
+      integer :: nx = 0, ny = 1, n = 0
+      !> the plan: the operator's own on the finest grid, `plan` on the coarser ones
+      type(fft_plan), pointer :: fft => null()
+      type(fft_plan), allocatable :: plan
+      real(wp) :: inv_n = 1.0_wp
+      real(wp), allocatable :: symbol(:)       !< circulant part, half spectrum (nx/2 + 1) x ny
+      real(wp), allocatable :: multiplier(:)   !< symbol/n, as applied after an unscaled r2c
+      real(wp) :: circulant_diagonal = 0.0_wp
+      !> the diagonal of the Jacobi steps: circulant_diagonal, or more where the symbol rises
+      !> so steeply that omega K/d would exceed 2 on some mode (see jacobi_margin)
+      real(wp) :: jacobi_diagonal = 0.0_wp
+      !> the penalty's stencil (coarse grids): penalty(ex, ey, i) couples point i with its
+      !> neighbour i + (ex, ey), periodic (ey = 0 only on a line)
+      real(wp), allocatable :: penalty(:, :, :)
+      real(wp), allocatable :: jacobi(:)       !< omega over the diagonal of the operator
+      real(wp), allocatable :: rhs(:), x(:), residual(:)
+      !> a surface's transfers work axis by axis: the field on the next grid's x and this ny
+      real(wp), allocatable :: halfway(:)
+      !> the stencils of three rows coarsened along x, for the next grid's rows in turn
+      real(wp), allocatable :: window(:, :, :, :)
+   end type grid_level
+
+   !> The grids of every 2^t-th point, t = 0..coarsest (one plan per size, shared by the
+   !> nested grids), the grid being solved (`top`: its operator is I K I, the coarser ones
+   !> are the V-cycle's) and the transform count.
+   type :: hierarchy
+      type(grid_level), allocatable :: level(:)
+      integer :: top = 0, coarsest = 0, n_fine = 0
+      logical :: surface = .false.   !< both axes are halved
+      real(wp), allocatable :: free(:)           !< 1 off the contact set, 0 on it (top grid)
+      real(wp), allocatable :: dense(:, :)       !< Cholesky factor of the coarsest operator
+      real(wp), allocatable :: coarse_column(:)  !< real-space column of its circulant part
+      real(wp) :: pairs = 0.0_wp
+      integer :: vcycles = 0
+   end type hierarchy
+
+contains
+
+   !> How many times a grid of nx x ny points (ny = 1: a line) halves along every axis
+   !> longer than 1 while the result has at least `smallest` points (and at least
+   !> shortest_side along each axis of a surface): the coarsest grid is nx/2**k x ny/2**k.
+   pure integer function halvings(nx, ny, smallest) result(k)
+      integer, intent(in) :: nx, ny, smallest
+      integer :: mx, my
+      k = 0
+      mx = nx
+      my = ny
+      do while (mod(mx, 2) == 0 .and. (mx/2)*max(my/2, 1) >= smallest)
+         if (my > 1) then
+            if (mod(my, 2) /= 0 .or. min(mx, my)/2 < shortest_side) exit
+            my = my/2
+         end if
+         mx = mx/2
+         k = k + 1
+      end do
+   end function halvings
+
+   !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse correction
+   !> added (not one after the other: no transform on the grid being solved; symmetric, as CG
+   !> needs), V the V-cycle of the next grid; the dense solve where the grid being solved is
+   !> the coarsest. r is zero on the contact set, and so is z.
+   subroutine precondition(h, r, z)
+      type(hierarchy), intent(inout) :: h
+      real(wp), contiguous, intent(in) :: r(:)
+      real(wp), contiguous, intent(inout) :: z(:)
+      h%vcycles = h%vcycles + 1
+      if (h%top == h%coarsest) then
+         z = r
+         call cholesky_solve(h%dense, z)
+         return
+      end if
+      call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
+      call vcycle(h, h%top + 1)
+      call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), r, &
+         & omega/h%level(h%top)%jacobi_diagonal)
+   end subroutine precondition
+
+   !> One V(1,1)-cycle on the coarse level t > h%top: x ~ A_t^-1 rhs with the penalised
+   !> Galerkin operators; the coarsest grid is solved exactly.
+   recursive subroutine vcycle(h, t)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      if (t == h%coarsest) then
+         h%level(t)%x = h%level(t)%rhs
+         call cholesky_solve(h%dense, h%level(t)%x)
+         return
+      end if
+      associate (lv => h%level(t))
+      lv%x = lv%jacobi*lv%rhs
+      call level_residual(h, t)
+      call restrict(h, t, lv%residual, h%level(t + 1)%rhs)
+      call vcycle(h, t + 1)
+      call prolong_add(h, t, h%level(t + 1)%x, lv%x)
+      call level_residual(h, t)
+      lv%x = lv%x + lv%jacobi*lv%residual
+      end associate
+   end subroutine vcycle
+
+   !> residual = rhs - A_t x on the coarse level t (one transform pair of that grid).
+   subroutine level_residual(h, t)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      associate (lv => h%level(t))
+      lv%fft%real_buffer = lv%x
+      call transform(h, t)
+      lv%residual = lv%rhs - lv%fft%real_buffer
+      call subtract_stencil(lv%penalty, lv%x, lv%residual, lv%nx, lv%ny)
+      end associate
+   end subroutine level_residual
+
+   !> r <- r - S x for the 9-point (3-point on a line, ny = 1) periodic stencil S:
+   !> (S x)(i) = sum over (ex, ey) of s(ex, ey, i) x(i + (ex, ey)).
+   pure subroutine subtract_stencil(s, x, r, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: s(-1:1, -min(ny - 1, 1):min(ny - 1, 1), 0:nx - 1, 0:ny - 1), x(0:nx - 1, 0:ny - 1)
+      real(wp), intent(inout) :: r(0:nx - 1, 0:ny - 1)
+      integer :: iy, ey, row
+      do iy = 0, ny - 1
+         do ey = merge(-1, 0, ny > 1), merge(1, 0, ny > 1)
+            row = modulo(iy + ey, ny)
+            call subtract_row(s(:, :, :, iy), min(ny - 1, 1), ey, x(:, row), r(:, iy), nx)
+         end do
+      end do
+   contains
+      !> rr <- rr - the stencil's row ey applied to the row xr, periodic
+      pure subroutine subtract_row(a, reach, ey, xr, rr, n)
+         integer, intent(in) :: n, reach, ey
+         real(wp), intent(in) :: a(-1:1, -reach:reach, 0:n - 1), xr(0:n - 1)
+         real(wp), intent(inout) :: rr(0:n - 1)
+         integer :: i
+         rr(0) = rr(0) - (a(-1, ey, 0)*xr(n - 1) + a(0, ey, 0)*xr(0) + a(1, ey, 0)*xr(1))
+         do i = 1, n - 2
+            rr(i) = rr(i) - (a(-1, ey, i)*xr(i - 1) + a(0, ey, i)*xr(i) + a(1, ey, i)*xr(i + 1))
+         end do
+         rr(n - 1) = rr(n - 1) - (a(-1, ey, n - 1)*xr(n - 2) + a(0, ey, n - 1)*xr(n - 1) + a(1, ey, n - 1)*xr(0))
+      end subroutine subtract_row
+   end subroutine subtract_stencil
+
+   !> y = K x (+ shift) on the grid being solved (one transform pair), and x.K x.
+   subroutine apply_stiffness(h, x, y, shift, xy)
+      type(hierarchy), intent(inout) :: h
+      real(wp), contiguous, intent(in) :: x(:)
+      real(wp), contiguous, intent(out) :: y(:)
+      real(wp), intent(in), optional :: shift   !< added to y
+      real(wp), intent(out), optional :: xy     !< x.y (without the shift)
+      real(wp) :: f, dot
+      integer :: j
+      h%level(h%top)%fft%real_buffer = x
+      call transform(h, h%top)
+      ! (the shift and the product in the pass that reads the result out)
+      f = 0.0_wp
+      if (present(shift)) f = shift
+      dot = 0.0_wp
+      associate (buffer => h%level(h%top)%fft%real_buffer)
+      !$omp simd reduction(+:dot)
+      do j = 1, size(x)
+         dot = dot + x(j)*buffer(j)
+         y(j) = buffer(j) + f
+      end do
+      end associate
+      if (present(xy)) xy = dot
+   end subroutine apply_stiffness
+
+   !> The buffer of level t times its circulant, counted in pairs of the finest grid.
+   subroutine transform(h, t)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      integer :: k
+      associate (lv => h%level(t))
+      call lv%fft%forward_unscaled()
+      do k = 1, size(lv%symbol)
+         lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%multiplier(k)
+      end do
+      call lv%fft%backward()
+      h%pairs = h%pairs + real(lv%n, wp)/h%n_fine
+      end associate
+   end subroutine transform
+
+   !> coarse (level t + 1) = P^T fine (level t); P: linear interpolation, periodic, along x
+   !> and (a surface) along y.
+   subroutine restrict(h, t, fine, coarse)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      real(wp), contiguous, intent(in) :: fine(:)
+      real(wp), contiguous, intent(out) :: coarse(:)
+      associate (lv => h%level(t))
+      if (h%surface) then
+         call restrict_x(fine, lv%halfway, lv%nx, lv%ny)
+         call restrict_y(lv%halfway, coarse, lv%nx/2, lv%ny)
+      else
+         call restrict_x(fine, coarse, lv%nx, 1)
+      end if
+      end associate
+   end subroutine restrict
+
+   !> fine (level t) <- fine + P coarse (level t + 1), masked by `free` if given; with
+   !> `base` fine <- scale base + P coarse masked (the grid being solved: its Jacobi step
+   !> and coarse correction in one pass).
+   subroutine prolong_add(h, t, coarse, fine, free, base, scale)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      real(wp), contiguous, intent(in) :: coarse(:)
+      real(wp), contiguous, intent(inout) :: fine(:)
+      real(wp), contiguous, intent(in), optional :: free(:), base(:)
+      real(wp), intent(in), optional :: scale
+      associate (lv => h%level(t))
+      if (h%surface) then
+         call prolong_y(coarse, lv%halfway, lv%nx/2, lv%ny)
+         call prolong_x_add(lv%halfway, fine, lv%nx, lv%ny, free, base, scale)
+      else
+         call prolong_x_add(coarse, fine, lv%nx, 1, free, base, scale)
+      end if
+      end associate
+   end subroutine prolong_add
+
+   !> Along x, row by row: coarse(i) = fine(2i - 1) + (fine(2i) + fine(2i - 2))/2.
+   pure subroutine restrict_x(fine, coarse, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: fine(nx, ny)
+      real(wp), intent(out) :: coarse(nx/2, ny)
+      integer :: i, j, m
+      m = nx/2
+      do j = 1, ny
+         coarse(1, j) = fine(1, j) + 0.5_wp*(fine(2, j) + fine(2*m, j))
+         do i = 2, m
+            coarse(i, j) = fine(2*i - 1, j) + 0.5_wp*(fine(2*i, j) + fine(2*i - 2, j))
+         end do
+      end do
+   end subroutine restrict_x
+
+   !> Along y: the same for the rows.
+   pure subroutine restrict_y(fine, coarse, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: fine(nx, ny)
+      real(wp), intent(out) :: coarse(nx, ny/2)
+      integer :: j, m
+      m = ny/2
+      coarse(:, 1) = fine(:, 1) + 0.5_wp*(fine(:, 2) + fine(:, 2*m))
+      do j = 2, m
+         coarse(:, j) = fine(:, 2*j - 1) + 0.5_wp*(fine(:, 2*j) + fine(:, 2*j - 2))
+      end do
+   end subroutine restrict_y
+
+   !> Along x, row by row: fine <- fine + P coarse, masked by `free` if given; with `base`
+   !> (and free), fine <- scale base + free P coarse.
+   pure subroutine prolong_x_add(coarse, fine, nx, ny, free, base, scale)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: coarse(nx/2, ny)
+      real(wp), intent(inout) :: fine(nx, ny)
+      real(wp), intent(in), optional :: free(nx, ny), base(nx, ny)
+      real(wp), intent(in), optional :: scale
+      integer :: i, j, m
+      m = nx/2
+      if (present(base)) then
+         do j = 1, ny
+            do i = 1, m
+               fine(2*i - 1, j) = scale*base(2*i - 1, j) + free(2*i - 1, j)*coarse(i, j)
+               fine(2*i, j) = scale*base(2*i, j) + free(2*i, j)*0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
+            end do
+         end do
+      else if (present(free)) then
+         do j = 1, ny
+            do i = 1, m
+               fine(2*i - 1, j) = fine(2*i - 1, j) + free(2*i - 1, j)*coarse(i, j)
+               fine(2*i, j) = fine(2*i, j) + free(2*i, j)*0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
+            end do
+         end do
+      else
+         do j = 1, ny
+            do i = 1, m
+               fine(2*i - 1, j) = fine(2*i - 1, j) + coarse(i, j)
+               fine(2*i, j) = fine(2*i, j) + 0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
+            end do
+         end do
+      end if
+   end subroutine prolong_x_add
+
+   !> Along y: fine = P coarse (assigned).
+   pure subroutine prolong_y(coarse, fine, nx, ny)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: coarse(nx, ny/2)
+      real(wp), intent(out) :: fine(nx, ny)
+      integer :: j, m
+      m = ny/2
+      do j = 1, m
+         fine(:, 2*j - 1) = coarse(:, j)
+         fine(:, 2*j) = 0.5_wp*(coarse(:, j) + coarse(:, mod(j, m) + 1))
+      end do
+   end subroutine prolong_y
+
+   !> The grids of every 2^t-th point while the next has at least coarsest_points points
+   !> (halvings), with their plans and work arrays (allocated once, for all the nested grids).
+   subroutine build_hierarchy(h, op, error)
+      type(hierarchy), intent(out), target :: h
+      type(compliance_operator), intent(inout), target :: op
+      type(error_type), allocatable, intent(out) :: error
+      integer :: t, m, nx, ny, reach
+      nx = op%grid%nx
+      ny = op%grid%ny
+      reach = merge(1, 0, ny > 1)
+      h%surface = ny > 1
+      h%coarsest = halvings(nx, ny, coarsest_points)
+      h%n_fine = nx*ny
+      allocate (h%level(0:h%coarsest), h%free(nx*ny))
+      h%free = 1.0_wp
+      do t = 0, h%coarsest
+         associate (lv => h%level(t))
+         lv%nx = nx/2**t
+         lv%ny = merge(ny/2**t, 1, h%surface)
+         lv%n = lv%nx*lv%ny
+         m = lv%n
+         lv%inv_n = 1.0_wp/m
+         if (t == 0) then
+            lv%fft => op%fft
+         else
+            allocate (lv%plan)
+            call lv%plan%init(lv%nx, lv%ny, 1, error)
+            if (allocated(error)) return
+            lv%fft => lv%plan
+         end if
+         allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier((lv%nx/2 + 1)*lv%ny))
+         ! (the finest grid is never a coarse one of the V-cycle)
+         ! (the stencil couples rows on a surface only)
+         if (t > 0) allocate (lv%penalty(-1:1, -reach:reach, m), lv%jacobi(m), lv%rhs(m), lv%x(m), lv%residual(m))
+         if (h%surface .and. t < h%coarsest) allocate (lv%halfway(m/2))
+         if (h%surface .and. t < h%coarsest) allocate (lv%window(-1:1, -1:1, lv%nx/2, -1:1))
+         end associate
+      end do
+      m = h%level(h%coarsest)%n
+      allocate (h%dense(m, m), h%coarse_column(m))
+   end subroutine build_hierarchy
+
+   !> The flat index on the half spectrum of an nx x ny grid of the mode (kx, ky), any
+   !> integers: periodic, and a mode outside the half spectrum is read at its mirror image
+   !> -(kx, ky) (the symbols here are real and even).
+   pure integer function mode_index(nx, ny, kx, ky) result(i)
+      integer, intent(in) :: nx, ny, kx, ky
+      integer :: mx, my
+      mx = modulo(kx, nx)
+      my = modulo(ky, ny)
+      if (2*mx > nx) then
+         mx = nx - mx
+         my = modulo(-my, ny)
+      end if
+      i = mx + (nx/2 + 1)*my + 1
+   end function mode_index
+
+   !> The stiffness K = 1/M on the half spectrum of grid `coarse` of the nested iteration
+   !> (K = 0 where M = 0; K(0) = 0 under load control, the uniform mode being dropped: see
+   !> drop_uniform_mode): the coarse grid's wavevectors are among the finest grid's (its
+   !> Nyquist modes read at +pi/dx: M is even in each component, |q| being all it depends on).
+   pure function level_symbol(op, load_control, coarse) result(stiffness)
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
+      type(grid_level), intent(in) :: coarse
+      real(wp) :: stiffness((coarse%nx/2 + 1)*coarse%ny)
+      real(wp) :: m
+      integer :: kx, ky, my
+      do ky = 0, coarse%ny - 1
+         my = merge(ky, ky - coarse%ny, 2*ky <= coarse%ny)
+         do kx = 0, coarse%nx/2
+            m = op%metric(mode_index(op%grid%nx, op%grid%ny, kx, my))
+            stiffness(kx + (coarse%nx/2 + 1)*ky + 1) = 0.0_wp
+            if (m > 0.0_wp) stiffness(kx + (coarse%nx/2 + 1)*ky + 1) = 1.0_wp/m
+         end do
+      end do
+      if (load_control) stiffness(1) = 0.0_wp
+   end function level_symbol
+
+   !> f (nx x ny) at every step-th point along each axis longer than 1.
+   pure subroutine sample(f, nx, ny, step, fc)
+      integer, intent(in) :: nx, ny, step
+      real(wp), intent(in) :: f(nx, ny)
+      real(wp), intent(out) :: fc(nx/step, max(ny/step, 1))
+      if (ny > 1) then
+         fc = f(1:nx:step, 1:ny:step)
+      else
+         fc = f(1:nx:step, :)
+      end if
+   end subroutine sample
+
+   !> Make grid `top` the one being solved, with the stiffness symbol K on its half spectrum:
+   !> the Galerkin circulants P^T C P below it (their symbols in closed form: along each
+   !> halved axis a coarse mode k gathers the fine modes k and k + m_c with the weights
+   !> 2 alpha^2 and 2 beta^2, alpha, beta = (1 +- cos(pi k/m_c))/2; on a surface the products
+   !> of the two axes' weights over the four fine modes), their diagonals, and the real-space
+   !> column of the coarsest one.
+   subroutine set_grid(h, top, symbol)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: top
+      real(wp), contiguous, intent(in) :: symbol(:)
+      real(wp), parameter :: pi = acos(-1.0_wp)
+      real(wp) :: ax, bx, ay, by
+      integer :: t, kx, ky, nkx, row, first, last
+      h%top = top
+      h%level(top)%symbol = symbol
+      do t = top + 1, h%coarsest
+         associate (c => h%level(t), f => h%level(t - 1))
+         nkx = c%nx/2 + 1
+         do ky = 0, c%ny - 1
+            do kx = 0, c%nx/2
+               ax = 0.5_wp*(1.0_wp + cos(pi*kx/c%nx))
+               bx = 0.5_wp*(1.0_wp - cos(pi*kx/c%nx))
+               if (h%surface) then
+                  ay = 0.5_wp*(1.0_wp + cos(pi*ky/c%ny))
+                  by = 0.5_wp*(1.0_wp - cos(pi*ky/c%ny))
+                  c%symbol(kx + nkx*ky + 1) = &
+                     & 2*ax**2*(2*ay**2*f%symbol(mode_index(f%nx, f%ny, kx, ky)) &
+                     &          + 2*by**2*f%symbol(mode_index(f%nx, f%ny, kx, ky + c%ny))) &
+                     & + 2*bx**2*(2*ay**2*f%symbol(mode_index(f%nx, f%ny, kx + c%nx, ky)) &
+                     &            + 2*by**2*f%symbol(mode_index(f%nx, f%ny, kx + c%nx, ky + c%ny)))
+               else
+                  c%symbol(kx + 1) = 2*ax**2*f%symbol(kx + 1) + 2*bx**2*f%symbol(mode_index(f%nx, 1, kx + c%nx, 0))
+               end if
+            end do
+         end do
+         end associate
+      end do
+      do t = top, h%coarsest
+         associate (lv => h%level(t))
+         ! (1/n) sum over the whole spectrum, row by row of the half spectrum: the modes of a
+         ! row stand for two, but for its mx = 0 and (even nx) Nyquist ones
+         nkx = lv%nx/2 + 1
+         lv%circulant_diagonal = 0.0_wp
+         do row = 1, lv%ny
+            first = (row - 1)*nkx + 1
+            last = row*nkx
+            lv%circulant_diagonal = lv%circulant_diagonal + (lv%symbol(first) + 2*sum(lv%symbol(first + 1:last)) &
+               & - merge(lv%symbol(last), 0.0_wp, mod(lv%nx, 2) == 0))
+         end do
+         lv%circulant_diagonal = lv%circulant_diagonal*lv%inv_n
+         lv%jacobi_diagonal = max(lv%circulant_diagonal, jacobi_margin*omega*maxval(lv%symbol)/2)
+         lv%multiplier = lv%symbol*lv%inv_n
+         end associate
+      end do
+      associate (lv => h%level(h%coarsest))
+      lv%fft%spectrum = cmplx(lv%multiplier, 0.0_wp, kind=wp)
+      call lv%fft%backward()
+      h%coarse_column = lv%fft%real_buffer
+      end associate
+   end subroutine set_grid
+
+   !> The coarse operators for the contact set of h%free: the Galerkin products of the
+   !> penalty d D_A (a 3- or 9-point stencil on every coarser grid), the
+   !> Jacobi weights, and the Cholesky factor of the coarsest operator.
+   subroutine set_contact(h)
+      type(hierarchy), intent(inout) :: h
+      integer :: t, info, attempt
+      real(wp) :: shift
+      do t = h%top + 1, h%coarsest
+         associate (c => h%level(t), f => h%level(t - 1))
+         if (h%surface) then
+            call coarsen_surface(h, t)
+         else if (t == h%top + 1) then
+            call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, 0, c%penalty)
+         else
+            call coarsen_x(f%penalty, f%nx, 0, c%penalty)
+         end if
+         c%jacobi = omega/(c%jacobi_diagonal + c%penalty(0, 0, :))
+         end associate
+      end do
+      ! the coarsest operator, dense: circulant plus penalty (on the grid being solved, when
+      ! it is the coarsest, I K I with the contact points' rows and columns the identity)
+      shift = 0.0_wp
+      do attempt = 1, 10
+         call fill_dense(h, shift)
+         call cholesky_factor(h%dense, info)
+         if (info == 0) exit
+         ! numerically singular (a rounding-level null space): shift the diagonal slightly;
+         ! the V-cycle only preconditions, and the Newton direction only needs descent
+         shift = max(10*shift, 1.0e-12_wp*h%level(h%coarsest)%circulant_diagonal)
+      end do
+   end subroutine set_contact
+
+   !> The penalty stencil of the surface's level t = P^T A P, A that of level t - 1 (on the
+   !> grid being solved the diagonal d D_A), P = Px Py: row by row of level t, from the three
+   !> rows of level t - 1 that reach it, coarsened along x (galerkin_diagonal, coarsen_x)
+   !> into the window, then along y (coarsen_y_row). (A row between two coarse ones is
+   !> coarsened twice: the window holds 3 rows, not a whole grid coarsened along x.)
+   subroutine coarsen_surface(h, t)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      integer :: cy, k, row, nx
+      associate (f => h%level(t - 1), c => h%level(t))
+      nx = f%nx
+      do cy = 0, c%ny - 1
+         do k = -1, 1
+            row = modulo(2*cy + k, f%ny)
+            if (t == h%top + 1) then
+               call galerkin_diagonal(h%free(row*nx + 1:(row + 1)*nx), penalty*f%circulant_diagonal, nx, 1, &
+                  & f%window(:, :, :, k))
+            else
+               call coarsen_x(f%penalty(:, :, row*nx + 1:(row + 1)*nx), nx, 1, f%window(:, :, :, k))
+            end if
+         end do
+         call coarsen_y_row(f%window, c%nx, c%penalty(:, :, cy*c%nx + 1:(cy + 1)*c%nx))
+      end do
+      end associate
+   end subroutine coarsen_surface
+
+   !> b = Px^T D Px for a row of nx points with the diagonal D = `weight` on the contact set
+   !> (free = 0) and 0 off it, Px linear interpolation: the 3-point stencil (ey = 0) of the
+   !> row of nx/2 points, in a stencil array reaching `reach` rows (0 on a line).
+   pure subroutine galerkin_diagonal(free, weight, nx, reach, b)
+      integer, intent(in) :: nx, reach
+      real(wp), intent(in) :: free(0:nx - 1), weight
+      real(wp), intent(out) :: b(-1:1, -reach:reach, 0:nx/2 - 1)
+      real(wp) :: left, centre, right
+      integer :: cx
+      b = 0.0_wp
+      do cx = 0, nx/2 - 1
+         ! the fine points 2 cx - 1, 2 cx, 2 cx + 1 (weights 1/2, 1, 1/2 from cx)
+         left = weight*(1.0_wp - free(modulo(2*cx - 1, nx)))
+         centre = weight*(1.0_wp - free(2*cx))
+         right = weight*(1.0_wp - free(2*cx + 1))
+         b(0, 0, cx) = centre + 0.25_wp*(left + right)
+         b(-1, 0, cx) = 0.25_wp*left
+         b(1, 0, cx) = 0.25_wp*right
+      end do
+   end subroutine galerkin_diagonal
+
+   !> The Galerkin products below use that the fine point 2I + k of an axis (zero-based,
+   !> k = -2..2 from the coarse point I) takes the values of the coarse points I + to(1:2, k)
+   !> with the weights of(1:2, k) under linear interpolation (a weight 0: no second point).
+   pure subroutine interpolation_weights(to, of)
+      integer, intent(out) :: to(2, -2:2)
+      real(wp), intent(out) :: of(2, -2:2)
+      to = reshape([-1, 0, -1, 0, 0, 0, 0, 1, 1, 0], [2, 5])
+      of = reshape([1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 0.0_wp], [2, 5])
+   end subroutine interpolation_weights
+
+   !> b = Px^T a Px for the 3 x 3 stencil `a` of a row of nx points, Px linear interpolation
+   !> along x: the stencil of the row of nx/2 points. `reach`: 1 if the stencil couples rows
+   !> (a surface), 0 on a line (ey = 0 only).
+   pure subroutine coarsen_x(a, nx, reach, b)
+      integer, intent(in) :: nx, reach
+      real(wp), intent(in) :: a(-1:1, -reach:reach, 0:nx - 1)
+      real(wp), intent(out) :: b(-1:1, -reach:reach, 0:nx/2 - 1)
+      integer :: to(2, -2:2), cx, k, e, ix, j, ey
+      real(wp) :: of(2, -2:2), w
+      call interpolation_weights(to, of)
+      b = 0.0_wp
+      do cx = 0, nx/2 - 1
+         do k = -1, 1
+            ix = modulo(2*cx + k, nx)
+            do e = -1, 1
+               do j = 1, 2
+                  w = of(1, k)*of(j, k + e)
+                  if (w == 0.0_wp) cycle
+                  do ey = -reach, reach
+                     b(to(j, k + e), ey, cx) = b(to(j, k + e), ey, cx) + w*a(e, ey, ix)
+                  end do
+               end do
+            end do
+         end do
+      end do
+   end subroutine coarsen_x
+
+   !> c = the row of Py^T b Py from the three rows rows(:, :, :, k) = b's rows 2 cy + k
+   !> (k = -1, 0, 1) of nx points, Py linear interpolation along y.
+   pure subroutine coarsen_y_row(rows, nx, c)
+      integer, intent(in) :: nx
+      real(wp), intent(in) :: rows(-1:1, -1:1, 0:nx - 1, -1:1)
+      real(wp), intent(out) :: c(-1:1, -1:1, 0:nx - 1)
+      integer :: to(2, -2:2), ix, k, e, j
+      real(wp) :: of(2, -2:2)
+      call interpolation_weights(to, of)
+      c = 0.0_wp
+      do k = -1, 1
+         do e = -1, 1
+            do j = 1, 2
+               do ix = 0, nx - 1
+                  c(:, to(j, k + e), ix) = c(:, to(j, k + e), ix) + (of(1, k)*of(j, k + e))*rows(:, e, ix, k)
+               end do
+            end do
+         end do
+      end do
+   end subroutine coarsen_y_row
+
+   !> The dense matrix of the coarsest grid's operator (see set_contact), its diagonal
+   !> shifted by `shift`.
+   pure subroutine fill_dense(h, shift)
+      type(hierarchy), intent(inout) :: h
+      real(wp), intent(in) :: shift
+      integer :: i, j, m, ix, iy, jx, jy, ex, ey
+      associate (lv => h%level(h%coarsest), a => h%dense)
+      m = lv%n
+      do i = 1, m
+         ix = mod(i - 1, lv%nx)
+         iy = (i - 1)/lv%nx
+         do j = 1, m
+            jx = mod(j - 1, lv%nx)
+            jy = (j - 1)/lv%nx
+            a(j, i) = h%coarse_column(modulo(jx - ix, lv%nx) + lv%nx*modulo(jy - iy, lv%ny) + 1)
+         end do
+      end do
+      if (h%top == h%coarsest) then
+         do i = 1, m
+            if (h%free(i) == 0.0_wp) then
+               a(:, i) = 0.0_wp
+               a(i, :) = 0.0_wp
+               a(i, i) = 1.0_wp
+            end if
+         end do
+      else
+         ! row i: sum over the stencil of penalty(ex, ey, i) x(i + (ex, ey))
+         do i = 1, m
+            ix = mod(i - 1, lv%nx)
+            iy = (i - 1)/lv%nx
+            do ey = lbound(lv%penalty, 2), ubound(lv%penalty, 2)
+               do ex = -1, 1
+                  if (lv%penalty(ex, ey, i) == 0.0_wp) cycle
+                  j = modulo(ix + ex, lv%nx) + lv%nx*modulo(iy + ey, lv%ny) + 1
+                  a(i, j) = a(i, j) + lv%penalty(ex, ey, i)
+               end do
+            end do
+         end do
+      end if
+      do i = 1, m
+         a(i, i) = a(i, i) + shift
+      end do
+      end associate
+   end subroutine fill_dense
+
+   !> The lower Cholesky factor L of the symmetric positive definite a (its lower triangle),
+   !> in place; info = the column where a pivot was not positive (0: factorised). (Written
+   !> out rather than LAPACK's dpotrf: for the few hundred points of the coarsest grid a
+   !> threaded BLAS spent more time waking and parking its threads than factorising.)
+   pure subroutine cholesky_factor(a, info)
+      real(wp), contiguous, intent(inout) :: a(:, :)
+      integer, intent(out) :: info
+      integer :: j, k
+      info = 0
+      do j = 1, size(a, 2)
+         do k = 1, j - 1
+            a(j:, j) = a(j:, j) - a(j, k)*a(j:, k)
+         end do
+         if (.not. a(j, j) > 0.0_wp) then
+            info = j
+            return
+         end if
+         a(j:, j) = a(j:, j)/sqrt(a(j, j))
+      end do
+   end subroutine cholesky_factor
+
+   !> x <- (L L^T)^-1 x with the factor of cholesky_factor.
+   pure subroutine cholesky_solve(l, x)
+      real(wp), contiguous, intent(in) :: l(:, :)
+      real(wp), contiguous, intent(inout) :: x(:)
+      integer :: j, m
+      m = size(x)
+      do j = 1, m
+         x(j) = x(j)/l(j, j)
+         x(j + 1:) = x(j + 1:) - x(j)*l(j + 1:, j)
+      end do
+      do j = m, 1, -1
+         x(j) = (x(j) - dot_product(l(j + 1:, j), x(j + 1:)))/l(j, j)
+      end do
+   end subroutine cholesky_solve
+
+   !> uf (on grid j) = the spectral interpolation of uc (on grid j + 1): its Fourier
+   !> coefficients, zero-padded.
+   subroutine interpolate(h, j, uc, uf)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: j
+      real(wp), contiguous, intent(in) :: uc(:)
+      real(wp), contiguous, intent(out) :: uf(:)
+      complex(wp) :: value
+      integer :: kx, ky, fy, nkc, nkf
+      associate (coarse => h%level(j + 1), fine => h%level(j))
+      nkc = coarse%nx/2 + 1
+      nkf = fine%nx/2 + 1
+      coarse%fft%real_buffer = uc
+      call coarse%fft%forward()
+      fine%fft%spectrum = (0.0_wp, 0.0_wp)
+      do ky = 0, coarse%ny - 1
+         ! (rows of negative ky move to the end of the longer fine axis)
+         fy = merge(ky, ky + fine%ny - coarse%ny, 2*ky <= coarse%ny)
+         do kx = 0, coarse%nx/2
+            value = coarse%fft%spectrum(kx + nkc*ky + 1)
+            ! a coarse Nyquist mode is a cosine: on the fine grid half of it is its mirror image
+            if (2*kx == coarse%nx) value = 0.5_wp*value
+            if (h%surface .and. 2*ky == coarse%ny) then
+               value = 0.5_wp*value
+               fine%fft%spectrum(kx + nkf*(fine%ny - ky) + 1) = value
+            end if
+            fine%fft%spectrum(kx + nkf*fy + 1) = value
+         end do
+      end do
+      call fine%fft%backward()
+      uf = fine%fft%real_buffer
+      h%pairs = h%pairs + 0.5_wp*(coarse%n + fine%n)/h%n_fine
+      end associate
+   end subroutine interpolate
+end module lc_contact_multigrid_hierarchy
