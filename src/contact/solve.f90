@@ -514,6 +514,8 @@ contains
       real(wp) :: sc
       integer :: ratio
 
+      pairs = 0
+      hard = .false.
       coarse_grid = grid%coarse()
       coarse = scene
       coarse%solver%tol = max(scene%solver%tol, coarse_tol*min(1.0_wp, real(coarse_tol_size, wp)/grid%nx))
