@@ -313,12 +313,15 @@ contains
    !> Coupled contact (friction, or a sliding viscoelastic layer) in the displacement form
    !> with the non-symmetric stiffness K = 1/G_eff: u >= o, p = K u + f >= 0, p (u - o) = 0.
    !> The TNNMG iteration of the symmetric solver with K in place of the symmetric stiffness:
-   !> projected damped Jacobi (d the real-space diagonal of K), the truncated Newton problem
+   !> projected damped Jacobi (d the real-space diagonal of Re K, or more: jacobi_margin), the
+   !> truncated Newton problem
    !> I K I c = -I p by GCR right-preconditioned by the symmetric multigrid preconditioner of
    !> the metric |G_eff| (the hierarchy's, whose penalty stands for the contact set), the
    !> direction projected onto u >= o and its step from the quadratic model of the symmetric
-   !> part. p: in, the start (the coarse start's interpolated solution, or the caller's
-   !> guess); out, the solution. The metric must pass metric_refusal.
+   !> part. It stops when its residual has not halved in coupled_stall iterations. p: in, the
+   !> start (the coarse start's interpolated solution, or the caller's guess); out, the
+   !> solution, or the best iterate if it did not converge. The metric must pass
+   !> metric_refusal.
    subroutine coupled_tnnmg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
          & history, progress, error)
       type(compliance_operator), intent(inout), target :: op
@@ -384,10 +387,7 @@ contains
             best = residual
             last_progress = step
          else if (step - last_progress > coupled_stall) then
-            ! (the non-symmetric part defeats the iteration: strongly glassy layers; the
-            ! caller goes on from the best iterate)
-            u = u_best
-            call apply_k(u, p)
+            ! (the non-symmetric part defeats the iteration: strongly glassy layers)
             exit
          end if
          if (load_control .and. contact == 0.0_wp) then
@@ -427,6 +427,10 @@ contains
          u = u + alpha*v
          p = p + alpha*kv
       end do
+      if (.not. (residual <= tol) .and. best_residual < residual) then
+         u = u_best
+         call apply_k(u, p)
+      end if
       ! the fields: p where it is the larger term of the residual, w = G p
       w = o
       call returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, w, gap, s, outcome%residual, full=.true.)
