@@ -349,8 +349,12 @@ contains
       if (allocated(error)) return
       call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
       call op%prepare_gcr()
-      d = max(op%inverse_diagonal, jacobi_margin*omega*maxval(abs(op%inverse_full)**2/(2*real(op%inverse_full)), &
-         & mask=real(op%inverse_full) > 0.0_wp))
+      ! (the Jacobi diagonal: see jacobi_margin; modes with Re K <= 0 are not damped by any)
+      d = op%inverse_diagonal
+      do j = 1, op%nk
+         if (real(op%inverse_full(j)) > 0.0_wp) &
+            & d = max(d, jacobi_margin*omega*abs(op%inverse_full(j))**2/(2*real(op%inverse_full(j))))
+      end do
       allocate (u(n), o(n), c(n), kc(n), v(n), kv(n), r(n), u_best(n), dirs(n, gcr_memory), kdirs(n, gcr_memory))
       f = merge(mean_pressure, 0.0_wp, load_control)
       o = b
