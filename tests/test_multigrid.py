@@ -116,9 +116,9 @@ def test_coupled_lines_agree_with_gcr(n, family, scene):
     assert np.abs(mg.pressure - gcr.pressure).max() <= bound
     assert mg.mean_pressure == pytest.approx(gcr.mean_pressure, rel=1e-10)
     assert mg.penetration == pytest.approx(gcr.penetration, abs=(TOL + TOL_GCR) * np.ptp(h))
-    # measured at tol 1e-10: 80-97 pairs (friction), 121-163 (viscoelastic); GCR needs up
+    # measured at tol 1e-10: 77-97 pairs (friction), 85-111 (viscoelastic); GCR needs up
     # to 1100 on the broadband line of 65536 points
-    assert mg.fft_pairs <= 250
+    assert mg.fft_pairs <= 200
 
 
 @pytest.mark.parametrize("control", ["load", "displacement"])
@@ -141,16 +141,30 @@ def test_coupled_surfaces_agree_with_gcr(control):
 
 
 def test_a_glassy_layer_it_cannot_solve_goes_on_with_gcr():
-    """A strongly glassy layer (E_inf/E0 = 100) at V tau/lambda = 1 on a broadband profile,
-    lightly loaded: the non-symmetric part defeats the multigrid iteration, which stops when
-    its residual no longer halves and hands its best iterate to GCR, which converges
-    (measured: 55 iterations in all)."""
+    """A strongly glassy layer (E_inf/E0 = 1000) sliding at V tau/lambda = 0.01 on a
+    broadband profile, lightly loaded: the multigrid iteration's residual no longer halves,
+    it stops and hands its best iterate to GCR, which converges (measured: 147 iterations in
+    all)."""
     h = lc.self_affine_profile(1024, 0.8, seed=5, short_wavelength=4 / 1024)
-    glassy = lc.StandardLinearSolid(e0=1.0, e_inf=100.0, tau=1.0)
-    res = lc.solve_line(h, method="multigrid", thickness=0.16, poisson=0.5, friction=0.5, material=glassy,
-                        speed=1.0, mean_pressure=0.015810609908501867, tol=1e-9, stress=False)
+    glassy = lc.StandardLinearSolid(e0=1.0, e_inf=1000.0, tau=1.0)
+    res = lc.solve_line(h, method="multigrid", thickness=0.16, poisson=0.3, material=glassy, speed=0.01,
+                        mean_pressure=0.0011388841675768026, tol=1e-9, stress=False)
     assert res.converged and res.solver.startswith("multigrid+gcr")
     assert res.residual <= 1e-9
+
+
+def test_a_line_with_its_loss_at_long_waves_takes_the_hierarchy_of_its_stiffness():
+    """A glassy layer (E_inf/E0 = 100) at V tau/lambda = 1 has its loss peak at the longest
+    waves, where the metric's symmetric hierarchy leaves the phase of K to GCR (the
+    broadband line of 65536 points stalled there); the hierarchy of K itself, complex
+    Galerkin symbols and LU on the coarsest grid, takes it in a few iterations (measured at
+    16384: 3 iterations, 106 pairs; the elastic layer 78)."""
+    h = profile(16384, "broadband")
+    glassy = lc.StandardLinearSolid(e0=1.0, e_inf=100.0, tau=1.0)
+    res = lc.solve_line(h, method="multigrid", thickness=0.16, poisson=0.5, friction=0.5, material=glassy,
+                        speed=1.0, mean_pressure=0.03, tol=1e-8, stress=False)
+    assert res.converged and res.solver == "multigrid"
+    assert res.iterations <= 6 and res.fft_pairs <= 160
 
 
 def test_a_stiffening_layer_takes_stable_jacobi_steps():

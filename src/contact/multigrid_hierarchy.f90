@@ -22,6 +22,23 @@ module lc_contact_multigrid_hierarchy
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private
+   interface
+      subroutine dgetrf(m, n, a, lda, ipiv, info)
+         import :: wp
+         integer, intent(in) :: m, n, lda
+         real(wp), intent(inout) :: a(lda, *)
+         integer, intent(out) :: ipiv(*), info
+      end subroutine dgetrf
+      subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+         import :: wp
+         character, intent(in) :: trans
+         integer, intent(in) :: n, nrhs, lda, ldb
+         real(wp), intent(in) :: a(lda, *)
+         integer, intent(in) :: ipiv(*)
+         real(wp), intent(inout) :: b(ldb, *)
+         integer, intent(out) :: info
+      end subroutine dgetrs
+   end interface
    public :: grid_level, hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit
    public :: build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate
    public :: precondition, apply_stiffness
@@ -61,6 +78,10 @@ module lc_contact_multigrid_hierarchy
       real(wp) :: inv_n = 1.0_wp
       real(wp), allocatable :: symbol(:)       !< circulant part, half spectrum (nx/2 + 1) x ny
       real(wp), allocatable :: multiplier(:)   !< symbol/n, as applied after an unscaled r2c
+      !> a non-symmetric hierarchy (h%complex): the symbol's imaginary part (odd in kx) and
+      !> the complex multiplier
+      real(wp), allocatable :: odd(:)
+      complex(wp), allocatable :: cmultiplier(:)
       real(wp) :: circulant_diagonal = 0.0_wp
       !> the diagonal of the Jacobi steps: circulant_diagonal, or more where the symbol rises
       !> so steeply that omega K/d would exceed 2 on some mode (see jacobi_margin)
@@ -83,6 +104,8 @@ module lc_contact_multigrid_hierarchy
       type(grid_level), allocatable :: level(:)
       integer :: top = 0, coarsest = 0, n_fine = 0
       logical :: surface = .false.   !< both axes are halved
+      logical :: complex = .false.   !< a complex symbol (lines): LU on the coarsest grid
+      integer, allocatable :: pivots(:)
       real(wp), allocatable :: free(:)           !< 1 off the contact set, 0 on it (top grid)
       real(wp), allocatable :: dense(:, :)       !< Cholesky factor of the coarsest operator
       real(wp), allocatable :: coarse_column(:)  !< real-space column of its circulant part
@@ -122,7 +145,7 @@ contains
       h%vcycles = h%vcycles + 1
       if (h%top == h%coarsest) then
          z = r
-         call cholesky_solve(h%dense, z)
+         call coarsest_solve(h, z)
          return
       end if
       call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
@@ -138,7 +161,7 @@ contains
       integer, intent(in) :: t
       if (t == h%coarsest) then
          h%level(t)%x = h%level(t)%rhs
-         call cholesky_solve(h%dense, h%level(t)%x)
+         call coarsest_solve(h, h%level(t)%x)
          return
       end if
       associate (lv => h%level(t))
@@ -224,9 +247,15 @@ contains
       integer :: k
       associate (lv => h%level(t))
       call lv%fft%forward_unscaled()
-      do k = 1, size(lv%symbol)
-         lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%multiplier(k)
-      end do
+      if (h%complex) then
+         do k = 1, size(lv%symbol)
+            lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%cmultiplier(k)
+         end do
+      else
+         do k = 1, size(lv%symbol)
+            lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%multiplier(k)
+         end do
+      end if
       call lv%fft%backward()
       h%pairs = h%pairs + real(lv%n, wp)/h%n_fine
       end associate
@@ -441,15 +470,38 @@ contains
    !> 2 alpha^2 and 2 beta^2, alpha, beta = (1 +- cos(pi k/m_c))/2; on a surface the products
    !> of the two axes' weights over the four fine modes), their diagonals, and the real-space
    !> column of the coarsest one.
-   subroutine set_grid(h, top, symbol)
+   subroutine set_grid(h, top, symbol, odd)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: top
       real(wp), contiguous, intent(in) :: symbol(:)
+      real(wp), contiguous, intent(in), optional :: odd(:)
+      integer :: mirror
       real(wp), parameter :: pi = acos(-1.0_wp)
       real(wp) :: ax, bx, ay, by
-      integer :: t, kx, ky, nkx, row, first, last
+      integer :: t, kx, ky, nkx, row, first, last, k
       h%top = top
       h%level(top)%symbol = symbol
+      h%complex = present(odd)
+      if (h%complex) then
+         do t = top, h%coarsest
+            associate (lv => h%level(t))
+            if (.not. allocated(lv%odd)) allocate (lv%odd(size(lv%symbol)), lv%cmultiplier(size(lv%symbol)))
+            end associate
+         end do
+         if (.not. allocated(h%pivots)) allocate (h%pivots(size(h%dense, 1)))
+         h%level(top)%odd = odd
+         ! (lines: the fine mode kx + nc is the mirror of nc - kx, its imaginary part negated)
+         do t = top + 1, h%coarsest
+            associate (c => h%level(t), f => h%level(t - 1))
+            do kx = 0, c%nx/2
+               ax = 0.5_wp*(1.0_wp + cos(pi*kx/c%nx))
+               bx = 0.5_wp*(1.0_wp - cos(pi*kx/c%nx))
+               mirror = c%nx - kx
+               c%odd(kx + 1) = 2*ax**2*f%odd(kx + 1) - 2*bx**2*f%odd(mirror + 1)
+            end do
+            end associate
+         end do
+      end if
       do t = top + 1, h%coarsest
          associate (c => h%level(t), f => h%level(t - 1))
          nkx = c%nx/2 + 1
@@ -487,10 +539,18 @@ contains
          lv%circulant_diagonal = lv%circulant_diagonal*lv%inv_n
          lv%jacobi_diagonal = max(lv%circulant_diagonal, jacobi_margin*omega*maxval(lv%symbol)/2)
          lv%multiplier = lv%symbol*lv%inv_n
+         if (h%complex) then
+            lv%cmultiplier = cmplx(lv%symbol, lv%odd, kind=wp)*lv%inv_n
+            do k = 1, size(lv%symbol)
+               if (lv%symbol(k) > 0.0_wp) lv%jacobi_diagonal = max(lv%jacobi_diagonal, &
+                  & jacobi_margin*omega*(lv%symbol(k)**2 + lv%odd(k)**2)/(2*lv%symbol(k)))
+            end do
+         end if
          end associate
       end do
       associate (lv => h%level(h%coarsest))
       lv%fft%spectrum = cmplx(lv%multiplier, 0.0_wp, kind=wp)
+      if (h%complex) lv%fft%spectrum = lv%cmultiplier
       call lv%fft%backward()
       h%coarse_column = lv%fft%real_buffer
       end associate
@@ -520,7 +580,11 @@ contains
       shift = 0.0_wp
       do attempt = 1, 10
          call fill_dense(h, shift)
-         call cholesky_factor(h%dense, info)
+         if (h%complex) then
+            call dgetrf(size(h%dense, 1), size(h%dense, 1), h%dense, size(h%dense, 1), h%pivots, info)
+         else
+            call cholesky_factor(h%dense, info)
+         end if
          if (info == 0) exit
          ! numerically singular (a rounding-level null space): shift the diagonal slightly;
          ! the V-cycle only preconditions, and the Newton direction only needs descent
@@ -698,6 +762,18 @@ contains
          a(j:, j) = a(j:, j)/sqrt(a(j, j))
       end do
    end subroutine cholesky_factor
+
+   !> x <- A^-1 x on the coarsest grid: Cholesky, or LU for a complex symbol.
+   subroutine coarsest_solve(h, x)
+      type(hierarchy), intent(inout) :: h
+      real(wp), contiguous, intent(inout) :: x(:)
+      integer :: info
+      if (h%complex) then
+         call dgetrs('N', size(x), 1, h%dense, size(x), h%pivots, x, size(x), info)
+      else
+         call cholesky_solve(h%dense, x)
+      end if
+   end subroutine coarsest_solve
 
    !> x <- (L L^T)^-1 x with the factor of cholesky_factor.
    pure subroutine cholesky_solve(l, x)

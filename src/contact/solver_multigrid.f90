@@ -347,8 +347,13 @@ contains
       n = size(p)
       call build_hierarchy(h, op, error)
       if (allocated(error)) return
-      call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
       call op%prepare_gcr()
+      ! the hierarchy of K itself where its loss lies at long waves, else of the metric
+      if (loss_at_long_waves(op)) then
+         call set_grid(h, 0, real(op%inverse_full), aimag(op%inverse_full))
+      else
+         call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
+      end if
       ! (the Jacobi diagonal: see jacobi_margin; modes with Re K <= 0 are not damped by any)
       d = op%inverse_diagonal
       do j = 1, op%nk
@@ -541,6 +546,32 @@ contains
          end do
       end subroutine truncated_gcr
    end subroutine coupled_tnnmg
+
+   !> Whether the coupled line's preconditioner takes the hierarchy of K = 1/G_eff itself
+   !> (complex Galerkin symbols, LU on the coarsest grid) rather than that of the metric
+   !> 1/|G_eff|: where the phase of K is largest (friction on a layer; a viscoelastic layer's
+   !> loss peak V q tau ~ 1) at long waves, |q| <= q_max/8, which the coarse grids carry. A
+   !> loss peak among the short waves (a slow glassy layer on a fine grid) is left to the
+   !> metric's hierarchy, whose Jacobi steps damp those modes better: E_inf/E0 = 100 at
+   !> V tau/lambda = 1e-4, n = 65536, 542 against 1004 pairs (docs/decisions/012-coupled-multigrid.md).
+   pure logical function loss_at_long_waves(op) result(long)
+      type(compliance_operator), intent(in) :: op
+      real(wp) :: loss, largest
+      integer :: i, at
+      long = .false.
+      if (.not. op%grid%is_line()) return
+      largest = 0.0_wp
+      at = 0
+      do i = 2, op%nk
+         if (.not. real(op%inverse_full(i)) > 0.0_wp) cycle
+         loss = abs(aimag(op%inverse_full(i)))/real(op%inverse_full(i))
+         if (loss > largest) then
+            largest = loss
+            at = i - 1
+         end if
+      end do
+      long = largest > 0.0_wp .and. 16*at <= op%grid%nx
+   end function loss_at_long_waves
 
    !> TNNMG iterations on the grid h%top from u until the residual on (K u + f, u - o) is at
    !> most tol or max_steps ran; p = K u + f on exit. steps: iterations run. history and
