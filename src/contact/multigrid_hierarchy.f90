@@ -11,7 +11,9 @@
 !> O(n) when the set changes. The penalty stands in for the truncated Galerkin operator
 !> P^T I K I P, whose application would cost a transform of the finest grid. Damped Jacobi
 !> smoothing; a dense Cholesky solve on the coarsest grid (at most coarsest_limit points).
-!> K is real and even (a symmetric stiffness: the operator's metric inverted); the solvers
+!> K is real and even (a symmetric stiffness: the operator's metric inverted), or, on a line,
+!> complex (the non-symmetric stiffness 1/G_eff of a coupled scene, whose imaginary part is
+!> odd in kx), with an LU factor of the coarsest operator in place of Cholesky's; the solvers
 !> only need B to approximate the truncated problem's inverse, which is what lets the
 !> coarse operators be this cheap. Fields are stored as the rest of the library stores
 !> them: nx x ny points, x fastest; spectra on the half spectrum (nx/2 + 1) x ny.
@@ -107,7 +109,7 @@ module lc_contact_multigrid_hierarchy
       logical :: complex = .false.   !< a complex symbol (lines): LU on the coarsest grid
       integer, allocatable :: pivots(:)
       real(wp), allocatable :: free(:)           !< 1 off the contact set, 0 on it (top grid)
-      real(wp), allocatable :: dense(:, :)       !< Cholesky factor of the coarsest operator
+      real(wp), allocatable :: dense(:, :)       !< Cholesky (LU) factor of the coarsest operator
       real(wp), allocatable :: coarse_column(:)  !< real-space column of its circulant part
       real(wp) :: pairs = 0.0_wp
       integer :: vcycles = 0
@@ -469,7 +471,8 @@ contains
    !> halved axis a coarse mode k gathers the fine modes k and k + m_c with the weights
    !> 2 alpha^2 and 2 beta^2, alpha, beta = (1 +- cos(pi k/m_c))/2; on a surface the products
    !> of the two axes' weights over the four fine modes), their diagonals, and the real-space
-   !> column of the coarsest one.
+   !> column of the coarsest one. With `odd` (a line only) the symbol is complex, symbol + i
+   !> odd, its imaginary part odd in kx: the hierarchy of a non-symmetric stiffness.
    subroutine set_grid(h, top, symbol, odd)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: top
