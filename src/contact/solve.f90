@@ -54,8 +54,8 @@ module lc_contact_solve
    !> that way itself. Measured on bench/scaling.py's coupled scenes (friction, SLS): those
    !> coarse solves need 4-14 GCR iterations where the spectrum is fixed (n = 8192 to 65536),
    !> where GCR takes 0.5-0.7x the multigrid's time, and 15-340 on broadband lines, where it
-   !> takes 0.6-1.3x at 8192, 1.2-2.2x at 16384, 1.8-3.5x at 32768 and 2.5-8x from 65536 on
-   !> (docs/decisions/012-coupled-multigrid.md). A coupled surface of at least 1024^2 points
+   !> takes 0.8-1.5x at 8192 (0.5-1.2x at 4096), 1.2-2.2x at 16384, 1.8-3.5x at 32768 and
+   !> 2.5-8x from 65536 on (docs/decisions/012-coupled-multigrid.md). A coupled surface of at least 1024^2 points
    !> goes the same way when its coarse solve needed more than 12 GCR iterations: those
    !> coarse solves need 5-7 on the physical family (512^2 to 2048^2), where GCR takes
    !> 0.3-0.5x the multigrid's time, and 7-28 on broadband surfaces, where it takes 1.3-1.6x
