@@ -340,7 +340,7 @@ contains
       type(hierarchy), target :: h
       type(residual_scales) :: scales
       real(wp), allocatable :: u(:), o(:), c(:), kc(:), v(:), kv(:), dirs(:, :), kdirs(:, :), r(:), u_best(:)
-      real(wp) :: f, d, b_max, residual, contact, vkv, alpha, best, best_residual
+      real(wp) :: f, d, b_max, residual, contact, best, best_residual
       integer :: n, step, changed, j, last_progress
       logical :: settled, finished, clipped, tension
 
@@ -417,24 +417,13 @@ contains
             if (step <= size(history)) history(step) = residual
             exit
          end if
-         clipped = .false.
-         do j = 1, n
-            v(j) = c(j)
-            if (u(j) + c(j) < o(j)) then
-               v(j) = o(j) - u(j)
-               clipped = .true.
-            end if
-         end do
+         call project_direction(u, o, c, v, clipped)
          if (clipped) then
             call apply_k(v, kv, shift=0.0_wp)
          else
             kv = kc
          end if
-         vkv = dot_product(v, kv)
-         if (.not. vkv > 0.0_wp) cycle
-         alpha = min(1.0_wp, max(0.0_wp, -dot_product(p, v)/vkv))
-         u = u + alpha*v
-         p = p + alpha*kv
+         call line_step(v, kv, dot_product(v, kv), u, p)
       end do
       if (.not. (residual <= tol) .and. best_residual < residual) then
          u = u_best
@@ -591,8 +580,8 @@ contains
       real(wp), contiguous, intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
       type(residual_scales) :: scales
-      real(wp) :: residual, diagonal, alpha, vkv, b_max, contact
-      integer :: m, step, changed, j
+      real(wp) :: residual, diagonal, vkv, b_max, contact
+      integer :: m, step, changed
       logical :: settled, finished, clipped, tension
 
       m = size(u)
@@ -644,24 +633,14 @@ contains
             exit
          end if
          ! projection onto u >= o and exact line search on the quadratic J
-         clipped = .false.
-         do j = 1, m
-            v(j) = c(j)
-            if (u(j) + c(j) < o(j)) then
-               v(j) = o(j) - u(j)
-               clipped = .true.
-            end if
-         end do
+         call project_direction(u, o, c, v, clipped)
          if (clipped) then
             call apply_stiffness(h, v, kv, xy=vkv)
          else
             kv = kc
             vkv = dot_product(v, kv)
          end if
-         if (.not. vkv > 0.0_wp) cycle
-         alpha = min(1.0_wp, max(0.0_wp, -dot_product(p, v)/vkv))
-         u = u + alpha*v
-         p = p + alpha*kv
+         call line_step(v, kv, vkv, u, p)
       end do
       end associate
    contains
@@ -674,6 +653,35 @@ contains
          if (present(progress)) call progress%tick(step, residual, contact)
       end subroutine record
    end subroutine tnnmg
+
+   !> v = the Newton direction c projected onto u + v >= o; clipped: some point was.
+   pure subroutine project_direction(u, o, c, v, clipped)
+      real(wp), contiguous, intent(in) :: u(:), o(:), c(:)
+      real(wp), contiguous, intent(out) :: v(:)
+      logical, intent(out) :: clipped
+      integer :: j
+      clipped = .false.
+      do j = 1, size(u)
+         v(j) = c(j)
+         if (u(j) + c(j) < o(j)) then
+            v(j) = o(j) - u(j)
+            clipped = .true.
+         end if
+      end do
+   end subroutine project_direction
+
+   !> u <- u + alpha v, p <- p + alpha K v with alpha = min(1, -p.v/v.K v), the exact line
+   !> search of the (symmetric part's) quadratic energy along v; no step unless v.K v > 0.
+   pure subroutine line_step(v, kv, vkv, u, p)
+      real(wp), contiguous, intent(in) :: v(:), kv(:)
+      real(wp), intent(in) :: vkv
+      real(wp), contiguous, intent(inout) :: u(:), p(:)
+      real(wp) :: alpha
+      if (.not. vkv > 0.0_wp) return
+      alpha = min(1.0_wp, max(0.0_wp, -dot_product(p, v)/vkv))
+      u = u + alpha*v
+      p = p + alpha*kv
+   end subroutine line_step
 
    !> CG on the truncated Newton problem I K I c = -I p (c = 0 on the contact set),
    !> preconditioned (precondition, below), from c = 0; kc = K c (carried along at no cost).
