@@ -41,9 +41,9 @@ module lc_contact_multigrid_hierarchy
          integer, intent(out) :: info
       end subroutine dgetrs
    end interface
-   public :: grid_level, hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit
+   public :: grid_level, hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, penalty
    public :: build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate
-   public :: precondition, apply_stiffness
+   public :: precondition, apply_stiffness, level_operator
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
    !> step lowers the energy monotonically; 2/3 damps the upper half of the spectrum best.
@@ -66,6 +66,11 @@ module lc_contact_multigrid_hierarchy
    !> ... and its coarsest grid (solved densely) may have at most this many.
    integer, parameter :: coarsest_limit = 256
 
+   !> coarsening_shapes halves both axes of a surface's grid while the Jacobi step's
+   !> smoothing factor over the modes the next grid cannot carry is at most this (K ~ |q|:
+   !> about 0.6).
+   real(wp), parameter :: accepted_smoothing = 0.75_wp
+
    !> Weight of the contact-set penalty d D_A in the coarse operators (in units of the
    !> diagonal d of K): 1 gave the fewest CG iterations on the final set against 0.5, 2, 10.
    real(wp), parameter :: penalty = 1.0_wp
@@ -74,6 +79,8 @@ module lc_contact_multigrid_hierarchy
    !> for the current hierarchy, and the V-cycle's work arrays.
    type :: grid_level
       integer :: nx = 0, ny = 1, n = 0
+      !> how the next grid is made of this one: along which axes it is halved (a line: x)
+      logical :: halve_x = .true., halve_y = .false.
       !> the plan: the operator's own on the finest grid, `plan` on the coarser ones
       type(fft_plan), pointer :: fft => null()
       type(fft_plan), allocatable :: plan
@@ -136,6 +143,101 @@ contains
       end do
    end function halvings
 
+   !> The shapes (nx, ny) of the grids t = 0..coarsest of the V-cycle. Every 2^t-th point
+   !> along every axis (halvings), or, given the stiffness symbol of a surface (finest half
+   !> spectrum, `odd` its imaginary part), grid by grid the halving that leaves the damped
+   !> Jacobi step the smallest smoothing factor (smoothing_factors): both axes while that
+   !> factor is at most accepted_smoothing, else the one axis along which the step damps the
+   !> modes the next grid cannot carry. A layer sliding with a frequency-dependent modulus is
+   !> stiffer along the sliding direction (E_inf/E0 = 10: tenfold between modes of one |q|);
+   !> halving both axes leaves the short waves across it, soft, to a step that barely damps
+   !> them. The full coarsening is kept if the other would end on a grid of more than
+   !> coarsest_limit points.
+   subroutine coarsening_shapes(nx, ny, shapes, symbol, odd)
+      integer, intent(in) :: nx, ny
+      integer, allocatable, intent(out) :: shapes(:, :)
+      real(wp), contiguous, intent(in), optional :: symbol(:), odd(:)
+      integer, allocatable :: chosen(:, :)
+      integer :: t, k, mx, my
+      real(wp) :: mu_x, mu_y, mu_both
+      logical :: can_x, can_y, can_both
+      k = halvings(nx, ny, coarsest_points)
+      allocate (shapes(2, 0:k))
+      do t = 0, k
+         shapes(:, t) = [nx/2**t, merge(ny/2**t, 1, ny > 1)]
+      end do
+      if (.not. present(symbol) .or. ny == 1) return
+      mx = nx
+      my = ny
+      allocate (chosen(2, 0:0))
+      chosen(:, 0) = [mx, my]
+      do
+         can_x = halvable(mx) .and. (mx/2)*my >= coarsest_points
+         can_y = halvable(my) .and. mx*(my/2) >= coarsest_points
+         can_both = halvable(mx) .and. halvable(my) .and. (mx/2)*(my/2) >= coarsest_points
+         if (.not. (can_x .or. can_y)) exit
+         call smoothing_factors(nx, ny, symbol, odd, mx, my, mu_x, mu_y, mu_both)
+         if (can_both .and. mu_both <= accepted_smoothing) then
+            mx = mx/2
+            my = my/2
+         else if (can_x .and. (.not. can_y .or. mu_x <= mu_y)) then
+            mx = mx/2
+         else
+            my = my/2
+         end if
+         chosen = reshape([chosen, mx, my], [2, size(chosen, 2) + 1])
+      end do
+      if (mx*my > coarsest_limit) return
+      deallocate (shapes)
+      allocate (shapes(2, 0:size(chosen, 2) - 1))
+      shapes(:, :) = chosen
+   contains
+      pure logical function halvable(m)
+         integer, intent(in) :: m
+         halvable = mod(m, 2) == 0 .and. m/2 >= shortest_side
+      end function halvable
+   end subroutine coarsening_shapes
+
+   !> The smoothing factors of the damped Jacobi step (its diagonal as set_grid takes it) on
+   !> an mx x my grid for the stiffness symbol of the finest nx x ny grid read at the coarse
+   !> grid's modes: the largest |1 - omega K(q)/d| over the modes a grid halved along x
+   !> (mu_x), along y (mu_y) or along both (mu_both) does not carry.
+   pure subroutine smoothing_factors(nx, ny, symbol, odd, mx, my, mu_x, mu_y, mu_both)
+      integer, intent(in) :: nx, ny, mx, my
+      real(wp), intent(in) :: symbol(:)
+      real(wp), intent(in), optional :: odd(:)
+      real(wp), intent(out) :: mu_x, mu_y, mu_both
+      complex(wp) :: stiffness
+      real(wp) :: mean, bound, factor
+      integer :: kx, ky, sy, pass
+      mean = 0.0_wp
+      bound = 0.0_wp
+      mu_x = 0.0_wp
+      mu_y = 0.0_wp
+      mu_both = 0.0_wp
+      do pass = 1, 2
+         do ky = 0, my - 1
+            sy = merge(ky, ky - my, 2*ky <= my)
+            do kx = 0, mx/2
+               stiffness = cmplx(symbol(mode_index(nx, ny, kx, sy)), 0.0_wp, kind=wp)
+               if (present(odd)) stiffness = cmplx(real(stiffness), odd(mode_index(nx, ny, kx, sy)), kind=wp)
+               if (.not. real(stiffness) > 0.0_wp) cycle
+               if (pass == 1) then
+                  mean = mean + real(stiffness)
+                  bound = max(bound, abs(stiffness)**2/(2*real(stiffness)))
+               else
+                  factor = abs(1.0_wp - omega*stiffness/mean)
+                  if (4*kx > mx) mu_x = max(mu_x, factor)
+                  if (4*abs(sy) > my) mu_y = max(mu_y, factor)
+                  if (4*kx > mx .or. 4*abs(sy) > my) mu_both = max(mu_both, factor)
+               end if
+            end do
+         end do
+         ! (the second pass takes the Jacobi diagonal for `mean`)
+         if (pass == 1) mean = max(mean/((mx/2 + 1)*my), jacobi_margin*omega*bound)
+      end do
+   end subroutine smoothing_factors
+
    !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse correction
    !> added (not one after the other: no transform on the grid being solved; symmetric, as CG
    !> needs), V the V-cycle of the next grid; the dense solve where the grid being solved is
@@ -188,6 +290,23 @@ contains
       call subtract_stencil(lv%penalty, lv%x, lv%residual, lv%nx, lv%ny)
       end associate
    end subroutine level_residual
+
+   !> y = A_t x, the operator of level t: its circulant plus, on a coarse level, the
+   !> penalty's stencil (the V-cycle's operator; on the grid being solved the circulant K
+   !> alone). For checks of the coarse operators against P^T A_(t-1) P.
+   subroutine level_operator(h, t, x, y)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      real(wp), contiguous, intent(in) :: x(:)
+      real(wp), contiguous, intent(out) :: y(:)
+      associate (lv => h%level(t))
+      lv%fft%real_buffer = x
+      call transform(h, t)
+      y = 0.0_wp
+      if (t > h%top) call subtract_stencil(lv%penalty, x, y, lv%nx, lv%ny)
+      y = lv%fft%real_buffer - y
+      end associate
+   end subroutine level_operator
 
    !> r <- r - S x for the 9-point (3-point on a line, ny = 1) periodic stencil S:
    !> (S x)(i) = sum over (ex, ey) of s(ex, ey, i) x(i + (ex, ey)).
@@ -271,11 +390,13 @@ contains
       real(wp), contiguous, intent(in) :: fine(:)
       real(wp), contiguous, intent(out) :: coarse(:)
       associate (lv => h%level(t))
-      if (h%surface) then
+      if (lv%halve_x .and. lv%halve_y) then
          call restrict_x(fine, lv%halfway, lv%nx, lv%ny)
          call restrict_y(lv%halfway, coarse, lv%nx/2, lv%ny)
+      else if (lv%halve_y) then
+         call restrict_y(fine, coarse, lv%nx, lv%ny)
       else
-         call restrict_x(fine, coarse, lv%nx, 1)
+         call restrict_x(fine, coarse, lv%nx, lv%ny)
       end if
       end associate
    end subroutine restrict
@@ -291,14 +412,33 @@ contains
       real(wp), contiguous, intent(in), optional :: free(:), base(:)
       real(wp), intent(in), optional :: scale
       associate (lv => h%level(t))
-      if (h%surface) then
+      if (lv%halve_x .and. lv%halve_y) then
          call prolong_y(coarse, lv%halfway, lv%nx/2, lv%ny)
          call prolong_x_add(lv%halfway, fine, lv%nx, lv%ny, free, base, scale)
+      else if (lv%halve_y) then
+         call prolong_y(coarse, lv%halfway, lv%nx, lv%ny)
+         call add_masked(lv%halfway, fine, free, base, scale)
       else
-         call prolong_x_add(coarse, fine, lv%nx, 1, free, base, scale)
+         call prolong_x_add(coarse, fine, lv%nx, lv%ny, free, base, scale)
       end if
       end associate
    end subroutine prolong_add
+
+   !> fine <- fine + x, masked by `free` if given; with `base` (and free),
+   !> fine <- scale base + free x (prolong_x_add's cases for a grid not halved along x).
+   pure subroutine add_masked(x, fine, free, base, scale)
+      real(wp), contiguous, intent(in) :: x(:)
+      real(wp), contiguous, intent(inout) :: fine(:)
+      real(wp), contiguous, intent(in), optional :: free(:), base(:)
+      real(wp), intent(in), optional :: scale
+      if (present(base)) then
+         fine = scale*base + free*x
+      else if (present(free)) then
+         fine = fine + free*x
+      else
+         fine = fine + x
+      end if
+   end subroutine add_masked
 
    !> Along x, row by row: coarse(i) = fine(2i - 1) + (fine(2i) + fine(2i - 2))/2.
    pure subroutine restrict_x(fine, coarse, nx, ny)
@@ -375,25 +515,34 @@ contains
       end do
    end subroutine prolong_y
 
-   !> The grids of every 2^t-th point while the next has at least coarsest_points points
-   !> (halvings), with their plans and work arrays (allocated once, for all the nested grids).
-   subroutine build_hierarchy(h, op, error)
+   !> The grids of the V-cycle (coarsening_shapes), with their plans and work arrays
+   !> (allocated once, for all the nested grids). With `symbol` (a surface's stiffness on the
+   !> finest grid's half spectrum, `odd` its imaginary part) a grid may be halved along one
+   !> axis only.
+   subroutine build_hierarchy(h, op, error, symbol, odd)
       type(hierarchy), intent(out), target :: h
       type(compliance_operator), intent(inout), target :: op
       type(error_type), allocatable, intent(out) :: error
+      real(wp), contiguous, intent(in), optional :: symbol(:), odd(:)
+      integer, allocatable :: shapes(:, :)
       integer :: t, m, nx, ny, reach
       nx = op%grid%nx
       ny = op%grid%ny
       reach = merge(1, 0, ny > 1)
       h%surface = ny > 1
-      h%coarsest = halvings(nx, ny, coarsest_points)
+      call coarsening_shapes(nx, ny, shapes, symbol, odd)
+      h%coarsest = ubound(shapes, 2)
       h%n_fine = nx*ny
       allocate (h%level(0:h%coarsest), h%free(nx*ny))
       h%free = 1.0_wp
       do t = 0, h%coarsest
          associate (lv => h%level(t))
-         lv%nx = nx/2**t
-         lv%ny = merge(ny/2**t, 1, h%surface)
+         lv%nx = shapes(1, t)
+         lv%ny = shapes(2, t)
+         if (t < h%coarsest) then
+            lv%halve_x = shapes(1, t + 1) < lv%nx
+            lv%halve_y = shapes(2, t + 1) < lv%ny
+         end if
          lv%n = lv%nx*lv%ny
          m = lv%n
          lv%inv_n = 1.0_wp/m
@@ -409,8 +558,9 @@ contains
          ! (the finest grid is never a coarse one of the V-cycle)
          ! (the stencil couples rows on a surface only)
          if (t > 0) allocate (lv%penalty(-1:1, -reach:reach, m), lv%jacobi(m), lv%rhs(m), lv%x(m), lv%residual(m))
-         if (h%surface .and. t < h%coarsest) allocate (lv%halfway(m/2))
-         if (h%surface .and. t < h%coarsest) allocate (lv%window(-1:1, -1:1, lv%nx/2, -1:1))
+         if (t < h%coarsest .and. lv%halve_y) then
+            allocate (lv%halfway(merge(m/2, m, lv%halve_x)), lv%window(-1:1, -1:1, shapes(1, t + 1), -1:1))
+         end if
          end associate
       end do
       m = h%level(h%coarsest)%n
@@ -436,19 +586,19 @@ contains
    !> (K = 0 where M = 0; K(0) = 0 under load control, the uniform mode being dropped: see
    !> drop_uniform_mode): the coarse grid's wavevectors are among the finest grid's (its
    !> Nyquist modes read at +pi/dx: M is even in each component, |q| being all it depends on).
-   pure function level_symbol(op, load_control, coarse) result(stiffness)
+   pure function level_symbol(op, load_control, nx, ny) result(stiffness)
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
-      type(grid_level), intent(in) :: coarse
-      real(wp) :: stiffness((coarse%nx/2 + 1)*coarse%ny)
+      integer, intent(in) :: nx, ny
+      real(wp) :: stiffness((nx/2 + 1)*ny)
       real(wp) :: m
       integer :: kx, ky, my
-      do ky = 0, coarse%ny - 1
-         my = merge(ky, ky - coarse%ny, 2*ky <= coarse%ny)
-         do kx = 0, coarse%nx/2
+      do ky = 0, ny - 1
+         my = merge(ky, ky - ny, 2*ky <= ny)
+         do kx = 0, nx/2
             m = op%metric(mode_index(op%grid%nx, op%grid%ny, kx, my))
-            stiffness(kx + (coarse%nx/2 + 1)*ky + 1) = 0.0_wp
-            if (m > 0.0_wp) stiffness(kx + (coarse%nx/2 + 1)*ky + 1) = 1.0_wp/m
+            stiffness(kx + (nx/2 + 1)*ky + 1) = 0.0_wp
+            if (m > 0.0_wp) stiffness(kx + (nx/2 + 1)*ky + 1) = 1.0_wp/m
          end do
       end do
       if (load_control) stiffness(1) = 0.0_wp
@@ -478,9 +628,7 @@ contains
       integer, intent(in) :: top
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
-      integer :: mirror
       real(wp), parameter :: pi = acos(-1.0_wp)
-      real(wp) :: ax, bx, ay, by
       integer :: t, kx, ky, nkx, row, first, last, k
       h%top = top
       h%level(top)%symbol = symbol
@@ -493,36 +641,14 @@ contains
          end do
          if (.not. allocated(h%pivots)) allocate (h%pivots(size(h%dense, 1)))
          h%level(top)%odd = odd
-         ! (lines: the fine mode kx + nc is the mirror of nc - kx, its imaginary part negated)
-         do t = top + 1, h%coarsest
-            associate (c => h%level(t), f => h%level(t - 1))
-            do kx = 0, c%nx/2
-               ax = 0.5_wp*(1.0_wp + cos(pi*kx/c%nx))
-               bx = 0.5_wp*(1.0_wp - cos(pi*kx/c%nx))
-               mirror = c%nx - kx
-               c%odd(kx + 1) = 2*ax**2*f%odd(kx + 1) - 2*bx**2*f%odd(mirror + 1)
-            end do
-            end associate
-         end do
       end if
       do t = top + 1, h%coarsest
          associate (c => h%level(t), f => h%level(t - 1))
          nkx = c%nx/2 + 1
          do ky = 0, c%ny - 1
             do kx = 0, c%nx/2
-               ax = 0.5_wp*(1.0_wp + cos(pi*kx/c%nx))
-               bx = 0.5_wp*(1.0_wp - cos(pi*kx/c%nx))
-               if (h%surface) then
-                  ay = 0.5_wp*(1.0_wp + cos(pi*ky/c%ny))
-                  by = 0.5_wp*(1.0_wp - cos(pi*ky/c%ny))
-                  c%symbol(kx + nkx*ky + 1) = &
-                     & 2*ax**2*(2*ay**2*f%symbol(mode_index(f%nx, f%ny, kx, ky)) &
-                     &          + 2*by**2*f%symbol(mode_index(f%nx, f%ny, kx, ky + c%ny))) &
-                     & + 2*bx**2*(2*ay**2*f%symbol(mode_index(f%nx, f%ny, kx + c%nx, ky)) &
-                     &            + 2*by**2*f%symbol(mode_index(f%nx, f%ny, kx + c%nx, ky + c%ny)))
-               else
-                  c%symbol(kx + 1) = 2*ax**2*f%symbol(kx + 1) + 2*bx**2*f%symbol(mode_index(f%nx, 1, kx + c%nx, 0))
-               end if
+               c%symbol(kx + nkx*ky + 1) = galerkin(f, c, kx, ky, .false.)
+               if (h%complex) c%odd(kx + nkx*ky + 1) = galerkin(f, c, kx, ky, .true.)
             end do
          end do
          end associate
@@ -558,6 +684,39 @@ contains
       h%coarse_column = lv%fft%real_buffer
       end associate
    end subroutine set_grid
+
+   !> The Galerkin symbol of grid c at its mode (kx, ky) from that of the grid f it is made
+   !> of (its real part, or with `imaginary` its odd imaginary part): along a halved axis the
+   !> modes k and k + m_c with the weights 2 alpha^2 and 2 beta^2, alpha, beta =
+   !> (1 +- cos(pi k/m_c))/2, along the other the mode k alone.
+   pure real(wp) function galerkin(f, c, kx, ky, imaginary) result(value)
+      type(grid_level), intent(in) :: f, c
+      integer, intent(in) :: kx, ky
+      logical, intent(in) :: imaginary
+      real(wp), parameter :: pi = acos(-1.0_wp)
+      real(wp) :: wx(0:1), wy(0:1)
+      wx = [1.0_wp, 0.0_wp]
+      wy = [1.0_wp, 0.0_wp]
+      if (f%halve_x) wx = [0.5_wp*(1.0_wp + cos(pi*kx/c%nx))**2, 0.5_wp*(1.0_wp - cos(pi*kx/c%nx))**2]
+      if (f%halve_y) wy = [0.5_wp*(1.0_wp + cos(pi*ky/c%ny))**2, 0.5_wp*(1.0_wp - cos(pi*ky/c%ny))**2]
+      value = wx(0)*(wy(0)*symbol_part(f, kx, ky, imaginary) + wy(1)*symbol_part(f, kx, ky + c%ny, imaginary)) &
+         & + wx(1)*(wy(0)*symbol_part(f, kx + c%nx, ky, imaginary) &
+         &          + wy(1)*symbol_part(f, kx + c%nx, ky + c%ny, imaginary))
+   end function galerkin
+
+   !> Level lv's symbol at the mode (kx, ky), any integers: its real part (even), or its
+   !> imaginary part (odd: a mode read at its mirror image, mode_index, takes the opposite sign).
+   pure real(wp) function symbol_part(lv, kx, ky, imaginary) result(value)
+      type(grid_level), intent(in) :: lv
+      integer, intent(in) :: kx, ky
+      logical, intent(in) :: imaginary
+      if (imaginary) then
+         value = lv%odd(mode_index(lv%nx, lv%ny, kx, ky))
+         if (2*modulo(kx, lv%nx) > lv%nx) value = -value
+      else
+         value = lv%symbol(mode_index(lv%nx, lv%ny, kx, ky))
+      end if
+   end function symbol_part
 
    !> The coarse operators for the contact set of h%free: the Galerkin products of the
    !> penalty d D_A (a 3- or 9-point stencil on every coarser grid), the
@@ -596,29 +755,52 @@ contains
    end subroutine set_contact
 
    !> The penalty stencil of the surface's level t = P^T A P, A that of level t - 1 (on the
-   !> grid being solved the diagonal d D_A), P = Px Py: row by row of level t, from the three
-   !> rows of level t - 1 that reach it, coarsened along x (galerkin_diagonal, coarsen_x)
-   !> into the window, then along y (coarsen_y_row). (A row between two coarse ones is
-   !> coarsened twice: the window holds 3 rows, not a whole grid coarsened along x.)
+   !> grid being solved the diagonal d D_A), P = Px Py (Px or Py the identity along an axis
+   !> not halved): row by row of level t, from the rows of level t - 1 that reach it, each
+   !> coarsened along x (coarsened_row), then along y (coarsen_y_row). (Halving both axes, a
+   !> row between two coarse ones is coarsened twice: the window holds 3 rows, not a whole
+   !> grid coarsened along x.)
    subroutine coarsen_surface(h, t)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
-      integer :: cy, k, row, nx
+      integer :: cy, k, row
       associate (f => h%level(t - 1), c => h%level(t))
-      nx = f%nx
-      do cy = 0, c%ny - 1
-         do k = -1, 1
-            row = modulo(2*cy + k, f%ny)
-            if (t == h%top + 1) then
-               call galerkin_diagonal(h%free(row*nx + 1:(row + 1)*nx), penalty*f%circulant_diagonal, nx, 1, &
-                  & f%window(:, :, :, k))
-            else
-               call coarsen_x(f%penalty(:, :, row*nx + 1:(row + 1)*nx), nx, 1, f%window(:, :, :, k))
-            end if
+      if (f%halve_y) then
+         do cy = 0, c%ny - 1
+            do k = -1, 1
+               call coarsened_row(modulo(2*cy + k, f%ny), f%window(:, :, :, k))
+            end do
+            call coarsen_y_row(f%window, c%nx, c%penalty(:, :, cy*c%nx + 1:(cy + 1)*c%nx))
          end do
-         call coarsen_y_row(f%window, c%nx, c%penalty(:, :, cy*c%nx + 1:(cy + 1)*c%nx))
-      end do
+      else
+         do row = 0, f%ny - 1
+            call coarsened_row(row, c%penalty(:, :, row*c%nx + 1:(row + 1)*c%nx))
+         end do
+      end if
       end associate
+   contains
+      !> b = the row `row` of level t - 1's stencil, coarsened along x if that grid is halved
+      !> along x (galerkin_diagonal, coarsen_x)
+      subroutine coarsened_row(row, b)
+         integer, intent(in) :: row
+         real(wp), contiguous, intent(out) :: b(:, :, :)
+         integer :: nx
+         associate (f => h%level(t - 1))
+         nx = f%nx
+         if (t == h%top + 1) then
+            if (f%halve_x) then
+               call galerkin_diagonal(h%free(row*nx + 1:(row + 1)*nx), penalty*f%circulant_diagonal, nx, 1, b)
+            else
+               b = 0.0_wp
+               b(2, 2, :) = penalty*f%circulant_diagonal*(1.0_wp - h%free(row*nx + 1:(row + 1)*nx))
+            end if
+         else if (f%halve_x) then
+            call coarsen_x(f%penalty(:, :, row*nx + 1:(row + 1)*nx), nx, 1, b)
+         else
+            b = f%penalty(:, :, row*nx + 1:(row + 1)*nx)
+         end if
+         end associate
+      end subroutine coarsened_row
    end subroutine coarsen_surface
 
    !> b = Px^T D Px for a row of nx points with the diagonal D = `weight` on the contact set

@@ -224,7 +224,7 @@ contains
             if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
             call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
                & '; it solves lines and surfaces on an elastic half-space or layer (nu <= 0.47, or ' // &
-               & 'h/lambda >~ 0.07), with friction, and lines on sliding viscoelastic layers; allowed here: ' // &
+               & 'h/lambda >~ 0.07), with friction or sliding viscoelastic; allowed here: ' // &
                & allowed, code_input)
             return
          end if

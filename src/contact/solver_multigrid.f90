@@ -205,40 +205,45 @@ contains
       outcome%vcycles = h%vcycles
    end subroutine finest_iterations
 
-   !> The largest factor by which the normal compliance M(q) on the grid's modes exceeds its
-   !> value at a longer wave: 1 where it falls with |q| (op%metric_falls). The modes are
-   !> gathered in bins of |q| one fundamental wide (on a line, one mode a bin: exact; on a
-   !> surface, modes within a bin count as equally long).
+   !> The largest factor by which the normal compliance M(q) exceeds its value at a longer
+   !> wave along the same axis: walking each row of the half spectrum from kx = 0 to nx/2
+   !> and (a surface) each column from ky = 0 to +-ny/2. 1 where it falls with |q|
+   !> (op%metric_falls). Along the axes, not by |q|: a sliding viscoelastic layer is stiffer
+   !> along the sliding direction, tenfold between modes of one |q|, which the grids halved
+   !> along one axis handle (coarsening_shapes); a rise along an axis is what pointwise
+   !> smoothing cannot.
    pure real(wp) function compliance_rise(op) result(rise)
       type(compliance_operator), intent(in) :: op
-      real(wp), parameter :: pi = acos(-1.0_wp)
-      real(wp), allocatable :: low(:), high(:)
-      real(wp) :: qx, qy, q_unit, q_max, lowest
-      integer :: i, bin
+      integer :: nkx, ny, kx, ky, sign, step
+      real(wp) :: lowest
       rise = 1.0_wp
       if (op%nk < 3) return
-      if (op%grid%is_line()) then
-         q_unit = 2*pi/op%grid%lx
-         q_max = pi*op%grid%nx/op%grid%lx
-      else
-         q_unit = 2*pi/max(op%grid%lx, op%grid%ly)
-         q_max = pi*hypot(op%grid%nx/op%grid%lx, op%grid%ny/op%grid%ly)
-      end if
-      allocate (low(ceiling(q_max/q_unit) + 1), high(ceiling(q_max/q_unit) + 1))
-      low = huge(1.0_wp)
-      high = 0.0_wp
-      do i = 2, op%nk
-         call op%grid%wavevector(i, qx, qy)
-         bin = nint(hypot(qx, qy)/q_unit)
-         low(bin) = min(low(bin), op%metric(i))
-         high(bin) = max(high(bin), op%metric(i))
+      nkx = op%grid%nx/2 + 1
+      ny = op%grid%ny
+      do ky = 0, ny - 1
+         lowest = huge(1.0_wp)
+         do kx = 0, nkx - 1
+            call walk(kx + nkx*ky + 1, lowest, rise)
+         end do
       end do
-      lowest = huge(1.0_wp)
-      do bin = 1, size(low)
-         if (high(bin) == 0.0_wp) cycle
-         lowest = min(lowest, low(bin))
-         rise = max(rise, high(bin)/lowest)
+      if (ny == 1) return
+      do kx = 0, nkx - 1
+         do sign = -1, 1, 2
+            lowest = huge(1.0_wp)
+            do step = 0, ny/2
+               call walk(kx + nkx*modulo(sign*step, ny) + 1, lowest, rise)
+            end do
+         end do
       end do
+   contains
+      pure subroutine walk(i, lowest, rise)
+         integer, intent(in) :: i
+         real(wp), intent(inout) :: lowest, rise
+         ! (the uniform mode has no compliance of its own)
+         if (i == 1 .or. .not. op%metric(i) > 0.0_wp) return
+         lowest = min(lowest, op%metric(i))
+         rise = max(rise, op%metric(i)/lowest)
+      end subroutine walk
    end function compliance_rise
 
    !> Solve the frictionless contact of a line or surface: w = M p, gap = w - b - s >= 0, p >= 0,
@@ -280,7 +285,7 @@ contains
       nested = halvings(op%grid%nx, op%grid%ny, nested_coarsest)
       do j = nested, 0, -1
          m = h%level(j)%n
-         call set_grid(h, j, level_symbol(op, load_control, h%level(j)))
+         call set_grid(h, j, level_symbol(op, load_control, h%level(j)%nx, h%level(j)%ny))
          call obstacle(j, o(1:m))
          if (j == nested) then
             u(1:m) = o(1:m)
@@ -345,14 +350,17 @@ contains
       logical :: settled, finished, clipped, tension
 
       n = size(p)
-      call build_hierarchy(h, op, error)
-      if (allocated(error)) return
       call op%prepare_gcr()
-      ! the hierarchy of K itself where its loss lies at long waves, else of the metric
+      ! the hierarchy of K itself where its loss lies at long waves, else of the metric (a
+      ! surface's grids halved along the axes its symbol needs)
       if (loss_at_long_waves(op)) then
+         call build_hierarchy(h, op, error, real(op%inverse_full), aimag(op%inverse_full))
+         if (allocated(error)) return
          call set_grid(h, 0, real(op%inverse_full), aimag(op%inverse_full))
       else
-         call set_grid(h, 0, level_symbol(op, load_control, h%level(0)))
+         call build_hierarchy(h, op, error, level_symbol(op, load_control, op%grid%nx, op%grid%ny))
+         if (allocated(error)) return
+         call set_grid(h, 0, level_symbol(op, load_control, op%grid%nx, op%grid%ny))
       end if
       ! (the Jacobi diagonal: see jacobi_margin; modes with Re K <= 0 are not damped by any)
       d = op%inverse_diagonal
@@ -546,9 +554,7 @@ contains
    pure logical function loss_at_long_waves(op) result(long)
       type(compliance_operator), intent(in) :: op
       real(wp) :: loss, largest
-      integer :: i, at
-      long = .false.
-      if (.not. op%grid%is_line()) return
+      integer :: i, at, nkx, kx, ky
       largest = 0.0_wp
       at = 0
       do i = 2, op%nk
@@ -556,10 +562,16 @@ contains
          loss = abs(aimag(op%inverse_full(i)))/real(op%inverse_full(i))
          if (loss > largest) then
             largest = loss
-            at = i - 1
+            at = i
          end if
       end do
-      long = largest > 0.0_wp .and. 16*at <= op%grid%nx
+      long = .false.
+      if (.not. largest > 0.0_wp) return
+      nkx = op%grid%nx/2 + 1
+      kx = mod(at - 1, nkx)
+      ky = (at - 1)/nkx
+      ky = min(ky, op%grid%ny - ky)
+      long = 16*kx <= op%grid%nx .and. (op%grid%is_line() .or. 16*ky <= op%grid%ny)
    end function loss_at_long_waves
 
    !> TNNMG iterations on the grid h%top from u until the residual on (K u + f, u - o) is at
