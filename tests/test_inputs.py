@@ -370,7 +370,7 @@ def limited_address_space(gib: float):
 
 
 def test_a_grid_too_large_for_the_memory_ends_with_code_5_and_writes_nothing(tmp_path):
-    """Under ulimit -v 2 GiB an areal coupled scene of 4096^2 points (about 6.5 GiB: method
+    """Under ulimit -v 2 GiB an areal coupled scene of 4096^2 points (about 9.0 GiB: method
     'auto' may take the multigrid method there) is refused before it allocates: exit 5, a
     message with what it needs and which limit; 256^2 runs under the same limit."""
     text = ("&scene\n geometry = 'areal'\n n = {n}\n/\n&layer\n thickness = 0.16\n/\n&friction\n coefficient = 0.5\n/\n"
@@ -382,7 +382,7 @@ def test_a_grid_too_large_for_the_memory_ends_with_code_5_and_writes_nothing(tmp
                               preexec_fn=limited_address_space(2.0))
         assert proc.returncode == code, proc.stderr
         if code == 5:
-            assert "not enough memory: this scene (16777216 grid points) needs about 6.5 GiB" in proc.stderr
+            assert "not enough memory: this scene (16777216 grid points) needs about 9.0 GiB" in proc.stderr
             assert "the address space limit (ulimit -v)" in proc.stderr and "Slurm: --mem" in proc.stderr
             assert not (tmp_path / f"r{n}.h5").exists() and not list(tmp_path.glob("*.tmp"))
         else:

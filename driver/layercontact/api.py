@@ -261,9 +261,9 @@ def solve_line(
     on an elastic half-space or a layer with ``poisson <= 0.47``, or an incompressible one
     from ``thickness ~ 0.07 period``; ``iterations`` counts its fine-grid iterations;
     ``coarse_start`` and ``precondition`` do not apply; on such a line or surface with
-    friction, or a line on a sliding viscoelastic layer, the same iteration with the
-    non-symmetric stiffness, from the coarse start, GCR going on where it stalls: transform
-    pairs that do not grow with ``n`` on broadband roughness). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
+    friction or on a sliding viscoelastic layer, the same iteration with the non-symmetric
+    stiffness, from the coarse start, GCR going on where it stalls: transform pairs that do
+    not grow with ``n`` on broadband roughness). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
     in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard

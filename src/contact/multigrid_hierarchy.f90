@@ -1,19 +1,20 @@
 !> The grids and coarse operators of the multigrid solvers (lc_contact_solver_multigrid):
-!> the grids of every 2^t-th point of a line or surface, and the preconditioner
+!> the grids of a line or surface, each made of the one before by halving it along x, y or
+!> both (coarsening_shapes: both, unless the symbol is anisotropic), and the preconditioner
 !> B = omega/d I + I P V P^T I of the truncated Newton problem I K I c = -I p (I the
 !> indicator of the free points, off the contact set A): a damped Jacobi step on the free
 !> points plus the coarse correction, added (no transform on the grid being solved), V a
-!> V(1,1)-cycle on the coarser grids. Linear interpolation P (bilinear on a surface: every
-!> axis longer than one is halved), restriction P^T; the coarse operators are the Galerkin
+!> V(1,1)-cycle on the coarser grids. Linear interpolation P along the axes halved
+!> (bilinear where both are), restriction P^T; the coarse operators are the Galerkin
 !> products of the penalised operator K + d D_A (D_A the indicator of the contact set, d the
 !> diagonal of K): a Galerkin circulant (a transform on the coarse grid; its symbol does not
 !> depend on the contact set) plus a 3-point (line) or 9-point (surface) stencil rebuilt in
 !> O(n) when the set changes. The penalty stands in for the truncated Galerkin operator
 !> P^T I K I P, whose application would cost a transform of the finest grid. Damped Jacobi
 !> smoothing; a dense Cholesky solve on the coarsest grid (at most coarsest_limit points).
-!> K is real and even (a symmetric stiffness: the operator's metric inverted), or, on a line,
-!> complex (the non-symmetric stiffness 1/G_eff of a coupled scene, whose imaginary part is
-!> odd in kx), with an LU factor of the coarsest operator in place of Cholesky's; the solvers
+!> K is real and even (a symmetric stiffness: the operator's metric inverted), or complex
+!> (the non-symmetric stiffness 1/G_eff of a coupled scene, whose imaginary part is odd),
+!> with an LU factor of the coarsest operator in place of Cholesky's; the solvers
 !> only need B to approximate the truncated problem's inverse, which is what lets the
 !> coarse operators be this cheap. Fields are stored as the rest of the library stores
 !> them: nx x ny points, x fastest; spectra on the half spectrum (nx/2 + 1) x ny.
@@ -619,10 +620,11 @@ contains
    !> Make grid `top` the one being solved, with the stiffness symbol K on its half spectrum:
    !> the Galerkin circulants P^T C P below it (their symbols in closed form: along each
    !> halved axis a coarse mode k gathers the fine modes k and k + m_c with the weights
-   !> 2 alpha^2 and 2 beta^2, alpha, beta = (1 +- cos(pi k/m_c))/2; on a surface the products
-   !> of the two axes' weights over the four fine modes), their diagonals, and the real-space
-   !> column of the coarsest one. With `odd` (a line only) the symbol is complex, symbol + i
-   !> odd, its imaginary part odd in kx: the hierarchy of a non-symmetric stiffness.
+   !> 2 alpha^2 and 2 beta^2, alpha, beta = (1 +- cos(pi k/m_c))/2; on a surface halved along
+   !> both axes the products of the two axes' weights over the four fine modes: galerkin),
+   !> their diagonals, and the real-space column of the coarsest one. With `odd` the symbol is
+   !> complex, symbol + i odd, its imaginary part odd (odd in kx on a line): the hierarchy of
+   !> a non-symmetric stiffness.
    subroutine set_grid(h, top, symbol, odd)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: top

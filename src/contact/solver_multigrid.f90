@@ -35,9 +35,11 @@
 !> max_j |min(p_j/p_ref, gap_j/g_ref)| (gaps below the rounding floor count as zero),
 !> evaluated on (K u + f, u - o) in the iteration and on the fields returned at the end.
 !>
-!> Applies where pointwise Jacobi smooths, i.e. the stiffness rises with |q| (the
-!> operator's metric_falls, or nearly: allowed_rise), to symmetric (not coupled), elastic
-!> lines and surfaces: multigrid_refusal; coupled ones whose metric passes metric_refusal.
+!> Applies where pointwise Jacobi smooths, i.e. the stiffness rises with |q| along each
+!> axis (the operator's metric_falls, or nearly: allowed_rise), to symmetric (not coupled),
+!> elastic lines and surfaces: multigrid_refusal; coupled ones whose metric passes
+!> metric_refusal (a surface stiffer along one axis, a sliding viscoelastic layer, takes
+!> grids halved along one axis).
 module lc_contact_solver_multigrid
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
@@ -544,10 +546,11 @@ contains
       end subroutine truncated_gcr
    end subroutine coupled_tnnmg
 
-   !> Whether the coupled line's preconditioner takes the hierarchy of K = 1/G_eff itself
+   !> Whether the coupled scene's preconditioner takes the hierarchy of K = 1/G_eff itself
    !> (complex Galerkin symbols, LU on the coarsest grid) rather than that of the metric
    !> 1/|G_eff|: where the phase of K is largest (friction on a layer; a viscoelastic layer's
-   !> loss peak V q tau ~ 1) at long waves, |q| <= q_max/8, which the coarse grids carry. A
+   !> loss peak V q tau ~ 1) at long waves, |kx| <= nx/16 (and |ky| <= ny/16 on a surface),
+   !> which the coarse grids carry. A
    !> loss peak among the short waves (a slow glassy layer on a fine grid) is left to the
    !> metric's hierarchy, whose Jacobi steps damp those modes better: E_inf/E0 = 100 at
    !> V tau/lambda = 1e-4, n = 65536, 542 against 1004 pairs (docs/decisions/012-coupled-multigrid.md).
