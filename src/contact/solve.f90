@@ -39,6 +39,13 @@ module lc_contact_solve
    !> grid of coarse_tol_size points along x, coarse_tol coarse_tol_size/nx beyond.
    real(wp), parameter :: coarse_tol = 1.0e-4_wp
    integer, parameter :: coarse_tol_size = 8192
+   !> The coarse grids of a coupled scene under method 'multigrid' (each solved by the same
+   !> method) are solved to this tolerance instead: the fine grid's iterations do not need a
+   !> closer start. Coupled lines from 1024 to 2^20 points (bench/scaling.py --scenes 2 4
+   !> --method multigrid) took 54-109 transform pairs, max/min 1.13-1.49 per family and
+   !> scene, against 61-126 and 1.11-1.66 with coarse_tol; surfaces 1-3 % fewer
+   !> (docs/decisions/012-coupled-multigrid.md).
+   real(wp), parameter :: multigrid_coarse_tol = 1.0e-3_wp
    !> Under method 'auto' the multigrid solver takes the frictionless elastic scenes it
    !> applies to (multigrid_refusal) from this many points on, lines and surfaces
    !> (bench/scaling.py --scenes 1 --method multigrid --against cg, tol 1e-8): on lines
@@ -519,6 +526,7 @@ contains
       coarse_grid = grid%coarse()
       coarse = scene
       coarse%solver%tol = max(scene%solver%tol, coarse_tol*min(1.0_wp, real(coarse_tol_size, wp)/grid%nx))
+      if (trim(scene%solver%method) == 'multigrid') coarse%solver%tol = max(scene%solver%tol, multigrid_coarse_tol)
       allocate (wc(coarse_grid%points()), gapc(coarse_grid%points()))
       hc = restrict(grid, height)
       pc = restrict(grid, p)
