@@ -43,7 +43,7 @@ module lc_contact_multigrid_hierarchy
       end subroutine dgetrs
    end interface
    public :: grid_level, hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, penalty
-   public :: build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate
+   public :: build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, worst_smoothing
    public :: precondition, apply_stiffness, level_operator
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
@@ -198,6 +198,35 @@ contains
          halvable = mod(m, 2) == 0 .and. m/2 >= shortest_side
       end function halvable
    end subroutine coarsening_shapes
+
+   !> The largest smoothing factor of the damped Jacobi step over the grids of the V-cycle
+   !> (coarsening_shapes; smoothing_factors for the halving each grid takes), for the
+   !> stiffness symbol of the finest nx x ny grid (`odd` its imaginary part): near 1, some
+   !> mode that the next grid cannot carry is barely damped.
+   function worst_smoothing(nx, ny, symbol, odd) result(worst)
+      integer, intent(in) :: nx, ny
+      real(wp), contiguous, intent(in) :: symbol(:)
+      real(wp), contiguous, intent(in), optional :: odd(:)
+      real(wp) :: worst
+      integer, allocatable :: shapes(:, :)
+      real(wp) :: mu_x, mu_y, mu_both
+      logical :: along_x, along_y
+      integer :: t
+      call coarsening_shapes(nx, ny, shapes, symbol, odd)
+      worst = 0.0_wp
+      do t = 0, ubound(shapes, 2) - 1
+         call smoothing_factors(nx, ny, symbol, odd, shapes(1, t), shapes(2, t), mu_x, mu_y, mu_both)
+         along_x = shapes(1, t + 1) < shapes(1, t)
+         along_y = shapes(2, t + 1) < shapes(2, t)
+         if (along_x .and. along_y) then
+            worst = max(worst, mu_both)
+         else if (along_y) then
+            worst = max(worst, mu_y)
+         else
+            worst = max(worst, mu_x)
+         end if
+      end do
+   end function worst_smoothing
 
    !> The smoothing factors of the damped Jacobi step (its diagonal as set_grid takes it) on
    !> an mx x my grid for the stiffness symbol of the finest nx x ny grid read at the coarse

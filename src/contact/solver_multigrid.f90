@@ -47,13 +47,13 @@ module lc_contact_solver_multigrid
    use lc_strings, only: to_string, formatted
    use lc_contact_operator, only: compliance_operator
    use lc_contact_multigrid_hierarchy, only: hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, &
-      & build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, precondition, &
+      & build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, precondition, worst_smoothing, &
       & apply_stiffness
    use lc_contact_solver_cg, only: complementarity_residual, rounding_floor, normalise
    use lc_contact_progress, only: progress_log
    implicit none (type, external)
    private
-   public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_tnnmg
+   public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -63,6 +63,13 @@ module lc_contact_solver_multigrid
    !> up to 31; 6 iterations but 300-1200 pairs at 16.5 (h/lambda = 0.001, nu = 0.495), no
    !> convergence in 300 iterations at 123 (h/lambda = 0.01, nu = 0.5).)
    real(wp), parameter :: allowed_rise = 4.0_wp
+   !> A coupled scene whose compliance rises more is admitted (coupled_refusal) if its
+   !> hierarchy's worst Jacobi smoothing factor is at most this. Coupled lines of 4096 and
+   !> 65536 points (shortest wavelength 8 points, h/lambda = 0.001 .. 0.03, nu = 0.45 .. 0.5,
+   !> mu_c = 0.1 .. 1.5): up to 0.988 (h/lambda = 0.01, nu = 0.5) the method took 64-201
+   !> transform pairs, at 0.999 and more (h/lambda <= 0.003, nu = 0.5) 358-13841 or stalled
+   !> (docs/decisions/014-thin-layers-by-multigrid.md).
+   real(wp), parameter :: coupled_smoothing = 0.995_wp
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256
    !> The inexact Newton solve: at most this many CG iterations, or a residual reduced by
@@ -134,30 +141,95 @@ contains
    function metric_refusal(op) result(reason)
       type(compliance_operator), intent(in) :: op
       character(len=:), allocatable :: reason
-      integer :: m, k
+      reason = rise_refusal(op)
+      if (len(reason) == 0) reason = size_refusal(op)
+   end function metric_refusal
+
+   !> Why the coupled multigrid method (coupled_tnnmg) cannot solve the scene of `op` (empty
+   !> if it can): metric_refusal, except that a compliance rising with |q| is admitted where
+   !> the hierarchy the method builds (coupled_symbol) still smooths on every grid, its
+   !> worst Jacobi smoothing factor at most coupled_smoothing: a thin incompressible layer
+   !> with friction whose stiff long waves lie on the coarsest grid.
+   function coupled_refusal(op, load_control) result(reason)
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
+      character(len=:), allocatable :: reason
+      real(wp), allocatable :: symbol(:), odd(:)
+      real(wp) :: worst
+      logical :: complex_symbol
+      reason = size_refusal(op)
+      if (len(reason) > 0) return
+      reason = rise_refusal(op)
+      if (len(reason) == 0) return
+      call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
+      if (complex_symbol) then
+         worst = worst_smoothing(op%grid%nx, op%grid%ny, symbol, odd)
+      else
+         worst = worst_smoothing(op%grid%nx, op%grid%ny, symbol)
+      end if
+      if (worst <= coupled_smoothing) then
+         reason = ''
+      else
+         reason = reason // ', and with friction the Jacobi step would smooth with a factor ' // &
+            & formatted(worst, '(f6.4)') // ' on its coarse grids (at most ' // formatted(coupled_smoothing, '(f5.3)') // ')'
+      end if
+   end function coupled_refusal
+
+   !> The refusal of a compliance that rises with |q| along an axis by more than allowed_rise.
+   function rise_refusal(op) result(reason)
+      type(compliance_operator), intent(in) :: op
+      character(len=:), allocatable :: reason
       real(wp) :: rise
       reason = ''
       rise = 1.0_wp
       if (.not. op%metric_falls) rise = compliance_rise(op)
-      if (rise > allowed_rise) then
-         reason = 'the compliance rises with |q| over the grid by a factor ' // formatted(rise, &
-            & '(f0.1)') // ' (a thin, nearly incompressible layer; pointwise smoothing needs at most ' // &
-            & formatted(allowed_rise, '(f0.1)') // ')'
+      if (rise > allowed_rise) reason = 'the compliance rises with |q| over the grid by a factor ' // &
+         & formatted(rise, '(f0.1)') // ' (a thin, nearly incompressible layer; pointwise smoothing needs at most ' // &
+         & formatted(allowed_rise, '(f0.1)') // ')'
+   end function rise_refusal
+
+   !> The refusal of a grid whose coarsest grid would have more than coarsest_limit points.
+   function size_refusal(op) result(reason)
+      type(compliance_operator), intent(in) :: op
+      character(len=:), allocatable :: reason
+      integer :: m, k
+      reason = ''
+      k = halvings(op%grid%nx, op%grid%ny, coarsest_points)
+      m = op%grid%points()/2**(k*merge(1, 2, op%grid%is_line()))
+      if (m <= coarsest_limit) return
+      if (op%grid%is_line()) then
+         reason = 'n = ' // to_string(op%grid%nx) // ' halves to an odd grid of ' // to_string(m) // &
+            & ' points; it needs n = m 2^k with m <= ' // to_string(coarsest_limit)
       else
-         k = halvings(op%grid%nx, op%grid%ny, coarsest_points)
-         m = op%grid%points()/2**(k*merge(1, 2, op%grid%is_line()))
-         if (m > coarsest_limit) then
-            if (op%grid%is_line()) then
-               reason = 'n = ' // to_string(op%grid%nx) // ' halves to an odd grid of ' // to_string(m) // &
-                  & ' points; it needs n = m 2^k with m <= ' // to_string(coarsest_limit)
-            else
-               reason = 'the ' // to_string(op%grid%nx) // ' x ' // to_string(op%grid%ny) // ' grid halves to one of ' &
-                  & // to_string(op%grid%nx/2**k) // ' x ' // to_string(op%grid%ny/2**k) // ' points; it needs ' // &
-                  & 'nx, ny = mx 2^k, my 2^k with mx my <= ' // to_string(coarsest_limit)
-            end if
-         end if
+         reason = 'the ' // to_string(op%grid%nx) // ' x ' // to_string(op%grid%ny) // ' grid halves to one of ' &
+            & // to_string(op%grid%nx/2**k) // ' x ' // to_string(op%grid%ny/2**k) // ' points; it needs ' // &
+            & 'nx, ny = mx 2^k, my 2^k with mx my <= ' // to_string(coarsest_limit)
       end if
-   end function metric_refusal
+   end function size_refusal
+
+   !> The stiffness symbol the coupled method's hierarchy is built on (half spectrum of the
+   !> grid): K = 1/G_eff itself (symbol + i odd) where its loss lies at long waves
+   !> (loss_at_long_waves), else the metric's 1/|G_eff| (level_symbol).
+   subroutine coupled_symbol(op, load_control, symbol, odd, complex_symbol)
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
+      real(wp), allocatable, intent(out) :: symbol(:), odd(:)
+      logical, intent(out) :: complex_symbol
+      complex(wp), allocatable :: stiffness(:)
+      complex_symbol = loss_at_long_waves(op)
+      if (complex_symbol) then
+         allocate (stiffness(op%nk))
+         where (abs(op%full) > 0.0_wp)
+            stiffness = 1.0_wp/op%full
+         elsewhere
+            stiffness = (0.0_wp, 0.0_wp)
+         end where
+         symbol = real(stiffness)
+         odd = aimag(stiffness)
+      else
+         symbol = level_symbol(op, load_control, op%grid%nx, op%grid%ny)
+      end if
+   end subroutine coupled_symbol
 
    !> TNNMG iterations on the finest grid from u until the fields returned (p, w, gap, s;
    !> returned_fields) meet tol: where they miss it the iteration goes on to a smaller
@@ -347,22 +419,24 @@ contains
       type(hierarchy), target :: h
       type(residual_scales) :: scales
       real(wp), allocatable :: u(:), o(:), c(:), kc(:), v(:), kv(:), dirs(:, :), kdirs(:, :), r(:), u_best(:)
+      real(wp), allocatable :: symbol(:), odd(:)
+      logical :: complex_symbol
       real(wp) :: f, d, b_max, residual, contact, best, best_residual
       integer :: n, step, changed, j, last_progress
       logical :: settled, finished, clipped, tension
 
       n = size(p)
       call op%prepare_gcr()
-      ! the hierarchy of K itself where its loss lies at long waves, else of the metric (a
-      ! surface's grids halved along the axes its symbol needs)
-      if (loss_at_long_waves(op)) then
-         call build_hierarchy(h, op, error, real(op%inverse_full), aimag(op%inverse_full))
+      ! (a surface's grids halved along the axes its symbol needs)
+      call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
+      if (complex_symbol) then
+         call build_hierarchy(h, op, error, symbol, odd)
          if (allocated(error)) return
-         call set_grid(h, 0, real(op%inverse_full), aimag(op%inverse_full))
+         call set_grid(h, 0, symbol, odd)
       else
-         call build_hierarchy(h, op, error, level_symbol(op, load_control, op%grid%nx, op%grid%ny))
+         call build_hierarchy(h, op, error, symbol)
          if (allocated(error)) return
-         call set_grid(h, 0, level_symbol(op, load_control, op%grid%nx, op%grid%ny))
+         call set_grid(h, 0, symbol)
       end if
       ! (the Jacobi diagonal: see jacobi_margin; modes with Re K <= 0 are not damped by any)
       d = op%inverse_diagonal
@@ -560,9 +634,10 @@ contains
       integer :: i, at, nkx, kx, ky
       largest = 0.0_wp
       at = 0
+      ! (|Im K|/Re K of K = 1/G_eff is |Im G_eff|/Re G_eff)
       do i = 2, op%nk
-         if (.not. real(op%inverse_full(i)) > 0.0_wp) cycle
-         loss = abs(aimag(op%inverse_full(i)))/real(op%inverse_full(i))
+         if (.not. real(op%full(i)) > 0.0_wp) cycle
+         loss = abs(aimag(op%full(i)))/real(op%full(i))
          if (loss > largest) then
             largest = loss
             at = i
