@@ -343,7 +343,7 @@ def test_auto_takes_the_multigrid_for_broadband_coupled_scenes():
 def test_auto_takes_the_multigrid_for_a_thin_incompressible_line_from_262144_points():
     """Method 'auto' sends the broadband thin incompressible line with friction to the
     multigrid method from 262144 points (where GCR takes 1.1-2.1x its time), and keeps GCR
-    at 65536 (0.4-0.8x), although the coarse solve was hard there too."""
+    at 65536 (0.6-0.8x), although the coarse solve was hard there too."""
     kw = dict(thickness=0.01, poisson=0.5, friction=1.5, mean_pressure=0.0015 * E_STAR, tol=1e-8, stress=False)
     large = lc.solve_line(profile(262144, "broadband"), **kw)
     small = lc.solve_line(profile(65536, "broadband"), **kw)

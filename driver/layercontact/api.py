@@ -252,8 +252,9 @@ def solve_line(
     applies to from 4096 points on, and surfaces from 1024², constrained CG for other
     symmetric scenes, constrained GCR for coupled ones, going on with its history kept
     across clips and then with Anderson if GCR stalls; a coupled line of 8192 points or
-    more whose coarse-start solve needed more than 20 GCR iterations, and a coupled surface
-    of 1024² or more whose coarse solve needed more than 12, i.e. broadband roughness, go to
+    more whose coarse-start solve needed more than 20 GCR iterations (a thin incompressible
+    one: 262144 points or more), and a coupled surface of 1024² or more whose coarse solve
+    needed more than 12, i.e. broadband roughness, go to
     ``'multigrid'`` below where that applies; grids of at most
     2048 points that stall are finished by the dense Newton method), ``'cg'``, ``'gcr'``,
     ``'anderson'``, ``'gfmd'``, ``'newton'`` (dense semismooth Newton, grids of at most 2048
@@ -261,9 +262,11 @@ def solve_line(
     on an elastic half-space or a layer with ``poisson <= 0.47``, or an incompressible one
     from ``thickness ~ 0.07 period``; ``iterations`` counts its fine-grid iterations;
     ``coarse_start`` and ``precondition`` do not apply; on such a line or surface with
-    friction or on a sliding viscoelastic layer, the same iteration with the non-symmetric
-    stiffness, from the coarse start, GCR going on where it stalls: transform pairs that do
-    not grow with ``n`` on broadband roughness). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
+    friction or on a sliding viscoelastic layer, and on a line with friction on a thinner
+    layer whose coarse grids still smooth (``thickness ~ 0.01 period`` at ``poisson =
+    0.5``), the same iteration with the non-symmetric stiffness, from the coarse start, GCR
+    going on where it stalls: transform pairs that do not grow with ``n`` on broadband
+    roughness). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
     in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard

@@ -228,7 +228,8 @@ contains
       end do
    end function worst_smoothing
 
-   !> The smoothing factors of the damped Jacobi step (its diagonal as set_grid takes it) on
+   !> The smoothing factors of the damped Jacobi step (its diagonal as set_grid takes it, with
+   !> the mean over the half spectrum) on
    !> an mx x my grid for the stiffness symbol of the finest nx x ny grid read at the coarse
    !> grid's modes: the largest |1 - omega K(q)/d| over the modes a grid halved along x
    !> (mu_x), along y (mu_y) or along both (mu_both) does not carry.
@@ -659,7 +660,6 @@ contains
       integer, intent(in) :: top
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
-      real(wp), parameter :: pi = acos(-1.0_wp)
       integer :: t, kx, ky, nkx, row, first, last, k
       h%top = top
       h%level(top)%symbol = symbol
@@ -1007,7 +1007,8 @@ contains
    end subroutine cholesky_solve
 
    !> uf (on grid j) = the spectral interpolation of uc (on grid j + 1): its Fourier
-   !> coefficients, zero-padded.
+   !> coefficients, zero-padded. (The nested iteration's grids: both axes halved, as a
+   !> hierarchy built without a symbol has them.)
    subroutine interpolate(h, j, uc, uf)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: j

@@ -73,8 +73,8 @@ module lc_contact_solve
    integer, parameter :: hard_coarse_iterations = 20, hard_coarse_surface_iterations = 12
    !> A coupled line whose compliance rises with |q| (a thin incompressible layer, admitted by
    !> coupled_refusal) goes the same way from this many points: its multigrid solves take
-   !> 130-200 transform pairs, and GCR takes 0.4-0.8x their time up to 65536 points on
-   !> broadband lines, 0.8-1.3x at 131072, 1.1-2.1x at 262144, 2.9-10.7x at 2^20 (0.2-0.3x
+   !> 130-200 transform pairs, and GCR takes 0.2-0.8x their time up to 65536 points on
+   !> broadband lines, 0.8-1.3x at 131072, 1.1-2.1x at 262144, 2.9-10.7x at 2^20 (0.1-0.3x
    !> on the physical family, whose coarse solves are easy: 10-14 GCR iterations).
    integer, parameter :: rising_multigrid_points = 262144
 

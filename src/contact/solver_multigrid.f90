@@ -66,9 +66,9 @@ module lc_contact_solver_multigrid
    !> A coupled scene whose compliance rises more is admitted (coupled_refusal) if its
    !> hierarchy's worst Jacobi smoothing factor is at most this. Coupled lines of 4096 and
    !> 65536 points (shortest wavelength 8 points, h/lambda = 0.001 .. 0.03, nu = 0.45 .. 0.5,
-   !> mu_c = 0.1 .. 1.5): up to 0.988 (h/lambda = 0.01, nu = 0.5) the method took 64-201
-   !> transform pairs, at 0.999 and more (h/lambda <= 0.003, nu = 0.5) 358-13841 or stalled
-   !> (docs/decisions/014-thin-layers-by-multigrid.md).
+   !> mu_c = 0.1 .. 1.5): up to 0.988 (h/lambda = 0.01, nu = 0.5) the method took 63-211
+   !> transform pairs (182-638 at 0.974), at 0.999 and more (h/lambda <= 0.003, nu = 0.5)
+   !> 358-13841 or went to the GCR fallback (docs/decisions/014-thin-layers-by-multigrid.md).
    real(wp), parameter :: coupled_smoothing = 0.995_wp
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256
