@@ -29,8 +29,8 @@ finest grid (plus the inner CG iterations after an Anderson fallback, marked +a)
 "pairs": FFT pairs in units of the finest grid's (coarse levels included); "ms": the
 library's solve time (``wall_time``). The last table gives max/min of the iterations and
 of the pairs over n per family and scene. ``--method`` sets ``&solver method`` (for
-'multigrid', scenes 1, 2 and 4 on lines, scene 1 on surfaces: it refuses the thin
-incompressible layer of scene 3). ``--against M`` solves every row with method M as well,
+'multigrid', every scene on lines, scenes 1, 2 and 4 on surfaces: it refuses the thin
+incompressible layer of scene 3 there). ``--against M`` solves every row with method M as well,
 the two solves alternating (best of ``--repeats`` each), and prints M's iterations, pairs
 and time and the time ratio M/method measured in this run: the comparison behind the
 choice of method 'auto'.

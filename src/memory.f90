@@ -47,7 +47,8 @@ contains
    !> in-plane fields of the stress observables.
    pure integer(i8) function solve_bytes(points, coupled, memory, stress, multigrid, line) result(bytes)
       integer, intent(in) :: points
-      !> friction or a moving viscoelastic law: the GCR (or Anderson) history
+      !> friction or a moving viscoelastic law: the GCR (or Anderson) history; or a frictionless
+      !> line that may go to the coupled multigrid iteration (a thin incompressible layer)
       logical, intent(in) :: coupled
       integer, intent(in) :: memory   !< &solver memory (history length)
       logical, intent(in) :: stress

@@ -249,7 +249,8 @@ def solve_line(
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
     and the surface stress ``stress_xx`` (one more FFT pair).
     ``method``: ``'auto'`` (the multigrid method for the frictionless elastic lines it
-    applies to from 4096 points on, and surfaces from 1024², constrained CG for other
+    applies to from 4096 points on (a thin incompressible one from 262144 points when its
+    coarse solve needed more than 20 CG iterations), and surfaces from 1024², constrained CG for other
     symmetric scenes, constrained GCR for coupled ones, going on with its history kept
     across clips and then with Anderson if GCR stalls; a coupled line of 8192 points or
     more whose coarse-start solve needed more than 20 GCR iterations (a thin incompressible
@@ -262,9 +263,9 @@ def solve_line(
     on an elastic half-space or a layer with ``poisson <= 0.47``, or an incompressible one
     from ``thickness ~ 0.07 period``; ``iterations`` counts its fine-grid iterations;
     ``coarse_start`` and ``precondition`` do not apply; on such a line or surface with
-    friction or on a sliding viscoelastic layer, and on a line with friction on a thinner
-    layer whose coarse grids still smooth (``thickness ~ 0.01 period`` at ``poisson =
-    0.5``), the same iteration with the non-symmetric stiffness, from the coarse start, GCR
+    friction or on a sliding viscoelastic layer, and on a line on a thinner layer, with
+    friction or without, whose coarse grids still smooth (``thickness ~ 0.01 period`` at
+    ``poisson = 0.5``), the same iteration with the non-symmetric stiffness, from the coarse start, GCR
     going on where it stalls: transform pairs that do not grow with ``n`` on broadband
     roughness). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid

@@ -23,7 +23,7 @@ module lc_contact_solve
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
    use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, &
-      & coupled_tnnmg
+      & coupled_tnnmg, allowed_rise
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -71,11 +71,14 @@ module lc_contact_solve
    !> 0.7-0.9x with 8-12.
    integer, parameter :: coupled_multigrid_points = 8192, coupled_multigrid_surface_points = 1024**2
    integer, parameter :: hard_coarse_iterations = 20, hard_coarse_surface_iterations = 12
-   !> A coupled line whose compliance rises with |q| (a thin incompressible layer, admitted by
-   !> coupled_refusal) goes the same way from this many points: its multigrid solves take
-   !> 130-200 transform pairs, and GCR takes 0.2-0.8x their time up to 65536 points on
+   !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
+   !> coupled_refusal) goes the same way from this many points, with friction or without
+   !> (the coarse solve's CG iterations counted then): with friction its multigrid solves
+   !> take 130-200 transform pairs, and GCR takes 0.2-0.8x their time up to 65536 points on
    !> broadband lines, 0.8-1.3x at 131072, 1.1-2.1x at 262144, 2.9-10.7x at 2^20 (0.1-0.3x
-   !> on the physical family, whose coarse solves are easy: 10-14 GCR iterations).
+   !> on the physical family, whose coarse solves are easy: 10-14 GCR iterations); without,
+   !> 95-286 pairs, and the constrained CG takes 1.3x their time at 65536 and 3.1x at
+   !> 262144 with the shortest wavelength 8 points.
    integer, parameter :: rising_multigrid_points = 262144
 
 contains
@@ -107,7 +110,8 @@ contains
       real(wp) :: pm, s, g_ref, lambda_max
       type(progress_log) :: progress
       integer(i8) :: start, finish, rate
-      logical :: load_control, may_multigrid
+      logical :: load_control, may_multigrid, coupled_memory
+      real(wp), parameter :: pi = acos(-1.0_wp)
       integer :: n
 
       call system_clock(start, rate)
@@ -142,7 +146,12 @@ contains
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
       end if
-      call check_memory(n, kernel%coupled(friction), scene%solver%memory, scene%stress .and. grid%ny > 1, &
+      ! (a frictionless line whose compliance rises too steeply for the symmetric multigrid
+      ! method, a thin incompressible layer, may go to the coupled iteration and hold its arrays)
+      coupled_memory = kernel%coupled(friction)
+      if (.not. coupled_memory .and. may_multigrid .and. grid%is_line()) &
+         & coupled_memory = kernel%compliance_rise(2*pi/grid%lx, pi*grid%nx/grid%lx) > allowed_rise
+      call check_memory(n, coupled_memory, scene%solver%memory, scene%stress .and. grid%ny > 1, &
          & may_multigrid, grid%is_line(), error)
       if (allocated(error)) return
       lambda_max = maxval(height)
@@ -212,7 +221,7 @@ contains
       character(len=len(scene%solver%method)) :: method
       real(wp) :: uniform, plain
       integer :: coarse_pairs
-      logical :: coarse_hard
+      logical :: coarse_hard, rising
 
       coarse_pairs = 0
       coarse_hard = .false.
@@ -226,19 +235,25 @@ contains
          return
       end if
       method = scene%solver%method
+      ! (a frictionless elastic scene whose compliance rises too steeply for the symmetric
+      ! multigrid method, a thin incompressible layer, goes to the coupled one where that
+      ! admits it)
+      rising = .not. op%coupled .and. .not. op%kernel%viscoelastic .and. len(multigrid_refusal(op)) > 0
+      if (rising) rising = len(coupled_refusal(op, load_control)) == 0
       if (method == 'multigrid') then
          if (op%coupled) then
             reason = coupled_refusal(op, load_control)
          else
             reason = multigrid_refusal(op)
+            if (len(reason) > 0 .and. .not. op%kernel%viscoelastic) reason = coupled_refusal(op, load_control)
          end if
          if (len(reason) > 0) then
             allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
             if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
             call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
                & '; it solves lines and surfaces on an elastic half-space or layer (nu <= 0.47, or ' // &
-               & 'h/lambda >~ 0.07), with friction or sliding viscoelastic, and lines with friction on thinner ' // &
-               & 'layers down to h/lambda ~ 0.01 at nu = 0.5; allowed here: ' // &
+               & 'h/lambda >~ 0.07), with friction or sliding viscoelastic, and lines on thinner layers down ' // &
+               & 'to h/lambda ~ 0.01 at nu = 0.5; allowed here: ' // &
                & allowed, code_input)
             return
          end if
@@ -250,7 +265,7 @@ contains
       ! on the displacement, where this start solves each coarse grid to coarse_tol; on a
       ! coupled scene it takes the start, whose contact set is nearly right)
       if (scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid) .and. &
-         & (method /= 'multigrid' .or. op%coupled)) then
+         & (method /= 'multigrid' .or. op%coupled .or. rising)) then
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
             & coarse_hard, progress, error)
          if (allocated(error)) return
@@ -260,6 +275,9 @@ contains
          if (len(coupled_refusal(op, load_control)) == 0 .and. (len(metric_refusal(op)) == 0 .or. &
             & grid%points() >= rising_multigrid_points)) method = 'multigrid'
       end if
+      if (method == 'auto' .and. rising .and. coarse_hard .and. grid%points() >= rising_multigrid_points) &
+         & method = 'multigrid'
+
       call progress%begin_level(grid%nx, grid%ny)
       uniform = 0.0_wp
       if (load_control) call op%drop_uniform_mode(uniform)
@@ -277,7 +295,7 @@ contains
             & gap, newton, progress)
          call record_solve(result, 'newton', newton%converged, newton%steps, 1, newton%fft_pairs, newton%residual, &
             & [newton%residual])
-      else if (method == 'multigrid' .and. op%coupled) then
+      else if (method == 'multigrid' .and. (op%coupled .or. rising)) then
          call coupled_tnnmg(op, height, load_control, pm, s, g_ref, scene%solver%tol, scene%solver%max_iter, p, w, &
             & gap, nested, history, progress, error)
          if (allocated(error)) return
@@ -516,7 +534,7 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: p(:), s
       integer, intent(out) :: pairs
-      !> the coarse solve needed more than hard_coarse_iterations GCR iterations
+      !> the coarse solve needed more than hard_coarse_iterations GCR (or CG) iterations
       !> (hard_coarse_surface_iterations on a surface), or went to the multigrid method
       logical, intent(out) :: hard
       type(progress_log), intent(inout) :: progress
@@ -546,7 +564,8 @@ contains
       if (load_control) s = sc
       ratio = grid%points()/coarse_grid%points()
       pairs = (coarse_result%fft_pairs + ratio - 1)/ratio
-      hard = index(coarse_result%solver, 'multigrid') == 1 .or. (index(coarse_result%solver, 'gcr') == 1 .and. &
+      hard = index(coarse_result%solver, 'multigrid') == 1 .or. ((index(coarse_result%solver, 'gcr') == 1 .or. &
+         & index(coarse_result%solver, 'cg') == 1) .and. &
          & coarse_result%iterations > merge(hard_coarse_iterations, hard_coarse_surface_iterations, grid%is_line()))
    end subroutine coarse_solution
 

@@ -54,6 +54,7 @@ module lc_contact_solver_multigrid
    implicit none (type, external)
    private
    public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
+   public :: allowed_rise
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -149,7 +150,8 @@ contains
    !> if it can): metric_refusal, except that a compliance rising with |q| is admitted where
    !> the hierarchy the method builds (coupled_symbol) still smooths on every grid, its
    !> worst Jacobi smoothing factor at most coupled_smoothing: a thin incompressible layer
-   !> with friction whose stiff long waves lie on the coarsest grid.
+   !> whose stiff long waves lie on the coarsest grid (with friction or without: the
+   !> iteration takes a symmetric stiffness as well).
    function coupled_refusal(op, load_control) result(reason)
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
@@ -170,7 +172,7 @@ contains
       if (worst <= coupled_smoothing) then
          reason = ''
       else
-         reason = reason // ', and with friction the Jacobi step would smooth with a factor ' // &
+         reason = reason // ', and the Jacobi step would smooth with a factor ' // &
             & formatted(worst, '(f6.4)') // ' on its coarse grids (at most ' // formatted(coupled_smoothing, '(f5.3)') // ')'
       end if
    end function coupled_refusal
@@ -632,6 +634,8 @@ contains
       type(compliance_operator), intent(in) :: op
       real(wp) :: loss, largest
       integer :: i, at, nkx, kx, ky
+      long = .false.
+      if (.not. op%coupled) return
       largest = 0.0_wp
       at = 0
       ! (|Im K|/Re K of K = 1/G_eff is |Im G_eff|/Re G_eff)
@@ -643,7 +647,6 @@ contains
             at = i
          end if
       end do
-      long = .false.
       if (.not. largest > 0.0_wp) return
       nkx = op%grid%nx/2 + 1
       kx = mod(at - 1, nkx)

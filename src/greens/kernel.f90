@@ -36,6 +36,7 @@ module lc_greens_kernel
       procedure :: contact_compliance
       procedure :: factors
       procedure :: compliance_falls
+      procedure :: compliance_rise
       procedure :: coupled
       procedure :: normal_uniform
       procedure :: shear_uniform
@@ -111,6 +112,26 @@ contains
          previous = current
       end do
    end function compliance_falls
+
+   !> The largest factor by which the normal compliance (1-A(|q| h))/|q| exceeds its value at
+   !> a longer wave on [q_min, q_max] (1/L), sampled as compliance_falls: 1 where it falls.
+   pure real(wp) function compliance_rise(self, q_min, q_max) result(rise)
+      class(layer_kernel), intent(in) :: self
+      real(wp), intent(in) :: q_min, q_max
+      real(wp) :: q, lowest, current, one_minus_a, one_minus_b, c
+      integer :: i, samples
+      rise = 1.0_wp
+      if (self%halfspace .or. .not. q_max > q_min) return
+      samples = max(2, ceiling(64*log10(q_max/q_min))) + 1
+      lowest = huge(1.0_wp)
+      do i = 0, samples - 1
+         q = q_min*(q_max/q_min)**(real(i, wp)/(samples - 1))
+         call self%factors(q, one_minus_a, one_minus_b, c)
+         current = one_minus_a/q
+         lowest = min(lowest, current)
+         rise = max(rise, current/lowest)
+      end do
+   end function compliance_rise
 
    !> Normal compliance of the uniform mode, h/M = h (1+nu)(1-2nu)/((1-nu) E) (L/S) with the
    !> static compliance C0 = (1 - nu^2) J(0) given; 0 for a half-space and exactly 0 for
