@@ -235,32 +235,26 @@ contains
          return
       end if
       method = scene%solver%method
-      ! (a frictionless elastic scene whose compliance rises too steeply for the symmetric
-      ! multigrid method, a thin incompressible layer, goes to the coupled one where that
-      ! admits it)
-      rising = .not. op%coupled .and. .not. op%kernel%viscoelastic .and. len(multigrid_refusal(op)) > 0
-      if (rising) rising = len(coupled_refusal(op, load_control)) == 0
-      if (method == 'multigrid') then
-         if (op%coupled) then
-            reason = coupled_refusal(op, load_control)
-         else
-            reason = multigrid_refusal(op)
-            if (len(reason) > 0 .and. .not. op%kernel%viscoelastic) reason = coupled_refusal(op, load_control)
-         end if
-         if (len(reason) > 0) then
-            allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
-            if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
-            call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
-               & '; it solves lines and surfaces on an elastic half-space or layer (nu <= 0.47, or ' // &
-               & 'h/lambda >~ 0.07), with friction or sliding viscoelastic, and lines on thinner layers down ' // &
-               & 'to h/lambda ~ 0.01 at nu = 0.5; allowed here: ' // &
-               & allowed, code_input)
-            return
-         end if
-      else if (method == 'auto' .and. grid%points() >= merge(multigrid_points, multigrid_surface_points, &
-         & grid%is_line())) then
-         if (len(multigrid_refusal(op)) == 0) method = 'multigrid'
+      ! Why no multigrid method can take the scene (empty: one can): the symmetric one, or the
+      ! coupled iteration for coupled scenes and for frictionless elastic ones whose compliance
+      ! rises too steeply for the symmetric one (a thin incompressible layer: `rising`)
+      reason = multigrid_refusal(op)
+      rising = .false.
+      if (op%coupled .or. (len(reason) > 0 .and. .not. op%kernel%viscoelastic)) then
+         reason = coupled_refusal(op, load_control)
+         rising = .not. op%coupled .and. len(reason) == 0
       end if
+      if (method == 'multigrid' .and. len(reason) > 0) then
+         allowed = "'auto', 'cg', 'gcr', 'anderson' or 'gfmd'"
+         if (op%coupled) allowed = "'auto', 'gcr' or 'anderson'"
+         call fatal_error(error, "&solver: method = 'multigrid' cannot solve this scene: " // reason // &
+            & '; it solves lines and surfaces on an elastic half-space or layer (nu <= 0.47, or ' // &
+            & 'h/lambda >~ 0.07), with friction or sliding viscoelastic, and lines on thinner layers down ' // &
+            & 'to h/lambda ~ 0.01 at nu = 0.5; allowed here: ' // allowed, code_input)
+         return
+      end if
+      if (method == 'auto' .and. .not. (op%coupled .or. rising) .and. len(reason) == 0 .and. &
+         & grid%points() >= merge(multigrid_points, multigrid_surface_points, grid%is_line())) method = 'multigrid'
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
       ! on the displacement, where this start solves each coarse grid to coarse_tol; on a
       ! coupled scene it takes the start, whose contact set is nearly right)
@@ -270,14 +264,12 @@ contains
             & coarse_hard, progress, error)
          if (allocated(error)) return
       end if
-      if (method == 'auto' .and. op%coupled .and. coarse_hard .and. &
+      ! (a coupled scene, or a frictionless one whose compliance rises, where its coarse solve
+      ! was hard: broadband roughness; a rising compliance from rising_multigrid_points)
+      if (method == 'auto' .and. (op%coupled .or. rising) .and. coarse_hard .and. len(reason) == 0 .and. &
          & grid%points() >= merge(coupled_multigrid_points, coupled_multigrid_surface_points, grid%is_line())) then
-         if (len(coupled_refusal(op, load_control)) == 0 .and. (len(metric_refusal(op)) == 0 .or. &
-            & grid%points() >= rising_multigrid_points)) method = 'multigrid'
+         if (len(metric_refusal(op)) == 0 .or. grid%points() >= rising_multigrid_points) method = 'multigrid'
       end if
-      if (method == 'auto' .and. rising .and. coarse_hard .and. grid%points() >= rising_multigrid_points) &
-         & method = 'multigrid'
-
       call progress%begin_level(grid%nx, grid%ny)
       uniform = 0.0_wp
       if (load_control) call op%drop_uniform_mode(uniform)
