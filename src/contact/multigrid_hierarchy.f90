@@ -42,8 +42,9 @@ module lc_contact_multigrid_hierarchy
          integer, intent(out) :: info
       end subroutine dgetrs
    end interface
-   public :: grid_level, hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, penalty
+   public :: grid_level, hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, penalty, accepted_smoothing
    public :: build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, worst_smoothing
+   public :: worst_row_smoothing, solve_rows
    public :: precondition, apply_stiffness, level_operator
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
@@ -99,7 +100,14 @@ module lc_contact_multigrid_hierarchy
       !> the penalty's stencil (coarse grids): penalty(ex, ey, i) couples point i with its
       !> neighbour i + (ex, ey), periodic (ey = 0 only on a line)
       real(wp), allocatable :: penalty(:, :, :)
-      real(wp), allocatable :: jacobi(:)       !< omega over the diagonal of the operator
+      !> the smoother's weights: omega over the diagonal of the operator (Jacobi steps), or
+      !> omega scaled down where the point is stiffer than its row (row smoothing: set_contact)
+      real(wp), allocatable :: jacobi(:)
+      !> row smoothing (hierarchy%rows): K_row(kx), the mean of the symbol over ky; its
+      !> inverse with the 1/nx of the rows' unscaled transform folded in; and per row the
+      !> mean of the penalty's diagonal over the row (coarse grids), added to K_row
+      complex(wp), allocatable :: row_symbol(:), row_inverse(:)
+      real(wp), allocatable :: row_shift(:)
       real(wp), allocatable :: rhs(:), x(:), residual(:)
       !> a surface's transfers work axis by axis: the field on the next grid's x and this ny
       real(wp), allocatable :: halfway(:)
@@ -115,6 +123,9 @@ module lc_contact_multigrid_hierarchy
       integer :: top = 0, coarsest = 0, n_fine = 0
       logical :: surface = .false.   !< both axes are halved
       logical :: complex = .false.   !< a complex symbol (lines): LU on the coarsest grid
+      !> Smoothing by rows (solve_rows) in place of Jacobi steps, on grids halved along both
+      !> axes: for a layer sliding along x, whose modulus depends on q_x
+      logical :: rows = .false.
       integer, allocatable :: pivots(:)
       real(wp), allocatable :: free(:)           !< 1 off the contact set, 0 on it (top grid)
       real(wp), allocatable :: dense(:, :)       !< Cholesky (LU) factor of the coarsest operator
@@ -228,6 +239,43 @@ contains
       end do
    end function worst_smoothing
 
+   !> The largest smoothing factor of the row smoothing step (solve_rows, damped by omega)
+   !> over the grids halved along both axes, for the stiffness symbol of the finest nx x ny
+   !> surface (`odd` its imaginary part), read at each grid's modes: the largest
+   !> |1 - omega K(q)/K_row(kx)| over the modes the next grid cannot carry.
+   function worst_row_smoothing(nx, ny, symbol, odd) result(worst)
+      integer, intent(in) :: nx, ny
+      real(wp), contiguous, intent(in) :: symbol(:)
+      real(wp), contiguous, intent(in), optional :: odd(:)
+      real(wp) :: worst
+      complex(wp), allocatable :: stiffness(:, :)
+      complex(wp) :: row
+      integer :: t, mx, my, kx, ky, sy, i
+      worst = 0.0_wp
+      do t = 0, halvings(nx, ny, coarsest_points) - 1
+         mx = nx/2**t
+         my = ny/2**t
+         allocate (stiffness(0:mx/2, 0:my - 1))
+         do ky = 0, my - 1
+            sy = merge(ky, ky - my, 2*ky <= my)
+            do kx = 0, mx/2
+               i = mode_index(nx, ny, kx, sy)
+               stiffness(kx, ky) = symbol(i)
+               if (present(odd)) stiffness(kx, ky) = cmplx(symbol(i), odd(i), kind=wp)
+            end do
+         end do
+         do kx = 0, mx/2
+            row = sum(stiffness(kx, :))/my
+            if (abs(row) == 0.0_wp) cycle
+            do ky = 0, my - 1
+               sy = merge(ky, ky - my, 2*ky <= my)
+               if (4*kx > mx .or. 4*abs(sy) > my) worst = max(worst, abs(1.0_wp - omega*stiffness(kx, ky)/row))
+            end do
+         end do
+         deallocate (stiffness)
+      end do
+   end function worst_row_smoothing
+
    !> The smoothing factors of the damped Jacobi step (its diagonal as set_grid takes it, with
    !> the mean over the half spectrum) on
    !> an mx x my grid for the stiffness symbol of the finest nx x ny grid read at the coarse
@@ -285,8 +333,18 @@ contains
       end if
       call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
       call vcycle(h, h%top + 1)
-      call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), r, &
-         & omega/h%level(h%top)%jacobi_diagonal)
+      if (h%rows) then
+         ! (the step masked, as r is; the coarse levels have their own buffers, so this one
+         ! still holds it for prolong_add)
+         call solve_rows(h, h%top, r)
+         associate (step => h%level(h%top)%fft%real_buffer)
+         step = h%free(1:size(r))*step
+         call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), step, omega)
+         end associate
+      else
+         call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), r, &
+            & omega/h%level(h%top)%jacobi_diagonal)
+      end if
    end subroutine precondition
 
    !> One V(1,1)-cycle on the coarse level t > h%top: x ~ A_t^-1 rhs with the penalised
@@ -300,15 +358,56 @@ contains
          return
       end if
       associate (lv => h%level(t))
-      lv%x = lv%jacobi*lv%rhs
+      if (h%rows) then
+         call solve_rows(h, t, lv%rhs)
+         lv%x = lv%jacobi*lv%fft%real_buffer
+      else
+         lv%x = lv%jacobi*lv%rhs
+      end if
       call level_residual(h, t)
       call restrict(h, t, lv%residual, h%level(t + 1)%rhs)
       call vcycle(h, t + 1)
       call prolong_add(h, t, h%level(t + 1)%x, lv%x)
       call level_residual(h, t)
-      lv%x = lv%x + lv%jacobi*lv%residual
+      if (h%rows) then
+         call solve_rows(h, t, lv%residual)
+         lv%x = lv%x + lv%jacobi*lv%fft%real_buffer
+      else
+         lv%x = lv%x + lv%jacobi*lv%residual
+      end if
       end associate
    end subroutine vcycle
+
+   !> The buffer of level t <- (K_row + s)^-1 r, row by row: the exact inverse of the part of
+   !> the circulant that couples the points of one row (its real-space column at y = 0, whose
+   !> symbol along x is K_row), s the row's shift. A layer sliding along x has a modulus
+   !> E(q_x V): within a column of the spectrum K/K_row does not depend on E, so the step
+   !> damps the modes the next grid cannot carry as a Jacobi step damps those of an elastic
+   !> layer (smoothing factor 0.55 where Jacobi's is 0.9-0.99, soft and lossy modes alike:
+   !> docs/decisions/015-row-smoothing.md). The rows' transforms are counted as half a
+   !> transform pair of the grid.
+   subroutine solve_rows(h, t, r)
+      type(hierarchy), intent(inout) :: h
+      integer, intent(in) :: t
+      real(wp), contiguous, intent(in) :: r(:)
+      integer :: row, nkx
+      associate (lv => h%level(t))
+      lv%fft%real_buffer = r
+      call lv%fft%rows_forward_unscaled()
+      nkx = lv%nx/2 + 1
+      do row = 0, lv%ny - 1
+         associate (coefficients => lv%fft%spectrum(row*nkx + 1:(row + 1)*nkx))
+         if (lv%row_shift(row + 1) == 0.0_wp) then
+            coefficients = coefficients*lv%row_inverse
+         else
+            coefficients = coefficients/((lv%row_symbol + lv%row_shift(row + 1))*lv%nx)
+         end if
+         end associate
+      end do
+      call lv%fft%rows_backward()
+      h%pairs = h%pairs + 0.5_wp*real(lv%n, wp)/h%n_fine
+      end associate
+   end subroutine solve_rows
 
    !> residual = rhs - A_t x on the coarse level t (one transform pair of that grid).
    subroutine level_residual(h, t)
@@ -550,18 +649,24 @@ contains
    !> (allocated once, for all the nested grids). With `symbol` (a surface's stiffness on the
    !> finest grid's half spectrum, `odd` its imaginary part) a grid may be halved along one
    !> axis only.
-   subroutine build_hierarchy(h, op, error, symbol, odd)
+   subroutine build_hierarchy(h, op, error, symbol, odd, rows)
       type(hierarchy), intent(out), target :: h
       type(compliance_operator), intent(inout), target :: op
       type(error_type), allocatable, intent(out) :: error
       real(wp), contiguous, intent(in), optional :: symbol(:), odd(:)
+      logical, intent(in), optional :: rows
       integer, allocatable :: shapes(:, :)
       integer :: t, m, nx, ny, reach
       nx = op%grid%nx
       ny = op%grid%ny
       reach = merge(1, 0, ny > 1)
       h%surface = ny > 1
-      call coarsening_shapes(nx, ny, shapes, symbol, odd)
+      if (present(rows)) h%rows = rows .and. h%surface
+      if (h%rows) then
+         call coarsening_shapes(nx, ny, shapes)
+      else
+         call coarsening_shapes(nx, ny, shapes, symbol, odd)
+      end if
       h%coarsest = ubound(shapes, 2)
       h%n_fine = nx*ny
       allocate (h%level(0:h%coarsest), h%free(nx*ny))
@@ -584,6 +689,12 @@ contains
             call lv%plan%init(lv%nx, lv%ny, 1, error)
             if (allocated(error)) return
             lv%fft => lv%plan
+         end if
+         if (h%rows) then
+            call lv%fft%plan_rows(error)
+            if (allocated(error)) return
+            allocate (lv%row_symbol(lv%nx/2 + 1), lv%row_inverse(lv%nx/2 + 1), lv%row_shift(lv%ny))
+            lv%row_shift = 0.0_wp
          end if
          allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier((lv%nx/2 + 1)*lv%ny))
          ! (the finest grid is never a coarse one of the V-cycle)
@@ -706,6 +817,7 @@ contains
                   & jacobi_margin*omega*(lv%symbol(k)**2 + lv%odd(k)**2)/(2*lv%symbol(k)))
             end do
          end if
+         if (h%rows) call set_rows(lv, h%complex)
          end associate
       end do
       associate (lv => h%level(h%coarsest))
@@ -715,6 +827,24 @@ contains
       h%coarse_column = lv%fft%real_buffer
       end associate
    end subroutine set_grid
+
+   !> Row smoothing's K_row on level lv, the mean over ky of its symbol (with the imaginary
+   !> part if `complex`), and its inverse (0 where K_row is 0).
+   pure subroutine set_rows(lv, complex)
+      type(grid_level), intent(inout) :: lv
+      logical, intent(in) :: complex
+      complex(wp) :: mean
+      integer :: kx, nkx
+      nkx = lv%nx/2 + 1
+      do kx = 1, nkx
+         mean = cmplx(sum(lv%symbol(kx::nkx)), 0.0_wp, kind=wp)
+         if (complex) mean = cmplx(real(mean), sum(lv%odd(kx::nkx)), kind=wp)
+         mean = mean/lv%ny
+         lv%row_symbol(kx) = mean
+         lv%row_inverse(kx) = 0.0_wp
+         if (abs(mean) > 0.0_wp) lv%row_inverse(kx) = 1.0_wp/(mean*lv%nx)
+      end do
+   end subroutine set_rows
 
    !> The Galerkin symbol of grid c at its mode (kx, ky) from that of the grid f it is made
    !> of (its real part, or with `imaginary` its odd imaginary part): along a halved axis the
@@ -765,7 +895,18 @@ contains
          else
             call coarsen_x(f%penalty, f%nx, 0, c%penalty)
          end if
-         c%jacobi = omega/(c%jacobi_diagonal + c%penalty(0, 0, :))
+         if (h%rows) then
+            ! the row solve takes the penalty's mean over the row as a shift (the contact
+            ! points' stiffness spread over it); a point stiffer than that, its step scaled
+            ! down as a Jacobi step would be: without either, a soft row's inverse applied
+            ! where the penalty pins the points overshoots (E_inf/E0 = 100 at V tau/lambda
+            ! = 1: the V-cycle diverged)
+            c%row_shift = sum(reshape(c%penalty(0, 0, :), [c%nx, c%ny]), dim=1)/c%nx
+            c%jacobi = omega*min(1.0_wp, reshape(spread(c%circulant_diagonal + c%row_shift, 1, c%nx), [c%n]) &
+               & /(c%circulant_diagonal + c%penalty(0, 0, :)))
+         else
+            c%jacobi = omega/(c%jacobi_diagonal + c%penalty(0, 0, :))
+         end if
          end associate
       end do
       ! the coarsest operator, dense: circulant plus penalty (on the grid being solved, when

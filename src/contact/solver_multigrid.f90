@@ -48,7 +48,7 @@ module lc_contact_solver_multigrid
    use lc_contact_operator, only: compliance_operator
    use lc_contact_multigrid_hierarchy, only: hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, &
       & build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, precondition, worst_smoothing, &
-      & apply_stiffness
+      & apply_stiffness, worst_row_smoothing, accepted_smoothing
    use lc_contact_solver_cg, only: complementarity_residual, rounding_floor, normalise
    use lc_contact_progress, only: progress_log
    implicit none (type, external)
@@ -71,6 +71,16 @@ module lc_contact_solver_multigrid
    !> transform pairs (182-638 at 0.974), at 0.999 and more (h/lambda <= 0.003, nu = 0.5)
    !> 358-13841 or went to the GCR fallback (docs/decisions/014-thin-layers-by-multigrid.md).
    real(wp), parameter :: coupled_smoothing = 0.995_wp
+   !> A coupled surface is smoothed by rows (hierarchy%rows) where the Jacobi steps' worst
+   !> smoothing factor on the grids coarsening_shapes would choose exceeds this and the
+   !> rows' (worst_row_smoothing) is at most accepted_smoothing: a layer sliding along x
+   !> whose modulus changes with q_x V. Measured at 256^2 (h/lambda = 0.16, E_inf/E0 = 10 and
+   !> 100, V tau/lambda = 1e-3 .. 1e2; the rows' factor 0.55 on all): at Jacobi's 0.70-0.82
+   !> Jacobi steps took 61-180 transform pairs and rows 80-196, at 0.91-0.99 rows 70-469
+   !> where Jacobi steps took 89-913. Thin incompressible layers (Jacobi 0.87-0.99, rows
+   !> 0.79-0.93) keep Jacobi steps: frictionless at h/lambda = 0.01, 681 against 10896
+   !> (docs/decisions/015-row-smoothing.md).
+   real(wp), parameter :: row_smoothing = 0.85_wp
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256
    !> The inexact Newton solve: at most this many CG iterations, or a residual reduced by
@@ -426,17 +436,22 @@ contains
       real(wp) :: f, d, b_max, residual, contact, best, best_residual
       integer :: n, step, changed, j, last_progress
       logical :: settled, finished, clipped, tension
+      logical :: rows
 
       n = size(p)
       call op%prepare_gcr()
-      ! (a surface's grids halved along the axes its symbol needs)
+      ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows; `odd`
+      ! is not allocated, so absent, for a real symbol)
       call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
+      rows = .false.
+      if (.not. op%grid%is_line()) rows = worst_smoothing(op%grid%nx, op%grid%ny, symbol, odd) > row_smoothing &
+         & .and. worst_row_smoothing(op%grid%nx, op%grid%ny, symbol, odd) <= accepted_smoothing
       if (complex_symbol) then
-         call build_hierarchy(h, op, error, symbol, odd)
+         call build_hierarchy(h, op, error, symbol, odd, rows=rows)
          if (allocated(error)) return
          call set_grid(h, 0, symbol, odd)
       else
-         call build_hierarchy(h, op, error, symbol)
+         call build_hierarchy(h, op, error, symbol, rows=rows)
          if (allocated(error)) return
          call set_grid(h, 0, symbol)
       end if

@@ -52,11 +52,16 @@ module lc_fft_plans
       complex(c_double_complex), pointer, contiguous, private :: in_place(:) => null()
       type(c_ptr), private :: columns_forward = c_null_ptr, columns_backward = c_null_ptr
       type(c_ptr), private :: last_forward = c_null_ptr, last_backward = c_null_ptr
+      !> the rows alone (plan_rows): r2c and c2r along x of each of the ny rows
+      type(c_ptr), private :: rows_r2c = c_null_ptr, rows_c2r = c_null_ptr
    contains
       procedure :: init
       procedure :: forward
       procedure :: forward_unscaled
       procedure :: backward
+      procedure :: plan_rows
+      procedure :: rows_forward_unscaled
+      procedure :: rows_backward
       procedure :: destroy
       final :: finalize
    end type fft_plan
@@ -157,6 +162,38 @@ contains
       end if
    end subroutine plan_split
 
+   !> Plans for transforming the rows alone (rows_forward_unscaled, rows_backward), on the
+   !> same buffers: the spectrum of row j (its nx/2 + 1 coefficients) where the half
+   !> spectrum's row j lies.
+   subroutine plan_rows(self, error)
+      class(fft_plan), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      integer(c_int) :: nx, ny, nkx
+      if (c_associated(self%rows_r2c)) return
+      nx = int(self%nx, c_int)
+      ny = int(self%ny, c_int)
+      nkx = nx/2 + 1
+      self%rows_r2c = fftw_plan_many_dft_r2c(1_c_int, [nx], ny, self%real_buffer, [nx], 1_c_int, nx, &
+         & self%spectrum, [nkx], 1_c_int, nkx, FFTW_ESTIMATE)
+      self%rows_c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], ny, self%spectrum, [nkx], 1_c_int, nkx, &
+         & self%real_buffer, [nx], 1_c_int, nx, ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
+      if (.not. (c_associated(self%rows_r2c) .and. c_associated(self%rows_c2r))) &
+         & call fatal_error(error, 'fft: FFTW could not plan the rows of ' // to_string(self%nx) // ' x ' // &
+         & to_string(self%ny) // ' points', code_internal)
+   end subroutine plan_rows
+
+   !> spectrum <- the bare r2c of every row of real_buffer (after plan_rows).
+   subroutine rows_forward_unscaled(self)
+      class(fft_plan), intent(inout) :: self
+      call fftw_execute_dft_r2c(self%rows_r2c, self%real_buffer, self%spectrum)
+   end subroutine rows_forward_unscaled
+
+   !> real_buffer <- the c2r of every row of the spectrum, which is destroyed.
+   subroutine rows_backward(self)
+      class(fft_plan), intent(inout) :: self
+      call fftw_execute_dft_c2r(self%rows_c2r, self%spectrum, self%real_buffer)
+   end subroutine rows_backward
+
    !> spectrum <- Fourier coefficients of real_buffer (r2c / (nx ny)). real_buffer is kept.
    subroutine forward(self)
       class(fft_plan), intent(inout) :: self
@@ -202,6 +239,10 @@ contains
       if (c_associated(self%columns_backward)) call fftw_destroy_plan(self%columns_backward)
       if (c_associated(self%last_forward)) call fftw_destroy_plan(self%last_forward)
       if (c_associated(self%last_backward)) call fftw_destroy_plan(self%last_backward)
+      if (c_associated(self%rows_r2c)) call fftw_destroy_plan(self%rows_r2c)
+      if (c_associated(self%rows_c2r)) call fftw_destroy_plan(self%rows_c2r)
+      self%rows_r2c = c_null_ptr
+      self%rows_c2r = c_null_ptr
       self%columns_forward = c_null_ptr
       self%columns_backward = c_null_ptr
       self%last_forward = c_null_ptr

@@ -3,8 +3,10 @@
 !> a field equals P^T A_(t-1) P applied to it, with P the linear interpolation written out
 !> here; A_0 is the circulant of the stiffness plus the penalty d D_A on the contact set.
 !> Real and complex (odd imaginary part) symbols, on a line and on surfaces whose grids are
-!> halved along both axes or along one (an anisotropic symbol). One line per check; exit 0
-!> on pass, error stop 1 on failure.
+!> halved along both axes or along one (an anisotropic symbol). And the row smoothing's solve
+!> (solve_rows): for a field on one row, its result x lies on that row and (C + s) x = r
+!> there, C the grid's circulant and s the row's shift. One line per check; exit 0 on pass,
+!> error stop 1 on failure.
 !>
 !> Tolerance: tol_identity = 1e-12 of the largest entry: the two sides are the same sums in
 !> another order (transforms of a few hundred points against explicit stencils).
@@ -14,7 +16,7 @@ program test_multigrid_hierarchy
    use lc_grid, only: line_grid, surface_grid
    use lc_contact_operator, only: compliance_operator
    use lc_contact_multigrid_hierarchy, only: hierarchy, build_hierarchy, set_grid, set_contact, level_operator, &
-      & penalty
+      & penalty, solve_rows, worst_row_smoothing
    implicit none (type, external)
 
    real(wp), parameter :: tol_identity = 1.0e-12_wp
@@ -29,6 +31,8 @@ program test_multigrid_hierarchy
    call check_galerkin('isotropic surface, complex symbol', 32, 32, 1.0_wp, 1.0_wp, .true., 'bb')
    call check_galerkin('surface stiff along x, complex symbol', 32, 32, 10.0_wp, 1.0_wp, .true., 'xxb')
    call check_galerkin('surface stiff along y, complex symbol', 32, 16, 1.0_wp, 10.0_wp, .true., 'yb')
+   call check_rows('rows, real symbol', 32, 16, .false.)
+   call check_rows('rows, complex symbol', 32, 16, .true.)
    if (failures > 0) then
       write (*, '(a, i0, a)') 'FAILED: ', failures, ' check(s)'
       error stop 1
@@ -126,6 +130,94 @@ contains
       end do
       call check(worst <= tol_identity, what // ': A_t = P^T A_(t-1) P on every coarse grid')
    end subroutine check_galerkin
+
+   !> A sliding layer's symbol K = E(kx) |q|, E(kx) = (1 + 100 i kx/nx)/(1 + i kx/nx) (a
+   !> standard linear solid, E_inf/E0 = 100; real part only if not complex) on an nx x ny
+   !> surface smoothed by rows: its grids halved along both axes, the rows' smoothing factor
+   !> that of K ~ |q| (E cancels in K/K_row: 0.55 at most), and on every grid, for a field r
+   !> on one row j, x = (C + s)^-1 r row by row lies on row j with (C x + s x) = r there,
+   !> with the shift s = 0 and s = 3 d.
+   subroutine check_rows(what, nx, ny, complex_symbol)
+      character(len=*), intent(in) :: what
+      integer, intent(in) :: nx, ny
+      logical, intent(in) :: complex_symbol
+      type(compliance_operator), target :: op
+      type(hierarchy), target :: h
+      type(error_type), allocatable :: error
+      real(wp), allocatable :: symbol(:), odd(:), r(:), x(:), cx(:)
+      complex(wp) :: modulus
+      integer :: kx, ky, sy, nkx, i, t, row, attempt
+      real(wp) :: worst, off_row, shift
+      logical :: full
+
+      op%grid = surface_grid(nx, ny, 1.0_wp, 1.0_wp)
+      call op%fft%init(nx, ny, 1, error)
+      if (allocated(error)) then
+         call check(.false., what // ': ' // error%message)
+         return
+      end if
+      nkx = nx/2 + 1
+      allocate (symbol(nkx*ny), odd(nkx*ny))
+      do ky = 0, ny - 1
+         sy = merge(ky, ky - ny, 2*ky <= ny)
+         do kx = 0, nx/2
+            modulus = (1.0_wp + (0.0_wp, 100.0_wp)*kx/nx)/(1.0_wp + (0.0_wp, 1.0_wp)*kx/nx)
+            if (2*kx == nx .or. .not. complex_symbol) modulus = abs(modulus)
+            symbol(kx + nkx*ky + 1) = real(modulus)*hypot(real(kx, wp), real(sy, wp))
+            odd(kx + nkx*ky + 1) = aimag(modulus)*hypot(real(kx, wp), real(sy, wp))
+         end do
+      end do
+      if (complex_symbol) then
+         call build_hierarchy(h, op, error, symbol, odd, rows=.true.)
+         if (.not. allocated(error)) call set_grid(h, 0, symbol, odd)
+         worst = worst_row_smoothing(nx, ny, symbol, odd)
+      else
+         call build_hierarchy(h, op, error, symbol, rows=.true.)
+         if (.not. allocated(error)) call set_grid(h, 0, symbol)
+         worst = worst_row_smoothing(nx, ny, symbol)
+      end if
+      if (allocated(error)) then
+         call check(.false., what // ': ' // error%message)
+         return
+      end if
+      call check(worst <= 0.55_wp, what // ': smoothing factor ' // trim(adjustl(fmt(worst))) // ' (at most 0.55)')
+      full = all([(h%level(t)%halve_x .and. h%level(t)%halve_y, t = 0, h%coarsest - 1)])
+      call check(full, what // ': every grid halved along both axes')
+      h%free = 1.0_wp
+      call set_contact(h)
+
+      worst = 0.0_wp
+      off_row = 0.0_wp
+      do t = 0, h%coarsest - 1
+         associate (lv => h%level(t))
+         row = lv%ny/2
+         allocate (r(lv%n), cx(lv%n))
+         do attempt = 1, 2
+            shift = merge(0.0_wp, 3*lv%circulant_diagonal, attempt == 1)
+            lv%row_shift = 0.0_wp
+            lv%row_shift(row + 1) = shift
+            r = 0.0_wp
+            r(row*lv%nx + 1:(row + 1)*lv%nx) = [(sin(1.3_wp*i) + 0.5_wp*cos(0.7_wp*i*i), i = 1, lv%nx)]
+            call solve_rows(h, t, r)
+            x = lv%fft%real_buffer
+            call level_operator(h, t, x, cx)
+            cx = cx + shift*x
+            worst = max(worst, maxval(abs(cx(row*lv%nx + 1:(row + 1)*lv%nx) - r(row*lv%nx + 1:(row + 1)*lv%nx))) &
+               & /maxval(abs(r)))
+            off_row = max(off_row, maxval(abs(x(:row*lv%nx))), maxval(abs(x((row + 1)*lv%nx + 1:))))
+         end do
+         deallocate (r, cx)
+         end associate
+      end do
+      call check(off_row == 0.0_wp, what // ': the row solve stays on its row')
+      call check(worst <= tol_identity, what // ': (C + s) x = r on the row, every grid')
+   end subroutine check_rows
+
+   pure function fmt(x) result(text)
+      real(wp), intent(in) :: x
+      character(len=12) :: text
+      write (text, '(f8.4)') x
+   end function fmt
 
    !> P x: x (mx x my) interpolated linearly (periodic) along the axes halved.
    pure function interpolated(x, mx, my, along_x, along_y) result(fine)
