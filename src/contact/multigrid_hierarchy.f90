@@ -77,6 +77,15 @@ module lc_contact_multigrid_hierarchy
    !> diagonal d of K): 1 gave the fewest CG iterations on the final set against 0.5, 2, 10.
    real(wp), parameter :: penalty = 1.0_wp
 
+   !> Row smoothing on a coarse grid: the shift of a row's solve, in units of the mean of the
+   !> penalty's diagonal over the row. Without it a soft row's inverse overshoots where the
+   !> penalty pins the points (the standard linear solid E_inf/E0 = 10 at V tau/lambda = 0.1,
+   !> 1024^2: the iteration stalled, GCR finished it). Transform pairs of that scene at 256^2,
+   !> 512^2, 2048^2 and of a glassy one (E_inf/E0 = 100, V tau/lambda = 1) at 256^2, 512^2,
+   !> for the weights 1, 0.5, 0.25, 0.1: 92, 109, 158 | 118, 122; 89, 90, 125 | 110, 106;
+   !> 84, 84, 97 | 114, 104; 83, 83, 91 | 112, 137 (docs/decisions/015-row-smoothing.md).
+   real(wp), parameter :: row_shift_weight = 0.25_wp
+
    !> One grid of nx/2^t x ny/2^t points (ny = 1 on a line): its plan, the operator on it
    !> for the current hierarchy, and the V-cycle's work arrays.
    type :: grid_level
@@ -249,7 +258,7 @@ contains
       real(wp), contiguous, intent(in), optional :: odd(:)
       real(wp) :: worst
       complex(wp), allocatable :: stiffness(:, :)
-      complex(wp) :: row
+      complex(wp) :: row   !< the sum of a column, then 1/K_row
       integer :: t, mx, my, kx, ky, sy, i
       worst = 0.0_wp
       do t = 0, halvings(nx, ny, coarsest_points) - 1
@@ -265,11 +274,12 @@ contains
             end do
          end do
          do kx = 0, mx/2
-            row = sum(stiffness(kx, :))/my
+            row = sum(stiffness(kx, :))
             if (abs(row) == 0.0_wp) cycle
+            row = my*inverse(row)
             do ky = 0, my - 1
                sy = merge(ky, ky - my, 2*ky <= my)
-               if (4*kx > mx .or. 4*abs(sy) > my) worst = max(worst, abs(1.0_wp - omega*stiffness(kx, ky)/row))
+               if (4*kx > mx .or. 4*abs(sy) > my) worst = max(worst, abs(1.0_wp - omega*stiffness(kx, ky)*row))
             end do
          end do
          deallocate (stiffness)
@@ -400,7 +410,7 @@ contains
          if (lv%row_shift(row + 1) == 0.0_wp) then
             coefficients = coefficients*lv%row_inverse
          else
-            coefficients = coefficients/((lv%row_symbol + lv%row_shift(row + 1))*lv%nx)
+            coefficients = coefficients*inverse(lv%row_symbol + lv%row_shift(row + 1))/lv%nx
          end if
          end associate
       end do
@@ -842,9 +852,16 @@ contains
          mean = mean/lv%ny
          lv%row_symbol(kx) = mean
          lv%row_inverse(kx) = 0.0_wp
-         if (abs(mean) > 0.0_wp) lv%row_inverse(kx) = 1.0_wp/(mean*lv%nx)
+         if (abs(mean) > 0.0_wp) lv%row_inverse(kx) = inverse(mean)/lv%nx
       end do
    end subroutine set_rows
+
+   !> 1/z as conj(z)/|z|^2 (z /= 0): complex division raises spurious floating-point flags
+   !> in vectorised code.
+   elemental complex(wp) function inverse(z)
+      complex(wp), intent(in) :: z
+      inverse = conjg(z)/(real(z)**2 + aimag(z)**2)
+   end function inverse
 
    !> The Galerkin symbol of grid c at its mode (kx, ky) from that of the grid f it is made
    !> of (its real part, or with `imaginary` its odd imaginary part): along a halved axis the
@@ -896,12 +913,10 @@ contains
             call coarsen_x(f%penalty, f%nx, 0, c%penalty)
          end if
          if (h%rows) then
-            ! the row solve takes the penalty's mean over the row as a shift (the contact
-            ! points' stiffness spread over it); a point stiffer than that, its step scaled
-            ! down as a Jacobi step would be: without either, a soft row's inverse applied
-            ! where the penalty pins the points overshoots (E_inf/E0 = 100 at V tau/lambda
-            ! = 1: the V-cycle diverged)
-            c%row_shift = sum(reshape(c%penalty(0, 0, :), [c%nx, c%ny]), dim=1)/c%nx
+            ! the row solve takes part of the penalty's mean over the row as a shift (the
+            ! contact points' stiffness spread over it); a point stiffer than that, its step
+            ! scaled down as a Jacobi step would be (see row_shift_weight)
+            c%row_shift = row_shift_weight*sum(reshape(c%penalty(0, 0, :), [c%nx, c%ny]), dim=1)/c%nx
             c%jacobi = omega*min(1.0_wp, reshape(spread(c%circulant_diagonal + c%row_shift, 1, c%nx), [c%n]) &
                & /(c%circulant_diagonal + c%penalty(0, 0, :)))
          else

@@ -161,7 +161,7 @@ contains
       do ky = 0, ny - 1
          sy = merge(ky, ky - ny, 2*ky <= ny)
          do kx = 0, nx/2
-            modulus = (1.0_wp + (0.0_wp, 100.0_wp)*kx/nx)/(1.0_wp + (0.0_wp, 1.0_wp)*kx/nx)
+            modulus = (1.0_wp + (0.0_wp, 100.0_wp)*kx/nx)*(1.0_wp - (0.0_wp, 1.0_wp)*kx/nx)/(1.0_wp + (real(kx, wp)/nx)**2)
             if (2*kx == nx .or. .not. complex_symbol) modulus = abs(modulus)
             symbol(kx + nkx*ky + 1) = real(modulus)*hypot(real(kx, wp), real(sy, wp))
             odd(kx + nkx*ky + 1) = aimag(modulus)*hypot(real(kx, wp), real(sy, wp))
