@@ -9,8 +9,9 @@ physical wavenumbers (shortest wavelength period/32) or the shortest wavelength 
 points (broadband); a layer h/lambda = 0.16, nu = 0.5, a standard linear solid E0 = 1,
 tau = 1 with E_inf/E0 = 10 and 100 sliding at V tau/lambda = 1e-3 .. 1e2, mu_c = 0 and 0.5,
 p_m = 0.02 E0. Along the sliding direction the layer's short waves are glassier than across
-it, so the multigrid halves its coarse grids along one axis where that smooths better
-(docs/decisions/013-anisotropic-coarsening.md). tol 1e-8, one thread. Per row: each
+it, so the multigrid halves its coarse grids along one axis where that smooths better, or
+smooths by rows (docs/decisions/013-anisotropic-coarsening.md, 015-row-smoothing.md).
+tol 1e-8, one thread. Per row: each
 method's solver, transform pairs and time (the library's `wall_time`).
 """
 

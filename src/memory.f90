@@ -42,9 +42,9 @@ contains
    !> frictionless areal solve at 2048^2 by the constrained CG, 26.1 by the multigrid at
    !> 1024^2, 30.3 for a coupled one with GCR's history of 12; a line's multigrid 39, its
    !> coarse grids halving only one axis; a coupled line by the multigrid 60.5 at 2^20, a
-   !> coupled surface 53.1 at 2048^2 with friction and 64.4 sliding viscoelastic, whose grids
-   !> are halved along one axis, with the history of its truncated Newton GCR), plus the
-   !> in-plane fields of the stress observables.
+   !> coupled surface 53.1 at 2048^2 with friction and 54 sliding viscoelastic, 64.4 where
+   !> its grids are halved along one axis, with the history of its truncated Newton GCR),
+   !> plus the in-plane fields of the stress observables.
    pure integer(i8) function solve_bytes(points, coupled, memory, stress, multigrid, line) result(bytes)
       integer, intent(in) :: points
       !> friction or a moving viscoelastic law: the GCR (or Anderson) history; or a frictionless

@@ -143,26 +143,30 @@ def test_coupled_surfaces_agree_with_gcr(control):
     assert mg.penetration == pytest.approx(gcr.penetration, abs=(TOL + TOL_GCR) * np.ptp(h))
 
 
-def test_a_sliding_viscoelastic_surface_agrees_with_gcr():
-    """A standard linear solid (E_inf/E0 = 10) sliding with friction at V tau/lambda = 0.1:
-    GCR's fixed point to the bound of the two tolerances (the largest stiffness bounded by
-    the elastic layer's with E_inf: |J*| >= 1/E_inf), the same load and penetration. Its
-    modes are up to tenfold stiffer along the sliding direction than across it; the grids
-    halved along one axis keep the transform pairs near the elastic surface's."""
+@pytest.mark.parametrize("e_inf, speed, most_pairs", [(10.0, 0.1, 130), (100.0, 1.0, 250)], ids=["sls", "glassy"])
+def test_a_sliding_viscoelastic_surface_agrees_with_gcr(e_inf, speed, most_pairs):
+    """A standard linear solid (E_inf/E0 = 10 at V tau/lambda = 0.1; glassy, 100 at 1) sliding
+    with friction: GCR's fixed point to the bound of the two tolerances (the largest stiffness
+    bounded by the elastic layer's with E_inf: |J*| >= 1/E_inf), the same load and
+    penetration. Its modes are up to tenfold (a hundredfold) stiffer along the sliding
+    direction than across it; the V-cycle smoothing by rows keeps the transform pairs within
+    about twice the elastic surface's, where Jacobi steps took 135 and 732."""
+    material = lc.StandardLinearSolid(e0=1.0, e_inf=e_inf, tau=1.0)
     h = surface(128, 128)
-    kw = dict(thickness=0.16, poisson=0.5, friction=0.5, material=SLS, speed=0.1, mean_pressure=0.015 * E_STAR,
-              stress=False)
+    kw = dict(thickness=0.16, poisson=0.5, friction=0.5, material=material, speed=speed,
+              mean_pressure=0.015 * E_STAR, stress=False)
     gcr = lc.solve_areal(h, method="gcr", tol=TOL_GCR, **kw)
     mg = lc.solve_areal(h, method="multigrid", tol=TOL, **kw)
     assert gcr.converged and mg.converged and mg.solver == "multigrid"
-    assert 0.02 < mg.contact_fraction < 0.5
-    g = g_eff_grid(128, 128, 1.0, 1.0, 0.16, SLS.e_inf, 0.5, 0.5)
+    assert 0.005 < mg.contact_fraction < 0.5
+    g = g_eff_grid(128, 128, 1.0, 1.0, 0.16, e_inf, 0.5, 0.5)
     bound = (TOL + TOL_GCR) * np.ptp(h) / np.abs(g[g != 0]).min()
     assert np.abs(mg.pressure - gcr.pressure).max() <= bound
     assert mg.mean_pressure == pytest.approx(gcr.mean_pressure, rel=1e-8)
     assert mg.penetration == pytest.approx(gcr.penetration, abs=(TOL + TOL_GCR) * np.ptp(h))
-    # measured: 135 (GCR: 118 at this size; 409-775 at 2048^2, bench/scaling.py)
-    assert mg.fft_pairs <= 200, mg.fft_pairs
+    # measured: 89 and 151 (GCR: 118 and 129 at this size; 409-775 at 2048^2 on the first,
+    # bench/scaling.py)
+    assert mg.fft_pairs <= most_pairs, mg.fft_pairs
 
 
 @pytest.mark.parametrize("n", [4096, 65536])

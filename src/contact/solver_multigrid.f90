@@ -39,7 +39,7 @@
 !> axis (the operator's metric_falls, or nearly: allowed_rise), to symmetric (not coupled),
 !> elastic lines and surfaces: multigrid_refusal; coupled ones whose metric passes
 !> metric_refusal (a surface stiffer along one axis, a sliding viscoelastic layer, takes
-!> grids halved along one axis).
+!> grids halved along one axis, or smoothing by rows).
 module lc_contact_solver_multigrid
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
@@ -75,11 +75,11 @@ module lc_contact_solver_multigrid
    !> smoothing factor on the grids coarsening_shapes would choose exceeds this and the
    !> rows' (worst_row_smoothing) is at most accepted_smoothing: a layer sliding along x
    !> whose modulus changes with q_x V. Measured at 256^2 (h/lambda = 0.16, E_inf/E0 = 10 and
-   !> 100, V tau/lambda = 1e-3 .. 1e2; the rows' factor 0.55 on all): at Jacobi's 0.70-0.82
-   !> Jacobi steps took 61-180 transform pairs and rows 80-196, at 0.91-0.99 rows 70-469
-   !> where Jacobi steps took 89-913. Thin incompressible layers (Jacobi 0.87-0.99, rows
-   !> 0.79-0.93) keep Jacobi steps: frictionless at h/lambda = 0.01, 681 against 10896
-   !> (docs/decisions/015-row-smoothing.md).
+   !> 100, V tau/lambda = 1e-3 .. 1e2; the rows' factor 0.55 on all): where Jacobi's is
+   !> 0.70-0.82 Jacobi steps took 61-180 transform pairs and rows 76-167, where it is
+   !> 0.91-0.99 rows took 70-423 and Jacobi steps 89-913. Thin incompressible layers (Jacobi
+   !> 0.87-0.99, rows 0.79-0.93) keep Jacobi steps: frictionless at h/lambda = 0.01, 681
+   !> pairs where rows stalled (1439 with GCR finishing) (docs/decisions/015-row-smoothing.md).
    real(wp), parameter :: row_smoothing = 0.85_wp
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256

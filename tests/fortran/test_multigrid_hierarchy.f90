@@ -132,7 +132,7 @@ contains
    end subroutine check_galerkin
 
    !> A sliding layer's symbol K = E(kx) |q|, E(kx) = (1 + 100 i kx/nx)/(1 + i kx/nx) (a
-   !> standard linear solid, E_inf/E0 = 100; real part only if not complex) on an nx x ny
+   !> standard linear solid, E_inf/E0 = 100; |E| if not complex) on an nx x ny
    !> surface smoothed by rows: its grids halved along both axes, the rows' smoothing factor
    !> that of K ~ |q| (E cancels in K/K_row: 0.55 at most), and on every grid, for a field r
    !> on one row j, x = (C + s)^-1 r row by row lies on row j with (C x + s x) = r there,
