@@ -349,6 +349,22 @@ def test_auto_takes_the_multigrid_for_broadband_coupled_scenes():
     assert physical.converged and physical.solver == "gcr"
 
 
+def test_auto_takes_the_multigrid_for_a_sliding_viscoelastic_surface_from_512_squared():
+    """Method 'auto' sends a surface that the multigrid method smooths by rows (a standard
+    linear solid sliding at V tau/lambda = 0.1, whose Jacobi steps smooth poorly) to it from
+    512^2 when the coarse solve was hard (GCR takes 1.05-1.55x its time there); the same
+    surface on the elastic layer with friction stays on GCR below 1024^2, and so does the
+    slowest sliding (V tau/lambda = 0.01, Jacobi steps kept). Measured on the broadband
+    512^2 surface (shortest wavelength 8 points): 110 transform pairs (GCR: 236)."""
+    h = surface(512, 512)
+    kw = dict(thickness=0.16, poisson=0.5, friction=0.5, mean_pressure=0.015 * E_STAR, tol=1e-8, stress=False)
+    sliding = lc.solve_areal(h, material=SLS, speed=0.1, **kw)
+    assert sliding.converged and sliding.solver == "multigrid"
+    assert sliding.fft_pairs <= 130, sliding.fft_pairs
+    assert lc.solve_areal(h, **kw).solver == "gcr"
+    assert lc.solve_areal(h, material=SLS, speed=0.01, **kw).solver == "gcr"
+
+
 def test_auto_takes_the_multigrid_for_a_thin_incompressible_line_from_262144_points():
     """Method 'auto' sends the broadband thin incompressible line with friction to the
     multigrid method from 262144 points (where GCR takes 1.1-2.1x its time), and keeps GCR

@@ -23,7 +23,7 @@ module lc_contact_solve
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
    use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, &
-      & coupled_tnnmg, allowed_rise
+      & coupled_tnnmg, allowed_rise, smoothed_by_rows
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -70,6 +70,14 @@ module lc_contact_solve
    !> at 2048^2 with 16-28 coarse iterations, 0.9x with 9, and at 1024^2 1.3x with 18,
    !> 0.7-0.9x with 8-12.
    integer, parameter :: coupled_multigrid_points = 8192, coupled_multigrid_surface_points = 1024**2
+   !> A sliding viscoelastic surface that the multigrid method smooths by rows
+   !> (smoothed_by_rows) goes to it from this many points, on the same condition. At 512^2
+   !> GCR takes 1.05-1.55x its time on the standard linear solid (bench/scaling.py --scenes 4,
+   !> both families); on glassy layers (E_inf/E0 = 100) 'auto' took 9.6-18.5 s through GCR,
+   !> its history kept and the Anderson iteration at V tau/lambda = 0.01 and now takes
+   !> 1.8-2.4 s, 0.8-1.2 s and now 0.5 s at 0.1, 0.29-0.37 s and now 0.36-0.37 s at 1; at
+   !> 256^2 GCR takes 0.8-1.16x the multigrid's time (docs/decisions/015-row-smoothing.md).
+   integer, parameter :: rows_multigrid_surface_points = 512**2
    integer, parameter :: hard_coarse_iterations = 20, hard_coarse_surface_iterations = 12
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
    !> coupled_refusal) goes the same way from this many points, with friction or without
@@ -82,6 +90,21 @@ module lc_contact_solve
    integer, parameter :: rising_multigrid_points = 262144
 
 contains
+
+   !> The fewest points from which method 'auto' may take the multigrid method for a coupled
+   !> scene on `grid` (a hard coarse solve given): a line's, or a surface's, lower for one
+   !> smoothed by rows (`rows`: it may be, a sliding viscoelastic layer).
+   pure integer function coupled_threshold(grid, rows) result(points)
+      type(grid_type), intent(in) :: grid
+      logical, intent(in) :: rows
+      if (grid%is_line()) then
+         points = coupled_multigrid_points
+      else if (rows) then
+         points = rows_multigrid_surface_points
+      else
+         points = coupled_multigrid_surface_points
+      end if
+   end function coupled_threshold
 
    !> p_m of a load-controlled scene on profile `height` (S): the given one, or the
    !> normalised pressure times its scale (pressure_scale).
@@ -141,7 +164,7 @@ contains
       ! multigrid's coarse grids if the scene may go to it: refusals need the operator)
       if (kernel%coupled(friction)) then
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
-            & n >= merge(coupled_multigrid_points, coupled_multigrid_surface_points, grid%is_line()))
+            & n >= coupled_threshold(grid, kernel%viscoelastic))
       else
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
@@ -267,8 +290,11 @@ contains
       ! (a coupled scene, or a frictionless one whose compliance rises, where its coarse solve
       ! was hard: broadband roughness; a rising compliance from rising_multigrid_points)
       if (method == 'auto' .and. (op%coupled .or. rising) .and. coarse_hard .and. len(reason) == 0 .and. &
-         & grid%points() >= merge(coupled_multigrid_points, coupled_multigrid_surface_points, grid%is_line())) then
+         & grid%points() >= coupled_threshold(grid, .false.)) then
          if (len(metric_refusal(op)) == 0 .or. grid%points() >= rising_multigrid_points) method = 'multigrid'
+      else if (method == 'auto' .and. op%coupled .and. coarse_hard .and. len(reason) == 0 .and. &
+         & grid%points() >= coupled_threshold(grid, .true.)) then
+         if (smoothed_by_rows(op, load_control)) method = 'multigrid'
       end if
       call progress%begin_level(grid%nx, grid%ny)
       uniform = 0.0_wp

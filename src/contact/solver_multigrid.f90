@@ -51,10 +51,11 @@ module lc_contact_solver_multigrid
       & apply_stiffness, worst_row_smoothing, accepted_smoothing
    use lc_contact_solver_cg, only: complementarity_residual, rounding_floor, normalise
    use lc_contact_progress, only: progress_log
+   use lc_grid, only: grid_type
    implicit none (type, external)
    private
    public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
-   public :: allowed_rise
+   public :: allowed_rise, smoothed_by_rows
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -218,6 +219,29 @@ contains
             & 'nx, ny = mx 2^k, my 2^k with mx my <= ' // to_string(coarsest_limit)
       end if
    end function size_refusal
+
+   !> Whether the coupled method smooths the scene of `op` by rows (row_smoothing): a
+   !> surface sliding on a viscoelastic layer whose Jacobi steps smooth poorly.
+   logical function smoothed_by_rows(op, load_control) result(rows)
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
+      real(wp), allocatable :: symbol(:), odd(:)
+      logical :: complex_symbol
+      call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
+      rows = rows_smooth(op%grid, symbol, odd)
+   end function smoothed_by_rows
+
+   !> The rule of row_smoothing for the stiffness symbol (+ i odd) of a grid; `odd` not
+   !> allocated (so absent) for a real symbol.
+   logical function rows_smooth(grid, symbol, odd) result(rows)
+      type(grid_type), intent(in) :: grid
+      real(wp), contiguous, intent(in) :: symbol(:)
+      real(wp), contiguous, intent(in), optional :: odd(:)
+      rows = .false.
+      if (grid%is_line()) return
+      rows = worst_smoothing(grid%nx, grid%ny, symbol, odd) > row_smoothing .and. &
+         & worst_row_smoothing(grid%nx, grid%ny, symbol, odd) <= accepted_smoothing
+   end function rows_smooth
 
    !> The stiffness symbol the coupled method's hierarchy is built on (half spectrum of the
    !> grid): K = 1/G_eff itself (symbol + i odd) where its loss lies at long waves
@@ -440,12 +464,9 @@ contains
 
       n = size(p)
       call op%prepare_gcr()
-      ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows; `odd`
-      ! is not allocated, so absent, for a real symbol)
+      ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows)
       call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
-      rows = .false.
-      if (.not. op%grid%is_line()) rows = worst_smoothing(op%grid%nx, op%grid%ny, symbol, odd) > row_smoothing &
-         & .and. worst_row_smoothing(op%grid%nx, op%grid%ny, symbol, odd) <= accepted_smoothing
+      rows = rows_smooth(op%grid, symbol, odd)
       if (complex_symbol) then
          call build_hierarchy(h, op, error, symbol, odd, rows=rows)
          if (allocated(error)) return
