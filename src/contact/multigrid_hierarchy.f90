@@ -11,7 +11,10 @@
 !> depend on the contact set) plus a 3-point (line) or 9-point (surface) stencil rebuilt in
 !> O(n) when the set changes. The penalty stands in for the truncated Galerkin operator
 !> P^T I K I P, whose application would cost a transform of the finest grid. Damped Jacobi
-!> smoothing; a dense Cholesky solve on the coarsest grid (at most coarsest_limit points).
+!> smoothing, or on a surface sliding on a viscoelastic layer smoothing by rows (solve_rows:
+!> each row's part of the operator solved by transforms of the rows, on grids halved along
+!> both axes; in B the masked row step in place of the Jacobi step); a dense Cholesky solve
+!> on the coarsest grid (at most coarsest_limit points).
 !> K is real and even (a symmetric stiffness: the operator's metric inverted), or complex
 !> (the non-symmetric stiffness 1/G_eff of a coupled scene, whose imaginary part is odd),
 !> with an LU factor of the coarsest operator in place of Cholesky's; the solvers
@@ -114,7 +117,8 @@ module lc_contact_multigrid_hierarchy
       real(wp), allocatable :: jacobi(:)
       !> row smoothing (hierarchy%rows): K_row(kx), the mean of the symbol over ky; its
       !> inverse with the 1/nx of the rows' unscaled transform folded in; and per row the
-      !> mean of the penalty's diagonal over the row (coarse grids), added to K_row
+      !> shift added to K_row (coarse grids: row_shift_weight times the mean of the
+      !> penalty's diagonal over the row)
       complex(wp), allocatable :: row_symbol(:), row_inverse(:)
       real(wp), allocatable :: row_shift(:)
       real(wp), allocatable :: rhs(:), x(:), residual(:)
@@ -330,7 +334,9 @@ contains
    !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse correction
    !> added (not one after the other: no transform on the grid being solved; symmetric, as CG
    !> needs), V the V-cycle of the next grid; the dense solve where the grid being solved is
-   !> the coarsest. r is zero on the contact set, and so is z.
+   !> the coarsest. Smoothing by rows, the row step omega I K_row^-1 I in place of the Jacobi
+   !> step (the rows' transforms on the grid being solved). r is zero on the contact set, and
+   !> so is z.
    subroutine precondition(h, r, z)
       type(hierarchy), intent(inout) :: h
       real(wp), contiguous, intent(in) :: r(:)

@@ -68,16 +68,7 @@ contains
       integer :: kx, ky, sy, nkx, i, t
       real(wp) :: worst
 
-      if (ny == 1) then
-         op%grid = line_grid(nx, 1.0_wp)
-      else
-         op%grid = surface_grid(nx, ny, 1.0_wp, 1.0_wp)
-      end if
-      call op%fft%init(nx, ny, 1, error)
-      if (allocated(error)) then
-         call check(.false., what // ': ' // error%message)
-         return
-      end if
+      if (.not. planned(what, op, nx, ny)) return
       nkx = nx/2 + 1
       allocate (symbol(nkx*ny), odd(nkx*ny))
       do ky = 0, ny - 1
@@ -150,12 +141,7 @@ contains
       real(wp) :: worst, off_row, shift
       logical :: full
 
-      op%grid = surface_grid(nx, ny, 1.0_wp, 1.0_wp)
-      call op%fft%init(nx, ny, 1, error)
-      if (allocated(error)) then
-         call check(.false., what // ': ' // error%message)
-         return
-      end if
+      if (.not. planned(what, op, nx, ny)) return
       nkx = nx/2 + 1
       allocate (symbol(nkx*ny), odd(nkx*ny))
       do ky = 0, ny - 1
@@ -212,6 +198,23 @@ contains
       call check(off_row == 0.0_wp, what // ': the row solve stays on its row')
       call check(worst <= tol_identity, what // ': (C + s) x = r on the row, every grid')
    end subroutine check_rows
+
+   !> op on a line (ny = 1) or surface of unit period with its plans; false (a failed
+   !> check) if FFTW could not plan it.
+   logical function planned(what, op, nx, ny)
+      character(len=*), intent(in) :: what
+      type(compliance_operator), intent(inout) :: op
+      integer, intent(in) :: nx, ny
+      type(error_type), allocatable :: error
+      if (ny == 1) then
+         op%grid = line_grid(nx, 1.0_wp)
+      else
+         op%grid = surface_grid(nx, ny, 1.0_wp, 1.0_wp)
+      end if
+      call op%fft%init(nx, ny, 1, error)
+      planned = .not. allocated(error)
+      if (.not. planned) call check(.false., what // ': ' // error%message)
+   end function planned
 
    pure function fmt(x) result(text)
       real(wp), intent(in) :: x
