@@ -169,6 +169,19 @@ def test_a_sliding_viscoelastic_surface_agrees_with_gcr(e_inf, speed, most_pairs
     assert mg.fft_pairs <= most_pairs, mg.fft_pairs
 
 
+def test_an_elongated_sliding_surface_keeps_the_jacobi_steps():
+    """On a grid with more than twice as many points along the sliding direction as across
+    it (512 x 128, period 1 x 0.25) smoothing by rows stalls (38120 transform pairs); the
+    standard linear solid there keeps the Jacobi steps on grids halved along one axis:
+    measured 76 pairs (tol 1e-8), against 200 for GCR."""
+    h = lc.self_affine_surface(nx=512, ny=128, period=(1.0, 0.25), hurst=0.8, seed=1, short_wavelength=8 / 512,
+                               rms_gradient=0.1)
+    res = lc.solve_areal(h, method="multigrid", thickness=0.16, poisson=0.5, friction=0.5, material=SLS, speed=0.1,
+                         mean_pressure=0.015 * E_STAR, tol=1e-8, stress=False)
+    assert res.converged and res.solver == "multigrid"
+    assert res.fft_pairs <= 120, res.fft_pairs
+
+
 @pytest.mark.parametrize("n", [4096, 65536])
 @pytest.mark.parametrize("friction, reference, tol_reference", [(0.0, "cg", TOL_CG), (1.5, "gcr", TOL_GCR)],
                          ids=["frictionless", "friction"])

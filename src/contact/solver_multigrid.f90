@@ -80,7 +80,12 @@ module lc_contact_solver_multigrid
    !> 0.70-0.82 Jacobi steps took 61-180 transform pairs and rows 76-167, where it is
    !> 0.91-0.99 rows took 70-423 and Jacobi steps 89-913. Thin incompressible layers (Jacobi
    !> 0.87-0.99, rows 0.79-0.93) keep Jacobi steps: frictionless at h/lambda = 0.01, 681
-   !> pairs where rows stalled (1439 with GCR finishing) (docs/decisions/015-row-smoothing.md).
+   !> pairs where rows stalled (1439 with GCR finishing). Grids with more than twice as many
+   !> points along x as along y keep Jacobi steps too: the standard linear solid at
+   !> V tau/lambda = 0.1 on 512 x 128 points took 38120 pairs smoothed by rows (91 with
+   !> Jacobi steps), on 384 x 128 199, on 512 x 192 213, where up to twice as many points
+   !> along x (512 x 256, 256 x 128, 128 x 256) took 89-110 (Jacobi steps 100-166)
+   !> (docs/decisions/015-row-smoothing.md).
    real(wp), parameter :: row_smoothing = 0.85_wp
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256
@@ -238,7 +243,8 @@ contains
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
       rows = .false.
-      if (grid%is_line()) return
+      ! (rows of more than twice as many points as there are rows: see row_smoothing)
+      if (grid%is_line() .or. grid%nx > 2*grid%ny) return
       rows = worst_smoothing(grid%nx, grid%ny, symbol, odd) > row_smoothing .and. &
          & worst_row_smoothing(grid%nx, grid%ny, symbol, odd) <= accepted_smoothing
    end function rows_smooth
