@@ -73,11 +73,9 @@ module lc_contact_solve
    !> A sliding viscoelastic surface that the multigrid method smooths by rows
    !> (smoothed_by_rows) goes to it from this many points, on the same condition. At 512^2
    !> GCR takes 1.05-1.55x its time on the standard linear solid (bench/scaling.py --scenes 4,
-   !> both families); on glassy layers (E_inf/E0 = 100) GCR, with its history kept and then
-   !> the Anderson iteration, takes 9.6-18.5 s against its 1.8-2.4 s at V tau/lambda = 0.01,
-   !> 0.8-1.2 s against 0.5 s at 0.1, 0.29-0.37 s against 0.36-0.37 s at 1; at 256^2 GCR
-   !> takes 0.8-1.16x its time on the standard linear solid
-   !> (docs/decisions/015-row-smoothing.md).
+   !> both families); on glassy layers (E_inf/E0 = 100) 0.8-1.2 s against 0.47-0.54 s at
+   !> V tau/lambda = 0.1, 0.29-0.37 s against 0.37-0.41 s at 1; at 256^2 GCR takes
+   !> 0.8-1.16x its time on the standard linear solid (docs/decisions/015-row-smoothing.md).
    integer, parameter :: rows_multigrid_surface_points = 512**2
    integer, parameter :: hard_coarse_iterations = 20, hard_coarse_surface_iterations = 12
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by

@@ -78,9 +78,14 @@ module lc_contact_solver_multigrid
    !> whose modulus changes with q_x V. Measured at 256^2 (h/lambda = 0.16, E_inf/E0 = 10 and
    !> 100, V tau/lambda = 1e-3 .. 1e2; the rows' factor 0.55 on all): where Jacobi's is
    !> 0.70-0.82 Jacobi steps took 61-180 transform pairs and rows 76-167, where it is
-   !> 0.91-0.99 rows took 70-423 and Jacobi steps 89-913. Thin incompressible layers (Jacobi
+   !> 0.91-0.99 rows took 70-305 and Jacobi steps 89-742. Thin incompressible layers (Jacobi
    !> 0.87-0.99, rows 0.79-0.93) keep Jacobi steps: frictionless at h/lambda = 0.01, 681
-   !> pairs where rows stalled (1439 with GCR finishing). Grids with more than twice as many
+   !> pairs where rows stalled (1439 with GCR finishing). Only K's own hierarchy is smoothed
+   !> by rows: on the metric's, the rows miss the phase of K (a glassy layer, E_inf/E0 =
+   !> 100, V tau/lambda = 1, on a compressible layer with friction, nu = 0.3: 16116-48560
+   !> pairs where its Jacobi steps took 541-683), and building K's where its loss lies
+   !> among the short waves stalled the glassy layer near its loss peak (V tau/lambda =
+   !> 0.01, 512^2: 10208 pairs). Grids with more than twice as many
    !> points along x as along y keep Jacobi steps too: the standard linear solid at
    !> V tau/lambda = 0.1 on 512 x 128 points took 38120 pairs smoothed by rows (91 with
    !> Jacobi steps), on 384 x 128 199, on 512 x 192 213, where up to twice as many points
@@ -233,7 +238,7 @@ contains
       real(wp), allocatable :: symbol(:), odd(:)
       logical :: complex_symbol
       call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
-      rows = rows_smooth(op%grid, symbol, odd)
+      rows = complex_symbol .and. rows_smooth(op%grid, symbol, odd)
    end function smoothed_by_rows
 
    !> The rule of row_smoothing for the stiffness symbol (+ i odd) of a grid; `odd` not
@@ -251,7 +256,8 @@ contains
 
    !> The stiffness symbol the coupled method's hierarchy is built on (half spectrum of the
    !> grid): K = 1/G_eff itself (symbol + i odd) where its loss lies at long waves
-   !> (loss_at_long_waves), else the metric's 1/|G_eff| (level_symbol).
+   !> (loss_at_long_waves), else the metric's 1/|G_eff| (level_symbol), which is never
+   !> smoothed by rows (see row_smoothing).
    subroutine coupled_symbol(op, load_control, symbol, odd, complex_symbol)
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
@@ -472,7 +478,7 @@ contains
       call op%prepare_gcr()
       ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows)
       call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
-      rows = rows_smooth(op%grid, symbol, odd)
+      rows = complex_symbol .and. rows_smooth(op%grid, symbol, odd)
       if (complex_symbol) then
          call build_hierarchy(h, op, error, symbol, odd, rows=rows)
          if (allocated(error)) return
