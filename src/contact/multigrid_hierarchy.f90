@@ -261,33 +261,40 @@ contains
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
       real(wp) :: worst
-      complex(wp), allocatable :: stiffness(:, :)
       complex(wp) :: row   !< the sum of a column, then 1/K_row
-      integer :: t, mx, my, kx, ky, sy, i
+      integer :: t, mx, my, kx, ky
       worst = 0.0_wp
+      ! (each column read twice, for its sum and for the factors, rather than stored)
       do t = 0, halvings(nx, ny, coarsest_points) - 1
          mx = nx/2**t
          my = ny/2**t
-         allocate (stiffness(0:mx/2, 0:my - 1))
-         do ky = 0, my - 1
-            sy = merge(ky, ky - my, 2*ky <= my)
-            do kx = 0, mx/2
-               i = mode_index(nx, ny, kx, sy)
-               stiffness(kx, ky) = symbol(i)
-               if (present(odd)) stiffness(kx, ky) = cmplx(symbol(i), odd(i), kind=wp)
-            end do
-         end do
          do kx = 0, mx/2
-            row = sum(stiffness(kx, :))
+            row = 0.0_wp
+            do ky = 0, my - 1
+               row = row + stiffness_at(kx, ky)
+            end do
             if (abs(row) == 0.0_wp) cycle
             row = my*inverse(row)
             do ky = 0, my - 1
-               sy = merge(ky, ky - my, 2*ky <= my)
-               if (4*kx > mx .or. 4*abs(sy) > my) worst = max(worst, abs(1.0_wp - omega*stiffness(kx, ky)*row))
+               if (4*kx > mx .or. 4*abs(signed(ky)) > my) &
+                  & worst = max(worst, abs(1.0_wp - omega*stiffness_at(kx, ky)*row))
             end do
          end do
-         deallocate (stiffness)
       end do
+   contains
+      !> the finest symbol at the mode (kx, ky) of the current grid
+      pure complex(wp) function stiffness_at(kx, ky) result(k)
+         integer, intent(in) :: kx, ky
+         integer :: i
+         i = mode_index(nx, ny, kx, signed(ky))
+         k = symbol(i)
+         if (present(odd)) k = cmplx(symbol(i), odd(i), kind=wp)
+      end function stiffness_at
+
+      pure integer function signed(ky)
+         integer, intent(in) :: ky
+         signed = merge(ky, ky - my, 2*ky <= my)
+      end function signed
    end function worst_row_smoothing
 
    !> The smoothing factors of the damped Jacobi step (its diagonal as set_grid takes it, with
