@@ -55,7 +55,7 @@ module lc_contact_solver_multigrid
    implicit none (type, external)
    private
    public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
-   public :: allowed_rise, smoothed_by_rows
+   public :: allowed_rise, long_wave_rows
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -83,15 +83,27 @@ module lc_contact_solver_multigrid
    !> pairs where rows stalled (1439 with GCR finishing). Only K's own hierarchy is smoothed
    !> by rows: on the metric's, the rows miss the phase of K (a glassy layer, E_inf/E0 =
    !> 100, V tau/lambda = 1, on a compressible layer with friction, nu = 0.3: 16116-48560
-   !> pairs where its Jacobi steps took 541-683), and building K's where its loss lies
-   !> among the short waves stalled the glassy layer near its loss peak (V tau/lambda =
-   !> 0.01, 512^2: 10208 pairs). Grids with more than twice as many
+   !> pairs where its Jacobi steps took 541-683); see short_loss_limit for where K's
+   !> hierarchy is built for the rows. Grids with more than twice as many
    !> points along x as along y keep Jacobi steps too: the standard linear solid at
    !> V tau/lambda = 0.1 on 512 x 128 points took 38120 pairs smoothed by rows (91 with
    !> Jacobi steps), on 384 x 128 199, on 512 x 192 213, where up to twice as many points
    !> along x (512 x 256, 256 x 128, 128 x 256) took 89-110 (Jacobi steps 100-166)
    !> (docs/decisions/015-row-smoothing.md).
    real(wp), parameter :: row_smoothing = 0.85_wp
+   !> A coupled surface whose loss is not largest at long waves (loss_at_long_waves) builds
+   !> K's own hierarchy, smoothed by rows, where its loss among the waves short along x
+   !> (short_wave_loss) is at most this and rows_smooth holds, else the metric's with Jacobi
+   !> steps. Measured to tol 1e-8 (h/lambda = 0.16, nu = 0.5, mu_c = 0 and 0.5, 512^2, both
+   !> roughness families): the standard linear solid E_inf/E0 = 10 (largest loss 1.42) at
+   !> V tau/lambda = 1e-3 and 1e-2 took 76-106 transform pairs where Jacobi steps took
+   !> 109-185; E_inf/E0 = 100 at 1e-3 (its loss peak beyond the grid) 85-95 against 139-157;
+   !> compressible layers with friction (nu = 0.3, glassy at V tau/lambda = 1, whose loss is
+   !> largest at long waves along x and short ones across) 96-168 at 256^2 against 541-683;
+   !> E_inf/E0 = 30 (2.65) at 1e-2 339-362 against 368-404; but E_inf/E0 = 100 (4.95) with
+   !> its peak among the short waves, at 1e-2 and 3e-2, 1603-10208 against 758-1667
+   !> (docs/decisions/015-row-smoothing.md).
+   real(wp), parameter :: short_loss_limit = 3.0_wp
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256
    !> The inexact Newton solve: at most this many CG iterations, or a residual reduced by
@@ -179,12 +191,12 @@ contains
       character(len=:), allocatable :: reason
       real(wp), allocatable :: symbol(:), odd(:)
       real(wp) :: worst
-      logical :: complex_symbol
+      logical :: complex_symbol, rows
       reason = size_refusal(op)
       if (len(reason) > 0) return
       reason = rise_refusal(op)
       if (len(reason) == 0) return
-      call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
+      call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
       if (complex_symbol) then
          worst = worst_smoothing(op%grid%nx, op%grid%ny, symbol, odd)
       else
@@ -230,16 +242,18 @@ contains
       end if
    end function size_refusal
 
-   !> Whether the coupled method smooths the scene of `op` by rows (row_smoothing): a
-   !> surface sliding on a viscoelastic layer whose Jacobi steps smooth poorly.
-   logical function smoothed_by_rows(op, load_control) result(rows)
+   !> Whether the coupled method smooths the scene of `op` by rows (row_smoothing) where the
+   !> loss of K lies at long waves (loss_at_long_waves): a surface sliding on a viscoelastic
+   !> layer near its loss peak, whose Jacobi steps smooth poorly. (Slower sliding, smoothed
+   !> by rows for its moderate loss among the short waves, short_loss_limit, is not one.)
+   logical function long_wave_rows(op, load_control) result(rows)
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
       real(wp), allocatable :: symbol(:), odd(:)
       logical :: complex_symbol
-      call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
-      rows = complex_symbol .and. rows_smooth(op%grid, symbol, odd)
-   end function smoothed_by_rows
+      rows = .false.
+      if (loss_at_long_waves(op)) call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+   end function long_wave_rows
 
    !> The rule of row_smoothing for the stiffness symbol (+ i odd) of a grid; `odd` not
    !> allocated (so absent) for a real symbol.
@@ -256,15 +270,22 @@ contains
 
    !> The stiffness symbol the coupled method's hierarchy is built on (half spectrum of the
    !> grid): K = 1/G_eff itself (symbol + i odd) where its loss lies at long waves
-   !> (loss_at_long_waves), else the metric's 1/|G_eff| (level_symbol), which is never
-   !> smoothed by rows (see row_smoothing).
-   subroutine coupled_symbol(op, load_control, symbol, odd, complex_symbol)
+   !> (loss_at_long_waves), or where the loss among the waves short along x is at most
+   !> short_loss_limit and the grid is smoothed by rows (rows_smooth); else the metric's
+   !> 1/|G_eff| (level_symbol), which is never smoothed by rows (see row_smoothing).
+   !> rows: whether the grid is smoothed by rows.
+   subroutine coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
       real(wp), allocatable, intent(out) :: symbol(:), odd(:)
-      logical, intent(out) :: complex_symbol
+      logical, intent(out) :: complex_symbol, rows
       complex(wp), allocatable :: stiffness(:)
-      complex_symbol = loss_at_long_waves(op)
+      logical :: long
+      long = loss_at_long_waves(op)
+      complex_symbol = long
+      if (.not. long .and. op%coupled .and. .not. op%grid%is_line()) &
+         & complex_symbol = short_wave_loss(op) <= short_loss_limit
+      rows = .false.
       if (complex_symbol) then
          allocate (stiffness(op%nk))
          where (abs(op%full) > 0.0_wp)
@@ -274,9 +295,13 @@ contains
          end where
          symbol = real(stiffness)
          odd = aimag(stiffness)
-      else
-         symbol = level_symbol(op, load_control, op%grid%nx, op%grid%ny)
+         rows = rows_smooth(op%grid, symbol, odd)
+         ! (a loss among the short waves: K's hierarchy only where it is smoothed by rows)
+         complex_symbol = long .or. rows
+         if (complex_symbol) return
+         deallocate (symbol, odd)
       end if
+      symbol = level_symbol(op, load_control, op%grid%nx, op%grid%ny)
    end subroutine coupled_symbol
 
    !> TNNMG iterations on the finest grid from u until the fields returned (p, w, gap, s;
@@ -477,8 +502,7 @@ contains
       n = size(p)
       call op%prepare_gcr()
       ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows)
-      call coupled_symbol(op, load_control, symbol, odd, complex_symbol)
-      rows = complex_symbol .and. rows_smooth(op%grid, symbol, odd)
+      call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
       if (complex_symbol) then
          call build_hierarchy(h, op, error, symbol, odd, rows=rows)
          if (allocated(error)) return
@@ -676,7 +700,8 @@ contains
    !> loss peak V q tau ~ 1) at long waves, |kx| <= nx/16 (and |ky| <= ny/16 on a surface),
    !> which the coarse grids carry. A
    !> loss peak among the short waves (a slow glassy layer on a fine grid) is left to the
-   !> metric's hierarchy, whose Jacobi steps damp those modes better: E_inf/E0 = 100 at
+   !> metric's hierarchy (on a surface, unless it is moderate: short_loss_limit), whose
+   !> Jacobi steps damp those modes better: E_inf/E0 = 100 at
    !> V tau/lambda = 1e-4, n = 65536, 542 against 1004 pairs (docs/decisions/012-coupled-multigrid.md).
    pure logical function loss_at_long_waves(op) result(long)
       type(compliance_operator), intent(in) :: op
@@ -702,6 +727,20 @@ contains
       end do
       long = largest > 0.0_wp .and. largest_long >= (1.0_wp - 1.0e-9_wp)*largest
    end function loss_at_long_waves
+
+   !> The largest loss |Im K|/Re K (= |Im G_eff|/Re G_eff) of the coupled scene of `op` over
+   !> the waves short along x, |kx| > nx/16, at any ky: a sliding layer's loss depends on kx
+   !> alone (a standard linear solid's peaks at (E_inf/E0 - 1)/(2 sqrt(E_inf/E0))).
+   pure real(wp) function short_wave_loss(op) result(largest)
+      type(compliance_operator), intent(in) :: op
+      integer :: i, nkx
+      largest = 0.0_wp
+      nkx = op%grid%nx/2 + 1
+      do i = 2, op%nk
+         if (16*mod(i - 1, nkx) <= op%grid%nx .or. .not. real(op%full(i)) > 0.0_wp) cycle
+         largest = max(largest, abs(aimag(op%full(i)))/real(op%full(i)))
+      end do
+   end function short_wave_loss
 
    !> TNNMG iterations on the grid h%top from u until the residual on (K u + f, u - o) is at
    !> most tol or max_steps ran; p = K u + f on exit. steps: iterations run. history and
