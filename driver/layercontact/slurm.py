@@ -477,14 +477,21 @@ write_record() {{
 
 # Time limit, scancel, node shutdown: Slurm sends SIGTERM (SIGKILL after KillWait). Record
 # which scene was cut short; the scenes after it stay without a record (missing).
-current="" child="" started="" start_ms=0
+# The same signal may reach the program first: then `wait` returns its status before the
+# trap runs, and the scene (still current until its record is written) is recorded here by
+# that status.
+current="" child="" code="" started="" start_ms=0
 on_signal() {{
   [ -n "$child" ] && kill -TERM "$child" 2>/dev/null
   if [ -n "$current" ]; then
     seconds_since "$start_ms"
     local wall=$REPLY
     now
-    write_record "$current" killed $(( 128 + $2 )) "$started" "$REPLY" "$wall"
+    if [ -z "$child" ] && [ -n "$code" ] && [ "$code" -lt 128 ]; then
+      write_record "$current" finished "$code" "$started" "$REPLY" "$wall"
+    else
+      write_record "$current" killed $(( 128 + $2 )) "$started" "$REPLY" "$wall"
+    fi
   fi
   echo "layercontact sweep: task ${{SLURM_ARRAY_TASK_ID:-?}} stopped by SIG$1 during ${{current:-no scene}}"
   exit $(( 128 + $2 ))
@@ -507,7 +514,7 @@ for scene in "${{scenes[@]}}"; do
   started=$REPLY
   milliseconds
   start_ms=$REPLY
-  current=$scene
+  current=$scene code=""
   write_record "$scene" running "" "$started" "" ""
   # temporary result files that a killed run of this scene left (this task alone runs it)
   rm -f "$sweep_directory/results/$scene".h5.*tmp
@@ -516,11 +523,12 @@ for scene in "${{scenes[@]}}"; do
   child=$!
   wait "$child"
   code=$?
-  child="" current=""
+  child=""
   seconds_since "$start_ms"
   wall=$REPLY
   now
   write_record "$scene" finished "$code" "$started" "$REPLY" "$wall"
+  current=""
   echo "$scene: exit $code on $host"
   [ "$code" -eq 0 ] || failures=$(( failures + 1 ))
 done
