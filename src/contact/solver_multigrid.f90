@@ -264,8 +264,10 @@ contains
       rows = .false.
       ! (rows of more than twice as many points as there are rows: see row_smoothing)
       if (grid%is_line() .or. grid%nx > 2*grid%ny) return
-      rows = worst_smoothing(grid%nx, grid%ny, symbol, odd) > row_smoothing .and. &
-         & worst_row_smoothing(grid%nx, grid%ny, symbol, odd) <= accepted_smoothing
+      ! (the rows' factor only where the Jacobi steps smooth poorly: an elastic surface with
+      ! friction is decided by the cheaper one)
+      if (worst_smoothing(grid%nx, grid%ny, symbol, odd) <= row_smoothing) return
+      rows = worst_row_smoothing(grid%nx, grid%ny, symbol, odd) <= accepted_smoothing
    end function rows_smooth
 
    !> The stiffness symbol the coupled method's hierarchy is built on (half spectrum of the
