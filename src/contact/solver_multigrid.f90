@@ -83,8 +83,8 @@ module lc_contact_solver_multigrid
    !> pairs where rows stalled (1439 with GCR finishing). Rows are taken on K's own
    !> hierarchy; on the metric's they miss the phase of K (a glassy layer, E_inf/E0 = 100,
    !> V tau/lambda = 1, on a compressible layer with friction, nu = 0.3: 16116-48560 pairs
-   !> where its Jacobi steps took 541-683), except for a large loss peaking in the grid's
-   !> top band: see short_loss_limit. Grids with more than twice as many
+   !> where its Jacobi steps took 541-683), except for a large loss peaking at the grid's
+   !> edge or in its top band: see short_loss_limit. Grids with more than twice as many
    !> points along x as along y keep Jacobi steps too: the standard linear solid at
    !> V tau/lambda = 0.1 on 512 x 128 points took 38120 pairs smoothed by rows (91 with
    !> Jacobi steps), on 384 x 128 199, on 512 x 192 213, where up to twice as many points
@@ -103,16 +103,23 @@ module lc_contact_solver_multigrid
    !> E_inf/E0 = 30 (2.65) at 1e-2 339-362 against 368-404; but E_inf/E0 = 100 (4.95) with
    !> its peak among the short waves, at 1e-2 and 3e-2, 1603-10208 against 758-1667.
    !> A larger loss is smoothed by rows on the metric's hierarchy where the largest loss
-   !> lies in the grid's top band, |kx| > nx/4 (modes no coarser grid carries), or beyond
-   !> the grid, and by Jacobi steps where it lies at middle waves: E_inf/E0 = 100 to 1000 at
-   !> V tau/lambda = 3e-3 to 3e-2, nu = 0.3 and 0.5, h/lambda = 0.05 to the half-space,
-   !> mu_c = 0 and 0.5, 256^2 and 512^2 (192 solves): 93-1917 pairs where Jacobi steps took
-   !> 93-12273 (1-6.4x fewer, none more); E_inf/E0 = 1000 at 0.1, whose peak lies at
-   !> middle waves on the grid solved but in the top band of its coarse start, took
-   !> 0.85-1.9x the Jacobi steps' pairs (one solve 13354 where 6908). With the peak at middle waves, rows on the metric's
+   !> lies at the grid's edge or beyond it, or in its top band, |kx| > nx/4 (modes no
+   !> coarser grid carries), up to top_band_loss; elsewhere (middle waves) by Jacobi steps.
+   !> E_inf/E0 = 100 to 1000 at V tau/lambda = 3e-3 to 0.1, nu = 0.3 and 0.5, mu_c = 0 and
+   !> 0.5 (h/lambda = 0.05 to the half-space at 256^2, 0.16 at 512^2): at 512^2 never more
+   !> pairs than the Jacobi steps and up to 9.4x fewer (E_inf/E0 = 100 at 0.01: 619-873
+   !> where 683-1666; 300 at 0.01: 605-1422 where 1133-3818; 1000 at 0.01: 1407-1994 where
+   !> 1440-14959); at 256^2 up to 3.5x fewer, and up to 15 % more on E_inf/E0 = 1000 at
+   !> 0.1 (6068-19356 pairs either way). With the peak at middle waves rows on the metric's
    !> stalled (E_inf/E0 = 100 at 3e-2, 512^2: 8414-8827 pairs, Jacobi steps 748-764)
    !> (docs/decisions/015-row-smoothing.md).
    real(wp), parameter :: short_loss_limit = 3.0_wp
+   !> ... and a larger loss peaking in the grid's top band, short of its edge, is smoothed by
+   !> rows on the metric's hierarchy only up to this loss: at 1024^2 a peak there with the
+   !> loss 8.6 (E_inf/E0 = 300 at V tau/lambda = 0.01) took 22439 pairs by rows where the
+   !> Jacobi steps took 4555, and 15.8 (1000) stalled; 4.95 (100 at 0.01, 512^2) took
+   !> 619-873 where 683-1666.
+   real(wp), parameter :: top_band_loss = 5.0_wp
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256
    !> The inexact Newton solve: at most this many CG iterations, or a residual reduced by
@@ -283,9 +290,9 @@ contains
    !> grid): K = 1/G_eff itself (symbol + i odd) where its loss lies at long waves
    !> (loss_at_long_waves), or where the loss among the waves short along x is at most
    !> short_loss_limit and the grid is smoothed by rows (rows_smooth); else the metric's
-   !> 1/|G_eff| (level_symbol), smoothed by rows only for a larger loss peaking in the
-   !> grid's top band or beyond it (see short_loss_limit). rows: whether the grid is
-   !> smoothed by rows.
+   !> 1/|G_eff| (level_symbol), smoothed by rows only for a larger loss peaking at the
+   !> grid's edge or in its top band (see short_loss_limit, top_band_loss). rows: whether
+   !> the grid is smoothed by rows.
    subroutine coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
@@ -320,8 +327,12 @@ contains
          deallocate (symbol, odd)
       end if
       symbol = level_symbol(op, load_control, op%grid%nx, op%grid%ny)
-      ! (a large loss peaking among the modes no coarser grid carries, or beyond the grid)
-      if (large .and. 4*peak > op%grid%nx) rows = rows_smooth(op%grid, symbol)
+      ! (a large loss peaking at the grid's edge or beyond it, or, if at most top_band_loss,
+      ! among the other modes no coarser grid carries)
+      if (large) then
+         if (2*(peak + 1) >= op%grid%nx .or. (4*peak > op%grid%nx .and. short_loss <= top_band_loss)) &
+            & rows = rows_smooth(op%grid, symbol)
+      end if
    end subroutine coupled_symbol
 
    !> TNNMG iterations on the finest grid from u until the fields returned (p, w, gap, s;
