@@ -255,8 +255,9 @@ def solve_line(
     across clips and then with Anderson if GCR stalls; a coupled line of 8192 points or
     more whose coarse-start solve needed more than 20 GCR iterations (a thin incompressible
     one: 262144 points or more), and a coupled surface of 1024² or more (512² for a sliding
-    viscoelastic one that the multigrid method smooths by rows for its loss at long waves)
-    whose coarse solve needed more than 12, i.e. broadband roughness, go to
+    viscoelastic one that the multigrid method smooths by rows for its loss at long waves
+    or its large loss among the short waves) whose coarse solve needed more than 12, i.e.
+    broadband roughness, go to
     ``'multigrid'`` below where that applies; grids of at most
     2048 points that stall are finished by the dense Newton method), ``'cg'``, ``'gcr'``,
     ``'anderson'``, ``'gfmd'``, ``'newton'`` (dense semismooth Newton, grids of at most 2048

@@ -23,7 +23,7 @@ module lc_contact_solve
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
    use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, &
-      & coupled_tnnmg, allowed_rise, long_wave_rows
+      & coupled_tnnmg, allowed_rise, rows_ahead_of_gcr
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -70,15 +70,17 @@ module lc_contact_solve
    !> at 2048^2 with 16-28 coarse iterations, 0.9x with 9, and at 1024^2 1.3x with 18,
    !> 0.7-0.9x with 8-12.
    integer, parameter :: coupled_multigrid_points = 8192, coupled_multigrid_surface_points = 1024**2
-   !> A sliding viscoelastic surface that the multigrid method smooths by rows for its loss
-   !> at long waves (long_wave_rows) goes to it from this many points, on the same
-   !> condition. At 512^2 GCR takes 1.05-1.55x its time on the standard linear solid
-   !> (bench/scaling.py --scenes 4, both families); on glassy layers (E_inf/E0 = 100)
-   !> 0.8-1.2 s against 0.47-0.54 s at V tau/lambda = 0.1, 0.29-0.37 s against 0.37-0.41 s
-   !> at 1; at 256^2 GCR takes 0.8-1.16x its time on the standard linear solid. Slower
-   !> sliding, smoothed by rows for a moderate loss among the short waves, waits for
-   !> 1024^2: at 512^2 GCR took 0.5-1.6x its time (E_inf/E0 = 10, V tau/lambda = 0.01)
-   !> (docs/decisions/015-row-smoothing.md).
+   !> A sliding viscoelastic surface that the multigrid method smooths by rows where GCR is
+   !> slow (rows_ahead_of_gcr) goes to it from this many points, on the same condition. At
+   !> 512^2 GCR takes 1.05-1.55x its time on the standard linear solid (bench/scaling.py
+   !> --scenes 4, both families); on glassy layers (E_inf/E0 = 100) 0.8-1.2 s against
+   !> 0.47-0.54 s at V tau/lambda = 0.1, 0.29-0.37 s against 0.37-0.41 s at 1; at 256^2 GCR
+   !> takes 0.8-1.16x its time on the standard linear solid. Near the loss peak (E_inf/E0 =
+   !> 100 to 1000 at V tau/lambda = 0.01, rows on the metric's hierarchy) GCR with the
+   !> Anderson iteration took 11-16 s where the multigrid 2.1-6.5 s, but at 3e-3 0.6-0.8 s
+   !> where 1.0-1.1 s. Slower sliding smoothed by rows for a moderate loss among the short
+   !> waves waits for 1024^2: at 512^2 GCR took 0.5-1.6x its time (E_inf/E0 = 10, V
+   !> tau/lambda = 0.01) (docs/decisions/015-row-smoothing.md).
    integer, parameter :: rows_multigrid_surface_points = 512**2
    integer, parameter :: hard_coarse_iterations = 20, hard_coarse_surface_iterations = 12
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
@@ -296,7 +298,7 @@ contains
          if (len(metric_refusal(op)) == 0 .or. grid%points() >= rising_multigrid_points) method = 'multigrid'
       else if (method == 'auto' .and. op%coupled .and. coarse_hard .and. len(reason) == 0 .and. &
          & grid%points() >= coupled_threshold(grid, .true.)) then
-         if (long_wave_rows(op, load_control)) method = 'multigrid'
+         if (rows_ahead_of_gcr(op, load_control)) method = 'multigrid'
       end if
       call progress%begin_level(grid%nx, grid%ny)
       uniform = 0.0_wp

@@ -55,7 +55,7 @@ module lc_contact_solver_multigrid
    implicit none (type, external)
    private
    public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
-   public :: allowed_rise, long_wave_rows
+   public :: allowed_rise, rows_ahead_of_gcr
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -258,18 +258,19 @@ contains
       end if
    end function size_refusal
 
-   !> Whether the coupled method smooths the scene of `op` by rows (row_smoothing) where the
-   !> loss of K lies at long waves (loss_at_long_waves): a surface sliding on a viscoelastic
-   !> layer near its loss peak, whose Jacobi steps smooth poorly. (Slower sliding, smoothed
-   !> by rows for its moderate loss among the short waves, short_loss_limit, is not one.)
-   logical function long_wave_rows(op, load_control) result(rows)
+   !> Whether the coupled method smooths the scene of `op` by rows (row_smoothing) where its
+   !> Jacobi steps smooth poorly and GCR is slow: a surface sliding on a viscoelastic layer
+   !> whose loss of K lies at long waves (loss_at_long_waves), or that is large among the
+   !> short waves (the metric's hierarchy smoothed by rows, short_loss_limit). Slower
+   !> sliding, smoothed by rows for its moderate loss among the short waves, is not one.
+   logical function rows_ahead_of_gcr(op, load_control) result(rows)
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
       real(wp), allocatable :: symbol(:), odd(:)
       logical :: complex_symbol
-      rows = .false.
-      if (loss_at_long_waves(op)) call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
-   end function long_wave_rows
+      call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+      rows = rows .and. (loss_at_long_waves(op) .or. .not. complex_symbol)
+   end function rows_ahead_of_gcr
 
    !> The rule of row_smoothing for the stiffness symbol (+ i odd) of a grid; `odd` not
    !> allocated (so absent) for a real symbol.
