@@ -104,7 +104,8 @@ module lc_contact_solver_multigrid
    !> its peak among the short waves, at 1e-2 and 3e-2, 1603-10208 against 758-1667.
    !> A larger loss is smoothed by rows on the metric's hierarchy where the largest loss
    !> lies at the grid's edge or beyond it, or in its top band, |kx| > nx/4 (modes no
-   !> coarser grid carries), up to top_band_loss; elsewhere (middle waves) by Jacobi steps.
+   !> coarser grid carries), up to top_band_loss, on grids with nx <= ny; elsewhere
+   !> (middle waves) by Jacobi steps.
    !> E_inf/E0 = 100 to 1000 at V tau/lambda = 3e-3 to 0.1, nu = 0.3 and 0.5, mu_c = 0 and
    !> 0.5 (h/lambda = 0.05 to the half-space at 256^2, 0.16 at 512^2): at 512^2 never more
    !> pairs than the Jacobi steps and up to 9.4x fewer (E_inf/E0 = 100 at 0.01: 619-873
@@ -118,7 +119,10 @@ module lc_contact_solver_multigrid
    !> rows on the metric's hierarchy only up to this loss: at 1024^2 a peak there with the
    !> loss 8.6 (E_inf/E0 = 300 at V tau/lambda = 0.01) took 22439 pairs by rows where the
    !> Jacobi steps took 4555, and 15.8 (1000) stalled; 4.95 (100 at 0.01, 512^2) took
-   !> 619-873 where 683-1666.
+   !> 619-873 where 683-1666. Grids with more points along x than across keep the Jacobi
+   !> steps there: on 512 x 256 points (period 2 x 1) that glassy layer took 4998-6239
+   !> pairs by rows where the Jacobi steps took 1168-1390, although 256 x 128 (periods 1 x 1
+   !> and 2 x 1) and 512 x 256 (1 x 0.5) took 1.1-2.1x fewer by rows.
    real(wp), parameter :: top_band_loss = 5.0_wp
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256
@@ -329,8 +333,9 @@ contains
       end if
       symbol = level_symbol(op, load_control, op%grid%nx, op%grid%ny)
       ! (a large loss peaking at the grid's edge or beyond it, or, if at most top_band_loss,
-      ! among the other modes no coarser grid carries)
-      if (large) then
+      ! among the other modes no coarser grid carries; on grids no longer along x than
+      ! across: see top_band_loss)
+      if (large .and. op%grid%nx <= op%grid%ny) then
          if (2*(peak + 1) >= op%grid%nx .or. (4*peak > op%grid%nx .and. short_loss <= top_band_loss)) &
             & rows = rows_smooth(op%grid, symbol)
       end if
