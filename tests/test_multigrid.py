@@ -155,8 +155,8 @@ def test_a_sliding_viscoelastic_surface_agrees_with_gcr(e_inf, speed, most_pairs
     about twice the elastic surface's, where Jacobi steps took 135 and 732. Sliding slower
     (V tau/lambda = 0.01) puts the loss among the short waves, moderate (at most 1.42):
     smoothed by rows on K's own hierarchy all the same, where the metric's with Jacobi steps
-    took 223. The glassy layer sliding as slowly has a large loss (up to 4.95) peaking beyond
-    the grid: rows on the metric's hierarchy, where its Jacobi steps took 498."""
+    took 223. The glassy layer sliding as slowly has a large loss (3.39 at this grid's edge)
+    peaking beyond the grid: rows on the metric's hierarchy, where its Jacobi steps took 498."""
     material = lc.StandardLinearSolid(e0=1.0, e_inf=e_inf, tau=1.0)
     h = surface(128, 128)
     kw = dict(thickness=0.16, poisson=0.5, friction=0.5, material=material, speed=speed,
