@@ -93,7 +93,7 @@ module lc_contact_solver_multigrid
    real(wp), parameter :: row_smoothing = 0.85_wp
    !> A coupled surface whose loss is not largest at long waves (loss_at_long_waves) builds
    !> K's own hierarchy, smoothed by rows, where its loss among the waves short along x
-   !> (loss_among_short_waves) is at most this and rows_smooth holds, else the metric's.
+   !> (loss_of: short_x) is at most this and rows_smooth holds, else the metric's.
    !> Measured to tol 1e-8 (h/lambda = 0.16, nu = 0.5, mu_c = 0 and 0.5, 512^2, both
    !> roughness families): the standard linear solid E_inf/E0 = 10 (largest loss 1.42) at
    !> V tau/lambda = 1e-3 and 1e-2 took 76-106 transform pairs where Jacobi steps took
@@ -168,6 +168,16 @@ module lc_contact_solver_multigrid
    type :: workspace
       real(wp), allocatable :: c(:), kc(:), cg(:, :)
    end type workspace
+
+   !> The loss |Im K|/Re K of a coupled scene over its modes (loss_of): the largest and the
+   !> |kx| where it is reached (a peak beyond the grid lies at its edge), the largest over
+   !> the long waves (|kx| <= nx/16 and, on a surface, |ky| <= ny/16) and over the waves
+   !> short along x (|kx| > nx/16, at any ky: a sliding layer's loss depends on kx alone; a
+   !> standard linear solid's peaks at (E_inf/E0 - 1)/(2 sqrt(E_inf/E0))).
+   type :: loss_profile
+      real(wp) :: largest = 0.0_wp, long = 0.0_wp, short_x = 0.0_wp
+      integer :: peak = 0
+   end type loss_profile
 
    !> The scales of the residual, from the last full evaluation of the state.
    type :: residual_scales
@@ -304,17 +314,16 @@ contains
       real(wp), allocatable, intent(out) :: symbol(:), odd(:)
       logical, intent(out) :: complex_symbol, rows
       complex(wp), allocatable :: stiffness(:)
-      real(wp) :: short_loss
-      integer :: peak
+      type(loss_profile) :: loss
       logical :: long, large
-      long = loss_at_long_waves(op)
-      complex_symbol = long
+      long = .false.
       large = .false.
-      if (.not. long .and. op%coupled .and. .not. op%grid%is_line()) then
-         call loss_among_short_waves(op, short_loss, peak)
-         large = short_loss > short_loss_limit
-         complex_symbol = .not. large
+      if (op%coupled) then
+         loss = loss_of(op)
+         long = at_long_waves(loss)
+         large = .not. long .and. .not. op%grid%is_line() .and. loss%short_x > short_loss_limit
       end if
+      complex_symbol = long .or. (op%coupled .and. .not. op%grid%is_line() .and. .not. large)
       rows = .false.
       if (complex_symbol) then
          allocate (stiffness(op%nk))
@@ -336,8 +345,8 @@ contains
       ! among the other modes no coarser grid carries; on grids no longer along x than
       ! across: see top_band_loss)
       if (large .and. op%grid%nx <= op%grid%ny) then
-         if (2*(peak + 1) >= op%grid%nx .or. (4*peak > op%grid%nx .and. short_loss <= top_band_loss)) &
-            & rows = rows_smooth(op%grid, symbol)
+         if (2*(loss%peak + 1) >= op%grid%nx .or. &
+            & (4*loss%peak > op%grid%nx .and. loss%short_x <= top_band_loss)) rows = rows_smooth(op%grid, symbol)
       end if
    end subroutine coupled_symbol
 
@@ -742,54 +751,38 @@ contains
    !> V tau/lambda = 1e-4, n = 65536, 542 against 1004 pairs (docs/decisions/012-coupled-multigrid.md).
    pure logical function loss_at_long_waves(op) result(long)
       type(compliance_operator), intent(in) :: op
-      real(wp) :: loss, largest, largest_long
-      integer :: i, nkx, kx, ky
       long = .false.
-      if (.not. op%coupled) return
-      largest = 0.0_wp
-      largest_long = 0.0_wp
+      if (op%coupled) long = at_long_waves(loss_of(op))
+   end function loss_at_long_waves
+
+   !> Whether the largest loss of `loss` is reached at long waves (loss_at_long_waves).
+   pure logical function at_long_waves(loss) result(long)
+      type(loss_profile), intent(in) :: loss
+      ! (a sliding layer's loss depends on kx alone, so on a surface the largest is reached
+      ! at long and short waves in y alike: ties go to the long waves)
+      long = loss%largest > 0.0_wp .and. loss%long >= (1.0_wp - 1.0e-9_wp)*loss%largest
+   end function at_long_waves
+
+   !> The loss |Im K|/Re K of K = 1/G_eff (= |Im G_eff|/Re G_eff) of the coupled scene of
+   !> `op`, mode by mode, summarised in one pass (loss_profile).
+   pure type(loss_profile) function loss_of(op) result(profile)
+      type(compliance_operator), intent(in) :: op
+      real(wp) :: loss
+      integer :: i, nkx, kx, ky
       nkx = op%grid%nx/2 + 1
-      ! (|Im K|/Re K of K = 1/G_eff is |Im G_eff|/Re G_eff; a sliding layer's loss depends on
-      ! kx alone, so on a surface the largest is reached at long and short waves in y alike:
-      ! ties go to the long waves)
       do i = 2, op%nk
          if (.not. real(op%full(i)) > 0.0_wp) cycle
          loss = abs(aimag(op%full(i)))/real(op%full(i))
-         largest = max(largest, loss)
          kx = mod(i - 1, nkx)
          ky = (i - 1)/nkx
          ky = min(ky, op%grid%ny - ky)
+         if (loss > profile%largest*(1.0_wp + 1.0e-9_wp)) profile%peak = kx
+         profile%largest = max(profile%largest, loss)
          if (16*kx <= op%grid%nx .and. (op%grid%is_line() .or. 16*ky <= op%grid%ny)) &
-            & largest_long = max(largest_long, loss)
+            & profile%long = max(profile%long, loss)
+         if (16*kx > op%grid%nx) profile%short_x = max(profile%short_x, loss)
       end do
-      long = largest > 0.0_wp .and. largest_long >= (1.0_wp - 1.0e-9_wp)*largest
-   end function loss_at_long_waves
-
-   !> The largest loss |Im K|/Re K (= |Im G_eff|/Re G_eff) of the coupled scene of `op` over
-   !> the waves short along x, |kx| > nx/16, at any ky (a sliding layer's loss depends on kx
-   !> alone; a standard linear solid's peaks at (E_inf/E0 - 1)/(2 sqrt(E_inf/E0))), and the
-   !> |kx| of the largest loss over all waves (a peak beyond the grid lies at its edge).
-   pure subroutine loss_among_short_waves(op, largest, peak)
-      type(compliance_operator), intent(in) :: op
-      real(wp), intent(out) :: largest
-      integer, intent(out) :: peak
-      real(wp) :: loss, highest
-      integer :: i, nkx, kx
-      largest = 0.0_wp
-      highest = 0.0_wp
-      peak = 0
-      nkx = op%grid%nx/2 + 1
-      do i = 2, op%nk
-         if (.not. real(op%full(i)) > 0.0_wp) cycle
-         loss = abs(aimag(op%full(i)))/real(op%full(i))
-         kx = mod(i - 1, nkx)
-         if (16*kx > op%grid%nx) largest = max(largest, loss)
-         if (loss > highest*(1.0_wp + 1.0e-9_wp)) then
-            highest = loss
-            peak = kx
-         end if
-      end do
-   end subroutine loss_among_short_waves
+   end function loss_of
 
    !> TNNMG iterations on the grid h%top from u until the residual on (K u + f, u - o) is at
    !> most tol or max_steps ran; p = K u + f on exit. steps: iterations run. history and
