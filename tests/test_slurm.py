@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -373,6 +374,32 @@ def test_a_killed_task_loses_only_the_scene_it_cut_short(tmp_path, monkeypatch, 
         record(out, "s_0001")["slurm_array_job_id"] == 90
         and record(out, "s_0000")["slurm_array_job_id"] == 77
     )
+
+
+def test_a_signal_while_the_task_writes_a_record_leaves_a_readable_record(tmp_path, monkeypatch):
+    # the record "running" is in place, but the task's shell is still in its function that
+    # writes records (held here in its first `mv`) when SIGTERM comes: the trap's record must not
+    # read that function's variables for the loop's
+    monkeypatch.chdir(tmp_path)
+    path = write_sweep(tmp_path)
+    assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 0
+    out = tmp_path / "out/s"
+    holding = tmp_path / "bin"
+    holding.mkdir()
+    (holding / "mv").write_text(
+        f'#!/bin/bash\n{shutil.which("mv")} "$@" || exit\n'
+        f'case "$*" in *s_0000.json) [ -e {holding}/held ] || {{ touch {holding}/held; sleep 60; }} ;; esac\n'
+    )
+    (holding / "mv").chmod(0o755)
+    monkeypatch.setenv("PATH", f"{holding}:{os.environ['PATH']}")
+    task = run_task(out / "slurm/s_001.sbatch", 0, start_new_session=True)
+    wait_for(lambda: record(out, "s_0000").get("state") == "running", "s_0000 to start")
+    os.killpg(task.pid, signal.SIGTERM)
+    assert task.wait(timeout=30) == 128 + signal.SIGTERM
+    rec = record(out, "s_0000")
+    assert rec["state"] == "killed" and rec["exit_code"] == 143
+    assert rec["started"] <= rec["finished"] and rec["started"].endswith("Z")
+    assert not (out / "runs/s_0001.json").exists()
 
 
 # ---------------------------------------------------------------------------------------

@@ -460,18 +460,20 @@ seconds_since() {{  # the wall time since $1 (milliseconds), as seconds with 3 d
 
 # The run record of a scene (layercontact.provenance), replaced atomically:
 # $1 scene, $2 state, $3 exit code, $4 started, $5 finished, $6 wall time (empty: null).
+# Its locals shadow none of the loop's variables: the trap may run while the loop is in
+# here and then passes those variables, which must not read as this function's locals.
 write_record() {{
   local file="$sweep_directory/{runs}/$1.json" tmp="$sweep_directory/{runs}/.$1.json.$$.tmp"
-  local started=null finished=null
-  [ -n "$4" ] && started="\"$4\""
-  [ -n "$5" ] && finished="\"$5\""
+  local started_json=null finished_json=null
+  [ -n "$4" ] && started_json="\"$4\""
+  [ -n "$5" ] && finished_json="\"$5\""
   printf '{{"scene": "%s", "runner": "slurm", "state": "%s", "exit_code": %s, "host": "%s", "pid": %s, ' \
     "$1" "$2" "${{3:-null}}" "$host" "$$" >"$tmp"
   printf '"slurm_job_id": %s, "slurm_array_job_id": %s, "slurm_array_task_id": %s, "submission": %s, ' \
     "${{SLURM_JOB_ID:-null}}" "${{SLURM_ARRAY_JOB_ID:-null}}" "${{SLURM_ARRAY_TASK_ID:-null}}" \
     "$submission" >>"$tmp"
   printf '"started": %s, "finished": %s, "wall_time": %s, "error": "", "log": "{logs}/%s.log"}}\n' \
-    "$started" "$finished" "${{6:-null}}" "$1" >>"$tmp"
+    "$started_json" "$finished_json" "${{6:-null}}" "$1" >>"$tmp"
   mv -f "$tmp" "$file"
 }}
 
