@@ -80,14 +80,17 @@ module lc_contact_multigrid_hierarchy
    !> diagonal d of K): 1 gave the fewest CG iterations on the final set against 0.5, 2, 10.
    real(wp), parameter :: penalty = 1.0_wp
 
-   !> Row smoothing on a coarse grid: the shift of a row's solve, in units of the mean of the
-   !> penalty's diagonal over the row. Without it a soft row's inverse overshoots where the
-   !> penalty pins the points (the standard linear solid E_inf/E0 = 10 at V tau/lambda = 0.1,
-   !> 1024^2: the iteration stalled, GCR finished it). Transform pairs of that scene at 256^2,
-   !> 512^2, 2048^2 and of a glassy one (E_inf/E0 = 100, V tau/lambda = 1) at 256^2, 512^2,
-   !> for the weights 1, 0.5, 0.25, 0.1: 92, 109, 158 | 118, 122; 89, 90, 125 | 110, 106;
-   !> 84, 84, 97 | 114, 104; 83, 83, 91 | 112, 137 (docs/decisions/015-row-smoothing.md).
-   real(wp), parameter :: row_shift_weight = 0.25_wp
+   !> Row smoothing on a coarse grid: the shift of a row's solve, in units of the geometric
+   !> mean of two values of the penalty's diagonal over the row, its mean (the contact
+   !> points' stiffness spread over the row) and its largest (one contact point's). Without
+   !> a shift a soft row's inverse overshoots where the penalty pins the points (the
+   !> standard linear solid E_inf/E0 = 10 at V tau/lambda = 0.1, 1024^2: the iteration
+   !> stalled, GCR finished it). A share of the mean alone is too much for rows with many
+   !> contact points and too little for rows with few: a quarter of it took 98-156 transform
+   !> pairs on that layer at V tau/lambda = 0.01 from 256^2 to 2048^2, a tenth 98-119 but
+   !> 137-239 on a glassy one (E_inf/E0 = 100, V tau/lambda = 1, 0.7 % contact) at 512^2
+   !> and 1024^2, where a quarter took 100-109 (docs/decisions/015-row-smoothing.md).
+   real(wp), parameter :: row_shift_weight = 0.05_wp
 
    !> One grid of nx/2^t x ny/2^t points (ny = 1 on a line): its plan, the operator on it
    !> for the current hierarchy, and the V-cycle's work arrays.
@@ -117,8 +120,7 @@ module lc_contact_multigrid_hierarchy
       real(wp), allocatable :: jacobi(:)
       !> row smoothing (hierarchy%rows): K_row(kx), the mean of the symbol over ky; its
       !> inverse with the 1/nx of the rows' unscaled transform folded in; and per row the
-      !> shift added to K_row (coarse grids: row_shift_weight times the mean of the
-      !> penalty's diagonal over the row)
+      !> shift added to K_row (coarse grids: see row_shift_weight)
       complex(wp), allocatable :: row_symbol(:), row_inverse(:)
       real(wp), allocatable :: row_shift(:)
       real(wp), allocatable :: rhs(:), x(:), residual(:)
@@ -916,6 +918,7 @@ contains
       type(hierarchy), intent(inout) :: h
       integer :: t, info, attempt
       real(wp) :: shift
+      real(wp), allocatable :: row_penalty(:, :)
       do t = h%top + 1, h%coarsest
          associate (c => h%level(t), f => h%level(t - 1))
          if (h%surface) then
@@ -926,10 +929,11 @@ contains
             call coarsen_x(f%penalty, f%nx, 0, c%penalty)
          end if
          if (h%rows) then
-            ! the row solve takes part of the penalty's mean over the row as a shift (the
-            ! contact points' stiffness spread over it); a point stiffer than that, its step
-            ! scaled down as a Jacobi step would be (see row_shift_weight)
-            c%row_shift = row_shift_weight*sum(reshape(c%penalty(0, 0, :), [c%nx, c%ny]), dim=1)/c%nx
+            ! the row solve takes a shift for the contact points' stiffness (see
+            ! row_shift_weight); a point stiffer than that, its step scaled down as a Jacobi
+            ! step would be
+            row_penalty = reshape(c%penalty(0, 0, :), [c%nx, c%ny])
+            c%row_shift = row_shift_weight*sqrt(sum(row_penalty, dim=1)/c%nx*maxval(row_penalty, dim=1))
             c%jacobi = omega*min(1.0_wp, reshape(spread(c%circulant_diagonal + c%row_shift, 1, c%nx), [c%n]) &
                & /(c%circulant_diagonal + c%penalty(0, 0, :)))
          else
