@@ -12,8 +12,9 @@
 !> O(n) when the set changes. The penalty stands in for the truncated Galerkin operator
 !> P^T I K I P, whose application would cost a transform of the finest grid. Damped Jacobi
 !> smoothing, or on a surface sliding on a viscoelastic layer smoothing by rows (solve_rows:
-!> each row's part of the operator solved by transforms of the rows, on grids halved along
-!> both axes; in B the masked row step in place of the Jacobi step); a dense Cholesky solve
+!> each row's part of the operator solved by transforms of the rows, on grids halved along y
+!> until square, then along both axes; in B the masked row step in place of the Jacobi
+!> step); a dense Cholesky solve
 !> on the coarsest grid (at most coarsest_limit points).
 !> K is real and even (a symmetric stiffness: the operator's metric inverted), or complex
 !> (the non-symmetric stiffness 1/G_eff of a coupled scene, whose imaginary part is odd),
@@ -138,8 +139,8 @@ module lc_contact_multigrid_hierarchy
       integer :: top = 0, coarsest = 0, n_fine = 0
       logical :: surface = .false.   !< both axes are halved
       logical :: complex = .false.   !< a complex symbol (lines): LU on the coarsest grid
-      !> Smoothing by rows (solve_rows) in place of Jacobi steps, on grids halved along both
-      !> axes: for a layer sliding along x, whose modulus depends on q_x
+      !> Smoothing by rows (solve_rows) in place of Jacobi steps, on the grids of row_shapes:
+      !> for a layer sliding along x, whose modulus depends on q_x
       logical :: rows = .false.
       integer, allocatable :: pivots(:)
       real(wp), allocatable :: free(:)           !< 1 off the contact set, 0 on it (top grid)
@@ -225,6 +226,52 @@ contains
       end function halvable
    end subroutine coarsening_shapes
 
+   !> The shapes (nx, ny) of the grids t = 0..coarsest of a V-cycle smoothed by rows, given
+   !> the stiffness symbol of the finest surface (`odd` its imaginary part): both axes halved
+   !> (as halvings), but y alone on a grid with more rows than points along them where
+   !> halving both would leave the row step a smoothing factor above accepted_smoothing.
+   !> The row step solves along x exactly, so on a grid halved along y alone it need only
+   !> damp the waves short across the rows, as a line relaxation does (the standard linear
+   !> solid E_inf/E0 = 10 at V tau/lambda = 0.01 on 128 x 512 points, period 0.25 x 1: 0.83
+   !> halving both axes, 0.50 with y first; on 128 x 256 points 0.70 halving both, kept:
+   !> halving y first there took 7-17 % more transform pairs, docs/decisions/015-row-smoothing.md).
+   subroutine row_shapes(nx, ny, symbol, odd, shapes)
+      integer, intent(in) :: nx, ny
+      real(wp), contiguous, intent(in) :: symbol(:)
+      real(wp), contiguous, intent(in), optional :: odd(:)
+      integer, allocatable, intent(out) :: shapes(:, :)
+      integer :: mx, my, k
+      integer :: chosen(2, 0:64)
+      logical :: can_y, can_both
+      mx = nx
+      my = ny
+      k = 0
+      chosen(:, 0) = [mx, my]
+      do
+         can_y = my > mx .and. halvable(my) .and. mx*(my/2) >= coarsest_points
+         can_both = halvable(mx) .and. halvable(my) .and. (mx/2)*(my/2) >= coarsest_points
+         if (can_y .and. can_both) &
+            & can_both = row_smoothing_factor(nx, ny, symbol, odd, mx, my, .true.) <= accepted_smoothing
+         if (can_both) then
+            mx = mx/2
+            my = my/2
+         else if (can_y) then
+            my = my/2
+         else
+            exit
+         end if
+         k = k + 1
+         chosen(:, k) = [mx, my]
+      end do
+      allocate (shapes(2, 0:k))
+      shapes(:, :) = chosen(:, 0:k)
+   contains
+      pure logical function halvable(m)
+         integer, intent(in) :: m
+         halvable = mod(m, 2) == 0 .and. m/2 >= shortest_side
+      end function halvable
+   end subroutine row_shapes
+
    !> The largest smoothing factor of the damped Jacobi step over the grids of the V-cycle
    !> (coarsening_shapes; smoothing_factors for the halving each grid takes), for the
    !> stiffness symbol of the finest nx x ny grid (`odd` its imaginary part): near 1, some
@@ -255,32 +302,46 @@ contains
    end function worst_smoothing
 
    !> The largest smoothing factor of the row smoothing step (solve_rows, damped by omega)
-   !> over the grids halved along both axes, for the stiffness symbol of the finest nx x ny
-   !> surface (`odd` its imaginary part), read at each grid's modes: the largest
-   !> |1 - omega K(q)/K_row(kx)| over the modes the next grid cannot carry.
+   !> over the grids of row_shapes, for the stiffness symbol of the finest nx x ny surface
+   !> (`odd` its imaginary part).
    function worst_row_smoothing(nx, ny, symbol, odd) result(worst)
       integer, intent(in) :: nx, ny
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
       real(wp) :: worst
+      integer, allocatable :: shapes(:, :)
+      integer :: t
+      call row_shapes(nx, ny, symbol, odd, shapes)
+      worst = 0.0_wp
+      do t = 0, ubound(shapes, 2) - 1
+         worst = max(worst, row_smoothing_factor(nx, ny, symbol, odd, shapes(1, t), shapes(2, t), &
+            & shapes(1, t + 1) < shapes(1, t)))
+      end do
+   end function worst_row_smoothing
+
+   !> The smoothing factor of the row step on an mx x my grid for the stiffness symbol of the
+   !> finest nx x ny surface read at the grid's modes: the largest |1 - omega K(q)/K_row(kx)|
+   !> over the modes the next grid cannot carry (halved along y, and along x if along_x).
+   function row_smoothing_factor(nx, ny, symbol, odd, mx, my, along_x) result(worst)
+      integer, intent(in) :: nx, ny, mx, my
+      real(wp), contiguous, intent(in) :: symbol(:)
+      real(wp), contiguous, intent(in), optional :: odd(:)
+      logical, intent(in) :: along_x
+      real(wp) :: worst
       complex(wp) :: row   !< the sum of a column, then 1/K_row
-      integer :: t, mx, my, kx, ky
+      integer :: kx, ky
       worst = 0.0_wp
       ! (each column read twice, for its sum and for the factors, rather than stored)
-      do t = 0, halvings(nx, ny, coarsest_points) - 1
-         mx = nx/2**t
-         my = ny/2**t
-         do kx = 0, mx/2
-            row = 0.0_wp
-            do ky = 0, my - 1
-               row = row + stiffness_at(kx, ky)
-            end do
-            if (abs(row) == 0.0_wp) cycle
-            row = my*inverse(row)
-            do ky = 0, my - 1
-               if (4*kx > mx .or. 4*abs(signed(ky)) > my) &
-                  & worst = max(worst, abs(1.0_wp - omega*stiffness_at(kx, ky)*row))
-            end do
+      do kx = 0, mx/2
+         row = 0.0_wp
+         do ky = 0, my - 1
+            row = row + stiffness_at(kx, ky)
+         end do
+         if (abs(row) == 0.0_wp) cycle
+         row = my*inverse(row)
+         do ky = 0, my - 1
+            if ((along_x .and. 4*kx > mx) .or. 4*abs(signed(ky)) > my) &
+               & worst = max(worst, abs(1.0_wp - omega*stiffness_at(kx, ky)*row))
          end do
       end do
    contains
@@ -297,7 +358,7 @@ contains
          integer, intent(in) :: ky
          signed = merge(ky, ky - my, 2*ky <= my)
       end function signed
-   end function worst_row_smoothing
+   end function row_smoothing_factor
 
    !> The smoothing factors of the damped Jacobi step (its diagonal as set_grid takes it, with
    !> the mean over the half spectrum) on
@@ -688,7 +749,7 @@ contains
       h%surface = ny > 1
       if (present(rows)) h%rows = rows .and. h%surface
       if (h%rows) then
-         call coarsening_shapes(nx, ny, shapes)
+         call row_shapes(nx, ny, symbol, odd, shapes)
       else
          call coarsening_shapes(nx, ny, shapes, symbol, odd)
       end if

@@ -33,6 +33,7 @@ program test_multigrid_hierarchy
    call check_galerkin('surface stiff along y, complex symbol', 32, 16, 1.0_wp, 10.0_wp, .true., 'yb')
    call check_rows('rows, real symbol', 32, 16, .false.)
    call check_rows('rows, complex symbol', 32, 16, .true.)
+   call check_rows('rows, stiff across the rows, more rows than points along them', 16, 64, .true., 4.0_wp)
    if (failures > 0) then
       write (*, '(a, i0, a)') 'FAILED: ', failures, ' check(s)'
       error stop 1
@@ -125,20 +126,25 @@ contains
    !> A sliding layer's symbol K = E(kx) |q|, E(kx) = (1 + 100 i kx/nx)/(1 + i kx/nx) (a
    !> standard linear solid, E_inf/E0 = 100; |E| if not complex) on an nx x ny
    !> surface smoothed by rows: its grids halved along both axes, the rows' smoothing factor
-   !> that of K ~ |q| (E cancels in K/K_row: 0.55 at most), and on every grid, for a field r
+   !> that of K ~ |q| (E cancels in K/K_row: 0.55 at most). With `stretch` the symbol is
+   !> E(kx) |(kx, stretch ky)|, stiffer across the rows, on a grid with more rows than points
+   !> along them: halving both axes would leave the row step its short waves along x at low
+   !> ky, barely damped (factor 0.8), so the grids are halved along y alone until square
+   !> (row_shapes). And on every grid, for a field r
    !> on one row j, x = (C + s)^-1 r row by row lies on row j with (C x + s x) = r there,
    !> with the shift s = 0 and s = 3 d.
-   subroutine check_rows(what, nx, ny, complex_symbol)
+   subroutine check_rows(what, nx, ny, complex_symbol, stretch)
       character(len=*), intent(in) :: what
       integer, intent(in) :: nx, ny
       logical, intent(in) :: complex_symbol
+      real(wp), intent(in), optional :: stretch
       type(compliance_operator), target :: op
       type(hierarchy), target :: h
       type(error_type), allocatable :: error
       real(wp), allocatable :: symbol(:), odd(:), r(:), x(:), cx(:)
       complex(wp) :: modulus
       integer :: kx, ky, sy, nkx, i, t, row, attempt
-      real(wp) :: worst, off_row, shift
+      real(wp) :: worst, off_row, shift, q
       logical :: full
 
       if (.not. planned(what, op, nx, ny)) return
@@ -149,8 +155,10 @@ contains
          do kx = 0, nx/2
             modulus = (1.0_wp + (0.0_wp, 100.0_wp)*kx/nx)*(1.0_wp - (0.0_wp, 1.0_wp)*kx/nx)/(1.0_wp + (real(kx, wp)/nx)**2)
             if (2*kx == nx .or. .not. complex_symbol) modulus = abs(modulus)
-            symbol(kx + nkx*ky + 1) = real(modulus)*hypot(real(kx, wp), real(sy, wp))
-            odd(kx + nkx*ky + 1) = aimag(modulus)*hypot(real(kx, wp), real(sy, wp))
+            q = hypot(real(kx, wp), real(sy, wp))
+            if (present(stretch)) q = hypot(real(kx, wp), stretch*sy)
+            symbol(kx + nkx*ky + 1) = real(modulus)*q
+            odd(kx + nkx*ky + 1) = aimag(modulus)*q
          end do
       end do
       if (complex_symbol) then
@@ -166,9 +174,15 @@ contains
          call check(.false., what // ': ' // error%message)
          return
       end if
-      call check(worst <= 0.55_wp, what // ': smoothing factor ' // trim(adjustl(fmt(worst))) // ' (at most 0.55)')
-      full = all([(h%level(t)%halve_x .and. h%level(t)%halve_y, t = 0, h%coarsest - 1)])
-      call check(full, what // ': every grid halved along both axes')
+      if (present(stretch)) then
+         full = all([(h%level(t)%halve_y .and. (h%level(t)%halve_x .eqv. h%level(t)%ny <= h%level(t)%nx), &
+            & t = 0, h%coarsest - 1)])
+         call check(full, what // ': grids halved along y alone until square, then along both axes')
+      else
+         call check(worst <= 0.55_wp, what // ': smoothing factor ' // trim(adjustl(fmt(worst))) // ' (at most 0.55)')
+         full = all([(h%level(t)%halve_x .and. h%level(t)%halve_y, t = 0, h%coarsest - 1)])
+         call check(full, what // ': every grid halved along both axes')
+      end if
       h%free = 1.0_wp
       call set_contact(h)
 
