@@ -31,6 +31,25 @@ def max_stiffness(n: int, thickness: float, poisson: float) -> float:
     return np.max(1 / np.abs(g[1:]))
 
 
+def test_a_sliding_surface_with_more_rows_than_points_along_them_agrees_with_gcr():
+    """On 128 x 512 points (period 0.25 x 1: sliding along the short side) rows halved along
+    both axes would smooth with a factor 0.83, and the Jacobi steps took 255 transform pairs;
+    halved along y alone until square, rows take 107 (measured). GCR's fixed point to the
+    bound of the two tolerances, the same load and penetration."""
+    h = lc.self_affine_surface(nx=128, ny=512, period=(0.25, 1.0), hurst=0.8, seed=1, short_wavelength=8 / 512,
+                               rms_gradient=0.1)
+    kw = dict(thickness=0.16, poisson=0.5, friction=0.5, material=SLS, speed=0.1, mean_pressure=0.02, stress=False)
+    gcr = lc.solve_areal(h, method="gcr", tol=TOL_GCR, **kw)
+    mg = lc.solve_areal(h, method="multigrid", tol=1e-8, **kw)
+    assert gcr.converged and mg.converged and mg.solver == "multigrid"
+    g = g_eff_grid(128, 512, 0.25, 1.0, 0.16, 10.0, 0.5, 0.5)
+    bound = (1e-8 + TOL_GCR) * np.ptp(h) / np.abs(g[g != 0]).min()
+    assert np.abs(mg.pressure - gcr.pressure).max() <= bound
+    assert mg.mean_pressure == pytest.approx(gcr.mean_pressure, rel=1e-8)
+    assert mg.penetration == pytest.approx(gcr.penetration, abs=(1e-8 + TOL_GCR) * np.ptp(h))
+    assert mg.fft_pairs <= 150, mg.fft_pairs
+
+
 @pytest.mark.parametrize("n", [4096, 65536])
 @pytest.mark.parametrize("family", ["physical", "broadband"])
 def test_agrees_with_constrained_cg(n, family):

@@ -233,8 +233,9 @@ contains
    !> The row step solves along x exactly, so on a grid halved along y alone it need only
    !> damp the waves short across the rows, as a line relaxation does (the standard linear
    !> solid E_inf/E0 = 10 at V tau/lambda = 0.01 on 128 x 512 points, period 0.25 x 1: 0.83
-   !> halving both axes, 0.50 with y first; on 128 x 256 points 0.70 halving both, kept:
-   !> halving y first there took 7-17 % more transform pairs, docs/decisions/015-row-smoothing.md).
+   !> halving both axes, 0.71 with y first, from the 128 x 256 grid on, which halves both;
+   !> halving y first on such 2:1 grids too took 7-17 % more transform pairs:
+   !> docs/decisions/015-row-smoothing.md).
    subroutine row_shapes(nx, ny, symbol, odd, shapes)
       integer, intent(in) :: nx, ny
       real(wp), contiguous, intent(in) :: symbol(:)
