@@ -43,7 +43,8 @@ contains
    !> 1024^2, 30.3 for a coupled one with GCR's history of 12; a line's multigrid 39, its
    !> coarse grids halving only one axis; a coupled line by the multigrid 60.5 at 2^20, a
    !> coupled surface 53.1 at 2048^2 with friction and 54 sliding viscoelastic, 64.4 where
-   !> its grids are halved along one axis, with the history of its truncated Newton GCR),
+   !> its grids are halved along one axis, 60.8-64.3 smoothed by rows on 512 x 2048 and
+   !> 256 x 2048 points (y halved alone first), with the history of its truncated Newton GCR),
    !> plus the in-plane fields of the stress observables.
    pure integer(i8) function solve_bytes(points, coupled, memory, stress, multigrid, line) result(bytes)
       integer, intent(in) :: points

@@ -12,10 +12,10 @@
 !> O(n) when the set changes. The penalty stands in for the truncated Galerkin operator
 !> P^T I K I P, whose application would cost a transform of the finest grid. Damped Jacobi
 !> smoothing, or on a surface sliding on a viscoelastic layer smoothing by rows (solve_rows:
-!> each row's part of the operator solved by transforms of the rows, on grids halved along y
-!> until square, then along both axes; in B the masked row step in place of the Jacobi
-!> step); a dense Cholesky solve
-!> on the coarsest grid (at most coarsest_limit points).
+!> each row's part of the operator solved by transforms of the rows, on grids halved along
+!> both axes, or along y alone where a grid has more rows than points along them and that
+!> smooths better; in B the masked row step in place of the Jacobi step); a dense Cholesky
+!> solve on the coarsest grid (at most coarsest_limit points).
 !> K is real and even (a symmetric stiffness: the operator's metric inverted), or complex
 !> (the non-symmetric stiffness 1/G_eff of a coupled scene, whose imaginary part is odd),
 !> with an LU factor of the coarsest operator in place of Cholesky's; the solvers

@@ -75,8 +75,9 @@ module lc_contact_solver_multigrid
    !> A coupled surface is smoothed by rows (hierarchy%rows) where the Jacobi steps' worst
    !> smoothing factor on the grids coarsening_shapes would choose exceeds this and the
    !> rows' (worst_row_smoothing, on the grids of row_shapes) is at most
-   !> accepted_smoothing: a layer sliding along x whose modulus changes with q_x V. Measured at 256^2 (h/lambda = 0.16, E_inf/E0 = 10 and
-   !> 100, V tau/lambda = 1e-3 .. 1e2; the rows' factor 0.55 on all): where Jacobi's is
+   !> accepted_smoothing: a layer sliding along x whose modulus changes with q_x V. Measured
+   !> at 256^2 (h/lambda = 0.16, E_inf/E0 = 10 and 100, V tau/lambda = 1e-3 .. 1e2; the
+   !> rows' factor 0.55 on all): where Jacobi's is
    !> 0.70-0.82 Jacobi steps took 61-180 transform pairs and rows 76-167, where it is
    !> 0.91-0.99 rows took 70-305 and Jacobi steps 89-742. Thin incompressible layers (Jacobi
    !> 0.87-0.99, rows 0.79-0.93) keep Jacobi steps: frictionless at h/lambda = 0.01, 681
