@@ -229,7 +229,9 @@ contains
    !> The shapes (nx, ny) of the grids t = 0..coarsest of a V-cycle smoothed by rows, given
    !> the stiffness symbol of the finest surface (`odd` its imaginary part): both axes halved
    !> (as halvings), but y alone on a grid with more rows than points along them where
-   !> halving both would leave the row step a smoothing factor above accepted_smoothing.
+   !> halving both would leave the row step a smoothing factor above accepted_smoothing, and
+   !> x alone until square where the finest grid has more than twice as many points along x
+   !> as along y (elongated: see elongated_row_smoothing in lc_contact_solver_multigrid).
    !> The row step solves along x exactly, so on a grid halved along y alone it need only
    !> damp the waves short across the rows, as a line relaxation does (the standard linear
    !> solid E_inf/E0 = 10 at V tau/lambda = 0.01 on 128 x 512 points, period 0.25 x 1: 0.83
@@ -243,12 +245,19 @@ contains
       integer, allocatable, intent(out) :: shapes(:, :)
       integer :: mx, my, k
       integer :: chosen(2, 0:64)
-      logical :: can_y, can_both
+      logical :: can_x, can_y, can_both
       mx = nx
       my = ny
       k = 0
       chosen(:, 0) = [mx, my]
       do
+         can_x = nx > 2*ny .and. mx > my .and. halvable(mx) .and. (mx/2)*my >= coarsest_points
+         if (can_x) then
+            mx = mx/2
+            k = k + 1
+            chosen(:, k) = [mx, my]
+            cycle
+         end if
          can_y = my > mx .and. halvable(my) .and. mx*(my/2) >= coarsest_points
          can_both = halvable(mx) .and. halvable(my) .and. (mx/2)*(my/2) >= coarsest_points
          if (can_y .and. can_both) &

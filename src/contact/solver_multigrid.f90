@@ -86,12 +86,22 @@ module lc_contact_solver_multigrid
    !> V tau/lambda = 1, on a compressible layer with friction, nu = 0.3: 16116-48560 pairs
    !> where its Jacobi steps took 541-683), except for a large loss peaking at the grid's
    !> edge or in its top band: see short_loss_limit. Grids with more than twice as many
-   !> points along x as along y keep Jacobi steps too: the standard linear solid at
-   !> V tau/lambda = 0.1 on 512 x 128 points took 38120 pairs smoothed by rows (91 with
-   !> Jacobi steps), on 384 x 128 199, on 512 x 192 213, where up to twice as many points
-   !> along x (512 x 256, 256 x 128, 128 x 256) took 89-110 (Jacobi steps 100-166)
-   !> (docs/decisions/015-row-smoothing.md).
+   !> points along x as along y follow elongated_row_smoothing: the standard linear solid
+   !> at V tau/lambda = 0.1 on 512 x 128 points took 38120 pairs smoothed by rows on grids
+   !> halved along both axes (91 with Jacobi steps), on 384 x 128 199, on 512 x 192 213,
+   !> where up to twice as many points along x (512 x 256, 256 x 128, 128 x 256) took
+   !> 89-110 (Jacobi steps 100-166) (docs/decisions/015-row-smoothing.md).
    real(wp), parameter :: row_smoothing = 0.85_wp
+   !> A grid with more than twice as many points along x as along y is smoothed by rows
+   !> (grids halved along x alone until square: row_shapes) only where the Jacobi steps'
+   !> worst smoothing factor exceeds this. Measured on 512 x 128, 384 x 128 and 1024 x 256
+   !> points (periods 1 x 0.25, 0.75 x 0.25), h/lambda = 0.16, nu = 0.5, mu_c = 0.5: glassy
+   !> layers (E_inf/E0 = 100; Jacobi 0.990-0.997) at V tau/lambda = 0.03 to 1 took 146-471
+   !> transform pairs where the Jacobi steps took 285-573, at 10 160-184 where 156-179; the
+   !> standard linear solid (E_inf/E0 = 10; Jacobi 0.90-0.94) at 0.01 to 1 107-164 where
+   !> 71-152. Rows halving both axes there stall (the standard linear solid at 0.1 on 512 x
+   !> 128: 9532 pairs; docs/decisions/015-row-smoothing.md).
+   real(wp), parameter :: elongated_row_smoothing = 0.98_wp
    !> A coupled surface whose loss is not largest at long waves (loss_at_long_waves) builds
    !> K's own hierarchy, smoothed by rows, where its loss among the waves short along x
    !> (loss_of: short_x) is at most this and rows_smooth holds, else the metric's.
@@ -294,11 +304,12 @@ contains
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
       rows = .false.
-      ! (rows of more than twice as many points as there are rows: see row_smoothing)
-      if (grid%is_line() .or. grid%nx > 2*grid%ny) return
+      if (grid%is_line()) return
       ! (the rows' factor only where the Jacobi steps smooth poorly: an elastic surface with
-      ! friction is decided by the cheaper one)
-      if (worst_smoothing(grid%nx, grid%ny, symbol, odd) <= row_smoothing) return
+      ! friction is decided by the cheaper one; on rows of more than twice as many points as
+      ! there are rows, only where they barely smooth: see elongated_row_smoothing)
+      if (worst_smoothing(grid%nx, grid%ny, symbol, odd) <= &
+         & merge(elongated_row_smoothing, row_smoothing, grid%nx > 2*grid%ny)) return
       rows = worst_row_smoothing(grid%nx, grid%ny, symbol, odd) <= accepted_smoothing
    end function rows_smooth
 
