@@ -219,12 +219,13 @@ contains
       deallocate (shapes)
       allocate (shapes(2, 0:size(chosen, 2) - 1))
       shapes(:, :) = chosen
-   contains
-      pure logical function halvable(m)
-         integer, intent(in) :: m
-         halvable = mod(m, 2) == 0 .and. m/2 >= shortest_side
-      end function halvable
    end subroutine coarsening_shapes
+
+   !> Whether an axis of m points halves to one of at least shortest_side points.
+   pure logical function halvable(m)
+      integer, intent(in) :: m
+      halvable = mod(m, 2) == 0 .and. m/2 >= shortest_side
+   end function halvable
 
    !> The shapes (nx, ny) of the grids t = 0..coarsest of a V-cycle smoothed by rows, given
    !> the stiffness symbol of the finest surface (`odd` its imaginary part): both axes halved
@@ -275,11 +276,6 @@ contains
       end do
       allocate (shapes(2, 0:k))
       shapes(:, :) = chosen(:, 0:k)
-   contains
-      pure logical function halvable(m)
-         integer, intent(in) :: m
-         halvable = mod(m, 2) == 0 .and. m/2 >= shortest_side
-      end function halvable
    end subroutine row_shapes
 
    !> The largest smoothing factor of the damped Jacobi step over the grids of the V-cycle
