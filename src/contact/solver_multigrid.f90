@@ -94,13 +94,14 @@ module lc_contact_solver_multigrid
    real(wp), parameter :: row_smoothing = 0.85_wp
    !> A grid with more than twice as many points along x as along y is smoothed by rows
    !> (grids halved along x alone until square: row_shapes) only where the Jacobi steps'
-   !> worst smoothing factor exceeds this. Measured on 512 x 128, 384 x 128 and 1024 x 256
-   !> points (periods 1 x 0.25, 0.75 x 0.25), h/lambda = 0.16, nu = 0.5, mu_c = 0.5: glassy
-   !> layers (E_inf/E0 = 100; Jacobi 0.990-0.997) at V tau/lambda = 0.03 to 1 took 146-471
-   !> transform pairs where the Jacobi steps took 285-573, at 10 160-184 where 156-179; the
-   !> standard linear solid (E_inf/E0 = 10; Jacobi 0.90-0.94) at 0.01 to 1 107-164 where
-   !> 71-152. Rows halving both axes there stall (the standard linear solid at 0.1 on 512 x
-   !> 128: 9532 pairs; docs/decisions/015-row-smoothing.md).
+   !> worst smoothing factor exceeds this. Measured on 512 x 128, 384 x 128, 768 x 256,
+   !> 1024 x 256 and 512 x 192 points (h/lambda = 0.16, nu = 0.3 and 0.5, mu_c = 0 and 0.5):
+   !> glassy layers (E_inf/E0 = 100; Jacobi 0.990-0.997) at V tau/lambda = 0.1 and 1 took
+   !> 146-409 transform pairs where the Jacobi steps took 285-527, at 10 159-182 where
+   !> 156-199, E_inf/E0 = 1000 at 1 331-468 where 2787-4490; smoothed so, the standard
+   !> linear solid (E_inf/E0 = 10; Jacobi 0.90-0.94) at 0.01 to 1 took 107-164 where 71-152.
+   !> Rows halving both axes there stall (the standard linear solid at 0.1 on 512 x 128:
+   !> 9532 pairs; docs/decisions/015-row-smoothing.md).
    real(wp), parameter :: elongated_row_smoothing = 0.98_wp
    !> A coupled surface whose loss is not largest at long waves (loss_at_long_waves) builds
    !> K's own hierarchy, smoothed by rows, where its loss among the waves short along x
