@@ -42,8 +42,9 @@
 !> grids halved along one axis, or smoothing by rows).
 module lc_contact_solver_multigrid
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp
+   use lc_kinds, only: wp, i8
    use lc_errors, only: error_type
+   use lc_memory, only: available_bytes
    use lc_strings, only: to_string, formatted
    use lc_contact_operator, only: compliance_operator
    use lc_contact_multigrid_hierarchy, only: hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, &
@@ -160,8 +161,25 @@ module lc_contact_solver_multigrid
    !> coupled_tnnmg: directions kept by the GCR on the truncated Newton problem (restarted
    !> when full).
    integer, parameter :: gcr_memory = 10
-   !> coupled_tnnmg: iterations without the residual halving after which it stops.
+   !> ... On a line, a finishing phase whose GCR stagnates (its Newton residual not reduced
+   !> by violated_reduction: the restarted GCR on a strongly non-normal K, glassy layers
+   !> near their loss peak) doubles the directions kept, up to this many, where half the
+   !> memory available holds them; a phase then runs at least as many iterations as it
+   !> keeps. Glassy lines of 16384 points (E_inf/E0 = 500 to 2000, V tau/lambda = 3e-3 to
+   !> 0.1, both roughness families): 4 of 24 do not converge with 10 directions, 1 with 40
+   !> (80: 1, and up to 2.3x the time of 40). A surface keeps gcr_memory: at 512^2 (E_inf/E0
+   !> = 300 and 1000) 40 directions saved 11-15 % of the transform pairs and cost 30 % more
+   !> time, their Gram-Schmidt passes over 2 MB vectors outweighing the transforms saved
+   !> (docs/decisions/012-coupled-multigrid.md).
+   integer, parameter :: longest_gcr_memory = 40
+   !> coupled_tnnmg: iterations without the residual halving after which it stops, or the
+   !> first time goes on from its best iterate with exact Newton steps: GCR to a residual
+   !> reduced by exact_reduction in at most exact_iterations, the projected step taken in
+   !> full (a primal-dual active set step) where the line search of the symmetric part's
+   !> energy crawls on a strongly non-symmetric K (glassy layers near their loss peak).
    integer, parameter :: coupled_stall = 30
+   integer, parameter :: exact_iterations = 20
+   real(wp), parameter :: exact_reduction = 0.01_wp
 
    !> What one multigrid solve did. `iterations` counts the TNNMG iterations on the finest
    !> grid (a finishing CG phase counts as one); `fft_pairs` every transform pair on every
@@ -529,7 +547,9 @@ contains
    !> I K I c = -I p by GCR right-preconditioned by the symmetric multigrid preconditioner of
    !> the metric |G_eff| (the hierarchy's, whose penalty stands for the contact set), the
    !> direction projected onto u >= o and its step from the quadratic model of the symmetric
-   !> part. It stops when its residual has not halved in coupled_stall iterations. p: in, the
+   !> part. Where its residual has not halved in coupled_stall iterations it goes on from its
+   !> best iterate with exact Newton steps taken in full (a primal-dual active set
+   !> iteration), and stops when those stall too. p: in, the
    !> start (the coarse start's interpolated solution, or the caller's guess); out, the
    !> solution, or the best iterate if it did not converge. The metric must pass
    !> metric_refusal.
@@ -554,8 +574,8 @@ contains
       real(wp), allocatable :: symbol(:), odd(:)
       logical :: complex_symbol
       real(wp) :: f, d, b_max, residual, contact, best, best_residual
-      integer :: n, step, changed, j, last_progress
-      logical :: settled, finished, clipped, tension
+      integer :: n, step, changed, j, last_progress, memory
+      logical :: settled, finished, clipped, tension, stagnated, exact
       logical :: rows
 
       n = size(p)
@@ -577,7 +597,8 @@ contains
          if (real(op%inverse_full(j)) > 0.0_wp) &
             & d = max(d, jacobi_margin*omega*abs(op%inverse_full(j))**2/(2*real(op%inverse_full(j))))
       end do
-      allocate (u(n), o(n), c(n), kc(n), v(n), kv(n), r(n), u_best(n), dirs(n, gcr_memory), kdirs(n, gcr_memory))
+      memory = gcr_memory
+      allocate (u(n), o(n), c(n), kc(n), v(n), kv(n), r(n), u_best(n), dirs(n, memory), kdirs(n, memory))
       f = merge(mean_pressure, 0.0_wp, load_control)
       o = b
       if (.not. load_control) o = o + s
@@ -596,6 +617,7 @@ contains
       best = huge(1.0_wp)
       best_residual = huge(1.0_wp)
       last_progress = 0
+      exact = .false.
       do step = 1, max_iter
          outcome%iterations = step
          u = max(o, u - (omega/d)*p)
@@ -614,7 +636,14 @@ contains
             last_progress = step
          else if (step - last_progress > coupled_stall) then
             ! (the non-symmetric part defeats the iteration: strongly glassy layers)
-            exit
+            if (exact) exit
+            exact = .true.
+            best = best_residual
+            last_progress = step
+            u = u_best
+            call apply_k(u, p)
+            call examine(u, p, o, scales, h%free, residual, contact, changed, tension)
+            changed = max(changed, 1)
          end if
          if (load_control .and. contact == 0.0_wp) then
             u = u - minval(u - o)
@@ -624,7 +653,10 @@ contains
          if (changed > 0 .or. step == 1) call set_contact(h)
          finished = .false.
          if (settled) then
-            call truncated_gcr(finish_iterations, 0.0_wp, .true.)
+            call truncated_gcr(max(finish_iterations, memory), 0.0_wp, .true.)
+            if (stagnated) call lengthen_memory()
+         else if (exact) then
+            call truncated_gcr(exact_iterations, exact_reduction, .false.)
          else
             call truncated_gcr(newton_iterations, newton_reduction, .false.)
          end if
@@ -640,7 +672,12 @@ contains
          else
             kv = kc
          end if
-         call line_step(v, kv, dot_product(v, kv), u, p)
+         if (exact) then
+            u = u + v
+            p = p + kv
+         else
+            call line_step(v, kv, dot_product(v, kv), u, p)
+         end if
       end do
       if (.not. (residual <= tol) .and. best_residual < residual) then
          u = u_best
@@ -654,6 +691,22 @@ contains
       outcome%fft_pairs = nint(h%pairs)
       outcome%vcycles = h%vcycles
    contains
+      !> Doubles the GCR's directions on a line (up to longest_gcr_memory) if their arrays fit
+      !> in half the memory available.
+      subroutine lengthen_memory()
+         integer(i8) :: available
+         character(len=:), allocatable :: limit
+         integer :: longer
+         if (.not. op%grid%is_line()) return
+         longer = min(2*memory, longest_gcr_memory)
+         if (longer == memory) return
+         call available_bytes(available, limit)
+         if (16_i8*(longer - memory)*n > available/2) return
+         memory = longer
+         deallocate (dirs, kdirs)
+         allocate (dirs(n, memory), kdirs(n, memory))
+      end subroutine lengthen_memory
+
       !> y = K x + shift (f by default): a transform pair of the finest grid
       subroutine apply_k(x, y, shift)
          real(wp), contiguous, intent(in) :: x(:)
@@ -672,11 +725,13 @@ contains
       end subroutine apply_k
 
       !> GCR on I K I c = -I p from c = 0 (kc = K c), right-preconditioned by the multigrid
-      !> preconditioner, restarted every gcr_memory iterations; at most max_steps
+      !> preconditioner, restarted every `memory` iterations; at most max_steps
       !> iterations or a residual reduced by `reduction`. check: after every iteration the
       !> complementarity residual of (u + c, p + kc); `finished` when it is at most tol;
       !> once a point leaves the feasible set the checks stop and c is iterated as a Newton
-      !> step to a residual reduced by violated_reduction.
+      !> step to a residual reduced by violated_reduction; `stagnated` when all max_steps
+      !> iterations of a checked phase ran and left more than violated_reduction of the
+      !> Newton problem's residual.
       subroutine truncated_gcr(max_steps, reduction, check)
          integer, intent(in) :: max_steps
          real(wp), intent(in) :: reduction
@@ -686,13 +741,14 @@ contains
          logical :: gone, violated
          c = 0.0_wp
          kc = 0.0_wp
+         stagnated = .false.
          r = -h%free*p
          b_norm = norm2(r)
          if (b_norm == 0.0_wp) return
          columns = 0
          gone = .false.
          do it = 1, max_steps
-            if (columns == gcr_memory) columns = 0
+            if (columns == memory) columns = 0
             columns = columns + 1
             associate (z => dirs(:, columns), kz => kdirs(:, columns), free => h%free)
             call precondition(h, r, z)
@@ -750,6 +806,7 @@ contains
             end if
             end associate
          end do
+         stagnated = check .and. .not. finished .and. it > max_steps .and. norm2(r) > violated_reduction*b_norm
       end subroutine truncated_gcr
    end subroutine coupled_tnnmg
 
