@@ -464,6 +464,23 @@ def test_auto_takes_the_multigrid_for_a_sliding_viscoelastic_surface_from_512_sq
     assert glassy.fft_pairs <= 900, glassy.fft_pairs
 
 
+def test_auto_takes_the_multigrid_for_a_line_lossy_among_its_short_waves_from_4096_points():
+    """Method 'auto' sends a sliding viscoelastic line of 4096 points or more whose loss
+    peaks among its short waves (E_inf/E0 = 100 at V tau/lambda = 0.01: loss 4.95 at
+    |kx| ~ 160) to the multigrid method, easy coarse solve or not (GCR with its kept history
+    took 1143 transform pairs, 2.9x the time; measured 386); at V tau/lambda = 1 the loss
+    peaks at the long waves and the line stays on GCR (138 pairs, 0.4x the multigrid's
+    time), and so does the line of 2048 points."""
+    glassy = lc.StandardLinearSolid(e0=1.0, e_inf=100.0, tau=1.0)
+    kw = dict(thickness=0.16, poisson=0.5, friction=0.5, mean_pressure=0.02, tol=1e-8, stress=False,
+              material=glassy)
+    lossy = lc.solve_line(profile(4096, "physical"), speed=0.01, **kw)
+    assert lossy.converged and lossy.solver == "multigrid"
+    assert lossy.fft_pairs <= 500, lossy.fft_pairs
+    assert lc.solve_line(profile(4096, "physical"), speed=1.0, **kw).solver == "gcr"
+    assert lc.solve_line(profile(2048, "physical"), speed=0.01, **kw).solver.startswith("gcr")
+
+
 def test_auto_takes_the_multigrid_for_a_thin_incompressible_line_from_262144_points():
     """Method 'auto' sends the broadband thin incompressible line with friction to the
     multigrid method from 262144 points (where GCR takes 1.1-2.1x its time), and keeps GCR

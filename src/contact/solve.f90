@@ -23,7 +23,7 @@ module lc_contact_solve
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
    use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, &
-      & coupled_tnnmg, allowed_rise, rows_ahead_of_gcr
+      & coupled_tnnmg, allowed_rise, rows_ahead_of_gcr, loss_among_short_waves
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -83,6 +83,18 @@ module lc_contact_solve
    !> tau/lambda = 0.01) (docs/decisions/015-row-smoothing.md).
    integer, parameter :: rows_multigrid_surface_points = 512**2
    integer, parameter :: hard_coarse_iterations = 20, hard_coarse_surface_iterations = 12
+   !> A sliding viscoelastic line of at least lossy_multigrid_points points whose loss
+   !> |Im K|/Re K among the waves short along x (|kx| > nx/16) reaches short_wave_loss (its
+   !> loss peak among the short waves) goes to the multigrid method under 'auto' whatever its
+   !> coarse solve took: GCR, with its kept history and the Anderson iteration, crawls there.
+   !> Measured (h/lambda = 0.16, nu = 0.5, mu_c = 0.5, tol 1e-8, both roughness families):
+   !> at 4096 points GCR took 1.3-3.6x the multigrid's time at loss 1.4-5.0 (E_inf/E0 = 10
+   !> to 100, V tau/lambda = 1e-3 and 0.01; 0.9x once), at 2048 points 0.5-4.3x at loss
+   !> 8.6-22 (E_inf/E0 = 300 to 2000, V tau/lambda = 3e-3 to 0.03), at 1024 0.26-7.9x; where
+   !> the loss lies at long waves (V tau/lambda >= 0.1) GCR took 0.3-0.8x
+   !> (docs/decisions/012-coupled-multigrid.md).
+   integer, parameter :: lossy_multigrid_points = 4096
+   real(wp), parameter :: short_wave_loss = 1.0_wp
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
    !> coupled_refusal) goes the same way from this many points, with friction or without
    !> (the coarse solve's CG iterations counted then): with friction its multigrid solves
@@ -168,7 +180,8 @@ contains
       ! multigrid's coarse grids if the scene may go to it: refusals need the operator)
       if (kernel%coupled(friction)) then
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
-            & n >= coupled_threshold(grid, kernel%viscoelastic))
+            & n >= coupled_threshold(grid, kernel%viscoelastic)) .or. (scene%solver%method == 'auto' .and. &
+            & kernel%viscoelastic .and. grid%is_line() .and. n >= lossy_multigrid_points)
       else
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
@@ -282,6 +295,10 @@ contains
       end if
       if (method == 'auto' .and. .not. (op%coupled .or. rising) .and. len(reason) == 0 .and. &
          & grid%points() >= merge(multigrid_points, multigrid_surface_points, grid%is_line())) method = 'multigrid'
+      if (method == 'auto' .and. op%kernel%viscoelastic .and. grid%is_line() .and. len(reason) == 0 .and. &
+         & grid%points() >= lossy_multigrid_points) then
+         if (loss_among_short_waves(op) >= short_wave_loss) method = 'multigrid'
+      end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
       ! on the displacement, where this start solves each coarse grid to coarse_tol; on a
       ! coupled scene it takes the start, whose contact set is nearly right)

@@ -56,7 +56,7 @@ module lc_contact_solver_multigrid
    implicit none (type, external)
    private
    public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
-   public :: allowed_rise, rows_ahead_of_gcr
+   public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -853,6 +853,15 @@ contains
          if (16*kx > op%grid%nx) profile%short_x = max(profile%short_x, loss)
       end do
    end function loss_of
+
+   !> The largest loss |Im K|/Re K of a coupled scene among its waves short along x
+   !> (|kx| > nx/16).
+   pure real(wp) function loss_among_short_waves(op) result(loss)
+      type(compliance_operator), intent(in) :: op
+      type(loss_profile) :: profile
+      profile = loss_of(op)
+      loss = profile%short_x
+   end function loss_among_short_waves
 
    !> TNNMG iterations on the grid h%top from u until the residual on (K u + f, u - o) is at
    !> most tol or max_steps ran; p = K u + f on exit. steps: iterations run. history and
