@@ -88,11 +88,11 @@ module lc_contact_solve
    !> loss peak among the short waves) goes to the multigrid method under 'auto' whatever its
    !> coarse solve took: GCR, with its kept history and the Anderson iteration, crawls there.
    !> Measured (h/lambda = 0.16, nu = 0.5, mu_c = 0.5, tol 1e-8, both roughness families):
-   !> at 4096 points GCR took 1.3-3.6x the multigrid's time at loss 1.4-5.0 (E_inf/E0 = 10
-   !> to 100, V tau/lambda = 1e-3 and 0.01; 0.9x once), at 2048 points 0.5-4.3x at loss
-   !> 8.6-22 (E_inf/E0 = 300 to 2000, V tau/lambda = 3e-3 to 0.03), at 1024 0.26-7.9x; where
-   !> the loss lies at long waves (V tau/lambda >= 0.1) GCR took 0.3-0.8x
-   !> (docs/decisions/012-coupled-multigrid.md).
+   !> at 4096 points GCR took 0.9-3.6x the multigrid's time at loss 1.6-5.0 (E_inf/E0 = 30
+   !> and 100, V tau/lambda = 1e-3 and 0.01), 2.3-13x or no convergence at E_inf/E0 = 500
+   !> to 2000; at 2048 points 0.5-4.3x at loss 8.6-22 (E_inf/E0 = 300 to 2000, V tau/lambda =
+   !> 3e-3 to 0.03), at 1024 0.26-7.9x; where the loss lies at long waves (V tau/lambda >=
+   !> 0.1) GCR took 0.3-0.8x at 4096 (docs/decisions/012-coupled-multigrid.md).
    integer, parameter :: lossy_multigrid_points = 4096
    real(wp), parameter :: short_wave_loss = 1.0_wp
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by

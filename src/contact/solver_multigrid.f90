@@ -163,13 +163,15 @@ module lc_contact_solver_multigrid
    integer, parameter :: gcr_memory = 10
    !> ... On a line, a finishing phase whose GCR stagnates (its Newton residual not reduced
    !> by violated_reduction: the restarted GCR on a strongly non-normal K, glassy layers
-   !> near their loss peak) doubles the directions kept, up to this many, where half the
-   !> memory available holds them; a phase then runs at least as many iterations as it
-   !> keeps. Glassy lines of 16384 points (E_inf/E0 = 500 to 2000, V tau/lambda = 3e-3 to
-   !> 0.1, both roughness families): 4 of 24 do not converge with 10 directions, 1 with 40
-   !> (80: 1, and up to 2.3x the time of 40). A surface keeps gcr_memory: at 512^2 (E_inf/E0
-   !> = 300 and 1000) 40 directions saved 11-15 % of the transform pairs and cost 30 % more
-   !> time, their Gram-Schmidt passes over 2 MB vectors outweighing the transforms saved
+   !> near their loss peak) doubles the directions kept, up to this many (twice as many
+   !> once the exact Newton steps run), where half the memory available holds them; a phase
+   !> then runs at least as many iterations as it keeps. Glassy lines (E_inf/E0 = 1000 and
+   !> 2000, V tau/lambda = 3e-3 to 0.03, both roughness families): of 24 at 16384 points 4
+   !> do not converge with 10 directions, 1 with 40, 80 or 40 and 80; of 12 at 65536 2 with
+   !> 40, none with 40 and 80; 80 throughout took up to 1.8x the time of 40 where 40
+   !> sufficed. A surface keeps gcr_memory: at 512^2 (E_inf/E0 = 300 and 1000) 40 directions
+   !> saved 11-15 % of the transform pairs and cost 30 % more time, their Gram-Schmidt passes
+   !> over 2 MB vectors outweighing the transforms saved
    !> (docs/decisions/012-coupled-multigrid.md).
    integer, parameter :: longest_gcr_memory = 40
    !> coupled_tnnmg: iterations without the residual halving after which it stops, or the
@@ -691,14 +693,14 @@ contains
       outcome%fft_pairs = nint(h%pairs)
       outcome%vcycles = h%vcycles
    contains
-      !> Doubles the GCR's directions on a line (up to longest_gcr_memory) if their arrays fit
-      !> in half the memory available.
+      !> Doubles the GCR's directions on a line (up to longest_gcr_memory, twice that in the
+      !> exact Newton steps) if their arrays fit in half the memory available.
       subroutine lengthen_memory()
          integer(i8) :: available
          character(len=:), allocatable :: limit
          integer :: longer
          if (.not. op%grid%is_line()) return
-         longer = min(2*memory, longest_gcr_memory)
+         longer = min(2*memory, merge(2*longest_gcr_memory, longest_gcr_memory, exact))
          if (longer == memory) return
          call available_bytes(available, limit)
          if (16_i8*(longer - memory)*n > available/2) return
