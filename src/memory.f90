@@ -60,6 +60,9 @@ contains
       if (multigrid) doubles = merge(40, 27, line)
       ! (a coupled scene by the multigrid holds its arrays, then, if it stalls, GCR's history)
       if (coupled) doubles = 6 + 2*max(memory, 1)
+      ! (a coupled line by the multigrid may keep up to 140 doubles per point more in its
+      ! GCR's directions where a finishing phase stagnates, only where they fit in half the
+      ! memory then left: not counted here)
       if (coupled .and. multigrid) doubles = max(doubles, merge(62, 66, line))
       if (stress) doubles = doubles + 6
       bytes = 8_i8*doubles*points
