@@ -175,13 +175,21 @@ module lc_contact_solver_multigrid
    !> (docs/decisions/012-coupled-multigrid.md).
    integer, parameter :: longest_gcr_memory = 40
    !> coupled_tnnmg: iterations without the residual halving after which it stops, or the
-   !> first time goes on from its best iterate with exact Newton steps: GCR to a residual
-   !> reduced by exact_reduction in at most exact_iterations, the projected step taken in
-   !> full (a primal-dual active set step) where the line search of the symmetric part's
-   !> energy crawls on a strongly non-symmetric K (glassy layers near their loss peak).
+   !> first time (a very lossy material: exact_loss) goes on from its best iterate with
+   !> exact Newton steps: GCR to a residual reduced by exact_reduction in at most
+   !> exact_iterations, the projected step taken in full (a primal-dual active set step)
+   !> where the line search of the symmetric part's energy crawls on a strongly
+   !> non-symmetric K (glassy layers near their loss peak).
    integer, parameter :: coupled_stall = 30
    integer, parameter :: exact_iterations = 20
    real(wp), parameter :: exact_reduction = 0.01_wp
+   !> ... The exact steps are taken where the material's loss tangent on the grid's sliding
+   !> frequencies reaches this (material_loss); below, the GCR goes on at once. Lines of
+   !> 1024 to 65536 points, both families: with E_inf/E0 = 100 and 300 (loss tangent 4.95,
+   !> 8.6) the exact steps after a coarse grid's stall cost up to 1.6x the pairs of going on
+   !> with GCR and converged nothing that it did not; 500 (11.2) about the same either way;
+   !> 1000 and 2000 (15.8, 22.3) need them (docs/decisions/012-coupled-multigrid.md).
+   real(wp), parameter :: exact_loss = 10.0_wp
 
    !> What one multigrid solve did. `iterations` counts the TNNMG iterations on the finest
    !> grid (a finishing CG phase counts as one); `fft_pairs` every transform pair on every
@@ -549,9 +557,10 @@ contains
    !> I K I c = -I p by GCR right-preconditioned by the symmetric multigrid preconditioner of
    !> the metric |G_eff| (the hierarchy's, whose penalty stands for the contact set), the
    !> direction projected onto u >= o and its step from the quadratic model of the symmetric
-   !> part. Where its residual has not halved in coupled_stall iterations it goes on from its
-   !> best iterate with exact Newton steps taken in full (a primal-dual active set
-   !> iteration), and stops when those stall too. p: in, the
+   !> part. Where its residual has not halved in coupled_stall iterations it stops, or, on a
+   !> very lossy material (exact_loss), goes on from its best iterate with exact Newton
+   !> steps taken in full (a primal-dual active set iteration) and stops when those stall
+   !> too. p: in, the
    !> start (the coarse start's interpolated solution, or the caller's guess); out, the
    !> solution, or the best iterate if it did not converge. The metric must pass
    !> metric_refusal.
@@ -638,7 +647,7 @@ contains
             last_progress = step
          else if (step - last_progress > coupled_stall) then
             ! (the non-symmetric part defeats the iteration: strongly glassy layers)
-            if (exact) exit
+            if (exact .or. material_loss(op) < exact_loss) exit
             exact = .true.
             best = best_residual
             last_progress = step
@@ -855,6 +864,17 @@ contains
          if (16*kx > op%grid%nx) profile%short_x = max(profile%short_x, loss)
       end do
    end function loss_of
+
+   !> The largest loss tangent |Im C|/Re C of the layer's material over the grid's sliding
+   !> frequencies q_x V (C the contact compliance; 0 for an elastic layer).
+   pure real(wp) function material_loss(op) result(loss)
+      type(compliance_operator), intent(in) :: op
+      integer :: i
+      loss = 0.0_wp
+      do i = 1, size(op%compliance)
+         if (real(op%compliance(i)) > 0.0_wp) loss = max(loss, abs(aimag(op%compliance(i)))/real(op%compliance(i)))
+      end do
+   end function material_loss
 
    !> The largest loss |Im K|/Re K of a coupled scene among its waves short along x
    !> (|kx| > nx/16).
