@@ -275,14 +275,15 @@ def test_a_glassy_layer_it_cannot_solve_goes_on_with_gcr():
     assert res.residual <= 1e-9
 
 
-@pytest.mark.parametrize("family, speed, max_pairs", [("physical", 0.01, 4000), ("broadband", 0.003, 8000)])
+@pytest.mark.parametrize("family, speed, max_pairs", [("physical", 0.01, 5000), ("broadband", 0.01, 6000)])
 def test_a_very_glassy_line_converges_by_exact_newton_steps(family, speed, max_pairs):
     """E_inf/E0 = 1000 (largest loss tangent 15.8) with friction, near its loss peak: the
     line search of the symmetric part's energy crawls, and the restarted GCR of the
     finishing phase stagnates on the strongly non-normal stiffness; the exact Newton steps
     taken in full and the longer GCR memory converge it without the GCR fallback (measured:
-    2642 and 5342 transform pairs; before, neither converged in 100000 iterations). The
-    contact conditions recomputed with numpy's operator hold to the tolerance."""
+    2582-3134 and 2887-4618 transform pairs, under loads perturbed by 1e-9 and 1e-7 and
+    reordered sums; the path through these iterations depends on rounding). The contact
+    conditions recomputed with numpy's operator hold to the tolerance."""
     h = profile(16384, family)
     glassy = lc.StandardLinearSolid(e0=1.0, e_inf=1000.0, tau=1.0)
     tol = 1e-8

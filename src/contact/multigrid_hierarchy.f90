@@ -452,7 +452,7 @@ contains
       associate (lv => h%level(t))
       if (h%rows) then
          call solve_rows(h, t, lv%rhs)
-         lv%x = lv%jacobi*lv%fft%real_buffer
+         call multiply(lv%jacobi, lv%fft%real_buffer, lv%x)
       else
          lv%x = lv%jacobi*lv%rhs
       end if
@@ -463,7 +463,7 @@ contains
       call level_residual(h, t)
       if (h%rows) then
          call solve_rows(h, t, lv%residual)
-         lv%x = lv%x + lv%jacobi*lv%fft%real_buffer
+         call multiply(lv%jacobi, lv%fft%real_buffer, lv%x, accumulate=.true.)
       else
          lv%x = lv%x + lv%jacobi*lv%residual
       end if
@@ -484,7 +484,7 @@ contains
       real(wp), contiguous, intent(in) :: r(:)
       integer :: row, nkx
       associate (lv => h%level(t))
-      lv%fft%real_buffer = r
+      call copy(r, lv%fft%real_buffer)
       call lv%fft%rows_forward_unscaled()
       nkx = lv%nx/2 + 1
       do row = 0, lv%ny - 1
@@ -506,12 +506,38 @@ contains
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
       associate (lv => h%level(t))
-      lv%fft%real_buffer = lv%x
+      call copy(lv%x, lv%fft%real_buffer)
       call transform(h, t)
-      lv%residual = lv%rhs - lv%fft%real_buffer
+      call difference(lv%rhs, lv%fft%real_buffer, lv%residual)
       call subtract_stencil(lv%penalty, lv%x, lv%residual, lv%nx, lv%ny)
       end associate
    end subroutine level_residual
+
+   !> The passes through a plan's buffer (a pointer component, which gfortran reads through
+   !> its descriptor at every element, unvectorised) go through these procedures, whose
+   !> contiguous dummies vectorise: b = a; c = a - b; c = a b, or c = c + a b.
+   pure subroutine copy(a, b)
+      real(wp), contiguous, intent(in) :: a(:)
+      real(wp), contiguous, intent(out) :: b(:)
+      b = a
+   end subroutine copy
+
+   pure subroutine difference(a, b, c)
+      real(wp), contiguous, intent(in) :: a(:), b(:)
+      real(wp), contiguous, intent(out) :: c(:)
+      c = a - b
+   end subroutine difference
+
+   pure subroutine multiply(a, b, c, accumulate)
+      real(wp), contiguous, intent(in) :: a(:), b(:)
+      real(wp), contiguous, intent(inout) :: c(:)
+      logical, intent(in), optional :: accumulate
+      if (present(accumulate)) then
+         c = c + a*b
+      else
+         c = a*b
+      end if
+   end subroutine multiply
 
    !> y = A_t x, the operator of level t: its circulant plus, on a coarse level, the
    !> penalty's stencil (the V-cycle's operator; on the grid being solved the circulant K
@@ -566,22 +592,29 @@ contains
       real(wp), intent(in), optional :: shift   !< added to y
       real(wp), intent(out), optional :: xy     !< x.y (without the shift)
       real(wp) :: f, dot
-      integer :: j
-      h%level(h%top)%fft%real_buffer = x
+      call copy(x, h%level(h%top)%fft%real_buffer)
       call transform(h, h%top)
       ! (the shift and the product in the pass that reads the result out)
       f = 0.0_wp
       if (present(shift)) f = shift
+      call read_out(h%level(h%top)%fft%real_buffer, x, f, y, dot)
+      if (present(xy)) xy = dot
+   end subroutine apply_stiffness
+
+   !> y = buffer + f and x.buffer in one pass (see copy)
+   pure subroutine read_out(buffer, x, f, y, dot)
+      real(wp), contiguous, intent(in) :: buffer(:), x(:)
+      real(wp), intent(in) :: f
+      real(wp), contiguous, intent(out) :: y(:)
+      real(wp), intent(out) :: dot
+      integer :: j
       dot = 0.0_wp
-      associate (buffer => h%level(h%top)%fft%real_buffer)
       !$omp simd reduction(+:dot)
       do j = 1, size(x)
          dot = dot + x(j)*buffer(j)
          y(j) = buffer(j) + f
       end do
-      end associate
-      if (present(xy)) xy = dot
-   end subroutine apply_stiffness
+   end subroutine read_out
 
    !> The buffer of level t times its circulant, counted in pairs of the finest grid.
    subroutine transform(h, t)
@@ -698,30 +731,26 @@ contains
       real(wp), intent(inout) :: fine(nx, ny)
       real(wp), intent(in), optional :: free(nx, ny), base(nx, ny)
       real(wp), intent(in), optional :: scale
-      integer :: i, j, m
+      integer :: j, m
+      ! (the last point of a row, between the last coarse point and the first, apart: the
+      ! passes over the others then vectorise)
       m = nx/2
-      if (present(base)) then
-         do j = 1, ny
-            do i = 1, m
-               fine(2*i - 1, j) = scale*base(2*i - 1, j) + free(2*i - 1, j)*coarse(i, j)
-               fine(2*i, j) = scale*base(2*i, j) + free(2*i, j)*0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
-            end do
-         end do
-      else if (present(free)) then
-         do j = 1, ny
-            do i = 1, m
-               fine(2*i - 1, j) = fine(2*i - 1, j) + free(2*i - 1, j)*coarse(i, j)
-               fine(2*i, j) = fine(2*i, j) + free(2*i, j)*0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
-            end do
-         end do
-      else
-         do j = 1, ny
-            do i = 1, m
-               fine(2*i - 1, j) = fine(2*i - 1, j) + coarse(i, j)
-               fine(2*i, j) = fine(2*i, j) + 0.5_wp*(coarse(i, j) + coarse(mod(i, m) + 1, j))
-            end do
-         end do
-      end if
+      do j = 1, ny
+         if (present(base)) then
+            fine(1:nx:2, j) = scale*base(1:nx:2, j) + free(1:nx:2, j)*coarse(:, j)
+            fine(2:nx - 2:2, j) = scale*base(2:nx - 2:2, j) + free(2:nx - 2:2, j)*0.5_wp*(coarse(1:m - 1, j) + &
+               & coarse(2:m, j))
+            fine(nx, j) = scale*base(nx, j) + free(nx, j)*0.5_wp*(coarse(m, j) + coarse(1, j))
+         else if (present(free)) then
+            fine(1:nx:2, j) = fine(1:nx:2, j) + free(1:nx:2, j)*coarse(:, j)
+            fine(2:nx - 2:2, j) = fine(2:nx - 2:2, j) + free(2:nx - 2:2, j)*0.5_wp*(coarse(1:m - 1, j) + coarse(2:m, j))
+            fine(nx, j) = fine(nx, j) + free(nx, j)*0.5_wp*(coarse(m, j) + coarse(1, j))
+         else
+            fine(1:nx:2, j) = fine(1:nx:2, j) + coarse(:, j)
+            fine(2:nx - 2:2, j) = fine(2:nx - 2:2, j) + 0.5_wp*(coarse(1:m - 1, j) + coarse(2:m, j))
+            fine(nx, j) = fine(nx, j) + 0.5_wp*(coarse(m, j) + coarse(1, j))
+         end if
+      end do
    end subroutine prolong_x_add
 
    !> Along y: fine = P coarse (assigned).
@@ -1086,7 +1115,7 @@ contains
       b = 0.0_wp
       do cx = 0, nx/2 - 1
          ! the fine points 2 cx - 1, 2 cx, 2 cx + 1 (weights 1/2, 1, 1/2 from cx)
-         left = weight*(1.0_wp - free(modulo(2*cx - 1, nx)))
+         left = weight*(1.0_wp - free(merge(nx - 1, 2*cx - 1, cx == 0)))
          centre = weight*(1.0_wp - free(2*cx))
          right = weight*(1.0_wp - free(2*cx + 1))
          b(0, 0, cx) = centre + 0.25_wp*(left + right)
@@ -1112,23 +1141,17 @@ contains
       integer, intent(in) :: nx, reach
       real(wp), intent(in) :: a(-1:1, -reach:reach, 0:nx - 1)
       real(wp), intent(out) :: b(-1:1, -reach:reach, 0:nx/2 - 1)
-      integer :: to(2, -2:2), cx, k, e, ix, j, ey
-      real(wp) :: of(2, -2:2), w
-      call interpolation_weights(to, of)
-      b = 0.0_wp
+      integer :: cx, l, c, r
+      ! (the coarse point cx takes the fine points l, c, r = 2 cx - 1, 2 cx, 2 cx + 1 with
+      ! the weights 1/2, 1, 1/2: interpolation_weights written out, one pass without branches)
       do cx = 0, nx/2 - 1
-         do k = -1, 1
-            ix = modulo(2*cx + k, nx)
-            do e = -1, 1
-               do j = 1, 2
-                  w = of(1, k)*of(j, k + e)
-                  if (w == 0.0_wp) cycle
-                  do ey = -reach, reach
-                     b(to(j, k + e), ey, cx) = b(to(j, k + e), ey, cx) + w*a(e, ey, ix)
-                  end do
-               end do
-            end do
-         end do
+         l = merge(nx - 1, 2*cx - 1, cx == 0)
+         c = 2*cx
+         r = 2*cx + 1
+         b(0, :, cx) = a(0, :, c) + 0.5_wp*(a(-1, :, c) + a(1, :, c) + a(1, :, l) + a(-1, :, r)) &
+            & + 0.25_wp*(a(0, :, l) + a(0, :, r))
+         b(1, :, cx) = 0.5_wp*(a(1, :, c) + a(1, :, r)) + 0.25_wp*a(0, :, r)
+         b(-1, :, cx) = 0.5_wp*(a(-1, :, c) + a(-1, :, l)) + 0.25_wp*a(0, :, l)
       end do
    end subroutine coarsen_x
 

@@ -747,14 +747,14 @@ contains
          integer, intent(in) :: max_steps
          real(wp), intent(in) :: reduction
          logical, intent(in) :: check
-         real(wp) :: b_norm, r_norm, beta, norm, gamma, res
-         integer :: it, k, columns, jj
+         real(wp) :: b_norm, r_norm, norm, gamma, res
+         integer :: it, columns
          logical :: gone, violated
          c = 0.0_wp
          kc = 0.0_wp
          stagnated = .false.
          r = -h%free*p
-         b_norm = norm2(r)
+         b_norm = euclidean_norm(r)
          if (b_norm == 0.0_wp) return
          columns = 0
          gone = .false.
@@ -764,26 +764,9 @@ contains
             associate (z => dirs(:, columns), kz => kdirs(:, columns), free => h%free)
             call precondition(h, r, z)
             call apply_k(z, kz, shift=0.0_wp)
-            ! orthogonal on the free points to the stored images (modified Gram-Schmidt)
-            do k = 1, columns - 1
-               beta = 0.0_wp
-               !$omp simd reduction(+:beta)
-               do jj = 1, n
-                  beta = beta + free(jj)*kz(jj)*kdirs(jj, k)
-               end do
-               !$omp simd
-               do jj = 1, n
-                  z(jj) = z(jj) - beta*dirs(jj, k)
-                  kz(jj) = kz(jj) - beta*kdirs(jj, k)
-               end do
-            end do
-            norm = 0.0_wp
-            gamma = 0.0_wp
-            !$omp simd reduction(+:norm, gamma)
-            do jj = 1, n
-               norm = norm + free(jj)*kz(jj)**2
-               gamma = gamma + free(jj)*r(jj)*kz(jj)
-            end do
+            ! (orthogonal on the free points to the stored images)
+            call orthogonalise(z, kz, dirs(:, :columns - 1), kdirs(:, :columns - 1), free)
+            call masked_products(kz, r, free, norm, gamma)
             norm = sqrt(norm)
             if (.not. norm > 0.0_wp) exit
             ! the minimal-residual step along z (z and kz then scaled to a unit image)
@@ -792,7 +775,7 @@ contains
                call step_and_check(u, o, p, gamma, z, kz, free, c, kc, r, scales, res, violated)
                z = z/norm
                kz = kz/norm
-               r_norm = norm2(r)
+               r_norm = euclidean_norm(r)
                if (violated) then
                   ! the set is not yet the final one: go on as a Newton step
                   gone = .true.
@@ -803,21 +786,12 @@ contains
                   exit
                end if
             else
-               r_norm = 0.0_wp
-               !$omp simd reduction(+:r_norm)
-               do jj = 1, n
-                  c(jj) = c(jj) + gamma*z(jj)
-                  kc(jj) = kc(jj) + gamma*kz(jj)
-                  r(jj) = r(jj) - gamma*free(jj)*kz(jj)
-                  z(jj) = z(jj)/norm
-                  kz(jj) = kz(jj)/norm
-                  r_norm = r_norm + r(jj)**2
-               end do
-               if (sqrt(r_norm) <= merge(violated_reduction, reduction, gone)*b_norm) exit
+               call minimal_residual_step(gamma, norm, z, kz, free, c, kc, r, r_norm)
+               if (r_norm <= merge(violated_reduction, reduction, gone)*b_norm) exit
             end if
             end associate
          end do
-         stagnated = check .and. .not. finished .and. it > max_steps .and. norm2(r) > violated_reduction*b_norm
+         stagnated = check .and. .not. finished .and. it > max_steps .and. euclidean_norm(r) > violated_reduction*b_norm
       end subroutine truncated_gcr
    end subroutine coupled_tnnmg
 
@@ -1037,7 +1011,7 @@ contains
       if (present(finished)) finished = .false.
       associate (r => work(:, 1), d => work(:, 2), kd => work(:, 3), free => h%free(1:m))
       r = -free*p
-      b_norm = norm2(r)
+      b_norm = euclidean_norm(r)
       if (b_norm == 0.0_wp) return
       call precondition(h, r, d)
       rz = dot_product(r, d)
@@ -1052,7 +1026,7 @@ contains
                ! the set is not yet the final one: go on as a Newton step (to a residual
                ! reduced by violated_reduction), which the line search then projects
                gone = .true.
-               if (norm2(r) <= violated_reduction*b_norm) exit
+               if (euclidean_norm(r) <= violated_reduction*b_norm) exit
             else if (residual <= tol) then
                finished = .true.
                exit
@@ -1136,6 +1110,77 @@ contains
       changed = nint(moved)
       tension = pulled > 0.0_wp
    end subroutine examine
+
+   !> z, kz <- z - sum_k beta_k dirs_k, kz - sum_k beta_k kdirs_k with beta_k = (I kz, kdirs_k),
+   !> one column after the other (modified Gram-Schmidt on the free points against unit
+   !> images kdirs_k). Its own procedure with contiguous dummies, which do not alias, so
+   !> that the passes vectorise.
+   pure subroutine orthogonalise(z, kz, dirs, kdirs, free)
+      real(wp), contiguous, intent(inout) :: z(:), kz(:)
+      real(wp), contiguous, intent(in) :: dirs(:, :), kdirs(:, :), free(:)
+      real(wp) :: beta
+      integer :: k, j
+      do k = 1, size(dirs, 2)
+         beta = 0.0_wp
+         !$omp simd reduction(+:beta)
+         do j = 1, size(z)
+            beta = beta + free(j)*kz(j)*kdirs(j, k)
+         end do
+         !$omp simd
+         do j = 1, size(z)
+            z(j) = z(j) - beta*dirs(j, k)
+            kz(j) = kz(j) - beta*kdirs(j, k)
+         end do
+      end do
+   end subroutine orthogonalise
+
+   !> |x|, in one vectorised pass (the intrinsic norm2 scales every element against
+   !> overflow, several times the cost; these residuals are far from the overflow threshold)
+   pure real(wp) function euclidean_norm(x) result(norm)
+      real(wp), contiguous, intent(in) :: x(:)
+      integer :: j
+      norm = 0.0_wp
+      !$omp simd reduction(+:norm)
+      do j = 1, size(x)
+         norm = norm + x(j)**2
+      end do
+      norm = sqrt(norm)
+   end function euclidean_norm
+
+   !> (I kz, kz) and (I r, kz)
+   pure subroutine masked_products(kz, r, free, squared, projection)
+      real(wp), contiguous, intent(in) :: kz(:), r(:), free(:)
+      real(wp), intent(out) :: squared, projection
+      integer :: j
+      squared = 0.0_wp
+      projection = 0.0_wp
+      !$omp simd reduction(+:squared, projection)
+      do j = 1, size(kz)
+         squared = squared + free(j)*kz(j)**2
+         projection = projection + free(j)*r(j)*kz(j)
+      end do
+   end subroutine masked_products
+
+   !> The GCR step c += gamma z, kc += gamma kz, r -= gamma I kz, with z and kz then scaled
+   !> by 1/norm (a unit image), and |r|.
+   pure subroutine minimal_residual_step(gamma, norm, z, kz, free, c, kc, r, r_norm)
+      real(wp), intent(in) :: gamma, norm
+      real(wp), contiguous, intent(inout) :: z(:), kz(:), c(:), kc(:), r(:)
+      real(wp), contiguous, intent(in) :: free(:)
+      real(wp), intent(out) :: r_norm
+      integer :: j
+      r_norm = 0.0_wp
+      !$omp simd reduction(+:r_norm)
+      do j = 1, size(z)
+         c(j) = c(j) + gamma*z(j)
+         kc(j) = kc(j) + gamma*kz(j)
+         r(j) = r(j) - gamma*free(j)*kz(j)
+         z(j) = z(j)/norm
+         kz(j) = kz(j)/norm
+         r_norm = r_norm + r(j)**2
+      end do
+      r_norm = sqrt(r_norm)
+   end subroutine minimal_residual_step
 
    !> The finishing phase's CG step (c += a d, kc += a kd, r -= a I kd) and its check of
    !> (u + c, p + kc), in one pass: the residual, and whether a point left the feasible set
