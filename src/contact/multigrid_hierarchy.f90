@@ -142,6 +142,10 @@ module lc_contact_multigrid_hierarchy
       !> Smoothing by rows (solve_rows) in place of Jacobi steps, on the grids of row_shapes:
       !> for a layer sliding along x, whose modulus depends on q_x
       logical :: rows = .false.
+      !> V(0,1)-cycles: each coarse grid smooths only after its coarse correction (one
+      !> residual, one transform pair of the grid, where V(1,1) takes two). The
+      !> preconditioner of a flexible method (GCR) need not be symmetric; CG's must.
+      logical :: sawtooth = .false.
       integer, allocatable :: pivots(:)
       real(wp), allocatable :: free(:)           !< 1 off the contact set, 0 on it (top grid)
       real(wp), allocatable :: dense(:, :)       !< Cholesky (LU) factor of the coarsest operator
@@ -439,8 +443,9 @@ contains
       end if
    end subroutine precondition
 
-   !> One V(1,1)-cycle on the coarse level t > h%top: x ~ A_t^-1 rhs with the penalised
-   !> Galerkin operators; the coarsest grid is solved exactly.
+   !> One V(1,1)-cycle (V(0,1) for a sawtooth hierarchy) on the coarse level t > h%top:
+   !> x ~ A_t^-1 rhs with the penalised Galerkin operators; the coarsest grid is solved
+   !> exactly.
    recursive subroutine vcycle(h, t)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
@@ -450,15 +455,21 @@ contains
          return
       end if
       associate (lv => h%level(t))
-      if (h%rows) then
-         call solve_rows(h, t, lv%rhs)
-         call multiply(lv%jacobi, lv%fft%real_buffer, lv%x)
+      if (h%sawtooth) then
+         call restrict(h, t, lv%rhs, h%level(t + 1)%rhs)
+         call vcycle(h, t + 1)
+         lv%x = 0.0_wp
       else
-         lv%x = lv%jacobi*lv%rhs
+         if (h%rows) then
+            call solve_rows(h, t, lv%rhs)
+            call multiply(lv%jacobi, lv%fft%real_buffer, lv%x)
+         else
+            lv%x = lv%jacobi*lv%rhs
+         end if
+         call level_residual(h, t)
+         call restrict(h, t, lv%residual, h%level(t + 1)%rhs)
+         call vcycle(h, t + 1)
       end if
-      call level_residual(h, t)
-      call restrict(h, t, lv%residual, h%level(t + 1)%rhs)
-      call vcycle(h, t + 1)
       call prolong_add(h, t, h%level(t + 1)%x, lv%x)
       call level_residual(h, t)
       if (h%rows) then

@@ -169,9 +169,9 @@ module lc_contact_solver_multigrid
    !> 2000, V tau/lambda = 3e-3 to 0.03, both roughness families): of 24 at 16384 points 4
    !> do not converge with 10 directions, 1 with 40, 80 or 40 and 80; of 12 at 65536 2 with
    !> 40, none with 40 and 80; 80 throughout took up to 1.8x the time of 40 where 40
-   !> sufficed. A surface keeps gcr_memory: at 512^2 (E_inf/E0 = 300 and 1000) 40 directions
-   !> saved 11-15 % of the transform pairs and cost 30 % more time, their Gram-Schmidt passes
-   !> over 2 MB vectors outweighing the transforms saved
+   !> sufficed. A surface keeps gcr_memory: at 512^2 (E_inf/E0 = 100 to 1000) 40 directions
+   !> saved about 10 % of the transform pairs and cost 1-25 % more time, their Gram-Schmidt
+   !> passes over 2 MB vectors outweighing the transforms saved
    !> (docs/decisions/012-coupled-multigrid.md).
    integer, parameter :: longest_gcr_memory = 40
    !> coupled_tnnmg: iterations without the residual halving after which it stops, or the
@@ -602,6 +602,11 @@ contains
          if (allocated(error)) return
          call set_grid(h, 0, symbol)
       end if
+      ! (GCR takes a preconditioner that is not symmetric. On a surface V(0,1)-cycles take
+      ! 10-20 % fewer transform pairs than V(1,1), 0.84-1.03 of the time; a line keeps
+      ! V(1,1): V(0,1) took 0.91-1.07 of its time there, and its pairs grew with the grid,
+      ! max/min 1.40-1.74 from 1024 to 2^20 points against 1.13-1.49; decisions/012)
+      h%sawtooth = .not. op%grid%is_line()
       ! (the Jacobi diagonal: see jacobi_margin; modes with Re K <= 0 are not damped by any)
       d = op%inverse_diagonal
       do j = 1, op%nk
