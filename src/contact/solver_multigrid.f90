@@ -603,7 +603,7 @@ contains
          call set_grid(h, 0, symbol)
       end if
       ! (GCR takes a preconditioner that is not symmetric. On a surface V(0,1)-cycles take
-      ! 10-20 % fewer transform pairs than V(1,1), 0.84-1.03 of the time; a line keeps
+      ! 10-20 % fewer transform pairs than V(1,1), 0.79-1.03 of the time; a line keeps
       ! V(1,1): V(0,1) took 0.91-1.07 of its time there, and its pairs grew with the grid,
       ! max/min 1.40-1.74 from 1024 to 2^20 points against 1.13-1.49; decisions/012)
       h%sawtooth = .not. op%grid%is_line()
