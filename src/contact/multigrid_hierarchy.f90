@@ -543,7 +543,10 @@ contains
       real(wp), contiguous, intent(in) :: a(:), b(:)
       real(wp), contiguous, intent(inout) :: c(:)
       logical, intent(in), optional :: accumulate
-      if (present(accumulate)) then
+      logical :: add
+      add = .false.
+      if (present(accumulate)) add = accumulate
+      if (add) then
          c = c + a*b
       else
          c = a*b
