@@ -429,7 +429,7 @@ contains
    !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
    !> (The stored images are centred on the set, so the mean of a need not be removed.)
    pure subroutine history_products(images, p, a, coeff)
-      real(wp), contiguous, intent(in) :: images(:, :), p(:), a(:)
+      real(wp), intent(in) :: images(:, :), p(:), a(:)
       real(wp), intent(out) :: coeff(:)
       real(wp) :: c
       integer :: i, i0, i1, k
@@ -449,9 +449,8 @@ contains
 
    !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks.
    pure subroutine subtract_history(dirs, images, coeff, d, a)
-      real(wp), contiguous, intent(in) :: dirs(:, :), images(:, :)
-      real(wp), intent(in) :: coeff(:)
-      real(wp), contiguous, intent(inout) :: d(:), a(:)
+      real(wp), intent(in) :: dirs(:, :), images(:, :), coeff(:)
+      real(wp), intent(inout) :: d(:), a(:)
       integer :: i, i0, i1, k
       do i0 = 1, size(a), block_rows
          i1 = min(size(a), i0 + block_rows - 1)
@@ -567,7 +566,7 @@ contains
    subroutine reorthonormalise(p, load_control, dirs, images, columns, newest)
       real(wp), contiguous, intent(in) :: p(:)
       logical, intent(in) :: load_control
-      real(wp), contiguous, intent(inout) :: dirs(:, :), images(:, :)
+      real(wp), intent(inout) :: dirs(:, :), images(:, :)
       integer, intent(inout) :: columns, newest
       real(wp), allocatable :: gram(:, :), sums(:), centre(:), length(:)
       integer, allocatable :: order(:)
@@ -663,7 +662,7 @@ contains
       real(wp), contiguous, intent(in) :: p(:)
       real(wp), contiguous, intent(in) :: delta(:)
       logical, intent(in) :: load_control
-      real(wp), contiguous, intent(inout) :: dirs(:, :), images(:, :)
+      real(wp), intent(inout) :: dirs(:, :), images(:, :)
       integer, intent(in) :: columns
       real(wp), contiguous, intent(out) :: work(:)
       integer, intent(inout) :: fft_pairs
