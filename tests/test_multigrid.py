@@ -472,7 +472,7 @@ def test_auto_takes_the_multigrid_for_a_line_lossy_among_its_short_waves_from_40
     |kx| ~ 160) to the multigrid method, easy coarse solve or not (GCR with its kept history
     took 1143 transform pairs, 2.9x the time; measured 386); at V tau/lambda = 1 the loss
     peaks at the long waves and the line stays on GCR (138 pairs, 0.4x the multigrid's
-    time), and so does the line of 2048 points."""
+    time), and so does the line of 2048 points, unless its loss there reaches 8."""
     glassy = lc.StandardLinearSolid(e0=1.0, e_inf=100.0, tau=1.0)
     kw = dict(thickness=0.16, poisson=0.5, friction=0.5, mean_pressure=0.02, tol=1e-8, stress=False,
               material=glassy)
@@ -481,6 +481,9 @@ def test_auto_takes_the_multigrid_for_a_line_lossy_among_its_short_waves_from_40
     assert lossy.fft_pairs <= 500, lossy.fft_pairs
     assert lc.solve_line(profile(4096, "physical"), speed=1.0, **kw).solver == "gcr"
     assert lc.solve_line(profile(2048, "physical"), speed=0.01, **kw).solver.startswith("gcr")
+    # a very glassy layer (loss 12.8 among the short waves) goes to it from 2048 points
+    very_glassy = dict(kw, material=lc.StandardLinearSolid(e0=1.0, e_inf=1000.0, tau=1.0))
+    assert lc.solve_line(profile(2048, "physical"), speed=0.01, **very_glassy).solver == "multigrid"
 
 
 def test_auto_takes_the_multigrid_for_a_thin_incompressible_line_from_262144_points():

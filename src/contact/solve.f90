@@ -95,6 +95,14 @@ module lc_contact_solve
    !> 0.1) GCR took 0.3-0.8x at 4096 (docs/decisions/012-coupled-multigrid.md).
    integer, parameter :: lossy_multigrid_points = 4096
    real(wp), parameter :: short_wave_loss = 1.0_wp
+   !> A very glassy line (that loss at least glassy_short_wave_loss: E_inf/E0 >~ 300 near its
+   !> peak) goes so from glassy_multigrid_points. Lines of 2048 points with E_inf/E0 = 500
+   !> to 2000 at V tau/lambda = 3e-3 to 0.1 (both families, bench/very_glassy.py): 1.15 s
+   !> in all where GCR with its kept history and the Anderson iteration took 2.60 s, faster
+   !> on 21 of 24; lines of 16384 points, whose coarse grids of 2048 points go so too:
+   !> 11.5 s where 14.0 s, the slowest 2.25 s where 3.08 s, but 5 of 24 up to 2x slower.
+   integer, parameter :: glassy_multigrid_points = 2048
+   real(wp), parameter :: glassy_short_wave_loss = 8.0_wp
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
    !> coupled_refusal) goes the same way from this many points, with friction or without
    !> (the coarse solve's CG iterations counted then): with friction its multigrid solves
@@ -181,7 +189,7 @@ contains
       if (kernel%coupled(friction)) then
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= coupled_threshold(grid, kernel%viscoelastic)) .or. (scene%solver%method == 'auto' .and. &
-            & kernel%viscoelastic .and. grid%is_line() .and. n >= lossy_multigrid_points)
+            & kernel%viscoelastic .and. grid%is_line() .and. n >= glassy_multigrid_points)
       else
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
@@ -259,7 +267,7 @@ contains
       real(wp), allocatable :: history(:)
       character(len=:), allocatable :: reason, allowed
       character(len=len(scene%solver%method)) :: method
-      real(wp) :: uniform, plain
+      real(wp) :: uniform, plain, loss
       integer :: coarse_pairs
       logical :: coarse_hard, rising
 
@@ -296,8 +304,10 @@ contains
       if (method == 'auto' .and. .not. (op%coupled .or. rising) .and. len(reason) == 0 .and. &
          & grid%points() >= merge(multigrid_points, multigrid_surface_points, grid%is_line())) method = 'multigrid'
       if (method == 'auto' .and. op%kernel%viscoelastic .and. grid%is_line() .and. len(reason) == 0 .and. &
-         & grid%points() >= lossy_multigrid_points) then
-         if (loss_among_short_waves(op) >= short_wave_loss) method = 'multigrid'
+         & grid%points() >= glassy_multigrid_points) then
+         loss = loss_among_short_waves(op)
+         if (loss >= glassy_short_wave_loss .or. (loss >= short_wave_loss .and. &
+            & grid%points() >= lossy_multigrid_points)) method = 'multigrid'
       end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
       ! on the displacement, where this start solves each coarse grid to coarse_tol; on a
