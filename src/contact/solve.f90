@@ -87,22 +87,19 @@ module lc_contact_solve
    !> |Im K|/Re K among the waves short along x (|kx| > nx/16) reaches short_wave_loss (its
    !> loss peak among the short waves) goes to the multigrid method under 'auto' whatever its
    !> coarse solve took: GCR, with its kept history and the Anderson iteration, crawls there.
-   !> Measured (h/lambda = 0.16, nu = 0.5, mu_c = 0.5, tol 1e-8, both roughness families):
-   !> at 4096 points GCR took 0.9-3.6x the multigrid's time at loss 1.6-5.0 (E_inf/E0 = 30
-   !> and 100, V tau/lambda = 1e-3 and 0.01), 2.3-13x or no convergence at E_inf/E0 = 500
-   !> to 2000; at 2048 points 0.5-4.3x at loss 8.6-22 (E_inf/E0 = 300 to 2000, V tau/lambda =
-   !> 3e-3 to 0.03), at 1024 0.26-7.9x; where the loss lies at long waves (V tau/lambda >=
-   !> 0.1) GCR took 0.3-0.8x at 4096 (docs/decisions/012-coupled-multigrid.md).
-   integer, parameter :: lossy_multigrid_points = 4096
+   !> The coarse grids of a longer line's coarse start go so too, by the same rule. Measured
+   !> (h/lambda = 0.16, nu = 0.5, mu_c = 0.5, tol 1e-8, both roughness families): lines of
+   !> 1024 to 16384 points with E_inf/E0 = 30 to 300 at V tau/lambda = 1e-3 to 0.03 took
+   !> 2.5 s in all where the rule from 4096 points took 9.6 s (2.1 s where 2.5 s without the
+   !> one line GCR crawled on), 39 of 96 lines faster, 24 slower (most by about a
+   !> millisecond: lines of 1024 points whose loss peak lies beyond the grid); the 48 very
+   !> glassy lines of 1024 and 16384 points (E_inf/E0 = 500 to 2000) 11.9 s where 13.5 s,
+   !> those of 2048 points 1.41 s where 1.21 s; the physical family's figure sweep, whose
+   !> coarse grids GCR solves easily, 3.3 s where 3.0 s. Where the loss lies at long waves
+   !> (V tau/lambda >= 0.1) GCR took 0.3-0.8x the multigrid's time at 4096 points
+   !> (docs/decisions/012-coupled-multigrid.md).
+   integer, parameter :: lossy_multigrid_points = 1024
    real(wp), parameter :: short_wave_loss = 1.0_wp
-   !> A very glassy line (that loss at least glassy_short_wave_loss: E_inf/E0 >~ 300 near its
-   !> peak) goes so from glassy_multigrid_points. Lines of 2048 points with E_inf/E0 = 500
-   !> to 2000 at V tau/lambda = 3e-3 to 0.1 (both families, bench/very_glassy.py): 1.15 s
-   !> in all where GCR with its kept history and the Anderson iteration took 2.60 s, faster
-   !> on 21 of 24; lines of 16384 points, whose coarse grids of 2048 points go so too:
-   !> 11.5 s where 14.0 s, the slowest 2.25 s where 3.08 s, but 5 of 24 up to 2x slower.
-   integer, parameter :: glassy_multigrid_points = 2048
-   real(wp), parameter :: glassy_short_wave_loss = 8.0_wp
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
    !> coupled_refusal) goes the same way from this many points, with friction or without
    !> (the coarse solve's CG iterations counted then): with friction its multigrid solves
@@ -189,7 +186,7 @@ contains
       if (kernel%coupled(friction)) then
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= coupled_threshold(grid, kernel%viscoelastic)) .or. (scene%solver%method == 'auto' .and. &
-            & kernel%viscoelastic .and. grid%is_line() .and. n >= glassy_multigrid_points)
+            & kernel%viscoelastic .and. grid%is_line() .and. n >= lossy_multigrid_points)
       else
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
@@ -304,10 +301,9 @@ contains
       if (method == 'auto' .and. .not. (op%coupled .or. rising) .and. len(reason) == 0 .and. &
          & grid%points() >= merge(multigrid_points, multigrid_surface_points, grid%is_line())) method = 'multigrid'
       if (method == 'auto' .and. op%kernel%viscoelastic .and. grid%is_line() .and. len(reason) == 0 .and. &
-         & grid%points() >= glassy_multigrid_points) then
+         & grid%points() >= lossy_multigrid_points) then
          loss = loss_among_short_waves(op)
-         if (loss >= glassy_short_wave_loss .or. (loss >= short_wave_loss .and. &
-            & grid%points() >= lossy_multigrid_points)) method = 'multigrid'
+         if (loss >= short_wave_loss) method = 'multigrid'
       end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
       ! on the displacement, where this start solves each coarse grid to coarse_tol; on a

@@ -703,6 +703,8 @@ contains
       w = o
       call returned_fields(op, u, b, load_control, mean_pressure, g_ref, p, w, gap, s, outcome%residual, full=.true.)
       h%pairs = h%pairs + 1.0_wp
+      ! (the history ends on the residual of the fields returned, as the other solvers' do)
+      if (outcome%iterations > 0) history(min(outcome%iterations, size(history))) = outcome%residual
       outcome%converged = outcome%residual <= tol
       outcome%fft_pairs = nint(h%pairs)
       outcome%vcycles = h%vcycles
