@@ -313,7 +313,8 @@ def test_gcr_and_anderson_agree(rough_profile, case):
 
 
 @pytest.mark.parametrize("e_inf, speed, shortest, friction, stages",
-                         [(100.0, 4.64e-3, 1 / 128, 0.0, "gcr+kept"), (2000.0, 0.0215, 1 / 64, 0.5, "gcr+kept+anderson")])
+                         [(100.0, 4.64e-3, 1 / 128, 0.0, "gcr+kept"),
+                          (2000.0, 0.0215, 1 / 64, 0.5, "gcr+kept+anderson")])
 def test_gcr_stall_goes_on(e_inf, speed, shortest, friction, stages):
     """A glassy layer near its loss peak on a line of 512 points, below the size from which
     'auto' takes the multigrid method for it: the GCR alone stalls and says so; method
@@ -321,8 +322,8 @@ def test_gcr_stall_goes_on(e_inf, speed, shortest, friction, stages):
     where that stalls too (E_inf/E0 = 2000), with the Anderson iteration, and converges, to
     the solution Anderson alone finds, in fewer transforms."""
     h = lc.self_affine_profile(512, 0.8, seed=1, short_wavelength=shortest, rms_gradient=0.1)
-    kw = dict(thickness=0.16, mean_pressure=(4 / 3) * (h.max() - h.mean()), speed=speed, friction=friction, tol=1e-8,
-              stress=False, material=lc.StandardLinearSolid(e0=1.0, e_inf=e_inf, tau=1.0))
+    kw = dict(thickness=0.16, mean_pressure=(4 / 3) * (h.max() - h.mean()), speed=speed, friction=friction,
+              tol=1e-8, stress=False, material=lc.StandardLinearSolid(e0=1.0, e_inf=e_inf, tau=1.0))
     alone = lc.solve_line(h, method="gcr", **kw)
     assert not alone.converged and alone.residual > 1e-8 and alone.solver == "gcr"
     auto = lc.solve_line(h, **kw)
