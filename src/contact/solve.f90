@@ -23,7 +23,7 @@ module lc_contact_solve
    use lc_contact_solver_gfmd, only: gfmd, gfmd_outcome
    use lc_contact_solver_newton, only: dense_newton, newton_outcome, dense_points, newton_step_limit
    use lc_contact_solver_multigrid, only: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, &
-      & coupled_tnnmg, allowed_rise, rows_ahead_of_gcr, loss_among_short_waves
+      & coupled_tnnmg, allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit
    use lc_contact_progress, only: progress_log
    use lc_memory, only: check_memory
    use lc_observables, only: observe
@@ -100,6 +100,18 @@ module lc_contact_solve
    !> (docs/decisions/012-coupled-multigrid.md).
    integer, parameter :: lossy_multigrid_points = 1024
    real(wp), parameter :: short_wave_loss = 1.0_wp
+   !> A sliding viscoelastic surface goes so from lossy_surface_points where that loss (along
+   !> x, at any ky) reaches short_loss_limit, beyond which the multigrid method smooths it by
+   !> rows on the metric's hierarchy: GCR with its kept history and the Anderson iteration
+   !> crawls there too. Measured (E_inf/E0 = 30 to 1000 at V tau/lambda = 1e-3 to 0.1, mu_c
+   !> = 0 and 0.5, tol 1e-8, 40 surfaces per size): at 128^2 2.5 s in all where 'auto' took
+   !> 4.8 s with GCR, at 256^2 14.9 s where 38.6 s, every surface of 256^2 faster (1.2-5.4x);
+   !> at 128^2 GCR takes half the time at V tau/lambda = 0.01 (12 ms against 26), up to a
+   !> fifth of it at 0.03 and 0.1; at 512^2 (both families,
+   !> E_inf/E0 = 100 and 1000 at 3e-3 to 0.1) 197 s where 328 s, one surface slower (the
+   !> physical E_inf/E0 = 1000 at 0.03 with friction, 58 s where 35 s: the multigrid
+   !> method stalls and GCR finishes) (docs/decisions/015-row-smoothing.md).
+   integer, parameter :: lossy_surface_points = 128**2
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
    !> coupled_refusal) goes the same way from this many points, with friction or without
    !> (the coarse solve's CG iterations counted then): with friction its multigrid solves
@@ -186,7 +198,7 @@ contains
       if (kernel%coupled(friction)) then
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= coupled_threshold(grid, kernel%viscoelastic)) .or. (scene%solver%method == 'auto' .and. &
-            & kernel%viscoelastic .and. grid%is_line() .and. n >= lossy_multigrid_points)
+            & kernel%viscoelastic .and. n >= merge(lossy_multigrid_points, lossy_surface_points, grid%is_line()))
       else
          may_multigrid = scene%solver%method == 'multigrid' .or. (scene%solver%method == 'auto' .and. &
             & n >= merge(multigrid_points, multigrid_surface_points, grid%is_line()))
@@ -300,10 +312,10 @@ contains
       end if
       if (method == 'auto' .and. .not. (op%coupled .or. rising) .and. len(reason) == 0 .and. &
          & grid%points() >= merge(multigrid_points, multigrid_surface_points, grid%is_line())) method = 'multigrid'
-      if (method == 'auto' .and. op%kernel%viscoelastic .and. grid%is_line() .and. len(reason) == 0 .and. &
-         & grid%points() >= lossy_multigrid_points) then
+      if (method == 'auto' .and. op%kernel%viscoelastic .and. len(reason) == 0 .and. &
+         & grid%points() >= merge(lossy_multigrid_points, lossy_surface_points, grid%is_line())) then
          loss = loss_among_short_waves(op)
-         if (loss >= short_wave_loss) method = 'multigrid'
+         if (loss >= merge(short_wave_loss, short_loss_limit, grid%is_line())) method = 'multigrid'
       end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
       ! on the displacement, where this start solves each coarse grid to coarse_tol; on a
