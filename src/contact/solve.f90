@@ -103,14 +103,15 @@ module lc_contact_solve
    !> A sliding viscoelastic surface goes so from lossy_surface_points where that loss (along
    !> x, at any ky) reaches short_loss_limit, beyond which the multigrid method smooths it by
    !> rows on the metric's hierarchy: GCR with its kept history and the Anderson iteration
-   !> crawls there too. Measured (E_inf/E0 = 30 to 1000 at V tau/lambda = 1e-3 to 0.1, mu_c
-   !> = 0 and 0.5, tol 1e-8, 40 surfaces per size): at 128^2 2.5 s in all where 'auto' took
-   !> 4.8 s with GCR, at 256^2 14.9 s where 38.6 s, every surface of 256^2 faster (1.2-5.4x);
-   !> at 128^2 GCR takes half the time at V tau/lambda = 0.01 (12 ms against 26), up to a
-   !> fifth of it at 0.03 and 0.1; at 512^2 (both families,
-   !> E_inf/E0 = 100 and 1000 at 3e-3 to 0.1) 197 s where 328 s, one surface slower (the
-   !> physical E_inf/E0 = 1000 at 0.03 with friction, 58 s where 35 s: the multigrid
-   !> method stalls and GCR finishes) (docs/decisions/015-row-smoothing.md).
+   !> crawls there too. Measured (h/lambda = 0.16, nu = 0.5, tol 1e-8; E_inf/E0 = 30 to 1000
+   !> at V tau/lambda = 1e-3 to 0.1, mu_c = 0 and 0.5, shortest wavelength 8 points, 40
+   !> surfaces per size): at 128^2 2.5 s in all where 'auto' took 4.8 s with GCR, at 256^2
+   !> 14.9 s where 38.6 s, every surface of 256^2 that changes method faster (1.2-5.4x); at
+   !> 128^2 GCR takes half the multigrid's time at V tau/lambda = 0.01 (12 ms against 26)
+   !> and up to 5.4x it at 0.03 and 0.1; at 512^2 (both families, E_inf/E0 = 100 and 1000 at
+   !> 3e-3 to 0.1) 197 s where 328 s, one surface slower (the physical E_inf/E0 = 1000 at
+   !> 0.03 with friction, 58 s where 35 s: the multigrid method stalls and GCR finishes)
+   !> (docs/decisions/015-row-smoothing.md).
    integer, parameter :: lossy_surface_points = 128**2
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
    !> coupled_refusal) goes the same way from this many points, with friction or without
