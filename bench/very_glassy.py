@@ -25,8 +25,8 @@ import layercontact as lc
 
 def cell(r) -> str:
     if not r.converged:
-        return f"stops at {r.residual:.1e} ({r.fft_pairs} pairs, {r.wall_time:.2f} s)"
-    return f"{r.solver}: {r.fft_pairs}, {r.wall_time:.2f}"
+        return f"stops at {r.residual:.1e} ({r.fft_pairs} pairs, {r.wall_time:.3g} s)"
+    return f"{r.solver}: {r.fft_pairs}, {r.wall_time:.3g}"
 
 
 def main() -> None:

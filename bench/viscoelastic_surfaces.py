@@ -5,6 +5,8 @@ every solve converges, and what it costs.
     .venv/bin/python bench/viscoelastic_surfaces.py --sizes 512     # (~4 min)
     .venv/bin/python bench/viscoelastic_surfaces.py --sizes 256 512 --ratios 100 300 1000 \
         --speeds 0.003 0.01 0.03 --poisson 0.3 0.5                  # near the loss peak (~20 min)
+    .venv/bin/python bench/viscoelastic_surfaces.py --sizes 128 256 --ratios 30 100 300 1000 \
+        --speeds 0.001 0.003 0.01 0.03 0.1 --methods auto          # what 'auto' picks (~2 min)
 
 Surfaces, self-affine (H = 0.8, rms gradient 0.1, seed 1) with the spectrum fixed in
 physical wavenumbers (shortest wavelength period/32) or the shortest wavelength 8 grid
@@ -14,8 +16,8 @@ solid E0 = 1, tau = 1 with E_inf/E0 = 10 and 100 (or --ratios) sliding at V tau/
 the layer's short waves are glassier than across it, so the multigrid halves its coarse
 grids along one axis where that smooths better, or smooths by rows
 (docs/decisions/013-anisotropic-coarsening.md, 015-row-smoothing.md). tol 1e-8, one
-thread. Per row: each method's solver, transform pairs and time (the library's
-`wall_time`).
+thread. Per row and method (--methods; 'multigrid' and 'gcr' unless given): the solver
+that ran, transform pairs and time (the library's `wall_time`).
 """
 
 from __future__ import annotations
@@ -32,11 +34,13 @@ def main() -> None:
     parser.add_argument("--ratios", type=float, nargs="+", default=[10.0, 100.0], help="E_inf/E0")
     parser.add_argument("--speeds", type=float, nargs="+", default=[1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0])
     parser.add_argument("--poisson", type=float, nargs="+", default=[0.5], help="the layer's Poisson ratios")
+    parser.add_argument("--methods", nargs="+", default=["multigrid", "gcr"],
+                        help="&solver methods, one column group each ('auto': the one the library picks)")
     args = parser.parse_args()
     print(f"layercontact {lc.__version__} ({lc.BUILD} build); tol 1e-8; one thread\n")
-    print("| n | family | nu | E_inf/E0 | V tau/lambda | mu_c | multigrid | pairs | ms | GCR | pairs | ms "
-          "| contact |")
-    print("|---:|---|---:|---:|---:|---:|---|---:|---:|---|---:|---:|---:|")
+    print("| n | family | nu | E_inf/E0 | V tau/lambda | mu_c | "
+          + " | ".join(f"{method} | pairs | ms" for method in args.methods) + " | contact |")
+    print("|---:|---|---:|---:|---:|---:|" + "---|---:|---:|" * len(args.methods) + "---:|")
     for n in args.sizes:
         for family, shortest in (("physical", 1 / 32), ("8 points", 8 / n)):
             h = lc.self_affine_surface(n=n, hurst=0.8, seed=1, short_wavelength=shortest, rms_gradient=0.1)
@@ -46,12 +50,12 @@ def main() -> None:
                 kw = dict(thickness=0.16, poisson=nu, friction=friction, material=material, speed=speed,
                           mean_pressure=0.02, tol=1e-8, threads=1, stress=False)
                 cells = []
-                for method in ("multigrid", "gcr"):
+                for method in args.methods:
                     r = lc.solve_areal(h, method=method, **kw)
                     cells.append(f"{r.solver}{'' if r.converged else ' NOT CONVERGED'} | {r.fft_pairs} "
                                  f"| {r.wall_time * 1e3:.0f}")
-                print(f"| {n}^2 | {family} | {nu:g} | {ratio:g} | {speed:g} | {friction:g} | {cells[0]} "
-                      f"| {cells[1]} | {r.contact_fraction:.3f} |", flush=True)
+                print(f"| {n}^2 | {family} | {nu:g} | {ratio:g} | {speed:g} | {friction:g} | "
+                      + " | ".join(cells) + f" | {r.contact_fraction:.3f} |", flush=True)
 
 
 if __name__ == "__main__":
