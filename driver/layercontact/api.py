@@ -258,7 +258,8 @@ def solve_line(
     viscoelastic one that the multigrid method smooths by rows for its loss at long waves
     or its large loss among the short waves) whose coarse solve needed more than 12, i.e.
     broadband roughness, and a sliding viscoelastic line of 1024 points or more (a surface
-    of 128² or more) whose loss ``|Im K|/Re K`` reaches 1 (3) among its short waves, go to
+    of 128² or more with 256 contact points in its coarse start) whose loss ``|Im K|/Re K``
+    reaches 1 (3) among its short waves, go to
     ``'multigrid'`` below where that applies; grids of at most
     2048 points that stall are finished by the dense Newton method), ``'cg'``, ``'gcr'``,
     ``'anderson'``, ``'gfmd'``, ``'newton'`` (dense semismooth Newton, grids of at most 2048

@@ -102,17 +102,24 @@ module lc_contact_solve
    real(wp), parameter :: short_wave_loss = 1.0_wp
    !> A sliding viscoelastic surface goes so from lossy_surface_points where that loss (along
    !> x, at any ky) reaches short_loss_limit, beyond which the multigrid method smooths it by
-   !> rows on the metric's hierarchy: GCR with its kept history and the Anderson iteration
-   !> crawls there too. Measured (h/lambda = 0.16, nu = 0.5, tol 1e-8; E_inf/E0 = 30 to 1000
-   !> at V tau/lambda = 1e-3 to 0.1, mu_c = 0 and 0.5, shortest wavelength 8 points, 40
+   !> rows on the metric's hierarchy, where its coarse start holds at least
+   !> lossy_surface_contacts contact points and where its metric passes metric_refusal: GCR
+   !> with its kept history and the Anderson iteration crawls there. A few contact points
+   !> (GCR 58-80 pairs at 256^2, the multigrid 170-180; up to 45x the time at 128^2 with
+   !> 0.2 % contact) and thin incompressible layers (h/lambda = 0.01: 3355 pairs, GCR 287) stay
+   !> on GCR. Measured (h/lambda = 0.16, nu = 0.5, tol 1e-8; E_inf/E0 = 30 to 1000 at
+   !> V tau/lambda = 1e-3 to 0.1, mu_c = 0 and 0.5, shortest wavelength 8 points, 40
    !> surfaces per size): at 128^2 2.5 s in all where 'auto' took 4.8 s with GCR, at 256^2
    !> 14.9 s where 38.6 s, every surface of 256^2 that changes method faster (1.2-5.4x); at
    !> 128^2 GCR takes half the multigrid's time at V tau/lambda = 0.01 (12 ms against 26)
    !> and up to 5.4x it at 0.03 and 0.1; at 512^2 (both families, E_inf/E0 = 100 and 1000 at
    !> 3e-3 to 0.1) 197 s where 328 s, one surface slower (the physical E_inf/E0 = 1000 at
-   !> 0.03 with friction, 58 s where 35 s: the multigrid method stalls and GCR finishes)
-   !> (docs/decisions/015-row-smoothing.md).
+   !> 0.03 with friction, 58 s where 35 s: the multigrid method stalls and GCR finishes); a
+   !> grid of 96 surfaces of 128^2 (h/lambda = 0.01 to the half-space, nu = 0.3 and 0.5,
+   !> E_inf/E0 = 100 and 1000 at 0.01 and 0.1, mu_c = 0 and 1.5, p_m = 0.001 and 0.3) 19.8 s
+   !> where 21.2 s, at most 2.9x slower (31 ms where 11) (docs/decisions/015-row-smoothing.md).
    integer, parameter :: lossy_surface_points = 128**2
+   integer, parameter :: lossy_surface_contacts = 256
    !> A line whose compliance rises with |q| (a thin incompressible layer, admitted by
    !> coupled_refusal) goes the same way from this many points, with friction or without
    !> (the coarse solve's CG iterations counted then): with friction its multigrid solves
@@ -313,11 +320,6 @@ contains
       end if
       if (method == 'auto' .and. .not. (op%coupled .or. rising) .and. len(reason) == 0 .and. &
          & grid%points() >= merge(multigrid_points, multigrid_surface_points, grid%is_line())) method = 'multigrid'
-      if (method == 'auto' .and. op%kernel%viscoelastic .and. len(reason) == 0 .and. &
-         & grid%points() >= merge(lossy_multigrid_points, lossy_surface_points, grid%is_line())) then
-         loss = loss_among_short_waves(op)
-         if (loss >= merge(short_wave_loss, short_loss_limit, grid%is_line())) method = 'multigrid'
-      end if
       ! (the multigrid solver makes its own nested iteration: one iteration per coarse grid
       ! on the displacement, where this start solves each coarse grid to coarse_tol; on a
       ! coupled scene it takes the start, whose contact set is nearly right)
@@ -326,6 +328,18 @@ contains
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, p, s, coarse_pairs, &
             & coarse_hard, progress, error)
          if (allocated(error)) return
+      end if
+      ! (a sliding viscoelastic scene lossy among its short waves, a surface only where its
+      ! coarse start holds enough contact points: with a few, GCR is the faster method)
+      if (method == 'auto' .and. op%kernel%viscoelastic .and. len(reason) == 0 .and. &
+         & grid%points() >= merge(lossy_multigrid_points, lossy_surface_points, grid%is_line())) then
+         loss = loss_among_short_waves(op)
+         if (grid%is_line()) then
+            if (loss >= short_wave_loss) method = 'multigrid'
+         else if (loss >= short_loss_limit .and. count(p > 0.0_wp) >= lossy_surface_contacts .and. &
+            & len(metric_refusal(op)) == 0) then
+            method = 'multigrid'
+         end if
       end if
       ! (a coupled scene, or a frictionless one whose compliance rises, where its coarse solve
       ! was hard: broadband roughness; a rising compliance from rising_multigrid_points)
