@@ -499,8 +499,9 @@ def test_auto_takes_the_multigrid_for_a_line_lossy_among_its_short_waves_from_10
     |kx| ~ 160) to the multigrid method, easy coarse solve or not (GCR with its kept history
     took 1143 transform pairs at 4096 points, 2.9x the time; measured 398); at
     V tau/lambda = 1 the loss peaks at the long waves and the line stays on GCR (138 pairs,
-    0.4x the multigrid's time), and so does a line of 512 points, the coarsest grid of a
-    coarse start."""
+    0.4x the multigrid's time), and so do a line of 512 points, the coarsest grid of a
+    coarse start, and the line at a load that puts one point in contact (GCR 43 pairs, the
+    multigrid 367)."""
     glassy = lc.StandardLinearSolid(e0=1.0, e_inf=100.0, tau=1.0)
     kw = dict(thickness=0.16, poisson=0.5, friction=0.5, mean_pressure=0.02, tol=1e-8, stress=False,
               material=glassy)
@@ -510,6 +511,9 @@ def test_auto_takes_the_multigrid_for_a_line_lossy_among_its_short_waves_from_10
     assert lc.solve_line(profile(4096, "physical"), speed=1.0, **kw).solver == "gcr"
     assert lc.solve_line(profile(1024, "physical"), speed=0.01, **kw).solver == "multigrid"
     assert lc.solve_line(profile(512, "physical"), speed=0.01, **kw).solver.startswith("gcr")
+    one_point = lc.solve_line(profile(1024, "physical"), speed=0.01, **dict(kw, mean_pressure=0.0002))
+    assert one_point.converged and one_point.solver == "gcr"
+    assert one_point.fft_pairs <= 100, one_point.fft_pairs
 
 
 def test_auto_takes_the_multigrid_for_a_thin_incompressible_line_from_262144_points():

@@ -257,9 +257,9 @@ def solve_line(
     one: 262144 points or more), and a coupled surface of 1024² or more (512² for a sliding
     viscoelastic one that the multigrid method smooths by rows for its loss at long waves
     or its large loss among the short waves) whose coarse solve needed more than 12, i.e.
-    broadband roughness, and a sliding viscoelastic line of 1024 points or more (a surface
-    of 128² or more with 256 contact points in its coarse start) whose loss ``|Im K|/Re K``
-    reaches 1 (3) among its short waves, go to
+    broadband roughness, and a sliding viscoelastic line of 1024 points or more with 16
+    contact points in its coarse start (a surface of 128² or more with 256) whose loss
+    ``|Im K|/Re K`` reaches 1 (3) among its short waves, go to
     ``'multigrid'`` below where that applies; grids of at most
     2048 points that stall are finished by the dense Newton method), ``'cg'``, ``'gcr'``,
     ``'anderson'``, ``'gfmd'``, ``'newton'`` (dense semismooth Newton, grids of at most 2048

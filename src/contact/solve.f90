@@ -99,6 +99,13 @@ module lc_contact_solve
    !> (V tau/lambda >= 0.1) GCR took 0.3-0.8x the multigrid's time at 4096 points
    !> (docs/decisions/012-coupled-multigrid.md).
    integer, parameter :: lossy_multigrid_points = 1024
+   !> ... where its coarse start holds at least lossy_line_contacts contact points: with one
+   !> or a few, GCR solves a glassy line in 24-43 transform pairs, the multigrid method in
+   !> 300-5000. On the viscoelastic extremes grid (tests/extremes_grid.py, 1296 lines of
+   !> 1024 points) 12.8 s where 13.5 s without the condition and 30.8 s with the rule from
+   !> 4096 points; 55 lines more than 2x slower than with that rule (at most 40x, 36 ms)
+   !> where 134 were (91x, 47 ms). The glassy lines above choose as without it.
+   integer, parameter :: lossy_line_contacts = 16
    real(wp), parameter :: short_wave_loss = 1.0_wp
    !> A sliding viscoelastic surface goes so from lossy_surface_points where that loss (along
    !> x, at any ky) reaches short_loss_limit, beyond which the multigrid method smooths it by
@@ -329,13 +336,13 @@ contains
             & coarse_hard, progress, error)
          if (allocated(error)) return
       end if
-      ! (a sliding viscoelastic scene lossy among its short waves, a surface only where its
-      ! coarse start holds enough contact points: with a few, GCR is the faster method)
+      ! (a sliding viscoelastic scene lossy among its short waves whose coarse start holds
+      ! enough contact points: with a few, GCR is the faster method)
       if (method == 'auto' .and. op%kernel%viscoelastic .and. len(reason) == 0 .and. &
          & grid%points() >= merge(lossy_multigrid_points, lossy_surface_points, grid%is_line())) then
          loss = loss_among_short_waves(op)
          if (grid%is_line()) then
-            if (loss >= short_wave_loss) method = 'multigrid'
+            if (loss >= short_wave_loss .and. count(p > 0.0_wp) >= lossy_line_contacts) method = 'multigrid'
          else if (loss >= short_loss_limit .and. count(p > 0.0_wp) >= lossy_surface_contacts .and. &
             & len(metric_refusal(op)) == 0) then
             method = 'multigrid'
