@@ -8,11 +8,12 @@ iterations after an Anderson fallback) and the outer (Anderson) iterations of th
 runs (1 without the fallback), min / median / max, grouped by h/lambda, by
 mu_c and by the measured contact fraction, with the number of runs not converged (and how
 many of those have Re G_eff < 0 on some mode, where the solution need not be unique), of
-runs whose GCR stalled (and went on with its history kept across clips), of those that
-went on with the Anderson iteration, and the FFT pairs; ``--list`` also lists the runs that
+runs that method 'auto' started in the multigrid method, of runs whose GCR stalled (and
+went on with its history kept across clips, after the multigrid method or alone), of those
+that went on with the Anderson iteration, and the FFT pairs; ``--list`` also lists the runs that
 did not converge, with what stopped them. ``--viscoelastic`` runs the viscoelastic grid
 instead (standard linear solids, E_inf/E0 10..1000, V tau/lambda 1e-4..1e2; n = 63 and
-1024, 2592 runs, ~60 s) and groups it also by E_inf/E0 and speed.
+1024, 2592 runs, ~30 s) and groups it also by E_inf/E0 and speed.
 
     .venv/bin/python bench/extremes.py [--viscoelastic] [--list] [--sizes 63 1024]
 """
@@ -38,20 +39,21 @@ def stats(values) -> str:
 
 
 def table(title: str, key: str, labels, rows) -> None:
-    print(f"| {title} | runs | not conv. (not monotone) | GCR stalled | then Anderson | it. min | median | max | "
-          f"outer it. min | median | max | FFT pairs median | max |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print(f"| {title} | runs | not conv. (not monotone) | multigrid | GCR stalled | then Anderson | it. min | median | "
+          f"max | outer it. min | median | max | FFT pairs median | max |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for label in labels:
         sel = [r for r in rows if r[key] == label]
         conv = [r for r in sel if r["converged"]]
         failed = [r for r in sel if not r["converged"]]
         odd = sum(not r["monotone"] for r in failed)
-        stalled = sum(r["solver"].startswith("gcr+") for r in sel)
-        fallback = sum(r["solver"].startswith("gcr+") and "anderson" in r["solver"] for r in sel)
+        multigrid = sum(r["solver"].startswith("multigrid") for r in sel)
+        stalled = sum("gcr+" in r["solver"] for r in sel)
+        fallback = sum("gcr+" in r["solver"] and "anderson" in r["solver"] for r in sel)
         pairs = [r["pairs"] for r in conv]
         pair_stats = f"{int(np.median(pairs))} | {max(pairs)}" if pairs else "– | –"
         name = "inf" if label == np.inf else f"{label:g}" if isinstance(label, float) else label
-        print(f"| {name} | {len(sel)} | {len(failed)} ({odd}) | {stalled} | {fallback} | "
+        print(f"| {name} | {len(sel)} | {len(failed)} ({odd}) | {multigrid} | {stalled} | {fallback} | "
               f"{stats([r['iterations'] for r in conv])} | {stats([r['outer'] for r in conv])} | {pair_stats} |")
     print()
 
@@ -80,9 +82,9 @@ def main() -> None:
     conv = sum(r["converged"] for r in rows)
     print(f"{len(rows)} runs (n = {', '.join(map(str, sizes))}), {conv} converged, tol {grid.TOL:g}, "
           f"max_iter {grid.MAX_ITER}, {elapsed:.0f} s; iteration counts of the converged runs; "
-          f"mu_c = 0 and the incompressible half-space are solved by CG, coupled scenes by GCR (1 outer it.) "
-          f"or, where GCR stalls, GCR again keeping its history across clips (1 outer it.), then Anderson "
-          f"(1 + its outer it.)")
+          f"mu_c = 0 and the incompressible half-space are solved by CG, coupled scenes by GCR or the "
+          f"multigrid method (1 outer it.) or, where GCR stalls, GCR again keeping its history across clips "
+          f"(1 outer it.), then Anderson (1 + its outer it.)")
     print()
     if args.viscoelastic:
         table("E_inf/E0", "ratio", grid.VISCO_RATIOS, rows)
