@@ -141,7 +141,7 @@ module lc_contact_solver_multigrid
    !> loss above this one only while its peak lies at |kx| <= nx/32 or below
    !> glassy_peak_mode, and the metric's hierarchy where it peaks nearer the long band's edge.
    !> Measured on very glassy layers sliding fast (E_inf/E0 = 1000 and 2000, peak loss 15.8
-   !> and 22.3, V tau/lambda = 0.1 to 0.3: the peak at kx = 17-50; both families): where K's
+   !> and 22.4, V tau/lambda = 0.1 to 0.3: the peak at kx = 17-50; both families): where K's
    !> hierarchy wandered for minutes, at 1024^2 more than 300 s, the metric's took 34-104 s,
    !> and at 512^2 9-21 s where 96-171 s; where K's converged, the metric's took up to 3.2x
    !> its time (512^2, E_inf/E0 = 1000 at 0.3 with the shortest wavelength 8 points: 5.7 s
