@@ -138,18 +138,18 @@ module lc_contact_solver_multigrid
    !> and 2 x 1) and 512 x 256 (1 x 0.5) took 1.1-2.1x fewer by rows.
    real(wp), parameter :: top_band_loss = 5.0_wp
    !> A surface whose loss peaks at long waves (at_long_waves) takes K's own hierarchy; a
-   !> loss above this one only while its peak lies at |kx| <= nx/32 or below
+   !> loss above this one only while its peak lies at |kx| <= nx/48 or below
    !> glassy_peak_mode, and the metric's hierarchy where it peaks nearer the long band's edge.
    !> Measured on very glassy layers sliding fast (E_inf/E0 = 1000 and 2000, peak loss 15.8
-   !> and 22.4, V tau/lambda = 0.1 to 0.3: the peak at kx = 17-50; both families): where K's
-   !> hierarchy wandered for minutes, at 1024^2 more than 300 s, the metric's took 34-104 s,
-   !> and at 512^2 9-21 s where 96-171 s; where K's converged, the metric's took up to 3.2x
-   !> its time (512^2, E_inf/E0 = 1000 at 0.3 with the shortest wavelength 8 points: 5.7 s
-   !> where 1.8 s; 1024^2 at 0.15: 41 s where 20 s). On 2048^2 (E_inf/E0 = 1000 at 0.1, the
-   !> peak at nx/41) K's hierarchy keeps it: the metric's took 2.7x its time on the
-   !> broadband family; the physical one did not finish in 900 s. E_inf/E0 = 300 (8.6) keeps K's
-   !> hierarchy: the metric's took 0.66-1.9x its pairs at 512^2 and 1024^2. Lines keep it at
-   !> every loss (docs/decisions/015-row-smoothing.md).
+   !> and 22.4, V tau/lambda = 0.1 to 0.3: the peak at kx = 17-50 = nx/41 to nx/20; both
+   !> families): where K's hierarchy wandered, on the physical family, for more than 300 s
+   !> at 1024^2 and 900 s at 2048^2, the metric's took 29-104 s and 713 s, and at 512^2 9-21 s
+   !> where 96-171 s; where K's converged, mostly on the broadband family, the metric's took
+   !> up to 3.8x its time (1024^2, E_inf/E0 = 1000 at 0.2: 28 s where 7.6 s; 2048^2 at 0.1:
+   !> 162 s where 61 s; 512^2 at 0.3: 5.7 s where 1.8 s). With the peak at nx/61 (1024^2 at
+   !> 0.3) K's hierarchy converged on both families, in 4.5-14 s where the metric's took 35-36 s.
+   !> E_inf/E0 = 300 (8.6) keeps K's hierarchy: the metric's took 0.66-1.9x its pairs at
+   !> 512^2 and 1024^2. Lines keep it at every loss (docs/decisions/015-row-smoothing.md).
    real(wp), parameter :: glassy_long_loss = 10.0_wp
    !> ... and a peak below this mode keeps K's hierarchy on any grid: E_inf/E0 = 1000 and
    !> 2000 at V tau/lambda = 1 and 3 (peak at kx = 2-7) took 0.96-3.7x the pairs by the
@@ -363,7 +363,7 @@ contains
    !> The stiffness symbol the coupled method's hierarchy is built on (half spectrum of the
    !> grid): K = 1/G_eff itself (symbol + i odd) where its loss lies at long waves
    !> (loss_at_long_waves; on a surface a loss above glassy_long_loss only where it peaks at
-   !> |kx| <= nx/32 or below glassy_peak_mode), or where the loss among the waves short
+   !> |kx| <= nx/48 or below glassy_peak_mode), or where the loss among the waves short
    !> along x is at most short_loss_limit and the grid is smoothed by rows (rows_smooth);
    !> else the metric's 1/|G_eff| (level_symbol), smoothed by rows only for a larger loss
    !> peaking at the grid's edge or in its top band (see short_loss_limit, top_band_loss).
@@ -382,7 +382,7 @@ contains
          loss = loss_of(op)
          long = at_long_waves(loss)
          if (long .and. .not. op%grid%is_line()) &
-            & long = loss%largest <= glassy_long_loss .or. 32*loss%peak <= op%grid%nx .or. &
+            & long = loss%largest <= glassy_long_loss .or. 48*loss%peak <= op%grid%nx .or. &
             & loss%peak < glassy_peak_mode
          large = .not. long .and. .not. op%grid%is_line() .and. loss%short_x > short_loss_limit
       end if
