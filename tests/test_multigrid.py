@@ -196,8 +196,8 @@ def test_slow_sliding_costs_as_many_transforms_on_finer_grids():
 
 def test_a_very_glassy_surface_sliding_fast_takes_the_metric_hierarchy():
     """E_inf/E0 = 1000 (largest loss 15.8) with friction at V tau/lambda = 0.2: the loss
-    peaks at kx = 25, among the long waves of a 512^2 grid (|kx| <= 32) but at a mode its
-    middle grids carry near their own shortest ones. K's own hierarchy wandered there
+    peaks at kx = 25, among the long waves of a 512^2 grid (|kx| <= 32) but beyond nx/48,
+    where the metric's hierarchy takes over from K's own. K's own hierarchy wandered there
     (measured: 437 iterations, 30152 transform pairs, 130 s); the metric's converges in 65
     iterations and 1914 pairs. The residual recomputed with numpy from the closed-form
     G_eff (the elastic layer's with E = 1 times the creep compliance J*(q_x V)) meets the
