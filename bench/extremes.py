@@ -10,8 +10,8 @@ mu_c and by the measured contact fraction, with the number of runs not converged
 many of those have Re G_eff < 0 on some mode, where the solution need not be unique), of
 runs that method 'auto' started in the multigrid method, of runs whose GCR stalled (and
 went on with its history kept across clips, after the multigrid method or alone), of those
-that went on with the Anderson iteration, and the FFT pairs; ``--list`` also lists the runs that
-did not converge, with what stopped them. ``--viscoelastic`` runs the viscoelastic grid
+that went on with the Anderson iteration, and the FFT pairs; ``--list`` also lists the runs
+that did not converge, with what stopped them. ``--viscoelastic`` runs the viscoelastic grid
 instead (standard linear solids, E_inf/E0 10..1000, V tau/lambda 1e-4..1e2; n = 63 and
 1024, 2592 runs, ~30 s) and groups it also by E_inf/E0 and speed.
 
@@ -39,8 +39,8 @@ def stats(values) -> str:
 
 
 def table(title: str, key: str, labels, rows) -> None:
-    print(f"| {title} | runs | not conv. (not monotone) | multigrid | GCR stalled | then Anderson | it. min | median | "
-          f"max | outer it. min | median | max | FFT pairs median | max |")
+    print(f"| {title} | runs | not conv. (not monotone) | multigrid | GCR stalled | then Anderson | "
+          f"it. min | median | max | outer it. min | median | max | FFT pairs median | max |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for label in labels:
         sel = [r for r in rows if r[key] == label]
