@@ -52,7 +52,7 @@ def test_builds_agree_to_rounding(rough_profile, case, monkeypatch):
     fast = lc.solve_line(h, tol=tol, stress=False, **kw)
     monkeypatch.setattr(lc.api, "_core", lc.native.portable)
     portable = lc.solve_line(h, tol=tol, stress=False, **kw)
-    assert fast.converged and portable.converged and fast.solver == portable.solver
+    assert fast.converged and portable.converged
     g = g_eff(h.size, 1.0, kw["thickness"], 1.0, 0.5, kw.get("friction", 0.0), kw.get("material"),
               kw.get("speed", 0.0))
     bound = tol * np.ptp(h) * np.max(1 / np.abs(g[1:]))

@@ -66,13 +66,15 @@ def test_every_input_runs_the_same_in_fortran_and_python(nml, tmp_path, monkeypa
     assert not list(exe_dir.rglob("*.tmp"))
     np.testing.assert_array_equal(res.pressure, ref.pressure)
     assert res.penetration == ref.penetration and res.delta_mu == ref.delta_mu
-    # the method that ran is recorded (GCR for a coupled scene, CG or multigrid for a
-    # symmetric one; the frictionless companion of a moving viscoelastic layer is still coupled)
+    # the method that ran is recorded; the first it tried is a symmetric one (CG or
+    # multigrid) exactly where the operator is symmetric: a frictionless companion is, unless
+    # a moving viscoelastic layer dissipates (the fallbacks after it may vary with rounding)
     symmetric = ("cg", "multigrid")
-    assert res.solver == ref.solver and ref.solver in symmetric + ("gcr", "gcr+kept", "gcr+kept+anderson")
+    first = lambda solver: solver.split("+")[0]  # noqa: E731
+    assert res.solver == ref.solver and first(ref.solver) in symmetric + ("gcr",)
     if ref.companion is not None:
-        assert ref.companion.solver in symmetric + ("gcr", "gcr+kept", "gcr+kept+anderson")
-        assert (ref.companion.solver in symmetric) == (ref.solver in symmetric or ref.dissipated_power == 0.0)
+        assert (first(ref.companion.solver) in symmetric) == (first(ref.solver) in symmetric
+                                                              or ref.dissipated_power == 0.0)
     with h5py.File(out) as f:
         assert f.attrs["layercontact_version"].decode() == lc.__version__
         assert f.attrs["layercontact_build"].decode() == "x86-64"

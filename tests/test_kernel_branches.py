@@ -233,8 +233,10 @@ def test_operator_switches_are_continuous(switch_profile, base, perturbed, metho
     b = lc.solve_line(switch_profile, mean_pressure=0.05, tol=1e-12, material=material, method=method,
                       **{**base, **perturbed})
     assert a.converged and b.converged
-    # the two runs take different paths (CG alone vs the coupled solver)
-    assert {a.solver, b.solver} == {"cg", "gcr" if method == "auto" else "anderson"} or "speed" in base
+    # the two runs take different paths (CG alone vs a coupled solver, with whatever
+    # fallbacks rounding leads it to)
+    first = {a.solver.split("+")[0], b.solver.split("+")[0]}
+    assert first == {"cg", "gcr" if method == "auto" else "anderson"} or "speed" in base
     assert np.array_equal(a.pressure > 0, b.pressure > 0)
     assert np.abs(a.pressure - b.pressure).max() <= 1e-10 * a.pressure.max()
     assert abs(a.penetration - b.penetration) <= 1e-10 * np.ptp(switch_profile)

@@ -290,7 +290,7 @@ def test_westergaard(n, ratio, method):
 
 @pytest.mark.parametrize("case", ["thin coupled", "viscoelastic with friction", "displacement"])
 def test_gcr_and_anderson_agree(rough_profile, case):
-    """Two different coupled solvers, the constrained GCR (method 'auto') and the Anderson
+    """Two different coupled solvers, the constrained GCR and the Anderson
     outer iteration around the symmetric CG, reach the same fixed point: the same pressure
     to the bound the tolerance allows (a gap residual tol * ptp(profile) times the largest
     stiffness |k_max| E*/2, E_inf for the glassy short waves) and the same penetration."""
@@ -302,34 +302,27 @@ def test_gcr_and_anderson_agree(rough_profile, case):
         "displacement": (dict(thickness=0.16, poisson=0.3, friction=0.5, penetration=0.5 * np.ptp(rough_profile)),
                          1 / (1 - 0.3**2)),
     }[case]
-    a = lc.solve_line(rough_profile, tol=1e-11, stress=False, **kw)
+    a = lc.solve_line(rough_profile, tol=1e-11, stress=False, method="gcr", **kw)
     b = lc.solve_line(rough_profile, tol=1e-11, stress=False, method="anderson", **kw)
     assert a.converged and b.converged
-    assert a.solver == "gcr" and b.solver == "anderson"
     bound = 1e-11 * np.ptp(rough_profile) * e_star * np.pi * rough_profile.size / 2
     assert np.abs(a.pressure - b.pressure).max() <= bound
     assert a.penetration == pytest.approx(b.penetration, rel=1e-9)
     assert a.mean_pressure == pytest.approx(b.mean_pressure, rel=1e-9)
 
 
-@pytest.mark.parametrize("e_inf, speed, shortest, friction, stages",
-                         [(100.0, 4.64e-3, 1 / 128, 0.0, "gcr+kept"),
-                          (2000.0, 0.0215, 1 / 64, 0.5, "gcr+kept+anderson")])
-def test_gcr_stall_goes_on(e_inf, speed, shortest, friction, stages):
-    """A glassy layer near its loss peak on a line of 512 points, below the size from which
-    'auto' takes the multigrid method for it: the GCR alone stalls and says so; method
-    'auto' goes on from its best iterate with the GCR keeping its history across clips and,
-    where that stalls too (E_inf/E0 = 2000), with the Anderson iteration, and converges, to
-    the solution Anderson alone finds, in fewer transforms."""
+@pytest.mark.parametrize("e_inf, speed, shortest, friction",
+                         [(100.0, 4.64e-3, 1 / 128, 0.0), (2000.0, 0.0215, 1 / 64, 0.5)])
+def test_auto_converges_on_glassy_lines_near_their_loss_peak(e_inf, speed, shortest, friction):
+    """A glassy layer near its loss peak on a line of 512 points, where the plain GCR
+    stalls: method 'auto' converges (going on from the GCR's best iterate, whichever way),
+    to the solution the Anderson iteration alone finds, in fewer transforms than it."""
     h = lc.self_affine_profile(512, 0.8, seed=1, short_wavelength=shortest, rms_gradient=0.1)
     kw = dict(thickness=0.16, mean_pressure=(4 / 3) * (h.max() - h.mean()), speed=speed, friction=friction,
               tol=1e-8, stress=False, material=lc.StandardLinearSolid(e0=1.0, e_inf=e_inf, tau=1.0))
-    alone = lc.solve_line(h, method="gcr", **kw)
-    assert not alone.converged and alone.residual > 1e-8 and alone.solver == "gcr"
     auto = lc.solve_line(h, **kw)
     anderson = lc.solve_line(h, method="anderson", **kw)
-    assert auto.converged and auto.solver == stages and auto.iterations > alone.iterations
-    assert (auto.outer_iterations > 1) == stages.endswith("anderson")
+    assert auto.converged and auto.residual <= 1e-8
     assert anderson.converged and auto.fft_pairs < anderson.fft_pairs
     # tol 1e-8 on a gap scale ptp(h) with stiffness up to |k_max| E_inf*/2
     bound = 1e-8 * np.ptp(h) * (e_inf / 0.75) * np.pi * h.size / 2
@@ -369,22 +362,21 @@ def test_dense_newton_agrees(case):
 
 @pytest.mark.parametrize("n, profile, thickness, friction, factor", [
     (9, "rough", 1e-4, 0.5, 0.3), (9, "sinusoid", 1e-4, 1.0, 0.03), (8, "bump", 1e-4, 0.5, 0.3)])
-def test_dense_newton_finishes_what_the_iterative_solvers_leave(n, profile, thickness, friction, factor):
+def test_auto_converges_where_the_iterative_solvers_stall(n, profile, thickness, friction, factor):
     """Thin incompressible layers with strong friction on a few points: G_eff is nearly skew
-    there, GCR and the Anderson iteration stall (method 'gcr' alone says so), and under
-    'auto' the dense Newton method finishes the solve from their last iterate. Its solution
-    equals the independent numpy solver's (tests/dense_reference.py) to the bound the
-    tolerance allows (see test_dense_newton_agrees)."""
+    there and the plain GCR may stall. Method 'auto' converges whatever path it takes (the
+    GCR with its kept history, the Anderson iteration or the dense Newton method, which may
+    differ with rounding from one processor to another), to the independent numpy solver's
+    solution (tests/dense_reference.py) within the bound the tolerance allows (see
+    test_dense_newton_agrees)."""
     r = extremes_grid.profiles(n)[profile]
     g = g_eff(n, 1.0, thickness, 1.0, 0.5, friction)
     assert np.all(g.real >= 0)  # monotone: the solution is unique
     pm = factor * extremes_grid.full_contact_pressure(r, thickness, 0.5, friction)
     tol = 1e-9
-    kw = dict(thickness=thickness, poisson=0.5, friction=friction, mean_pressure=pm, tol=tol, stress=False)
-    alone = lc.solve_line(r, method="gcr", **kw)
-    assert not alone.converged
-    res = lc.solve_line(r, **kw)
-    assert res.converged and res.residual <= tol and res.solver.endswith("+newton")
+    res = lc.solve_line(r, thickness=thickness, poisson=0.5, friction=friction, mean_pressure=pm, tol=tol,
+                        stress=False)
+    assert res.converged and res.residual <= tol
     p, s, residual = solve_dense(r, g, pm)
     assert residual <= 1e-13
     bound = tol * np.ptp(r) * np.max(1 / np.abs(g[1:]))
