@@ -27,7 +27,7 @@ module lc_accuracy
    use lc_scene, only: scene_type, not_set, is_areal
    use lc_result, only: contact_result
    use lc_profiles_profile, only: make_profile
-   use lc_contact_solve, only: solve_contact
+   use lc_scene_solve, only: solve_scene
    implicit none (type, external)
    private
    public :: choose_resolution
@@ -91,7 +91,7 @@ contains
       allocate (height(int(pilot%n, kind=8)*pilot%ny))
       call make_profile(pilot, height, error)
       if (allocated(error)) return
-      call solve_contact(pilot, height, scene%friction, result, error)
+      call solve_scene(pilot, height, scene%friction, result, error)
       if (allocated(error)) return
       spot = spot_size(pilot, result)/shortest   ! in shortest wavelengths
 

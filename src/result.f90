@@ -7,6 +7,9 @@ module lc_result
    private
    public :: contact_result, result_scalar, result_scalars
 
+   !> The longest text a scalar holds (the solver's reason).
+   integer, parameter :: text_length = 1024
+
    !> One solved contact problem (a scene, or its frictionless companion).
    type :: contact_result
       real(wp), allocatable :: pressure(:)         !< p >= 0 (S), compressive positive
@@ -76,6 +79,9 @@ module lc_result
       !> '+newton' when the dense Newton method finished a small grid the iterative solver
       !> left unconverged
       character(len=48) :: solver = ''
+      !> why the policy chose those methods (lc_contact_policy), e.g. 'a coupled operator
+      !> (friction, or a sliding viscoelastic layer): the constrained GCR; where it stalls, ...'
+      character(len=:), allocatable :: solver_reason
       integer :: fft_pairs = 0                !< FFT r2c+c2r pairs spent
       real(wp) :: residual = huge(1.0_wp)     !< final dimensionless complementarity residual
       !> an upper bound of the rounding of w - r relative to the profile's peak-to-valley:
@@ -95,7 +101,7 @@ module lc_result
       character(len=8) :: unit = '1'
       logical :: is_integer = .false.
       logical :: is_text = .false.
-      character(len=48) :: text = ''
+      character(len=text_length) :: text = ''
    end type result_scalar
 
 contains
@@ -125,6 +131,7 @@ contains
          & integer_scalar('iterations', res%iterations), &
          & integer_scalar('outer_iterations', res%outer_iterations), &
          & result_scalar('solver', is_text=.true., text=res%solver), &
+         & result_scalar('solver_reason', is_text=.true., text=reason(res)), &
          & integer_scalar('fft_pairs', res%fft_pairs), &
          & real_scalar('residual', res%residual), &
          & real_scalar('gap_resolution', res%gap_resolution), &
@@ -148,6 +155,14 @@ contains
          & real_scalar('normalised_thickness', res%normalised_thickness)]
       if (present(a_over_a0)) table = [table, real_scalar('a_over_a0', a_over_a0)]
    end function result_scalars
+
+   !> The solver's reason, or '' where none was recorded.
+   pure function reason(res) result(text)
+      type(contact_result), intent(in) :: res
+      character(len=:), allocatable :: text
+      text = ''
+      if (allocated(res%solver_reason)) text = res%solver_reason
+   end function reason
 
    pure type(result_scalar) function real_scalar(name, value, unit)
       character(len=*), intent(in) :: name

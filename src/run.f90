@@ -16,7 +16,7 @@ module lc_run
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
    use lc_profiles_profile, only: make_profile
    use lc_profiles_measured, only: measured_grid
-   use lc_contact_solve, only: solve_contact
+   use lc_scene_solve, only: solve_scene
    use lc_accuracy, only: choose_resolution
    use lc_version, only: version_string, build_isa
    implicit none (type, external)
@@ -73,7 +73,7 @@ contains
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
 
-      call solve_contact(scene, height, scene%friction, result, error)
+      call solve_scene(scene, height, scene%friction, result, error)
       if (allocated(error)) return
       converged = result%converged
       if (scene%leakage) then
@@ -81,7 +81,7 @@ contains
          if (allocated(error)) return
       end if
       if (scene%companion) then
-         call solve_contact(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
+         call solve_scene(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
          if (allocated(error)) return
          if (scene%leakage) then
             call leakage_of(scene, companion, error)
@@ -202,8 +202,7 @@ contains
       end if
       write (unit, '(2x, a, t34, a14)') 'solver', trim(result%solver)
       write (unit, int_fmt) 'iterations', result%iterations
-      if (index(result%solver, 'anderson') > 0) write (unit, int_fmt) 'outer (Anderson) iterations', &
-         & result%outer_iterations
+      if (result%outer_iterations > 1) write (unit, int_fmt) 'outer (Anderson) iterations', result%outer_iterations
       write (unit, real_fmt) 'residual', result%residual
       write (unit, '(2x, a, t34, l14)') 'converged', result%converged
       if (present(companion)) write (unit, '(2x, a, t34, l14)') 'converged, mu_c = 0', companion%converged

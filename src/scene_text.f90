@@ -12,7 +12,7 @@ module lc_scene_text
       & kernel_of, default_rms_gradient
    use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_io_namelist, only: read_scene_text
-   use lc_contact_solve, only: solve_contact
+   use lc_scene_solve, only: solve_scene
    use lc_profiles_profile, only: make_profile
    use lc_greens_viscoelastic, only: material_law, max_prony_terms
    use lc_greens_kernel, only: layer_kernel
@@ -68,13 +68,13 @@ contains
       scene%profile%kind = 'file'
       scene%profile%file = '(heights given as an array)'
       scene%gap_bins = 0
-      call solve_contact(scene, height, scene%friction, result, error)
+      call solve_scene(scene, height, scene%friction, result, error)
       if (allocated(error)) return
       ! the cell, as /input of a result file has it (period_y resolved)
       description = 'input/period = ' // real_text(scene%period) // newline // 'input/period_y = ' // &
          & real_text(merge(scene%period_y, scene%period, scene%period_y /= not_set)) // newline
       if (scene%companion) then
-         call solve_contact(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
+         call solve_scene(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
          if (allocated(error)) return
          call describe_run(result, is_areal(scene), '', fields(:, :, 1), spots(:, :, 1), history(:, 1), &
             & description, result%contact_fraction/companion%contact_fraction)
@@ -204,8 +204,9 @@ contains
       end if
       text = ''
       do i = 1, size(scalars)
-         text = text // prefix // 'results/' // trim(scalars(i)%name) // ' = ' // value_text(scalars(i)) // ' ' // &
-            & trim(scalars(i)%unit) // newline
+         text = text // prefix // 'results/' // trim(scalars(i)%name) // ' = ' // value_text(scalars(i))
+         if (.not. scalars(i)%is_text) text = text // ' ' // trim(scalars(i)%unit)
+         text = text // newline
       end do
 
       names = ''

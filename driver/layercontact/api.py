@@ -167,6 +167,8 @@ class LineResult:
     residual: float
     wall_time: float
     residual_history: np.ndarray = field(repr=False)
+    #: why the methods of ``solver`` were chosen (docs/numerics.md, "How 'auto' chooses")
+    solver_reason: str = ""
     #: the smallest gap, relative to the profile's height range, that double precision
     #: resolves at this load; above ``tol`` the run reports ``converged = False``
     gap_resolution: float = 0.0
@@ -353,9 +355,11 @@ def _typed(cls, scalars: dict) -> dict:
             continue
         if isinstance(value, bytes):
             value = value.decode()
-        if isinstance(value, str):
+        if isinstance(value, str) and kind == "str":
+            value = "" if value.strip() == "''" else value.strip()
+        elif isinstance(value, str):
             words = value.split()
-            value = "" if not words or words[0] == "''" else words[0]
+            value = "" if not words else words[0]
         out[name] = {"bool": lambda v: bool(int(v)), "int": int, "str": str}.get(kind, float)(value)
     return out
 
@@ -431,6 +435,8 @@ class ArealResult:
     residual: float
     wall_time: float
     residual_history: np.ndarray = field(repr=False)
+    #: why the methods of ``solver`` were chosen (docs/numerics.md, "How 'auto' chooses")
+    solver_reason: str = ""
     #: the smallest gap, relative to the profile's height range, that double precision
     #: resolves at this load; above ``tol`` the run reports ``converged = False``
     gap_resolution: float = 0.0

@@ -25,6 +25,7 @@ module lc_contact_progress
    contains
       procedure :: begin
       procedure :: begin_level
+      procedure :: plan
       procedure :: tick
       procedure :: level_done
       procedure :: elapsed
@@ -53,6 +54,14 @@ contains
          self%level = to_string(nx) // ' x ' // to_string(ny)
       end if
    end subroutine begin_level
+
+   !> The methods chosen for the level and why (lc_contact_policy).
+   subroutine plan(self, reason)
+      class(progress_log), intent(inout) :: self
+      character(len=*), intent(in) :: reason
+      if (.not. self%enabled) return
+      call say(self%level // ': ' // reason)
+   end subroutine plan
 
    !> Called once per iteration; writes a line if `interval` seconds passed since the last.
    subroutine tick(self, iteration, residual, contact_fraction)

@@ -15,11 +15,14 @@ module lc_contact_solver_anderson
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, code_internal
    use lc_contact_operator, only: compliance_operator
-   use lc_contact_solver_cg, only: constrained_cg, cg_outcome, complementarity_residual, rounding_floor
+   use lc_contact_solver_cg, only: constrained_cg, cg_outcome
+   use lc_contact_residual, only: complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
+   use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
+   use lc_contact_solver, only: contact_solver
    implicit none (type, external)
    private
-   public :: anderson_coupled, anderson_outcome
+   public :: anderson_coupled, anderson_outcome, anderson_solver
 
    !> Rows per block of the sweeps over the history (a few columns' blocks fit in L1/L2).
    integer, parameter :: block_rows = 2048
@@ -47,6 +50,14 @@ module lc_contact_solver_anderson
          integer, intent(out) :: rank, iwork(*), info
       end subroutine dgelsd
    end interface
+
+
+   !> Method 'anderson': the Anderson outer iteration around the constrained CG on the metric.
+   type, extends(contact_solver) :: anderson_solver
+   contains
+      procedure :: solve => solve_by_anderson
+      procedure :: name => anderson_name
+   end type anderson_solver
 
 contains
 
@@ -300,4 +311,30 @@ contains
          end do
       end do
    end subroutine mix
+   subroutine solve_by_anderson(self, problem, state, budget, outcome, progress, error)
+      class(anderson_solver), intent(inout) :: self
+      type(contact_problem), intent(in) :: problem
+      type(contact_state), intent(inout) :: state
+      integer, intent(in) :: budget
+      type(solve_outcome), intent(out) :: outcome
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(anderson_outcome) :: outer
+      real(wp), allocatable :: history(:)
+      allocate (history(budget))
+      call anderson_coupled(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
+         & problem%g_ref, problem%tol, budget, problem%memory, problem%precondition, state%p, state%w, state%gap, &
+         & outer, history, error, progress)
+      if (allocated(error)) return
+      outcome = solve_outcome(converged=outer%converged, iterations=outer%cg_iterations, &
+         & outer_iterations=outer%outer_iterations, fft_pairs=outer%fft_pairs, residual=outer%residual, &
+         & history=history(1:outer%outer_iterations))
+   end subroutine solve_by_anderson
+
+   pure function anderson_name(self) result(name)
+      class(anderson_solver), intent(in) :: self
+      character(len=:), allocatable :: name
+      name = 'anderson'
+   end function anderson_name
+
 end module lc_contact_solver_anderson

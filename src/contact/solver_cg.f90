@@ -10,13 +10,17 @@
 !> (zero exactly at the solution) falls to tol; p_ref = p_m (load control) or the
 !> current mean pressure, g_ref is given by the caller (the profile's peak-to-valley).
 module lc_contact_solver_cg
-   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    use lc_contact_progress, only: progress_log
+   use lc_errors, only: error_type
+   use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
+   use lc_contact_solver, only: contact_solver
+   use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
    implicit none (type, external)
    private
-   public :: constrained_cg, cg_outcome, complementarity_residual, rounding_floor, normalise
+   public :: constrained_cg, cg_outcome, cg_solver
 
    !> Iterations without the residual halving after which the preconditioner is dropped.
    integer, parameter :: stall_window = 100
@@ -47,6 +51,14 @@ module lc_contact_solver_cg
       real(wp) :: p_max = 0.0_wp
       real(wp) :: p_sum = 0.0_wp
    end type grid_sums
+
+
+   !> Method 'cg': the constrained CG on the metric M (a symmetric operator: M = G_eff).
+   type, extends(contact_solver) :: cg_solver
+   contains
+      procedure :: solve => solve_by_cg
+      procedure :: name => cg_name
+   end type cg_solver
 
 contains
 
@@ -467,42 +479,27 @@ contains
          gap(j) = d(j) - s
       end do
    end subroutine final_fields
+   subroutine solve_by_cg(self, problem, state, budget, outcome, progress, error)
+      class(cg_solver), intent(inout) :: self
+      type(contact_problem), intent(in) :: problem
+      type(contact_state), intent(inout) :: state
+      integer, intent(in) :: budget
+      type(solve_outcome), intent(out) :: outcome
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(cg_outcome) :: cg
+      real(wp), allocatable :: history(:)
+      allocate (history(budget))
+      call constrained_cg(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
+         & problem%tol, budget, problem%precondition, state%p, state%w, state%gap, cg, history, progress)
+      outcome = solve_outcome(converged=cg%converged, iterations=cg%iterations, outer_iterations=0, &
+         & fft_pairs=cg%fft_pairs, residual=cg%residual, history=history(1:cg%iterations))
+   end subroutine solve_by_cg
 
-   !> max_j |min(p_j/p_ref, gap_j/g_ref)|: zero iff p >= 0, gap >= 0 and p gap = 0.
-   !> Gaps within `g_floor` of zero count as zero: below that the gap is rounding noise of
-   !> w - b (see rounding_floor), and no iteration can make it smaller.
-   pure real(wp) function complementarity_residual(p, gap, p_ref, g_ref, g_floor) result(res)
-      real(wp), intent(in) :: p(:), gap(:), p_ref, g_ref, g_floor
-      real(wp) :: pscale
-      integer :: j
-      pscale = 1.0_wp/max(p_ref, tiny(1.0_wp))
-      res = 0.0_wp
-      do j = 1, size(p)
-         if (abs(gap(j)) > g_floor) res = max(res, abs(min(p(j)*pscale, gap(j)/g_ref)))
-         if (ieee_is_nan(gap(j)) .or. ieee_is_nan(p(j))) res = huge(1.0_wp)
-         if (p(j) < 0.0_wp) res = max(res, -p(j)*pscale)
-      end do
-   end function complementarity_residual
+   pure function cg_name(self) result(name)
+      class(cg_solver), intent(in) :: self
+      character(len=:), allocatable :: name
+      name = 'cg'
+   end function cg_name
 
-   !> Attainable accuracy of a gap g = w - b with w = G p computed through FFTs: a few
-   !> hundred ulps of the largest term, max|w|, max|b| or max|p| max_k|G(k)| (the rounding of
-   !> the transforms of p; it dominates w when a large uniform pressure is nearly
-   !> annihilated, as on a half-space in full contact). Matters only at extreme loads.
-   pure real(wp) function rounding_floor(w_max, b_max, p_max, m_max) result(floor)
-      real(wp), intent(in) :: w_max, b_max, p_max, m_max
-      floor = 256*epsilon(1.0_wp)*max(w_max, b_max, p_max*m_max)
-   end function rounding_floor
-
-   !> Scale p to mean p_m (uniform if p vanished altogether).
-   pure subroutine normalise(p, mean_pressure)
-      real(wp), intent(inout) :: p(:)
-      real(wp), intent(in) :: mean_pressure
-      real(wp) :: total
-      total = sum(p)
-      if (total > 0.0_wp) then
-         p = p*(mean_pressure*size(p)/total)
-      else
-         p = mean_pressure
-      end if
-   end subroutine normalise
 end module lc_contact_solver_cg

@@ -25,11 +25,14 @@ module lc_contact_solver_gfmd
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
-   use lc_contact_solver_cg, only: complementarity_residual, rounding_floor
+   use lc_contact_residual, only: complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
+   use lc_errors, only: error_type
+   use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
+   use lc_contact_solver, only: contact_solver
    implicit none (type, external)
    private
-   public :: gfmd, gfmd_outcome
+   public :: gfmd, gfmd_outcome, gfmd_solver
 
    !> FIRE's parameters (Bitzek et al.): steps with positive power before the step grows,
    !> growth and shrink factors of the step, the initial and the decay of the mixing.
@@ -50,6 +53,14 @@ module lc_contact_solver_gfmd
       integer :: fft_pairs = 0
       real(wp) :: residual = huge(1.0_wp)
    end type gfmd_outcome
+
+
+   !> Method 'gfmd': damped dynamics of the normal displacement.
+   type, extends(contact_solver) :: gfmd_solver
+   contains
+      procedure :: solve => solve_by_gfmd
+      procedure :: name => gfmd_name
+   end type gfmd_solver
 
 contains
 
@@ -192,4 +203,28 @@ contains
       contact = count(p > 0.0_wp)
       if (contact > 0) s = sum(w - b, mask=p > 0.0_wp)/contact
    end subroutine contact_shift
+   subroutine solve_by_gfmd(self, problem, state, budget, outcome, progress, error)
+      class(gfmd_solver), intent(inout) :: self
+      type(contact_problem), intent(in) :: problem
+      type(contact_state), intent(inout) :: state
+      integer, intent(in) :: budget
+      type(solve_outcome), intent(out) :: outcome
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(gfmd_outcome) :: dynamics
+      real(wp), allocatable :: history(:)
+      allocate (history(budget))
+      call gfmd(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
+         & problem%tol, budget, state%p, state%w, state%gap, dynamics, history, progress)
+      outcome = solve_outcome(converged=dynamics%converged, iterations=dynamics%iterations, outer_iterations=0, &
+         & fft_pairs=dynamics%fft_pairs, residual=dynamics%residual, &
+         & history=history(1:min(dynamics%checks, size(history))))
+   end subroutine solve_by_gfmd
+
+   pure function gfmd_name(self) result(name)
+      class(gfmd_solver), intent(in) :: self
+      character(len=:), allocatable :: name
+      name = 'gfmd'
+   end function gfmd_name
+
 end module lc_contact_solver_gfmd

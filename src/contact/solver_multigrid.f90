@@ -50,12 +50,14 @@ module lc_contact_solver_multigrid
    use lc_contact_multigrid_hierarchy, only: hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, &
       & build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, precondition, worst_smoothing, &
       & apply_stiffness, worst_row_smoothing, accepted_smoothing
-   use lc_contact_solver_cg, only: complementarity_residual, rounding_floor, normalise
+   use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
    use lc_contact_progress, only: progress_log
+   use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
+   use lc_contact_solver, only: contact_solver
    use lc_grid, only: grid_type
    implicit none (type, external)
    private
-   public :: multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
+   public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
    public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
@@ -241,6 +243,16 @@ module lc_contact_solver_multigrid
    type :: residual_scales
       real(wp) :: p_scale = 1.0_wp, g_scale = 1.0_wp, floor = 0.0_wp
    end type residual_scales
+
+
+   !> Method 'multigrid': the TNNMG iteration on the metric's hierarchy for a symmetric
+   !> operator (multigrid), on K = 1/G_eff for a coupled one or for a compliance rising too
+   !> steeply for the symmetric form (coupled_tnnmg; coupled_refusal admits the scene).
+   type, extends(contact_solver) :: multigrid_solver
+   contains
+      procedure :: solve => solve_by_multigrid
+      procedure :: name => multigrid_name
+   end type multigrid_solver
 
 contains
 
@@ -1280,4 +1292,34 @@ contains
       residual = complementarity_residual(p, gap, p_ref, g_ref, &
          & rounding_floor(maxval(abs(w)), maxval(abs(b)), maxval(p), op%largest))
    end subroutine returned_fields
+   subroutine solve_by_multigrid(self, problem, state, budget, outcome, progress, error)
+      class(multigrid_solver), intent(inout) :: self
+      type(contact_problem), intent(in) :: problem
+      type(contact_state), intent(inout) :: state
+      integer, intent(in) :: budget
+      type(solve_outcome), intent(out) :: outcome
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(multigrid_outcome) :: nested
+      real(wp), allocatable :: history(:)
+      allocate (history(budget))
+      if (problem%op%coupled .or. len(multigrid_refusal(problem%op)) > 0) then
+         call coupled_tnnmg(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
+            & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
+      else
+         call multigrid(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
+            & problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
+      end if
+      if (allocated(error)) return
+      outcome = solve_outcome(converged=nested%converged, iterations=nested%iterations, outer_iterations=0, &
+         & fft_pairs=nested%fft_pairs, residual=nested%residual, &
+         & history=history(1:min(nested%iterations, size(history))))
+   end subroutine solve_by_multigrid
+
+   pure function multigrid_name(self) result(name)
+      class(multigrid_solver), intent(in) :: self
+      character(len=:), allocatable :: name
+      name = 'multigrid'
+   end function multigrid_name
+
 end module lc_contact_solver_multigrid

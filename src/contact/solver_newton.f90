@@ -21,11 +21,15 @@ module lc_contact_solver_newton
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
-   use lc_contact_solver_cg, only: complementarity_residual, rounding_floor
+   use lc_contact_residual, only: complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
+   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_strings, only: to_string
+   use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
+   use lc_contact_solver, only: contact_solver
    implicit none (type, external)
    private
-   public :: dense_newton, newton_outcome, dense_points, newton_step_limit
+   public :: dense_newton, newton_outcome, dense_points, newton_step_limit, newton_solver
 
    !> Largest grid (points) the method is used on: the matrices take 2 n^2 doubles (64 MiB
    !> at 2048 points) and a step ~(2/3) n^3 flops (~0.3 s at 2048 points on one core).
@@ -56,6 +60,15 @@ module lc_contact_solver_newton
          integer, intent(out) :: ipiv(*), info
       end subroutine dgesv
    end interface
+
+
+   !> Method 'newton': the dense semismooth Newton method, on grids of at most dense_points.
+   type, extends(contact_solver) :: newton_solver
+   contains
+      procedure :: solve => solve_by_newton
+      procedure :: name => newton_name
+      procedure :: step_limit => newton_steps
+   end type newton_solver
 
 contains
 
@@ -237,4 +250,36 @@ contains
          end do
       end do
    end subroutine dense_operator
+   subroutine solve_by_newton(self, problem, state, budget, outcome, progress, error)
+      class(newton_solver), intent(inout) :: self
+      type(contact_problem), intent(in) :: problem
+      type(contact_state), intent(inout) :: state
+      integer, intent(in) :: budget
+      type(solve_outcome), intent(out) :: outcome
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(newton_outcome) :: newton
+      if (problem%op%n > dense_points) then
+         call fatal_error(error, "&solver: method = 'newton' (dense) needs a grid of at most " // &
+            & to_string(dense_points) // ' points; this one has ' // to_string(problem%op%n), code_input)
+         return
+      end if
+      call dense_newton(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
+         & problem%tol, budget, state%p, state%w, state%gap, newton, progress)
+      outcome = solve_outcome(converged=newton%converged, iterations=newton%steps, outer_iterations=0, &
+         & fft_pairs=newton%fft_pairs, residual=newton%residual, history=[newton%residual])
+   end subroutine solve_by_newton
+
+   pure function newton_name(self) result(name)
+      class(newton_solver), intent(in) :: self
+      character(len=:), allocatable :: name
+      name = 'newton'
+   end function newton_name
+
+   !> A step costs ~(2/3) n^3 flops: newton_step_limit at most.
+   pure integer function newton_steps(self)
+      class(newton_solver), intent(in) :: self
+      newton_steps = newton_step_limit
+   end function newton_steps
+
 end module lc_contact_solver_newton
