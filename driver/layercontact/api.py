@@ -130,17 +130,16 @@ class LineResult:
     ``stress_xx`` at a trailing edge sub-grid when there is friction; ``max_tension_grid``
     (``spot_max_tension_grid``) is the largest grid value.
     ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
-    ``solver`` names the method that ran: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled
-    scenes), ``'anderson'``, ``'multigrid'``, ``'multigrid+cg'`` (the constrained CG finished
-    fields the multigrid left just above a tolerance near the rounding floor),
-    ``'multigrid+gcr'`` (GCR went on where the multigrid method stalled on a coupled scene,
-    strongly glassy layers; ``'+kept'``, ``'+anderson'`` may follow as after ``'gcr'``),
-    ``'gcr+kept'`` (GCR stalled and went on from its
-    best iterate keeping its history across clips) or ``'gcr+kept+anderson'`` (that stalled
-    too and the Anderson outer iteration went on); ``'+newton'`` is appended when the dense
-    Newton method finished a grid of at most 2048 points that the iterative solver left
-    unconverged. ``iterations`` counts CG or GCR iterations (all inner CG iterations for
-    Anderson, plus the Newton steps). ``residual_history`` holds the residual per
+    ``solver`` names the methods that ran, joined by ``'+'`` where one went on from the
+    last one's iterate: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled scenes),
+    ``'multigrid'``, ``'anderson'``, ``'gfmd'``, ``'newton'``; after ``'multigrid'`` the
+    constrained CG (``'+cg'``) or GCR (``'+gcr'``) may finish, after ``'gcr'`` the GCR keeping
+    its history across clips (``'+kept'``) and the Anderson iteration (``'+anderson'``), and
+    on a grid of at most 2048 points with a unique solution the dense Newton method
+    (``'+newton'``). ``solver_reason`` says why method ``'auto'`` chose them (docs/numerics.md,
+    "How 'auto' chooses"); which fallback finishes may vary with rounding from one processor
+    to another, the solution does not. ``iterations`` counts the iterations of every method
+    (all inner CG iterations for Anderson, plus the Newton steps). ``residual_history`` holds the residual per
     iteration (per outer iteration for Anderson); from :func:`solve_line`, the last
     ``HISTORY_CAPACITY`` (10000) of them.
     """
