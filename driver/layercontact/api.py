@@ -139,9 +139,9 @@ class LineResult:
     (``'+newton'``). ``solver_reason`` says why method ``'auto'`` chose them (docs/numerics.md,
     "How 'auto' chooses"); which fallback finishes may vary with rounding from one processor
     to another, the solution does not. ``iterations`` counts the iterations of every method
-    (all inner CG iterations for Anderson, plus the Newton steps). ``residual_history`` holds the residual per
-    iteration (per outer iteration for Anderson); from :func:`solve_line`, the last
-    ``HISTORY_CAPACITY`` (10000) of them.
+    (all inner CG iterations for Anderson, plus the Newton steps). ``residual_history``
+    holds the residual per iteration (per outer iteration for Anderson); from
+    :func:`solve_line`, the last ``HISTORY_CAPACITY`` (10000) of them.
     """
 
     pressure: np.ndarray
