@@ -17,6 +17,7 @@ module lc_run
    use lc_profiles_profile, only: make_profile
    use lc_profiles_measured, only: measured_grid
    use lc_scene_solve, only: solve_scene
+   use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_accuracy, only: choose_resolution
    use lc_version, only: version_string, build_isa
    implicit none (type, external)
@@ -165,7 +166,7 @@ contains
       end if
       write (unit, real_fmt) 'penetration Delta', result%penetration, '(L)'
       if (present(companion)) write (unit, real_fmt) 'penetration Delta, mu_c = 0', companion%penetration, '(L)'
-      if (trim(scene%material%model) /= 'elastic') then
+      if (is_viscoelastic(scene%material)) then
          write (unit, '(2x, a, t34, a)') 'material', trim(scene%material%model) // ' (viscoelastic)'
          write (unit, real_fmt) 'sliding speed V', scene%speed, '(L/T)'
          write (unit, real_fmt) 'dissipated power', result%dissipated_power, '(S L/T)'

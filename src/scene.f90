@@ -11,7 +11,7 @@ module lc_scene
    use lc_kinds, only: wp, i8
    use lc_errors, only: error_type, input_error, positive_finite
    use lc_strings, only: to_string
-   use lc_greens_viscoelastic, only: material_law, check_material, static_modulus
+   use lc_greens_viscoelastic, only: material_law, check_material, static_modulus, is_viscoelastic
    use lc_grid, only: grid_type, line_grid, surface_grid
    use lc_greens_kernel, only: layer_kernel, make_kernel
    use lc_leakage_reynolds, only: leakage_tol_allowed, leakage_tol_range
@@ -157,7 +157,7 @@ contains
    end function grid_of
 
    !> The scene's layer kernel (lc_greens_kernel).
-   pure function kernel_of(scene) result(kernel)
+   function kernel_of(scene) result(kernel)
       type(scene_type), intent(in) :: scene
       type(layer_kernel) :: kernel
       kernel = make_kernel(scene%thickness, material_of(scene), scene%poisson, scene%speed)
@@ -168,11 +168,11 @@ contains
       type(scene_type), intent(in) :: scene
       type(material_law) :: law
       law = scene%material
-      if (trim(law%model) == 'elastic') law%young = scene%young
+      law%young = scene%young
    end function material_of
 
    !> E* = E/(1 - nu^2) with the static (V -> 0) modulus: the seed's pressure scale (S).
-   pure real(wp) function static_contact_modulus(scene)
+   real(wp) function static_contact_modulus(scene)
       type(scene_type), intent(in) :: scene
       static_contact_modulus = static_modulus(material_of(scene))/(1.0_wp - scene%poisson**2)
    end function static_contact_modulus
@@ -181,7 +181,7 @@ contains
    !> contact on a half-space (Lambda0 = max r - mean r, the highest summit above the mean
    !> plane), E* h/lambda for an areal contact on a layer; E* with the static modulus,
    !> lambda the period along x.
-   pure real(wp) function pressure_scale(scene, height)
+   real(wp) function pressure_scale(scene, height)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: height(:)
       real(wp) :: lambda0
@@ -252,7 +252,7 @@ contains
          if (allocated(error)) return
          call check_material(scene%material, error)
          if (allocated(error)) return
-         if (trim(scene%material%model) == 'elastic' .and. scene%speed /= 0.0_wp) then
+         if (.not. is_viscoelastic(scene%material) .and. scene%speed /= 0.0_wp) then
             call input_error(error, 'material', 'speed', to_string(scene%speed), &
                & "0 with model = 'elastic' (an elastic layer does not depend on the speed)")
             return

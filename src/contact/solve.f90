@@ -51,7 +51,7 @@ contains
 
    !> p_m of a load-controlled scene on profile `height` (S): the given one, or the
    !> normalised pressure times its scale (pressure_scale).
-   pure real(wp) function scene_mean_pressure(scene, height) result(pm)
+   real(wp) function scene_mean_pressure(scene, height) result(pm)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: height(:)
       if (scene%mean_pressure /= not_set) then
@@ -177,7 +177,7 @@ contains
       type(solve_outcome) :: outcome
       real(wp) :: uniform, plain
       integer :: coarse_pairs, coarse_iterations
-      logical :: coarse_multigrid
+      logical :: coarse_multigrid, started
 
       ! (the operator first: which methods run depends on it, and refusals come before any
       ! coarse solve)
@@ -197,7 +197,8 @@ contains
       if (trim(scene%solver%method) == 'auto') then
          ! (the start decides what the fine grid is: the rules of lc_contact_policy, step 3)
          call measure_start(indicators, op, load_control, coarse_iterations, coarse_multigrid, state%p)
-         call plan_solve(indicators, plan%coarse_start, plan, error)
+         started = plan%coarse_start
+         call plan_solve(indicators, started, plan, error)
          if (allocated(error)) return
       end if
       call progress%begin_level(grid%nx, grid%ny)

@@ -17,7 +17,7 @@ module lc_greens_kernel
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp
    use lc_greens_layer, only: layer_coefficients
-   use lc_greens_viscoelastic, only: material_law, creep_compliance
+   use lc_greens_viscoelastic, only: material_law, material_model, material_model_of
    implicit none (type, external)
    private
    public :: layer_kernel, make_kernel
@@ -27,7 +27,8 @@ module lc_greens_kernel
       real(wp) :: thickness = 1.0_wp     !< h (L); +Inf = half-space
       real(wp) :: poisson = 0.5_wp       !< nu, constant in time
       real(wp) :: speed = 0.0_wp         !< V (L/T)
-      type(material_law) :: law
+      !> the layer's material (material_model_of its &material values)
+      class(material_model), allocatable :: material
       logical :: halfspace = .false.
       !> a moving viscoelastic law: complex compliances (an elastic law, or any law at rest,
       !> has the real compliance of its static modulus)
@@ -49,16 +50,17 @@ contains
 
    !> The kernel of a layer of thickness h (+Inf: half-space), material law, Poisson ratio
    !> and sliding speed.
-   pure function make_kernel(thickness, law, poisson, speed) result(kernel)
+   function make_kernel(thickness, law, poisson, speed) result(kernel)
       real(wp), intent(in) :: thickness, poisson, speed
       type(material_law), intent(in) :: law
       type(layer_kernel) :: kernel
       kernel%thickness = thickness
       kernel%poisson = poisson
       kernel%speed = speed
-      kernel%law = law
+      call material_model_of(law, kernel%material)
       kernel%halfspace = .not. ieee_is_finite(thickness)
-      kernel%viscoelastic = trim(law%model) /= 'elastic' .and. speed > 0.0_wp
+      kernel%viscoelastic = .false.
+      if (allocated(kernel%material)) kernel%viscoelastic = kernel%material%viscoelastic() .and. speed > 0.0_wp
    end function make_kernel
 
    !> C = (1 - nu^2) J*(q_x V) (1/S) for the sliding wavenumbers q_x (1/L).
@@ -66,7 +68,7 @@ contains
       class(layer_kernel), intent(in) :: self
       real(wp), intent(in) :: qx(:)
       complex(wp) :: c(size(qx))
-      c = (1.0_wp - self%poisson**2)*creep_compliance(self%law, qx*self%speed)
+      c = (1.0_wp - self%poisson**2)*self%material%compliance(qx*self%speed)
    end function contact_compliance
 
    !> 1-A, 1-B and c for |q| > 0 (1/L).
