@@ -302,7 +302,7 @@ def main() -> None:
                           f"{solve_error(problem, tight['pressure']):.1e}")
             tols = [calibrated_tolerance(problem, solve, lc_error)]
             if name == "tamaas" and problem.n == 8192:
-                tols.append(TARGET_TOL)  # the setting, for reference
+                tols.append(TARGET_TOL)  # layercontact's tolerance, for reference
             for tol in tols:
                 seconds, solution = best_of(lambda: solve(problem, tol))
                 if name == "tamaas":

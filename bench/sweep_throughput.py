@@ -16,10 +16,10 @@ scratch in a temporary directory (deleted at the end; nothing is written in the 
   optional: (f) as (b) with OPENBLAS_NUM_THREADS=1; (g) as (e) with OMP_WAIT_POLICY=passive
 
 Why OPENBLAS_NUM_THREADS: the library's LAPACK is Debian's OpenBLAS (openblas-pthread).
-The Anderson mixing step used to call dgelsd on an n x (<= 12) matrix, which OpenBLAS ran
-on as many threads as there are cores, spinning while waiting (a single-process solve
-burnt ~1.8 cores, and (d) was faster than (a)). It now solves a small Gram system, and (d)
-checks that nothing threaded is left (measured: no gain).
+A least-squares call (dgelsd) on an n x (<= 12) matrix in the Anderson mixing step would
+run on as many threads as there are cores, spinning while waiting (a single-process solve
+burns ~1.8 cores, and (d) is faster than (a)). The mixing step solves a small Gram system,
+and (d) checks that nothing threaded is left (measured: no gain).
 
 (c), (e) and (g) need a second venv built with the meson option ``openmp`` (docs/namelist.md: &solver
 threads), e.g. ``--build-openmp`` or by hand::

@@ -18,8 +18,8 @@
 !> (frictionless half-space, h/lambda = 0.16 and 0.01 with mu_c = 0.5, a viscoelastic layer)
 !> for eps = 1e-1 .. 1e-3 and three areal scenes for eps = 1e-1 .. 1e-2, each on the fitted
 !> surface and on a second one. On a surface the rule leaves out the largest tension: its
-!> grid value converges at order 0.75-0.95 (the trailing-edge cusp is resolved sub-grid on
-!> lines only; 4-5 % at ppw 64), so it is reported, not targeted.
+!> grid value converges more slowly (the trailing-edge cusp is resolved sub-grid on lines
+!> only; docs/accuracy.md), so it is reported, not targeted.
 module lc_accuracy
    use lc_kinds, only: wp
    use lc_errors, only: error_type, fatal_error, input_error, code_input

@@ -38,14 +38,10 @@ module lc_memory
 contains
 
    !> Bytes a solve of `points` grid points needs: the fields, the multipliers, the FFT
-   !> buffers and the solver's work arrays (doubles per point, bench/memory.py: 14.6 for a
-   !> frictionless areal solve at 2048^2 by the constrained CG, 26.1 by the multigrid at
-   !> 1024^2, 30.3 for a coupled one with GCR's history of 12; a line's multigrid 39, its
-   !> coarse grids halving only one axis; a coupled line by the multigrid 60.5 at 2^20, a
-   !> coupled surface 53.1 at 2048^2 with friction and 54 sliding viscoelastic, 64.4 where
-   !> its grids are halved along one axis, 60.8-64.3 smoothed by rows on 512 x 2048 and
-   !> 256 x 2048 points (y halved alone first), with the history of its truncated Newton GCR),
-   !> plus the in-plane fields of the stress observables.
+   !> buffers and the solver's work arrays, in doubles per point by solver and geometry, as
+   !> bench/memory.py measures them (docs/performance.md, 'Throughput and memory'; docs/numerics.md,
+   !> 'Constants of the solvers and their measurements'), plus the in-plane fields of the
+   !> stress observables.
    pure integer(i8) function solve_bytes(points, coupled, memory, stress, multigrid, line) result(bytes)
       integer, intent(in) :: points
       !> friction or a moving viscoelastic law: the GCR (or Anderson) history; or a frictionless

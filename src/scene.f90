@@ -77,7 +77,8 @@ module lc_scene
       !> Anderson memory (number of previous iterates mixed) for coupled problems
       integer :: memory = 12
       !> precondition the constrained CG with the stiffness 1/M (Fourier) on the contact set:
-      !> one more FFT pair per iteration, 3-6x fewer iterations on fine grids (bench/iterations.py)
+      !> one more FFT pair per iteration, far fewer iterations on fine grids (docs/numerics.md,
+      !> 'Symmetric problems'; bench/iterations.py)
       logical :: precondition = .true.
       !> start from the solution on the grid of every second point (recursively): the
       !> contact set is then nearly known and the fine-grid iterations few

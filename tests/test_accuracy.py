@@ -97,7 +97,7 @@ def test_rule_meets_the_measured_table(tmp_path):
                 assert error <= eps, (scene, eps, stress, ppw, tol, error)
                 verified += 1
     # all 30 (scene, target, stress) cases: with the sub-grid trailing-edge peak the largest
-    # tension of a sliding layer no longer needs grids beyond the table (ppw <= 1024)
+    # tension of a sliding layer needs no grid beyond the table (ppw <= 1024)
     assert verified == 30
 
 

@@ -209,8 +209,8 @@ def test_factors_against_mpmath(nu):
 
 
 def test_factor_signs_and_limits():
-    """DESIGN sign checks: c -> Dundurs' beta > 0 for the half-space; c ~ -x^2 < 0 for a thin
-    incompressible layer; c ~ x^2 (1-4nu)/(4(1-nu)^2) for small x."""
+    """The sign checks of docs/theory.md: c -> Dundurs' beta > 0 for the half-space; c ~ -x^2 < 0
+    for a thin incompressible layer; c ~ x^2 (1-4nu)/(4(1-nu)^2) for small x."""
     _, _, c = ar.layer_factors(np.array([1e3, np.inf]), 0.3)
     np.testing.assert_allclose(c, 0.4 / 1.4, rtol=1e-15)
     x = 1e-4

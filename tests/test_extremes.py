@@ -134,7 +134,7 @@ def test_viscoelastic_runs_converge_or_say_so(n):
 def test_anderson_memory_above_n():
     """n = 8 (allowed) with the default Anderson memory 12: once the outer iteration has
     more columns than grid points, the least-squares problem is underdetermined; dgelsd
-    needs ldb >= max(m, ncol) (it used to be called with ldb = m and fail, code 5)."""
+    needs ldb >= max(m, ncol) (called with ldb = m it fails, code 5)."""
     r = profiles(8)["rough"]
     p_full = full_contact_pressure(r, 1e-4, 0.5, 0.5)
     res = lc.solve_line(r, thickness=1e-4, poisson=0.5, friction=0.5, mean_pressure=0.3 * p_full, tol=TOL)
@@ -145,7 +145,7 @@ def test_single_contact_node_with_an_overlapping_neighbour():
     """Coupled scene whose inner CG is warm-started (by the outer iteration) on one
     contact node while a neighbour overlaps: the projected gradient on one node is zero
     under load control and the step denominator is zero; the CG must let the overlapping
-    node in (it used to restart forever, spending max_iter in 2 outer iterations).
+    node in (restarting instead would spend max_iter in 2 outer iterations).
     The problem is monotone (Re G_eff > 0) and has a solution on one or two nodes. (The
     same stall: 1 contact node after 2 outer iterations at n = 9, sinusoid, h/lambda = 0.16,
     nu = -0.9, mu_c = 1, p_m/p_full = 0.03.)"""
@@ -160,8 +160,8 @@ def test_single_contact_node_with_an_overlapping_neighbour():
 def test_thick_finite_layer_reports_an_honest_residual(thickness):
     """h/lambda up to 1e15 (finite, compressible): w carries the uniform compression
     h p_m/M, up to 1e15 times the profile. Under load control that mode is a rigid shift,
-    left out of the solve (it used to set a rounding floor of the gap, 256 eps max|w|, that
-    hid every gap: 'converged' with the contact conditions violated by 4e-6 at h = 1e8
+    left out of the solve (in the solve it would set a rounding floor of the gap, 256 eps max|w|,
+    that hides every gap: 'converged' with the contact conditions violated by 4e-6 at h = 1e8
     and 0.57 at 1e15). The contact conditions hold, and the pressure is the half-space one
     (the layer factors are exactly 1 beyond kh = 40; 1e-12: rounding of two solves)."""
     r = lc.self_affine_profile(512, 0.8, seed=3, short_wavelength=8 / 512)

@@ -57,11 +57,11 @@ module lc_contact_multigrid_hierarchy
 
    !> A damped Jacobi step with the diagonal d multiplies the error's mode q by
    !> 1 - omega K(q)/d, which grows if it exceeds 1 in modulus: where the symbol rises faster
-   !> than |q| (a viscoelastic layer stiffening with the frequency q V, whose largest K is
-   !> 3-6x the mean on a line of 16384 points at E_inf/E0 = 100, V tau/lambda = 1e-4: the
-   !> residual grew 3x per iteration) the steps take d >= jacobi_margin omega max K/2 (for a
-   !> complex K, max |K|^2/(2 Re K)) instead of the mean. K ~ |q| has max K = 2 mean on a line
-   !> (1.9 on a square surface), below the bound, and keeps the mean.
+   !> than |q| (a viscoelastic layer stiffening with the frequency q V) the steps take
+   !> d >= jacobi_margin omega max K/2 (for a complex K, max |K|^2/(2 Re K)) instead of the
+   !> mean. K ~ |q| has max K = 2 mean on a line (1.9 on a square surface), below the bound,
+   !> and keeps the mean (docs/decisions/012-coupled-multigrid.md, 'What does: the TNNMG
+   !> iteration with the non-symmetric stiffness').
    real(wp), parameter :: jacobi_margin = 1.1_wp
 
    !> The V-cycle coarsens while the next grid has at least this many points (and, on a
@@ -78,19 +78,16 @@ module lc_contact_multigrid_hierarchy
    real(wp), parameter :: accepted_smoothing = 0.75_wp
 
    !> Weight of the contact-set penalty d D_A in the coarse operators (in units of the
-   !> diagonal d of K): 1 gave the fewest CG iterations on the final set against 0.5, 2, 10.
+   !> diagonal d of K): the fewest CG iterations on the final set
+   !> (docs/decisions/009-multigrid-for-symmetric-lines.md, 'Measured').
    real(wp), parameter :: penalty = 1.0_wp
 
    !> Row smoothing on a coarse grid: the shift of a row's solve, in units of the geometric
    !> mean of two values of the penalty's diagonal over the row, its mean (the contact
    !> points' stiffness spread over the row) and its largest (one contact point's). Without
-   !> a shift a soft row's inverse overshoots where the penalty pins the points (the
-   !> standard linear solid E_inf/E0 = 10 at V tau/lambda = 0.1, 1024^2: the iteration
-   !> stalled, GCR finished it). A share of the mean alone is too much for rows with many
-   !> contact points and too little for rows with few: a quarter of it took 98-156 transform
-   !> pairs on that layer at V tau/lambda = 0.01 from 256^2 to 2048^2, a tenth 98-119 but
-   !> 137-239 on a glassy one (E_inf/E0 = 100, V tau/lambda = 1, 0.7 % contact) at 512^2
-   !> and 1024^2, where a quarter took 100-109 (docs/decisions/015-row-smoothing.md).
+   !> a shift a soft row's inverse overshoots where the penalty pins the points; a share of
+   !> the mean alone is too much for rows with many contact points and too little for rows
+   !> with few (docs/decisions/015-row-smoothing.md, 'What is done').
    real(wp), parameter :: row_shift_weight = 0.05_wp
 
    !> One grid of nx/2^t x ny/2^t points (ny = 1 on a line): its plan, the operator on it
@@ -238,11 +235,9 @@ contains
    !> x alone until square where the finest grid has more than twice as many points along x
    !> as along y (elongated: see elongated_row_smoothing in lc_contact_solver_multigrid).
    !> The row step solves along x exactly, so on a grid halved along y alone it need only
-   !> damp the waves short across the rows, as a line relaxation does (the standard linear
-   !> solid E_inf/E0 = 10 at V tau/lambda = 0.01 on 128 x 512 points, period 0.25 x 1: 0.83
-   !> halving both axes, 0.71 with y first, from the 128 x 256 grid on, which halves both;
-   !> halving y first on such 2:1 grids too took 7-17 % more transform pairs:
-   !> docs/decisions/015-row-smoothing.md).
+   !> damp the waves short across the rows, as a line relaxation does; the 2:1 grids after
+   !> it halve both axes (docs/decisions/015-row-smoothing.md, 'What is done', 'Grids with
+   !> more rows than points along them').
    subroutine row_shapes(nx, ny, symbol, odd, shapes)
       integer, intent(in) :: nx, ny
       real(wp), contiguous, intent(in) :: symbol(:)
@@ -486,8 +481,8 @@ contains
    !> symbol along x is K_row), s the row's shift. A layer sliding along x has a modulus
    !> E(q_x V): within a column of the spectrum K/K_row does not depend on E, so the step
    !> damps the modes the next grid cannot carry as a Jacobi step damps those of an elastic
-   !> layer (smoothing factor 0.55 where Jacobi's is 0.9-0.99, soft and lossy modes alike:
-   !> docs/decisions/015-row-smoothing.md). The rows' transforms are counted as half a
+   !> layer, soft and lossy modes alike (docs/decisions/015-row-smoothing.md, 'What is
+   !> done', 'Row smoothing'). The rows' transforms are counted as half a
    !> transform pair of the grid.
    subroutine solve_rows(h, t, r)
       type(hierarchy), intent(inout) :: h

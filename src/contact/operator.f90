@@ -32,18 +32,12 @@ module lc_contact_operator
 
    real(wp), parameter :: pi = acos(-1.0_wp)
    !> The Fourier preconditioner of the inner CG is (|J*(kV)|/|J*(k1 V)|)^preconditioner_exponent/M:
-   !> the exact inverse of the metric with exponent 0, which on a glassy layer (compliance
-   !> falling by E_inf/E0 across the spectrum) amplifies the short waves so much that the
-   !> contact set oscillates and the CG stalls; with exponent 1 (the elastic inverse) the
-   !> preconditioned problem keeps a condition number ~E_inf/E0. Measured on 20 scenes
-   !> (n = 8192, E_inf/E0 = 10 and 100, V = 0.003 .. 10, mu_c = 0 and 0.5, tol 1e-8): 1/2
-   !> takes 2.6 s, exponent 0 8.0 s (18883 CG iterations on one scene against 2084), 1
-   !> up to 20552 CG iterations on one. (The metric was |G_eff| (|J*(k1V)|/|J*(kV)|)^(1/2)
-   !> before, which spread the outer map's eigenvalues in modulus: on
-   !> inputs/sweeps/viscoelastic_speed.nml, 576 scenes, it failed 4 at tol 1e-8 and 6 at
-   !> 1e-10 with 19021 outer iterations in all; |G_eff| with this preconditioner fails none
-   !> at either tolerance, with 8155 outer iterations, in 50 s instead of 80.) Relative to
-   !> k1, not k = 0, so that V -> 0 and V -> inf give back the elastic preconditioner.
+   !> half of the material's frequency dependence, between the exact inverse of the metric
+   !> (0: on a glassy layer the contact set oscillates and the CG stalls) and the elastic one
+   !> (1: a condition number ~E_inf/E0). Relative to k1, so that V -> 0 and V -> inf give back
+   !> the elastic preconditioner (docs/decisions/000-line-solver-measurements.md, 'Solver
+   !> speed: what dominated, what changed'; docs/numerics.md, 'Constants of the solvers and
+   !> their measurements').
    real(wp), parameter :: preconditioner_exponent = 0.5_wp
 
    !> Fourier multipliers of one scene on one grid and the FFT plans to apply them. The

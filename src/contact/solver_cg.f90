@@ -113,9 +113,9 @@ contains
       ! Where the metric falls with |q| (half-space, compressible layers) its masked Fourier
       ! inverse preconditions well at every scale; on broadband roughness points enter at
       ! most iterations, and restarting the conjugacy at each entry would reduce CG to
-      ! steepest descent (docs/decisions/005-broadband-iterations.md: 5698 -> 252 iterations
-      ! on a line of 65536 points with roughness down to 8 grid points; on a few hundred
-      ! points the restarts are cheaper, 24 against 62 at 1024). Elsewhere (the metric of
+      ! steepest descent; on a few hundred points the restarts are cheaper
+      ! (docs/decisions/005-broadband-iterations.md, 'The constrained CG: conjugacy kept when
+      ! points enter'). Elsewhere (the metric of
       ! a coupled operator in the Anderson iteration, thin incompressible layers whose
       ! compliance rises with |q|) the inverse is far off at the edges of the contact set:
       ! there the iteration is safeguarded: the conjugacy restarts when points are let in,

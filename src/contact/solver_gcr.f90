@@ -39,14 +39,11 @@ module lc_contact_solver_gcr
    !> iteration goes on from there). On a smooth surface a converging solve halves the
    !> residual every one to three iterations; on broadband roughness (the shortest
    !> wavelength a few grid points) the contact set settles over many iterations and the
-   !> residual halves only every 50-60 at n = 65536. What still stalls: glassy
+   !> residual halves only every few dozen iterations on fine grids. What still stalls: glassy
    !> viscoelastic layers at low speeds, whose fine-grid contact sets settle slowly (a clip
    !> restarts the history) and erratically, and a few thin incompressible layers with
-   !> strong friction on tiny grids. Measured (docs/decisions/005-broadband-iterations.md):
-   !> a window of 25 sent the broadband coupled lines at n = 65536 to the Anderson
-   !> iteration (3198 iterations against 342) and cost inputs/sweeps/viscoelastic_speed.nml
-   !> 503k transform pairs against 341k with 200 (100: 350k; 400: 434k); the
-   !> viscoelastic extremes grid is unchanged (1236 against 1233 of 1296 converged).
+   !> strong friction on tiny grids (docs/decisions/005-broadband-iterations.md, 'The
+   !> constrained GCR: a longer stall window').
    integer, parameter :: stall_window = 200
    !> Iterations after which w = G_eff p is recomputed (bounds the drift of the updates).
    integer, parameter :: refresh_interval = 50
@@ -67,8 +64,8 @@ module lc_contact_solver_gcr
    !> strong friction and small contact sets stagnate so (G_eff restricted to the set is
    !> nearly skew, arg G_eff near -90 degrees at long waves, and nearly singular), with
    !> alpha^2/|r|^2 ~ 1e-16; slow steady progress on glassy viscoelastic layers takes
-   !> 1e-3..1e-5 per step and must not be cut (a threshold of 1e-4 doubled the iterations
-   !> at n = 65536 and made the solve fall back to Anderson).
+   !> 1e-3..1e-5 per step and must not be cut (docs/decisions/000-line-solver-measurements.md,
+   !> 'Constrained GCR for coupled scenes').
    real(wp), parameter :: stagnation = 1.0e-10_wp
    !> Rows per block of the sweeps over the history.
    integer, parameter :: block_rows = 2048
@@ -77,20 +74,19 @@ module lc_contact_solver_gcr
    real(wp), parameter :: breakdown = 1.0e-10_wp
    !> Least fraction of its norm on the set that a stored image keeps after centring and
    !> orthogonalisation against the older ones when the history is re-orthonormalised;
-   !> below, the history is dropped. A pivot of 1e-8 (8 columns on a set of 8 points) left
-   !> images and directions 40 % apart after the transform; the rounding grows like
-   !> eps/pivot, 1e-10 here.
+   !> below, the history is dropped: the rounding of directions and images grows like
+   !> eps/pivot, 1e-10 here (docs/decisions/005-broadband-iterations.md, 'The kept history
+   !> as a second stage').
    real(wp), parameter :: independence = 1.0e-6_wp
    !> keep_clipped: most points clipped at once whose removal from the stored directions is
    !> added to their images column by column (a pass over the grid per point and
-   !> direction); beyond, each image is transformed afresh. Measured at n = 65536
-   !> (h/lambda = 0.16, mu_c = 0.5, broadband): 64 and 8 take the same time, with 537 and
-   !> 755 transform pairs.
+   !> direction); beyond, each image is transformed afresh (docs/numerics.md, 'Constants of
+   !> the solvers and their measurements').
    integer, parameter :: clipped_columns = 64
    !> keep_clipped: with the history full (memory columns), a step that takes less than this
    !> fraction of the residual's squared norm on the set restarts GCR: the sliding window
-   !> of the truncated GCR stagnated on fixed contact sets at residuals near the tolerance
-   !> (SLS, V = 0.1, n = 4096: 34 iterations against 22 with the restart).
+   !> of the truncated GCR stagnates on fixed contact sets at residuals near the tolerance
+   !> (docs/decisions/005-broadband-iterations.md, 'The cause: a clip drops GCR's history').
    real(wp), parameter :: truncation = 1.0e-2_wp
 
    !> What one constrained GCR solve did.

@@ -62,115 +62,57 @@ module lc_contact_solver_multigrid
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
-   !> relative to a longer wave. (Measured to tol 1e-8, n = 4096 and 65536, both roughness
-   !> families: 2-4 fine iterations on compressible layers, whose compliance rises by 2 %
-   !> (nu = 0.3) to 2.1 (nu = 0.45) below |q| h ~ 1, and on incompressible ones rising by
-   !> up to 31; 6 iterations but 300-1200 pairs at 16.5 (h/lambda = 0.001, nu = 0.495), no
-   !> convergence in 300 iterations at 123 (h/lambda = 0.01, nu = 0.5).)
+   !> relative to a longer wave (docs/decisions/009-multigrid-for-symmetric-lines.md,
+   !> 'Where it applies, and the choice under 'auto'').
    real(wp), parameter :: allowed_rise = 4.0_wp
    !> A coupled scene whose compliance rises more is admitted (coupled_refusal) if its
-   !> hierarchy's worst Jacobi smoothing factor is at most this. Coupled lines of 4096 and
-   !> 65536 points (shortest wavelength 8 points, h/lambda = 0.001 .. 0.03, nu = 0.45 .. 0.5,
-   !> mu_c = 0.1 .. 1.5): up to 0.988 (h/lambda = 0.01, nu = 0.5) the method took 63-211
-   !> transform pairs (182-638 at 0.974), at 0.999 and more (h/lambda <= 0.003, nu = 0.5)
-   !> 358-13841 or went to the GCR fallback (docs/decisions/014-thin-layers-by-multigrid.md).
+   !> hierarchy's worst Jacobi smoothing factor is at most this: thin incompressible layers
+   !> up to h/lambda ~ 0.01 (docs/decisions/014-thin-layers-by-multigrid.md, 'Measured').
    real(wp), parameter :: coupled_smoothing = 0.995_wp
-   !> A coupled surface is smoothed by rows (hierarchy%rows) where the Jacobi steps' worst
-   !> smoothing factor on the grids coarsening_shapes would choose exceeds this and the
-   !> rows' (worst_row_smoothing, on the grids of row_shapes) is at most
-   !> accepted_smoothing: a layer sliding along x whose modulus changes with q_x V. Measured
-   !> at 256^2 (h/lambda = 0.16, E_inf/E0 = 10 and 100, V tau/lambda = 1e-3 .. 1e2; the
-   !> rows' factor 0.55 on all): where Jacobi's is
-   !> 0.70-0.82 Jacobi steps took 61-180 transform pairs and rows 76-167, where it is
-   !> 0.91-0.99 rows took 70-305 and Jacobi steps 89-742. Thin incompressible layers (Jacobi
-   !> 0.87-0.99, rows 0.79-0.93) keep Jacobi steps: frictionless at h/lambda = 0.01, 681
-   !> pairs where rows stalled (1439 with GCR finishing). Rows are taken on K's own
-   !> hierarchy; on the metric's they miss the phase of K (a glassy layer, E_inf/E0 = 100,
-   !> V tau/lambda = 1, on a compressible layer with friction, nu = 0.3: 16116-48560 pairs
-   !> where its Jacobi steps took 541-683), except for a large loss peaking at the grid's
-   !> edge or in its top band: see short_loss_limit. Grids with more than twice as many
-   !> points along x as along y follow elongated_row_smoothing: the standard linear solid
-   !> at V tau/lambda = 0.1 on 512 x 128 points took 38120 pairs smoothed by rows on grids
-   !> halved along both axes (91 with Jacobi steps), on 384 x 128 199, on 512 x 192 213,
-   !> where up to twice as many points along x (512 x 256, 256 x 128, 128 x 256) took
-   !> 89-110 (Jacobi steps 100-166) (docs/decisions/015-row-smoothing.md).
+   !> A coupled surface is smoothed by rows (rows_smooth) where the Jacobi steps' worst
+   !> smoothing factor exceeds this and the rows' is at most accepted_smoothing: a layer
+   !> sliding along x, whose modulus changes with q_x V, which Jacobi steps smooth poorly
+   !> (docs/decisions/015-row-smoothing.md, 'What is done'; docs/numerics.md, 'Constants of
+   !> the solvers and their measurements').
    real(wp), parameter :: row_smoothing = 0.85_wp
    !> A grid with more than twice as many points along x as along y is smoothed by rows
    !> (grids halved along x alone until square: row_shapes) only where the Jacobi steps'
-   !> worst smoothing factor exceeds this. Measured on 512 x 128, 384 x 128, 768 x 256,
-   !> 1024 x 256 and 512 x 192 points (h/lambda = 0.16, nu = 0.3 and 0.5, mu_c = 0 and 0.5):
-   !> glassy layers (E_inf/E0 = 100; Jacobi 0.990-0.997) at V tau/lambda = 0.1 and 1 took
-   !> 146-409 transform pairs where the Jacobi steps took 285-527, at 10 159-182 where
-   !> 156-199, E_inf/E0 = 1000 at 1 331-468 where 2787-4490; smoothed so, the standard
-   !> linear solid (E_inf/E0 = 10; Jacobi 0.90-0.94) at 0.01 to 1 took 107-164 where 71-152.
-   !> Rows halving both axes there stall (the standard linear solid at 0.1 on 512 x 128:
-   !> 9532 pairs; docs/decisions/015-row-smoothing.md).
+   !> worst smoothing factor exceeds this (glassy layers): rows halving both axes stall
+   !> there (docs/decisions/015-row-smoothing.md, 'What is done', 'Elongated grids').
    real(wp), parameter :: elongated_row_smoothing = 0.98_wp
-   !> A coupled surface whose loss is not largest at long waves (loss_at_long_waves) builds
-   !> K's own hierarchy, smoothed by rows, where its loss among the waves short along x
-   !> (loss_of: short_x) is at most this and rows_smooth holds, else the metric's.
-   !> Measured to tol 1e-8 (h/lambda = 0.16, nu = 0.5, mu_c = 0 and 0.5, 512^2, both
-   !> roughness families): the standard linear solid E_inf/E0 = 10 (largest loss 1.42) at
-   !> V tau/lambda = 1e-3 and 1e-2 took 76-106 transform pairs where Jacobi steps took
-   !> 109-185; E_inf/E0 = 100 at 1e-3 (its loss peak beyond the grid) 85-95 against 139-157;
-   !> compressible layers with friction (nu = 0.3, glassy at V tau/lambda = 1, whose loss is
-   !> largest at long waves along x and short ones across) 96-168 at 256^2 against 541-683;
-   !> E_inf/E0 = 30 (2.65) at 1e-2 339-362 against 368-404; but E_inf/E0 = 100 (4.95) with
-   !> its peak among the short waves, at 1e-2 and 3e-2, 1603-10208 against 758-1667.
-   !> A larger loss is smoothed by rows on the metric's hierarchy where the largest loss
-   !> lies at the grid's edge or beyond it, or in its top band, |kx| > nx/4 (modes no
-   !> coarser grid carries), up to top_band_loss, on grids with nx <= ny; elsewhere
-   !> (middle waves) by Jacobi steps.
-   !> E_inf/E0 = 100 to 1000 at V tau/lambda = 3e-3 to 0.1, nu = 0.3 and 0.5, mu_c = 0 and
-   !> 0.5 (h/lambda = 0.05 to the half-space at 256^2, 0.16 at 512^2): at 512^2 never more
-   !> pairs than the Jacobi steps and up to 9.4x fewer (E_inf/E0 = 100 at 0.01: 619-873
-   !> where 683-1666; 300 at 0.01: 605-1422 where 1133-3818; 1000 at 0.01: 1407-1994 where
-   !> 1440-14959); at 256^2 up to 3.5x fewer, and up to 15 % more on E_inf/E0 = 1000 at
-   !> 0.1 (6068-19356 pairs either way). With the peak at middle waves rows on the metric's
-   !> stalled (E_inf/E0 = 100 at 3e-2, 512^2: 8414-8827 pairs, Jacobi steps 748-764)
-   !> (docs/decisions/015-row-smoothing.md).
+   !> A coupled surface whose loss is not largest at long waves builds K's own hierarchy,
+   !> smoothed by rows, where its loss among the waves short along x is at most this; above,
+   !> the metric's, where rows on K's stall (coupled_symbol; docs/decisions/015-row-smoothing.md,
+   !> 'What is done': 'A moderate loss among the short waves', 'A larger loss ...').
    real(wp), parameter :: short_loss_limit = 3.0_wp
    !> ... and a larger loss peaking in the grid's top band, short of its edge, is smoothed by
-   !> rows on the metric's hierarchy only up to this loss: at 1024^2 a peak there with the
-   !> loss 8.6 (E_inf/E0 = 300 at V tau/lambda = 0.01) took 22439 pairs by rows where the
-   !> Jacobi steps took 4555, and 15.8 (1000) stalled; 4.95 (100 at 0.01, 512^2) took
-   !> 619-873 where 683-1666. Grids with more points along x than across keep the Jacobi
-   !> steps there: on 512 x 256 points (period 2 x 1) that glassy layer took 4998-6239
-   !> pairs by rows where the Jacobi steps took 1168-1390, although 256 x 128 (periods 1 x 1
-   !> and 2 x 1) and 512 x 256 (1 x 0.5) took 1.1-2.1x fewer by rows.
+   !> rows on the metric's hierarchy only up to this loss, on grids no longer along x than
+   !> across: rows stall beyond it (docs/decisions/015-row-smoothing.md, 'What is done':
+   !> 'A larger loss among the short waves').
    real(wp), parameter :: top_band_loss = 5.0_wp
-   !> A surface whose loss peaks at long waves (at_long_waves) takes K's own hierarchy; a
-   !> loss above this one only while its peak lies at |kx| <= nx/48 or below
-   !> glassy_peak_mode, and the metric's hierarchy where it peaks nearer the long band's edge.
-   !> Measured on very glassy layers sliding fast (E_inf/E0 = 1000 and 2000, peak loss 15.8
-   !> and 22.4, V tau/lambda = 0.1 to 0.3: the peak at kx = 17-50 = nx/41 to nx/20; both
-   !> families): where K's hierarchy wandered, on the physical family, for more than 300 s
-   !> at 1024^2 and 900 s at 2048^2, the metric's took 29-104 s and 713 s, and at 512^2 9-21 s
-   !> where 96-171 s; where K's converged, mostly on the broadband family, the metric's took
-   !> up to 3.8x its time (1024^2, E_inf/E0 = 1000 at 0.2: 28 s where 7.6 s; 2048^2 at 0.1:
-   !> 162 s where 61 s; 512^2 at 0.3: 5.7 s where 1.8 s). With the peak at nx/61 (1024^2 at
-   !> 0.3) K's hierarchy converged on both families, in 4.5-14 s where the metric's took 35-36 s.
-   !> E_inf/E0 = 300 (8.6) keeps K's hierarchy: the metric's took 0.66-1.9x its pairs at
-   !> 512^2 and 1024^2. Lines keep it at every loss (docs/decisions/015-row-smoothing.md).
+   !> A surface whose loss peaks at long waves takes K's own hierarchy; a loss above this one
+   !> only while its peak lies at |kx| <= nx/48 or below glassy_peak_mode: nearer the long
+   !> band's edge K's wanders and the metric's converges; lines keep K's at every loss
+   !> (docs/decisions/015-row-smoothing.md, 'Very glassy layers whose loss peaks near the long
+   !> band's edge').
    real(wp), parameter :: glassy_long_loss = 10.0_wp
-   !> ... and a peak below this mode keeps K's hierarchy on any grid: E_inf/E0 = 1000 and
-   !> 2000 at V tau/lambda = 1 and 3 (peak at kx = 2-7) took 0.96-3.7x the pairs by the
-   !> metric's on 128^2 and on the coarse grids of 256^2.
+   !> ... and a peak below this mode keeps K's hierarchy on any grid (the same section of
+   !> docs/decisions/015-row-smoothing.md).
    integer, parameter :: glassy_peak_mode = 16
    !> The nested iteration starts on the coarsest grid of at least this many points.
    integer, parameter :: nested_coarsest = 256
    !> The inexact Newton solve: at most this many CG iterations, or a residual reduced by
-   !> newton_reduction; more exact solves cost more transforms than the iterations saved.
+   !> newton_reduction; more exact solves cost more transforms than the iterations saved
+   !> (docs/decisions/009-multigrid-for-symmetric-lines.md, 'Measured').
    integer, parameter :: newton_iterations = 2
    real(wp), parameter :: newton_reduction = 0.1_wp
    !> The finishing phase starts when no contact point carries tension and at most this
    !> fraction of the contact set changed in the last iteration ...
    real(wp), parameter :: settled_fraction = 1.0e-3_wp
-   !> ... and runs at most this many CG iterations. When a point leaves the feasible set
-   !> it goes on as a Newton step until its residual fell by violated_reduction (stopping
-   !> at the first such point moved the last points of the set one per iteration: 10
-   !> iterations, 85 pairs on the broadband line of 2^20 points, shortest wavelength 8
-   !> points; 6 and 76 with 0.1; 0.01 and 0.001 spend more pairs elsewhere).
+   !> ... and runs at most this many CG iterations. When a point leaves the feasible set it
+   !> goes on as a Newton step until its residual fell by violated_reduction, so that the
+   !> points leaving the set are handled together (docs/decisions/011-multigrid-for-surfaces.md,
+   !> 'The finishing phase does not stop at the first point that leaves the set').
    integer, parameter :: finish_iterations = 40
    real(wp), parameter :: violated_reduction = 0.1_wp
    !> If the fields returned miss tol (their residual is evaluated on the pressure with the
@@ -181,34 +123,25 @@ module lc_contact_solver_multigrid
    !> coupled_tnnmg: directions kept by the GCR on the truncated Newton problem (restarted
    !> when full).
    integer, parameter :: gcr_memory = 10
-   !> ... On a line, a finishing phase whose GCR stagnates (its Newton residual not reduced
-   !> by violated_reduction: the restarted GCR on a strongly non-normal K, glassy layers
-   !> near their loss peak) doubles the directions kept, up to this many (twice as many
-   !> once the exact Newton steps run), where half the memory available holds them; a phase
-   !> then runs at least as many iterations as it keeps. Glassy lines (E_inf/E0 = 1000 and
-   !> 2000, V tau/lambda = 3e-3 to 0.03, both roughness families): of 24 at 16384 points 4
-   !> do not converge with 10 directions, 1 with 40, 80 or 40 and 80; of 12 at 65536 2 with
-   !> 40, none with 40 and 80; 80 throughout took up to 1.8x the time of 40 where 40
-   !> sufficed. A surface keeps gcr_memory: at 512^2 (E_inf/E0 = 100 to 1000) 40 directions
-   !> saved about 10 % of the transform pairs and cost 1-25 % more time, their Gram-Schmidt
-   !> passes over 2 MB vectors outweighing the transforms saved
-   !> (docs/decisions/012-coupled-multigrid.md).
+   !> ... On a line whose finishing GCR stagnates (a strongly non-normal K) the directions
+   !> kept double up to this many (twice that in the exact Newton steps) where half the memory
+   !> available holds them; a surface keeps gcr_memory, its Gram-Schmidt passes outweighing
+   !> the transforms saved (docs/decisions/012-coupled-multigrid.md, 'Very glassy lines: exact
+   !> Newton steps after a stall'; docs/numerics.md, 'Constants of the solvers and their
+   !> measurements').
    integer, parameter :: longest_gcr_memory = 40
-   !> coupled_tnnmg: iterations without the residual halving after which it stops, or the
-   !> first time (a very lossy material: exact_loss) goes on from its best iterate with
-   !> exact Newton steps: GCR to a residual reduced by exact_reduction in at most
-   !> exact_iterations, the projected step taken in full (a primal-dual active set step)
-   !> where the line search of the symmetric part's energy crawls on a strongly
-   !> non-symmetric K (glassy layers near their loss peak).
+   !> coupled_tnnmg: iterations without the residual halving after which it stops, or (a very
+   !> lossy material: exact_loss) goes on with exact Newton steps taken in full, GCR to a
+   !> residual reduced by exact_reduction in at most exact_iterations, where the line search
+   !> crawls on a strongly non-symmetric K (docs/decisions/012-coupled-multigrid.md, 'Very
+   !> glassy lines: exact Newton steps after a stall').
    integer, parameter :: coupled_stall = 30
    integer, parameter :: exact_iterations = 20
    real(wp), parameter :: exact_reduction = 0.01_wp
    !> ... The exact steps are taken where the material's loss tangent on the grid's sliding
-   !> frequencies reaches this (material_loss); below, the GCR goes on at once. Lines of
-   !> 1024 to 65536 points, both families: with E_inf/E0 = 100 and 300 (loss tangent 4.95,
-   !> 8.6) the exact steps after a coarse grid's stall cost up to 1.6x the pairs of going on
-   !> with GCR and converged nothing that it did not; 500 (11.2) about the same either way;
-   !> 1000 and 2000 (15.8, 22.3) need them (docs/decisions/012-coupled-multigrid.md).
+   !> frequencies reaches this (material_loss); below, the GCR goes on at once: the exact
+   !> steps cost more there and converge nothing it does not (docs/decisions/012-coupled-multigrid.md,
+   !> 'Very glassy lines: exact Newton steps after a stall').
    real(wp), parameter :: exact_loss = 10.0_wp
 
    !> What one multigrid solve did. `iterations` counts the TNNMG iterations on the finest
@@ -636,10 +569,10 @@ contains
          if (allocated(error)) return
          call set_grid(h, 0, symbol)
       end if
-      ! (GCR takes a preconditioner that is not symmetric. On a surface V(0,1)-cycles take
-      ! 10-20 % fewer transform pairs than V(1,1), 0.79-1.03 of the time; a line keeps
-      ! V(1,1): V(0,1) took 0.91-1.07 of its time there, and its pairs grew with the grid,
-      ! max/min 1.40-1.74 from 1024 to 2^20 points against 1.13-1.49; decisions/012)
+      ! (GCR takes a preconditioner that is not symmetric: a surface smooths only after the
+      ! coarse correction, V(0,1), which saves transforms there; a line keeps V(1,1), whose
+      ! pairs stay flat in the grid: docs/decisions/012-coupled-multigrid.md, 'The cost of a
+      ! GCR iteration, and the sawtooth cycle')
       h%sawtooth = .not. op%grid%is_line()
       ! (the Jacobi diagonal: see jacobi_margin; modes with Re K <= 0 are not damped by any)
       d = op%inverse_diagonal
@@ -840,11 +773,11 @@ contains
    !> (complex Galerkin symbols, LU on the coarsest grid) rather than that of the metric
    !> 1/|G_eff|: where the phase of K is largest (friction on a layer; a viscoelastic layer's
    !> loss peak V q tau ~ 1) at long waves, |kx| <= nx/16 (and |ky| <= ny/16 on a surface),
-   !> which the coarse grids carry. A
-   !> loss peak among the short waves (a slow glassy layer on a fine grid) is left to the
-   !> metric's hierarchy (on a surface, unless it is moderate: short_loss_limit), whose
-   !> Jacobi steps damp those modes better: E_inf/E0 = 100 at
-   !> V tau/lambda = 1e-4, n = 65536, 542 against 1004 pairs (docs/decisions/012-coupled-multigrid.md).
+   !> which the coarse grids carry. A loss peak among the short waves (a slow glassy layer on
+   !> a fine grid) is left to the metric's hierarchy (on a surface, unless it is moderate:
+   !> short_loss_limit), whose Jacobi steps damp those modes better
+   !> (docs/decisions/012-coupled-multigrid.md, 'The hierarchy of K itself where the loss lies
+   !> at long waves').
    pure logical function loss_at_long_waves(op) result(long)
       type(compliance_operator), intent(in) :: op
       long = .false.

@@ -31,14 +31,15 @@ module lc_contact_solver_newton
    private
    public :: dense_newton, newton_outcome, dense_points, newton_step_limit, newton_solver
 
-   !> Largest grid (points) the method is used on: the matrices take 2 n^2 doubles (64 MiB
-   !> at 2048 points) and a step ~(2/3) n^3 flops (~0.3 s at 2048 points on one core).
+   !> Largest grid (points) the method is used on: the matrices take 2 n^2 doubles and a step
+   !> ~(2/3) n^3 flops (docs/decisions/005-broadband-iterations.md, 'Small grids: a dense
+   !> Newton method behind the iterative solvers'; docs/numerics.md, 'Constants of the
+   !> solvers and their measurements').
    integer, parameter :: dense_points = 2048
    !> Newton steps at most when the method finishes a stalled iterative solve (the budget
-   !> left permitting). A monotone problem converges from any start tried, but a glassy layer
-   !> near full contact (E_inf/E0 = 1000, 70 % contact, n = 1024) takes 114 steps from a
-   !> uniform start and up to 260 from the coarse start or a stalled iterate; the Armijo
-   !> steps stay short while many points change sides. (0.01-0.08 s a step at n = 1024.)
+   !> left permitting). A monotone problem converges from any start, but a glassy layer near
+   !> full contact takes hundreds of steps: the Armijo steps stay short while many points
+   !> change sides (docs/numerics.md, 'Constants of the solvers and their measurements').
    integer, parameter :: newton_step_limit = 400
    !> Smallest Armijo step tried before the iteration gives up.
    real(wp), parameter :: smallest_step = 1.0e-12_wp

@@ -24,18 +24,15 @@ module lc_fft_plans
    !> then the columns of the half spectrum in blocks of `column_block` adjacent columns.
    !> FFTW_ESTIMATE's plan for the 2D transform walks the columns one at a time with a
    !> stride of nx/2 + 1 complex numbers, a cache line per element; blocks of 8 share the
-   !> lines. Measured per r2c + c2r pair (bench/fft_plans.c, FFTW 3.3.10, one thread):
-   !> 1000^2 9.4 -> 7.2 ms, 1024^2 10.0 -> 7.3 ms, 2048^2 61 -> 42 ms, where FFTW_MEASURE
-   !> (0.5-0.8 s of planning, and a plan that may differ from run to run) reaches 6.2 and
-   !> 33 ms; from 640^2 to 768^2 the two are equal. Below, the gain is not steady: 512^2
-   !> took 1.06 against 1.44 ms on a quiet machine, 640^2 3.3 against 2.2 ms under load.
+   !> lines. The gain is steady from about 1000^2 on (docs/performance.md, 'Cost': 'Large surfaces:
+   !> a two-pass transform'; bench/fft_plans.c).
    integer, parameter :: split_points = 800000
    integer, parameter :: column_block = 8
 
    !> An r2c/c2r plan pair with its buffers: copy data into `real_buffer`, call
    !> `forward`, work on `spectrum`, call `backward`, read `real_buffer`. Planning with
-   !> FFTW_ESTIMATE costs a few transforms' time (45 us at 1024 points, 0.45 ms at 65536)
-   !> and gives the same plan, so the same bits, on every run.
+   !> FFTW_ESTIMATE costs a few transforms' time and gives the same plan, so the same bits,
+   !> on every run (docs/decisions/002-one-core-for-lines-and-surfaces.md).
    type :: fft_plan
       integer :: n = 0    !< real points nx*ny
       integer :: nk = 0   !< spectral coefficients (nx/2 + 1)*ny

@@ -33,15 +33,16 @@ module lc_greens_layer
    !> exp(2 x_h)/2: cosh(2 x_h) would overflow past x_h ~ 355, and at x_h = 20 both forms
    !> are free of cancellation.
    real(wp), parameter :: x_large = 20.0_wp
-   !> Range of x_h accepted by the mode solver. Measured against the closed forms
-   !> (tests/fortran/test_greens_layer.f90): ~1e-14 for x_h >= 0.1, ~1e-12 at x_h = 1e-2 and
-   !> ~1e-9 at x_h = 1e-3: the Papkovich-Neuber potentials stay O(1) while the surface
-   !> displacements are O(x_h) (1-A is O(x_h^3) at nu = 0.5), so digits are lost like
-   !> eps/x_h^2. Above x_h = 20 the layer is a half-space to 1e-17 and needs no check.
+   !> Range of x_h accepted by the mode solver: the Papkovich-Neuber potentials stay O(1)
+   !> while the surface displacements are O(x_h) (1-A is O(x_h^3) at nu = 0.5), so digits
+   !> are lost like eps/x_h^2; above x_h = 20 the layer is a half-space and needs no check
+   !> (its accuracy against the closed forms: docs/numerics.md, 'Constants of the solvers and
+   !> their measurements').
    real(wp), parameter :: lapack_x_min = 1.0e-3_wp
    real(wp), parameter :: lapack_x_max = 20.0_wp
-   !> x_h where the mode solver changes its harmonic basis from cosh/sinh to exponentials
-   !> (measured: each basis is accurate to ~1e-14 on its side of x_h = 1).
+   !> x_h where the mode solver changes its harmonic basis from cosh/sinh to exponentials,
+   !> each basis accurate on its side (docs/numerics.md, 'Constants of the solvers and their
+   !> measurements').
    real(wp), parameter :: basis_switch = 1.0_wp
 
    interface

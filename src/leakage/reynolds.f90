@@ -31,8 +31,9 @@ module lc_leakage_reynolds
    !> The tolerances allowed for &output leakage_tol (the relative accuracy of k_eff).
    character(len=*), parameter :: leakage_tol_range = '1e-14 <= leakage_tol <= 1e-2'
    !> CG iterations per direction of a run's leakage: one that has not met tol by then is
-   !> reported as not converged (k_eff is then an upper bound); 16-40 iterations were
-   !> measured near percolation up to 2048^2.
+   !> reported as not converged (k_eff is then an upper bound); well above the iterations
+   !> taken near percolation (docs/numerics.md, 'Constants of the solvers and their
+   !> measurements').
    integer, parameter :: leakage_max_iter = 500
    !> What solves the flow (recorded in results).
    character(len=*), parameter :: leakage_solver = 'cg + hypre BoomerAMG'
