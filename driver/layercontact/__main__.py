@@ -36,7 +36,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .api import LayercontactError, _check
+from ._library import LayercontactError, _check
 from .native import core as _core
 
 _BAD_SWEEP = (ValueError, LayercontactError, OSError)

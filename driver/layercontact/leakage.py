@@ -672,7 +672,7 @@ def core_leakage(
     max_iter : int, optional
         Largest number of CG iterations per direction; default that of a run (500).
     """
-    from .api import _CONSTANTS, _check
+    from ._library import _CONSTANTS, _check
     from .native import core
 
     tol = float(_CONSTANTS["output/leakage_tol"]) if tol is None else float(tol)

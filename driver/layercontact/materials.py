@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .api import _CONSTANTS, _check, _namelist
+from ._library import _CONSTANTS, _check, _namelist
 from .native import core as _core
 
 #: Largest number of Prony terms (the library's max_prony_terms).

@@ -13,7 +13,7 @@ import os
 import numpy as np
 
 from .native import core as _core
-from .api import _CONSTANTS, NOT_SET, LayercontactError, _check, _namelist
+from ._library import _CONSTANTS, NOT_SET, LayercontactError, _check, _namelist
 
 # Length of the Fortran scene's file-name fields (lc_scene max_string).
 _MAX_STRING = 512
