@@ -19,7 +19,7 @@ module lc_scene_text
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_observables_surface, only: surface_fields
    use lc_observables_stress, only: surface_stress
-   use lc_leakage_reynolds, only: leakage_max_iter, leakage_solver
+   use lc_leakage_reynolds, only: leakage_max_iter, leakage_solver, smallest_leakage_tol, largest_leakage_tol
    implicit none (type, external)
    private
    public :: solve_scene_text, profile_of_text, material_of_text, surface_stress_of_text, tensor_of_text, &
@@ -177,6 +177,8 @@ contains
       text = 'max_prony_terms = ' // to_string(max_prony_terms) // newline // &
          & 'output/leakage_tol = ' // real_text(scene%leakage_tol) // newline // &
          & 'leakage/max_iter = ' // to_string(leakage_max_iter) // newline // &
+         & 'leakage/tol_range = ' // real_text(smallest_leakage_tol) // ' ' // real_text(largest_leakage_tol) // &
+         & newline // &
          & 'leakage/solver = ' // leakage_solver // newline // &
          & 'not_set = ' // real_text(not_set) // newline // &
          & 'profile/hurst = ' // real_text(profile%hurst) // newline // &

@@ -70,3 +70,67 @@ def _namelist(groups: dict[str, dict]) -> str:
         if given:
             text += [f"&{group}", *given, "/"]
     return "\n".join(text) + "\n"
+
+
+# The largest grid a generator or reader of the package makes: 2^30 points (8 GiB of
+# heights), far above what one node solves, and below what would overflow the library's
+# default integers.
+MAX_POINTS = 2**30
+
+
+def _input_error(name: str, value, allowed: str) -> InputError:
+    return InputError(f"{name} = {value!r} is not allowed; allowed: {allowed}", 2)
+
+
+def grid_points(value, name: str, *, smallest: int = 4) -> int:
+    """A number of grid points given in Python: an integer (not a bool, not 16.7) from
+    ``smallest`` on, else :class:`InputError` naming it."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        if not (isinstance(value, (float, np.floating)) and float(value).is_integer()):
+            raise _input_error(name, value, f"an integer >= {smallest}")
+    points = int(value)
+    if points < smallest:
+        raise _input_error(name, value, f"an integer >= {smallest}")
+    return points
+
+
+def grid_size(nx: int, ny: int) -> None:
+    """Refuse a grid of more than MAX_POINTS points before anything is allocated."""
+    if nx * ny > MAX_POINTS:
+        raise _input_error("nx x ny", f"{nx} x {ny}", f"at most {MAX_POINTS} points (2^30)")
+
+
+def periods(value, name: str = "period") -> tuple[float, float]:
+    """``(lx, ly)`` from one period (both axes) or a pair; positive and finite."""
+    if np.ndim(value) == 0:
+        lx = ly = value
+    elif np.ndim(value) == 1 and len(value) == 2:
+        lx, ly = value
+    else:
+        raise _input_error(name, value, "a positive length, or a pair (lx, ly) of them")
+    try:
+        lx, ly = float(lx), float(ly)
+    except (TypeError, ValueError):
+        raise _input_error(name, value, "a positive length, or a pair (lx, ly) of them") from None
+    if not (lx > 0 and ly > 0 and np.isfinite(lx) and np.isfinite(ly)):
+        raise _input_error(name, value, "positive, finite lengths")
+    return lx, ly
+
+
+def real_array(value, name: str, *, ndim: tuple[int, ...], finite: bool = True) -> np.ndarray:
+    """A float64 array of real numbers given in Python: complex, boolean and non-numeric
+    arrays are refused (rather than losing an imaginary part or taking True as 1), and so
+    are NaN and infinite values where ``finite``; :class:`InputError` names it."""
+    raw = np.asarray(value)
+    if raw.dtype.kind not in "iuf":
+        kind = {"c": "complex", "b": "boolean"}.get(raw.dtype.kind, f"of dtype {raw.dtype}")
+        raise InputError(f"{name}: a {kind} array is not allowed; allowed: real numbers", 2)
+    if raw.ndim not in ndim or raw.size == 0:
+        shapes = " or ".join(f"{d}D" for d in ndim)
+        raise InputError(f"{name}: an array of shape {raw.shape} is not allowed; allowed: a non-empty {shapes} array",
+                         2)
+    out = raw.astype(np.float64)
+    if finite and not np.all(np.isfinite(out)):
+        bad = int(np.count_nonzero(~np.isfinite(out)))
+        raise InputError(f"{name}: {bad} NaN or infinite values are not allowed; allowed: finite values", 2)
+    return out

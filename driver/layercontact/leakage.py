@@ -52,6 +52,8 @@ import scipy.ndimage as ndi
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ._library import _CONSTANTS, InputError, _check, periods, real_array
+
 __all__ = ["CoreLeakage", "LeakageResult", "core_leakage", "reynolds_leakage"]
 
 # Largest number of unknowns solved with the sparse direct solver under method="auto": on
@@ -152,18 +154,25 @@ class LeakageResult:
 def _cell(gap, period, contact, *, smallest: int) -> tuple[np.ndarray, tuple[float, float], np.ndarray]:
     """The gap as a finite ``(ny, nx)`` array (each side >= ``smallest``), the periods
     ``(lx, ly)`` and the contact mask (False where not given), checked."""
-    g = np.array(gap, dtype=np.float64)
-    if g.ndim != 2 or min(g.shape) < smallest:
-        raise ValueError(f"gap must be a (ny, nx) array with nx, ny >= {smallest}; got shape {g.shape}")
-    if not np.all(np.isfinite(g)):
-        raise ValueError("gap must be finite")
-    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else tuple(float(p) for p in period)
-    if not (lx > 0 and ly > 0 and np.isfinite(lx) and np.isfinite(ly)):
-        raise ValueError(f"period must be positive and finite; got {(lx, ly)}")
+    g = real_array(gap, "gap", ndim=(2,))
+    if min(g.shape) < smallest:
+        raise InputError(f"gap: an array of shape {g.shape} is not allowed; allowed: (ny, nx) with nx, ny >= "
+                         f"{smallest}", 2)
+    lx, ly = periods(period)
     closed = np.zeros(g.shape, dtype=bool) if contact is None else np.asarray(contact, dtype=bool)
     if closed.shape != g.shape:
-        raise ValueError(f"contact has shape {closed.shape}, the gap {g.shape}")
+        raise InputError(f"contact: shape {closed.shape} is not allowed; allowed: the gap's, {g.shape}", 2)
     return g, (lx, ly), closed
+
+
+def _check_iteration(tol, max_iter) -> None:
+    """The iteration's tolerance and budget: the ranges of ``&output leakage_tol`` and a
+    positive number of iterations (InputError otherwise)."""
+    low, high = (float(v) for v in _CONSTANTS["leakage/tol_range"].split())
+    if not (isinstance(tol, (int, float, np.floating, np.integer)) and low <= float(tol) <= high):
+        raise InputError(f"tol = {tol!r} is not allowed; allowed: {low:g} <= tol <= {high:g}", 2)
+    if isinstance(max_iter, (bool, np.bool_)) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
+        raise InputError(f"max_iter = {max_iter!r} is not allowed; allowed: an integer >= 1", 2)
 
 
 def reynolds_leakage(
@@ -234,6 +243,7 @@ def reynolds_leakage(
         raise ValueError(f"method must be 'auto', 'direct' or 'amg'; got {method!r}")
     if not (viscosity > 0 and pressure_gradient >= 0):
         raise ValueError("viscosity must be > 0 and pressure_gradient >= 0")
+    _check_iteration(tol, max_iter)
 
     if contact_threshold is None:
         contact_threshold = _CONTACT_THRESHOLD_RELATIVE * max(float(g.max()), 0.0)
@@ -672,11 +682,12 @@ def core_leakage(
     max_iter : int, optional
         Largest number of CG iterations per direction; default that of a run (500).
     """
-    from ._library import _CONSTANTS, _check
     from .native import core
 
-    tol = float(_CONSTANTS["output/leakage_tol"]) if tol is None else float(tol)
-    max_iter = int(_CONSTANTS["leakage/max_iter"]) if max_iter is None else int(max_iter)
+    tol = float(_CONSTANTS["output/leakage_tol"]) if tol is None else tol
+    max_iter = int(_CONSTANTS["leakage/max_iter"]) if max_iter is None else max_iter
+    _check_iteration(tol, max_iter)
+    tol = float(tol)
 
     # (nx, ny >= 4: an areal grid, as the core's run has)
     g, (lx, ly), closed = _cell(gap, period, contact, smallest=4)

@@ -13,7 +13,8 @@ import os
 import numpy as np
 
 from .native import core as _core
-from ._library import _CONSTANTS, NOT_SET, LayercontactError, _check, _namelist
+from ._library import _CONSTANTS, NOT_SET, LayercontactError, _check, _namelist, grid_points, grid_size, periods, \
+    real_array
 
 # Length of the Fortran scene's file-name fields (lc_scene max_string).
 _MAX_STRING = 512
@@ -42,7 +43,9 @@ def self_affine_profile(
     (give at most one; neither: rms_gradient 0.1). Raises LayercontactError with the
     namelist's message for a value it does not allow.
     """
-    text = _namelist({"scene": {"n": int(n), "period": period},
+    n = grid_points(n, "n")
+    grid_size(n, 1)
+    text = _namelist({"scene": {"n": n, "period": period},
                       "profile": {"kind": "self_affine", "hurst": hurst, "seed": seed,
                                   "rolloff_wavelength": rolloff_wavelength, "short_wavelength": short_wavelength,
                                   "rms_gradient": rms_gradient, "rms_height": rms_height}})
@@ -55,7 +58,9 @@ def sinusoid_profile(n: int, amplitude: float, *, mode: int | None = None, perio
     """``amplitude * cos(2 pi mode x/period)`` on ``n`` points of one period, the heights
     of ``&profile kind='sinusoid'`` (``mode`` default 1, ``1 <= mode <= (n-1)/2``;
     ``period`` default 1; raises LayercontactError otherwise)."""
-    text = _namelist({"scene": {"n": int(n), "period": period},
+    n = grid_points(n, "n")
+    grid_size(n, 1)
+    text = _namelist({"scene": {"n": n, "period": period},
                       "profile": {"kind": "sinusoid", "amplitude": amplitude, "mode": mode}})
     height, stat, errmsg = _core.py_make_profile(text, int(n))
     _check(stat, errmsg)
@@ -97,9 +102,10 @@ def _as_read(path: str | os.PathLike, dataset: str | None, *, areal: bool) -> np
 def _surface_grid(n, period, nx, ny) -> tuple[int, int, float, float]:
     """``(nx, ny, lx, ly)`` from ``n`` (both sizes unless ``nx``/``ny`` are given) and
     ``period`` (one length for both axes, or a pair ``(lx, ly)``)."""
-    nx = int(n if nx is None else nx)
-    ny = int(n if ny is None else ny)
-    lx, ly = (float(period), float(period)) if np.ndim(period) == 0 else map(float, period)
+    nx = grid_points(n if nx is None else nx, "n" if nx is None else "nx")
+    ny = grid_points(n if ny is None else ny, "n" if ny is None else "ny")
+    grid_size(nx, ny)
+    lx, ly = periods(period)
     return nx, ny, lx, ly
 
 
@@ -301,9 +307,7 @@ def prepare_heights(
         The heights, 1D for a line, ``(ny, nx)`` for a surface. Raises LayercontactError
         (code 2) for a bad value.
     """
-    raw = np.asarray(height, dtype=np.float64)
-    if raw.ndim not in (1, 2) or raw.size == 0 or not np.all(np.isfinite(raw)):
-        raise ValueError(f"heights of shape {raw.shape}: allowed a 1D or 2D array of finite heights")
+    raw = real_array(height, "height", ndim=(1, 2))
     areal = raw.ndim == 2
     factor = 2 if boundary == "mirror" else 1
     if shape is None:

@@ -27,8 +27,9 @@ module lc_leakage_reynolds
    implicit none (type, external)
    private
    public :: leakage_flow, leakage_result, reynolds_leakage, leakage_tol_allowed, leakage_tol_range, &
-      & leakage_max_iter, leakage_solver
+      & leakage_max_iter, leakage_solver, smallest_leakage_tol, largest_leakage_tol
    !> The tolerances allowed for &output leakage_tol (the relative accuracy of k_eff).
+   real(wp), parameter :: smallest_leakage_tol = 1.0e-14_wp, largest_leakage_tol = 1.0e-2_wp
    character(len=*), parameter :: leakage_tol_range = '1e-14 <= leakage_tol <= 1e-2'
    !> CG iterations per direction of a run's leakage: one that has not met tol by then is
    !> reported as not converged (k_eff is then an upper bound); well above the iterations
@@ -160,7 +161,7 @@ contains
    !> True for a tolerance in leakage_tol_range (false for NaN).
    pure logical function leakage_tol_allowed(tol)
       real(wp), intent(in) :: tol
-      leakage_tol_allowed = tol >= 1.0e-14_wp .and. tol <= 1.0e-2_wp
+      leakage_tol_allowed = tol >= smallest_leakage_tol .and. tol <= largest_leakage_tol
    end function leakage_tol_allowed
 
    !> c/h^2 of the face from each cell to its east (+x) and north (+y) neighbour: the harmonic

@@ -1,0 +1,90 @@
+"""Bad values given to the Python functions that make or read arrays are refused with an
+InputError (code 2, a LayercontactError and a ValueError) that names the argument and the
+allowed range, before anything is allocated; none is taken silently (a complex height
+losing its imaginary part, True taken as 1, 16.7 points taken as 16)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import layercontact as lc
+
+
+def refused(match: str):
+    return pytest.raises(lc.InputError, match=match)
+
+
+@pytest.mark.parametrize("heights, word", [
+    (np.ones(64, dtype=complex), "complex"),
+    (np.ones(64, dtype=bool), "boolean"),
+    (np.array(["a"] * 64), "dtype"),
+    (np.full(64, np.nan), "NaN"),
+    (np.ones((4, 4, 4)), "shape"),
+    (np.ones(0), "shape"),
+])
+def test_prepare_heights_refuses_what_is_not_real_heights(heights, word):
+    with refused(word) as err:
+        lc.prepare_heights(heights)
+    assert err.value.code == 2 and isinstance(err.value, ValueError) and "height" in str(err.value)
+
+
+@pytest.mark.parametrize("n", [16.7, True, "16", -8, 2])
+def test_a_generator_refuses_a_grid_that_is_not_an_integer_of_points(n):
+    with refused("allowed: an integer >= 4") as err:
+        lc.self_affine_surface(n)
+    assert err.value.code == 2
+    with refused("allowed: an integer >= 4"):
+        lc.self_affine_profile(n)
+
+
+def test_a_whole_float_is_a_number_of_points():
+    assert lc.self_affine_surface(16.0).shape == (16, 16)
+
+
+@pytest.mark.parametrize("n", [2**31, 2**16])
+def test_a_grid_too_large_is_refused_before_anything_is_allocated(n):
+    with refused("at most 1073741824 points"):
+        lc.self_affine_surface(n)
+
+
+@pytest.mark.parametrize("period", [(1.0,), (1.0, 2.0, 3.0), (1.0, -1.0), "one", np.inf])
+def test_a_period_is_one_length_or_a_pair(period):
+    with refused("period"):
+        lc.self_affine_surface(16, period=period)
+
+
+def test_a_pair_of_periods_is_taken():
+    assert lc.self_affine_surface(16, period=(2.0, 1.0), nx=32).shape == (16, 32)
+
+
+@pytest.mark.parametrize("tol", [-1.0, 0.0, 0.5, float("nan")])
+def test_the_leakage_refuses_a_tolerance_out_of_range(tol):
+    gap = np.ones((8, 8))
+    with refused("tol"):
+        lc.reynolds_leakage(gap, tol=tol)
+    with refused("tol"):
+        lc.core_leakage(gap, tol=tol)
+
+
+@pytest.mark.parametrize("max_iter", [0, -5, 2.5, True])
+def test_the_leakage_refuses_a_budget_that_is_not_a_positive_integer(max_iter):
+    gap = np.ones((8, 8))
+    with refused("max_iter") as err:
+        lc.core_leakage(gap, max_iter=max_iter)
+    assert err.value.code == 2
+    with refused("max_iter"):
+        lc.reynolds_leakage(gap, max_iter=max_iter)
+
+
+@pytest.mark.parametrize("gap, word", [
+    (np.ones((8, 8), dtype=complex), "complex"),
+    (np.ones((8, 8), dtype=bool), "boolean"),
+    (np.full((8, 8), np.inf), "infinite"),
+    (np.ones(8), "shape"),
+])
+def test_the_leakage_refuses_a_gap_that_is_not_a_real_map(gap, word):
+    with refused(word):
+        lc.reynolds_leakage(gap)
+    with refused(word):
+        lc.core_leakage(gap)
