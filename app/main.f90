@@ -6,9 +6,9 @@
 !> written, flagged converged = 0); 4 I/O failure; 5 not enough memory or internal failure; 1 usage.
 program layercontact
    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-   use lc_errors, only: error_type, code_not_converged
-   use lc_run, only: run_scene_file
-   use lc_version, only: version_string, build_isa
+   use lc_base_errors, only: error_type, code_not_converged
+   use lc_application_run, only: run_scene_file
+   use lc_base_version, only: version_string, build_isa
    implicit none (type, external)
    type(error_type), allocatable :: error
    character(len=:), allocatable :: input, output_file

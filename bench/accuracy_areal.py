@@ -92,7 +92,7 @@ REF = (128, 64)  # (reference ppw, check ppw)
 TARGETS = (1e-1, 3e-2, 1e-2)
 LEAK_TOL = 1e-8
 
-# ---- the areal accuracy rule (src/accuracy.f90 implements the same) -------------------
+# ---- the areal accuracy rule (src/application/accuracy.f90 implements the same) -------------------
 # ppw = smallest power of two >= 4 with ppw >= RULE_SPOT / (spot * eps), where spot is the
 # mean patch size 2 A / P (contact area over half the perimeter, in lambda_s; a line spot's
 # length) from a pilot solve at ppw 4, tol 1e-4; tol = the largest of TOLS <= (eps/12)^1.5.

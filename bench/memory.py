@@ -38,7 +38,7 @@ multigrid method under 'auto' from 1024^2), solve_areal's
 defaults (tol 1e-10, coarse start, memory 12, threads 1) without the stress fields. The
 increase of the peak over the resident set after making the surface is printed in doubles
 per grid point (targets: <= 20 frictionless, <= 30 coupled by GCR, <= 46 by the multigrid:
-the memory check's allowance, src/memory.f90), and the slope between the two largest sizes (the
+the memory check's allowance, src/base/memory.f90), and the slope between the two largest sizes (the
 fixed part removed). ``--big 4096`` adds one frictionless half-space solve at 4096^2
 (time and peak; skipped if the peak predicted from the largest measured size exceeds
 ~20 GiB or the memory available).
@@ -100,7 +100,7 @@ CG = 4          # src/contact/solver_cg.f90: t, r, z, inside (a real 0/1 mask)
 ANDERSON = 7    # src/contact/solver_anderson.f90: x, f, x_old, f_old, tx, b, nw
 OBSERVE = 9     # src/result.f90 pressure, gap, displacement_z, displacement_x, shear, stress_xx;
 #                 src/observables/surface.f90: ph, uh, sh (complex)
-WRAP_END = 6    # lc_scene_text copying the result (6 fields) into `fields`
+WRAP_END = 6    # lc_application_scene_text copying the result (6 fields) into `fields`
 PYTHON = 7      # api._solve_scene: 6 field copies; solve_line: height copy
 MEMORY = 12     # Anderson memory (default)
 

@@ -1,7 +1,7 @@
 !> The only file f2py sees: thin py_* wrappers with plain, explicit-shape arguments.
 !> Each builds the library's types from its arguments, calls one library routine, copies
 !> the results out and maps an error to stat (the exit code it would have) and errmsg.
-!> stat = 0 means success. A scene comes as namelist text (lc_scene_text), so that its
+!> stat = 0 means success. A scene comes as namelist text (lc_application_scene_text), so that its
 !> defaults, checks and messages are those of scene_type and a namelist file.
 
 !> 1-A, 1-B and c (convention P) for kh = |k| h, closed forms.
@@ -17,7 +17,7 @@ end subroutine py_layer_coefficients
 
 !> The same from the 4x4 plane-strain mode problem solved with LAPACK.
 subroutine py_layer_coefficients_lapack(n, kh, nu, one_minus_a, one_minus_b, c, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_greens_layer, only: layer_coefficients_lapack
    implicit none (type, external)
    integer, intent(in) :: n
@@ -38,12 +38,12 @@ end subroutine py_layer_coefficients_lapack
 !> Solve the scene that the namelist `text` describes (made from Python keywords: the
 !> defaults, checks and messages of a namelist file) on the given heights (n = nx*ny, x
 !> fastest); with &friction companion, the frictionless companion is run 2. `table` names
-!> what each run returns (lc_scene_text): its scalars, the columns of fields(:, :, run) and
+!> what each run returns (lc_application_scene_text): its scalars, the columns of fields(:, :, run) and
 !> spots(:, :, run), and how many of the last residuals history(:, run) holds.
 subroutine py_solve_scene(text, n, height, runs, n_fields, spot_capacity, spot_columns, capacity, fields, spots, &
       & history, table, stat, errmsg)
-   use lc_errors, only: error_type, status_of
-   use lc_scene_text, only: solve_scene_text
+   use lc_base_errors, only: error_type, status_of
+   use lc_application_scene_text, only: solve_scene_text
    implicit none (type, external)
    character(len=*), intent(in) :: text
    integer, intent(in) :: n, runs, n_fields, spot_capacity, spot_columns, capacity
@@ -61,8 +61,8 @@ end subroutine py_solve_scene
 !> The heights of the &profile of the scene in the namelist `text` (n = nx*ny values, x
 !> fastest), made as a namelist run makes them.
 subroutine py_make_profile(text, n, height, stat, errmsg)
-   use lc_errors, only: error_type, status_of
-   use lc_scene_text, only: profile_of_text
+   use lc_base_errors, only: error_type, status_of
+   use lc_application_scene_text, only: profile_of_text
    implicit none (type, external)
    character(len=*), intent(in) :: text
    integer, intent(in) :: n
@@ -74,9 +74,9 @@ subroutine py_make_profile(text, n, height, stat, errmsg)
    call status_of(error, stat, errmsg)
 end subroutine py_make_profile
 
-!> The library's limits and markers as `name = value` lines (lc_scene_text).
+!> The library's limits and markers as `name = value` lines (lc_application_scene_text).
 subroutine py_constants(table)
-   use lc_scene_text, only: library_constants
+   use lc_application_scene_text, only: library_constants
    implicit none (type, external)
    character(len=1024), intent(out) :: table
    table = library_constants()
@@ -85,7 +85,7 @@ end subroutine py_constants
 !> Prony terms from a two-column text file, read as &material prony_file reads it: the
 !> first `count` of times and values (room for `capacity`).
 subroutine py_read_prony_file(filename, capacity, times, values, count, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_io_namelist, only: read_prony_file
    implicit none (type, external)
    character(len=*), intent(in) :: filename
@@ -108,7 +108,7 @@ end subroutine py_read_prony_file
 !> 'relaxation' or 'creep', the number of terms, their signs and order); times and values
 !> have room for one more than the larger count.
 subroutine py_check_prony(form, equilibrium, nt, nv, capacity, times, values, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_greens_viscoelastic, only: material_law, check_material
    implicit none (type, external)
    character(len=*), intent(in) :: form
@@ -127,8 +127,8 @@ end subroutine py_check_prony
 !> verbose = 1). converged: 0/1.
 subroutine py_run(input, verbose, output_file, converged, stat, errmsg)
    use, intrinsic :: iso_fortran_env, only: output_unit
-   use lc_errors, only: error_type, status_of
-   use lc_run, only: run_scene_file
+   use lc_base_errors, only: error_type, status_of
+   use lc_application_run, only: run_scene_file
    implicit none (type, external)
    character(len=*), intent(in) :: input
    integer, intent(in) :: verbose
@@ -148,7 +148,7 @@ end subroutine py_run
 
 !> Read and validate a namelist file without solving (what the executable checks first).
 subroutine py_check_scene_file(input, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_scene, only: scene_type
    use lc_io_namelist, only: read_scene
    implicit none (type, external)
@@ -165,10 +165,10 @@ end subroutine py_check_scene_file
 !> The grid (n, and ny: 1 on a line) and tolerance tol the accuracy rule picks for a scene
 !> file with &solver target_error (runs the pilot solve; writes nothing).
 subroutine py_choose_resolution(input, n, ny, tol, stat, errmsg)
-   use lc_errors, only: error_type, fatal_error, code_input, status_of
+   use lc_base_errors, only: error_type, fatal_error, code_input, status_of
    use lc_scene, only: scene_type, not_set
    use lc_io_namelist, only: read_scene
-   use lc_accuracy, only: choose_resolution
+   use lc_application_accuracy, only: choose_resolution
    implicit none (type, external)
    character(len=*), intent(in) :: input
    integer, intent(out) :: n, ny
@@ -197,8 +197,8 @@ end subroutine py_choose_resolution
 !> pressure p (n = nx*ny values, x fastest) and the shear friction*p along x (no contact
 !> solve; a line has u_x and sigma_xx only).
 subroutine py_surface_stress(text, n, p, fields, stat, errmsg)
-   use lc_errors, only: error_type, status_of
-   use lc_scene_text, only: surface_stress_of_text
+   use lc_base_errors, only: error_type, status_of
+   use lc_application_scene_text, only: surface_stress_of_text
    implicit none (type, external)
    character(len=*), intent(in) :: text
    integer, intent(in) :: n
@@ -215,9 +215,9 @@ end subroutine py_surface_stress
 !> J*(k) of seed Eq. (14) at omega = k V for the material law of the &layer and &material
 !> groups of the namelist `text`.
 subroutine py_creep_compliance(text, nw, omega, compliance, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_greens_viscoelastic, only: material_law, creep_compliance
-   use lc_scene_text, only: material_of_text
+   use lc_application_scene_text, only: material_of_text
    implicit none (type, external)
    character(len=*), intent(in) :: text
    integer, intent(in) :: nw
@@ -238,7 +238,7 @@ end subroutine py_creep_compliance
 !> of `rounds` timings of `repeats` pairs each.
 subroutine py_fft_pair_seconds(n, repeats, rounds, seconds, stat, errmsg)
    use, intrinsic :: iso_fortran_env, only: int64
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_fft_plans, only: fft_plan
    implicit none (type, external)
    integer, intent(in) :: n, repeats, rounds
@@ -269,7 +269,7 @@ end subroutine py_fft_pair_seconds
 !> build (AVX2, FMA), else 1; isa = the instruction set this extension was compiled for.
 subroutine py_cpu_level(level, isa)
    use lc_cpu, only: cpu_level
-   use lc_version, only: build_isa
+   use lc_base_version, only: build_isa
    implicit none (type, external)
    integer, intent(out) :: level
    character(len=16), intent(out) :: isa
@@ -280,8 +280,8 @@ end subroutine py_cpu_level
 !> The 3x3 surface compliance (lc_greens_kernel) of the layer of the scene in the namelist
 !> `text` for the wavevectors (qx, qy): (u_x^, u_y^, w^) = tensor(i, :, :) (tau_x^, tau_y^, p^).
 subroutine py_surface_tensor(text, n, qx, qy, tensor, stat, errmsg)
-   use lc_errors, only: error_type, status_of
-   use lc_scene_text, only: tensor_of_text
+   use lc_base_errors, only: error_type, status_of
+   use lc_application_scene_text, only: tensor_of_text
    implicit none (type, external)
    character(len=*), intent(in) :: text
    integer, intent(in) :: n
@@ -299,7 +299,7 @@ end subroutine py_surface_tensor
 !> (numpy height.reshape(ny, nx)). Not-given lengths and targets are passed as -1.
 subroutine py_self_affine_surface(nx, ny, lx, ly, hurst, seed, rolloff, short, rms_gradient, rms_height, height, &
       & stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_profiles_surface, only: self_affine_surface
    implicit none (type, external)
    integer, intent(in) :: nx, ny
@@ -317,7 +317,7 @@ end subroutine py_self_affine_surface
 !> &profile kind = 'file' (lc_profiles_height_file): nx x ny with x fastest, (n, 1) for a
 !> 1D array.
 subroutine py_height_file_shape(filename, dataset, nx, ny, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_profiles_height_file, only: read_height_file
    implicit none (type, external)
    character(len=*), intent(in) :: filename, dataset
@@ -339,7 +339,7 @@ end subroutine py_height_file_shape
 !> boundary, resample), as &profile kind = 'file' makes them; areal = 0: a line of nx
 !> points (ny = 1).
 subroutine py_measured_heights(filename, dataset, areal, detrend, boundary, resample, nx, ny, height, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_profiles_measured, only: measured_heights
    implicit none (type, external)
    character(len=*), intent(in) :: filename, dataset, detrend, boundary, resample
@@ -355,7 +355,7 @@ end subroutine py_measured_heights
 !> Detrend, boundary and resample (lc_profiles_measured) of heights raw (mx x n/mx, x
 !> fastest) onto an nx x ny grid; areal = 0: a line (ny = 1).
 subroutine py_prepare_heights(n, raw, mx, areal, detrend, boundary, resample, nx, ny, height, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_profiles_measured, only: prepare_heights
    implicit none (type, external)
    integer, intent(in) :: n, mx, areal, nx, ny
@@ -377,7 +377,7 @@ end subroutine py_prepare_heights
 !> residual_y, wall_time]; counts = [percolating_x, percolating_y,
 !> iterations_x, iterations_y, unknowns_x, unknowns_y, converged_x, converged_y].
 subroutine py_reynolds_leakage(n, gap, closed, nx, lx, ly, tol, max_iter, values, counts, stat, errmsg)
-   use lc_errors, only: error_type, status_of
+   use lc_base_errors, only: error_type, status_of
    use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
    implicit none (type, external)
    integer, intent(in) :: n, nx, max_iter

@@ -1,7 +1,7 @@
 !> What a contact solve returns: fields on the grid, scalar observables, and the
 !> convergence record. Units are the scene's (lengths L, pressures S).
 module lc_result
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_leakage_reynolds, only: leakage_result
    implicit none (type, external)
    private

@@ -8,11 +8,11 @@
 !> units; the seed's normalised values are stored next to them.
 module lc_scene
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, input_error, positive_finite
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, input_error, positive_finite
+   use lc_base_strings, only: to_string
    use lc_greens_viscoelastic, only: material_law, check_material, static_modulus, is_viscoelastic
-   use lc_grid, only: grid_type, line_grid, surface_grid
+   use lc_base_grid, only: grid_type, line_grid, surface_grid
    use lc_greens_kernel, only: layer_kernel, make_kernel
    use lc_leakage_reynolds, only: leakage_tol_allowed, leakage_tol_range
    use lc_profiles_measured, only: check_treatments
@@ -88,7 +88,7 @@ module lc_scene
       !> progress on standard error: a line per grid level and every 2 s within one
       logical :: verbose = .false.
       !> target error of the observables: when set, &scene n and tol are chosen by the
-      !> accuracy rule (lc_accuracy)
+      !> accuracy rule (lc_application_accuracy)
       real(wp) :: target_error = not_set
    end type solver_settings
 

@@ -4,7 +4,7 @@ against a converged reference at ppw = 8192, for every ppw x tol measured; the l
 tension of a sliding layer is resolved sub-grid at the trailing edge), and bad uses are
 refused with a clear message.
 
-The rule runs in the library (src/accuracy.f90: a pilot solve for the mean spot length,
+The rule runs in the library (src/application/accuracy.f90: a pilot solve for the mean spot length,
 then ppw and tol); here its choices are read with layercontact.choose_resolution and
 looked up in the table. A target is "verifiable" where the table has that (ppw, tol) with
 the default solver and the reference's own uncertainty (ppw 8192 vs 4096) is below a

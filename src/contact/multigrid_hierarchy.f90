@@ -23,8 +23,8 @@
 !> coarse operators be this cheap. Fields are stored as the rest of the library stores
 !> them: nx x ny points, x fastest; spectra on the half spectrum (nx/2 + 1) x ny.
 module lc_contact_multigrid_hierarchy
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type
    use lc_fft_plans, only: fft_plan
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)

@@ -1,5 +1,5 @@
 !> The compliance operator of a scene: w = G_eff * p as a Fourier multiplier on a grid
-!> (a line, or a surface: lc_grid), the same code for both.
+!> (a line, or a surface: lc_base_grid), the same code for both.
 !>
 !> Convention P (docs/theory.md): for a mode q of p(x) = sum_q p^(q) exp(i q.x),
 !>    w^(q) = 2 C(q_x)/|q| [ (1-A) - i (q_x/|q|) mu_c c ] p^(q),
@@ -20,11 +20,11 @@
 !> 1 - i Im G/Re G, up to ~300 in modulus for thin incompressible layers).
 module lc_contact_operator
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, code_input
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, code_input
+   use lc_base_strings, only: to_string
    use lc_fft_plans, only: fft_plan, fft_threads_available
-   use lc_grid, only: grid_type
+   use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
    implicit none (type, external)
    private
@@ -42,7 +42,7 @@ module lc_contact_operator
 
    !> Fourier multipliers of one scene on one grid and the FFT plans to apply them. The
    !> solvers use it through its procedures only; multipliers are on the grid's half
-   !> spectrum (lc_grid), fields flat with x fastest.
+   !> spectrum (lc_base_grid), fields flat with x fastest.
    type :: compliance_operator
       type(grid_type) :: grid
       type(layer_kernel) :: kernel

@@ -20,9 +20,9 @@
 !>     then the Anderson iteration, and on small grids of a monotone operator the dense
 !>     Newton method finishes.
 module lc_contact_policy
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, code_input
-   use lc_strings, only: to_string, formatted
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, code_input
+   use lc_base_strings, only: to_string, formatted
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_newton, only: dense_points
    use lc_contact_solver_multigrid, only: multigrid_refusal, metric_refusal, coupled_refusal, rows_ahead_of_gcr, &

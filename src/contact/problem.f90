@@ -7,7 +7,7 @@
 !> under load control (mean(p) = p_m given, the constant s found) or displacement control
 !> (s given). The solvers stop on the complementarity residual (lc_contact_residual).
 module lc_contact_problem
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private
@@ -28,7 +28,7 @@ module lc_contact_problem
    end type contact_problem
 
    !> The fields a solver changes: on entry the start, on exit the solution (or the best
-   !> iterate found). On a grid of n points, flat with x fastest (lc_grid).
+   !> iterate found). On a grid of n points, flat with x fastest (lc_base_grid).
    type :: contact_state
       real(wp), allocatable :: p(:)     !< pressure (S), >= 0 on exit
       real(wp), allocatable :: w(:)     !< w = G_eff p (L)

@@ -4,8 +4,8 @@
 !> library stay silent.
 module lc_contact_progress
    use, intrinsic :: iso_fortran_env, only: error_unit
-   use lc_kinds, only: wp, i8
-   use lc_strings, only: to_string, formatted
+   use lc_base_kinds, only: wp, i8
+   use lc_base_strings, only: to_string, formatted
    implicit none (type, external)
    private
    public :: progress_log

@@ -3,7 +3,7 @@
 !> gap w - b computed through FFTs is noise, and the scaling of p to the load.
 module lc_contact_residual
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    implicit none (type, external)
    private
    public :: complementarity_residual, rounding_floor, normalise

@@ -1,4 +1,4 @@
-!> Solve one contact scene, a line or a surface (lc_grid), for a given Coulomb
+!> Solve one contact scene, a line or a surface (lc_base_grid), for a given Coulomb
 !> coefficient: build the operator the scene needs, ask the policy (lc_contact_policy)
 !> which methods solve it, run them (lc_contact_stages), fill a contact_result.
 !>
@@ -13,12 +13,12 @@
 !> as a scene of its own to a tolerance a starting guess needs.
 module lc_contact_solve
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, code_input
+   use lc_base_strings, only: to_string
    use lc_scene, only: scene_type, is_halfspace, not_set, grid_of, kernel_of, pressure_scale
    use lc_result, only: contact_result
-   use lc_grid, only: grid_type
+   use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_contact_residual, only: rounding_floor, complementarity_residual
@@ -28,7 +28,7 @@ module lc_contact_solve
    use lc_contact_stages, only: solve_in_stages
    use lc_contact_solver_multigrid, only: allowed_rise
    use lc_contact_progress, only: progress_log
-   use lc_memory, only: check_memory
+   use lc_base_memory, only: check_memory
    implicit none (type, external)
    private
    public :: solve_contact, scene_mean_pressure
@@ -61,7 +61,7 @@ contains
       end if
    end function scene_mean_pressure
 
-   !> Solve the scene on profile `height` (flat, x fastest: lc_grid) with Coulomb
+   !> Solve the scene on profile `height` (flat, x fastest: lc_base_grid) with Coulomb
    !> coefficient `friction` (the scene's, or 0 for the frictionless companion). `op`: the
    !> operator of the grid solved, for the observables.
    subroutine solve_contact(scene, height, friction, result, op, error)

@@ -4,7 +4,7 @@
 !> including the start) says so with `ends_no_worse`, so that a solve which goes on
 !> from another method's iterate keeps the better of the two (lc_contact_stages).
 module lc_contact_solver
-   use lc_errors, only: error_type
+   use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_progress, only: progress_log
    implicit none (type, external)

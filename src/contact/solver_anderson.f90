@@ -12,8 +12,8 @@
 !> T's output (which is always feasible: p >= 0 and the load is exact). A run that stops
 !> without converging returns its best iterate (the smallest residual).
 module lc_contact_solver_anderson
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, code_internal
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome
    use lc_contact_residual, only: complementarity_residual, rounding_floor

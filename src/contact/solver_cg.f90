@@ -11,10 +11,10 @@
 !> current mean pressure, g_ref is given by the caller (the profile's peak-to-valley).
 module lc_contact_solver_cg
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    use lc_contact_progress, only: progress_log
-   use lc_errors, only: error_type
+   use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
    use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise

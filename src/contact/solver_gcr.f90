@@ -23,11 +23,11 @@
 !> fields returned belong together. Stopping rule and residual as in lc_contact_solver_cg.
 module lc_contact_solver_gcr
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    use lc_contact_residual, only: rounding_floor, normalise
    use lc_contact_progress, only: progress_log
-   use lc_errors, only: error_type
+   use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
    implicit none (type, external)

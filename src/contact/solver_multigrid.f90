@@ -42,10 +42,10 @@
 !> grids halved along one axis, or smoothing by rows).
 module lc_contact_solver_multigrid
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type
-   use lc_memory, only: available_bytes
-   use lc_strings, only: to_string, formatted
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type
+   use lc_base_memory, only: available_bytes
+   use lc_base_strings, only: to_string, formatted
    use lc_contact_operator, only: compliance_operator
    use lc_contact_multigrid_hierarchy, only: hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, &
       & build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, precondition, worst_smoothing, &
@@ -54,7 +54,7 @@ module lc_contact_solver_multigrid
    use lc_contact_progress, only: progress_log
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
-   use lc_grid, only: grid_type
+   use lc_base_grid, only: grid_type
    implicit none (type, external)
    private
    public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg

@@ -19,12 +19,12 @@
 !> docs/numerics.md), not a general solver.
 module lc_contact_solver_newton
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    use lc_contact_residual, only: complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
-   use lc_errors, only: error_type, fatal_error, code_input
-   use lc_strings, only: to_string
+   use lc_base_errors, only: error_type, fatal_error, code_input
+   use lc_base_strings, only: to_string
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
    implicit none (type, external)

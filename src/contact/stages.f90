@@ -9,7 +9,7 @@
 !>  - the outcome adds up the iterations and transform pairs, joins the residual histories,
 !>    and names the path, e.g. 'gcr+kept+anderson'.
 module lc_contact_stages
-   use lc_errors, only: error_type, fatal_error, code_internal
+   use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
    use lc_contact_registry, only: new_solver

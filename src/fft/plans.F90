@@ -1,5 +1,5 @@
 !> FFTW plans owned by a type: one real-to-complex / complex-to-real pair for a line of
-!> nx points or a surface of nx x ny points (x fastest, lc_grid's layout), made by each
+!> nx points or a surface of nx x ny points (x fastest, lc_base_grid's layout), made by each
 !> object for itself, with their own aligned buffers. No state outside the objects.
 !>
 !> Convention: f(x_j) = sum_q f^(q) exp(i q.x_j). `forward` returns f^(q) on the half
@@ -13,9 +13,9 @@ module lc_fft_plans
       & fftw_execute_dft_c2r, fftw_destroy_plan, fftw_init_threads, fftw_plan_with_nthreads, FFTW_ESTIMATE, &
       & FFTW_DESTROY_INPUT, fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft, &
       & FFTW_FORWARD, FFTW_BACKWARD, FFTW_UNALIGNED
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_internal
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, code_internal
+   use lc_base_strings, only: to_string
    implicit none (type, external)
    private
    public :: fft_plan, fft_threads_available

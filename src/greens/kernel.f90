@@ -15,7 +15,7 @@
 !> has none (set to zero).
 module lc_greens_kernel
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_greens_layer, only: layer_coefficients
    use lc_greens_viscoelastic, only: material_law, material_model, material_model_of
    implicit none (type, external)

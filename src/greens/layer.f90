@@ -17,8 +17,8 @@
 !> the plane-strain boundary-value problem of one Fourier mode, as a test oracle.
 module lc_greens_layer
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, code_input, code_internal
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, code_input, code_internal
    implicit none (type, external)
    private
    public :: layer_coefficients, halfspace_coupling

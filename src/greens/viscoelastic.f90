@@ -24,9 +24,9 @@
 !> variables in the scene schema.
 module lc_greens_viscoelastic
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, input_error, positive_finite
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, input_error, positive_finite
+   use lc_base_strings, only: to_string
    implicit none (type, external)
    private
    public :: material_law, material_model, material_model_of, creep_compliance, static_modulus, check_material, &

@@ -26,13 +26,13 @@ module lc_io_hdf5
       & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
       & h5acreate_f, h5awrite_f, h5aclose_f, &
       & h5dcreate_f, h5dopen_f, h5dwrite_f, h5dread_f, h5dclose_f, h5dget_space_f, h5dget_type_f
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
-   use lc_strings, only: to_string, lower_case
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, code_input, code_io, code_internal
+   use lc_base_strings, only: to_string, lower_case
    use lc_scene, only: scene_type, is_areal
    use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_leakage_reynolds, only: leakage_result
-   use lc_version, only: build_isa
+   use lc_base_version, only: build_isa
    implicit none (type, external)
    private
    public :: check_output, write_results, run_record, utc_now

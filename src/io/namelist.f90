@@ -8,9 +8,9 @@
 module lc_io_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, input_error, code_input, code_io
-   use lc_strings, only: to_string, lower_case
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, input_error, code_input, code_io
+   use lc_base_strings, only: to_string, lower_case
    use lc_scene, only: scene_type, check_scene, not_set, max_string
    use lc_greens_viscoelastic, only: max_prony_terms
    implicit none (type, external)

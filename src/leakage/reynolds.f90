@@ -21,9 +21,9 @@
 !> dissipation, so tol is the relative accuracy of k_eff.
 module lc_leakage_reynolds
    use, intrinsic :: iso_c_binding, only: c_int, c_double
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, input_error, code_internal
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, input_error, code_internal
+   use lc_base_strings, only: to_string
    implicit none (type, external)
    private
    public :: leakage_flow, leakage_result, reynolds_leakage, leakage_tol_allowed, leakage_tol_range, &

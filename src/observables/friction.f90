@@ -11,9 +11,9 @@
 !>                    is refined (the spectral slope of w - r is not zero at contact nodes
 !>                    next to an edge), which makes it a per-run accuracy indicator.
 !> Comparing them checks the solver and the sign conventions (docs/theory.md).
-!> On a surface (lc_grid) the derivatives are along the sliding direction x.
+!> On a surface (lc_base_grid) the derivatives are along the sliding direction x.
 module lc_observables_friction
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private

@@ -13,7 +13,7 @@
 !> any point touches.
 module lc_observables_geometry
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    implicit none (type, external)
    private
    public :: contact_spots, leak_rate, gap_histogram, nearest_trailing_offset, spot_tension, spot_asymmetry

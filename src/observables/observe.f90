@@ -2,7 +2,7 @@
 !> computed only as the scene asks: gap statistics and the interlocking friction on any
 !> grid; contact spots, leak rate and the surface stress of line contacts.
 module lc_observables
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use lc_scene, only: scene_type, pressure_scale
    use lc_result, only: contact_result

@@ -8,8 +8,8 @@
 !> and a node out of contact (an edge normal to x has length dy, one normal to y length dx),
 !> so a patch that wraps round the cell has no edge there.
 module lc_observables_patches
-   use lc_kinds, only: wp
-   use lc_grid, only: grid_type
+   use lc_base_kinds, only: wp
+   use lc_base_grid, only: grid_type
    implicit none (type, external)
    private
    public :: contact_patches

@@ -19,7 +19,7 @@
 !> mirror average (M(q_x, q_y) + conj M(q_x, -q_y))/2; a mode of the Nyquist row (even ny)
 !> stands for q_y = +-pi/dy: (M(q_x, q_y) + M(q_x, -q_y))/2.
 module lc_observables_stress
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private

@@ -15,7 +15,7 @@
 !> every contact edge, from which the cusp's peak is interpolated sub-grid
 !> (lc_observables_geometry's spot_tension).
 module lc_observables_surface
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private

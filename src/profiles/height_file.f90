@@ -24,9 +24,9 @@ module lc_profiles_height_file
       & H5F_CLOSE_STRONG_F, h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, h5dopen_f, h5dclose_f, &
       & h5dread_f, h5dget_space_f, h5dget_type_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
       & h5sget_simple_extent_dims_f, h5tget_class_f, h5tclose_f, H5T_NATIVE_DOUBLE, H5T_FLOAT_F
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input, code_io, code_internal
-   use lc_strings, only: to_string, lower_case
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, code_input, code_io, code_internal
+   use lc_base_strings, only: to_string, lower_case
    implicit none (type, external)
    private
    public :: read_height_file, named, shape_text

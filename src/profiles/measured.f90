@@ -24,9 +24,9 @@
 !> space of x and y is the same in any affine coordinates, so the fit does not depend on
 !> the periods, and the scaled normal equations stay well conditioned.
 module lc_profiles_measured
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, input_error, code_input
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, input_error, code_input
+   use lc_base_strings, only: to_string
    use lc_fft_plans, only: fft_plan
    use lc_profiles_height_file, only: read_height_file, named, shape_text
    implicit none (type, external)

@@ -14,9 +14,9 @@
 !> For a self-affine profile (lc_profiles_self_affine) these equal its scaling target to
 !> roundoff.
 module lc_profiles_profile
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, code_input, input_error, positive_finite
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, code_input, input_error, positive_finite
+   use lc_base_strings, only: to_string
    use lc_scene, only: scene_type, not_set, default_rms_gradient, is_areal
    use lc_fft_plans, only: fft_plan
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile

@@ -18,7 +18,7 @@
 !> -fsanitize=undefined), so the sums and products mod 2^64 are done on 16-bit limbs,
 !> where no intermediate exceeds 2^35.
 module lc_profiles_random
-   use lc_kinds, only: wp, i8
+   use lc_base_kinds, only: wp, i8
    implicit none (type, external)
    private
    public :: splitmix64, splitmix64_uniform

@@ -22,9 +22,9 @@
 !>    i.e. r_j = sum_m s a_m cos(q_m x_j + phi_m): the c2r backward transform of
 !>    lc_fft_plans. The heights have zero mean.
 module lc_profiles_self_affine
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_input, input_error, positive_finite
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, code_input, input_error, positive_finite
+   use lc_base_strings, only: to_string
    use lc_scene, only: not_set
    use lc_fft_plans, only: fft_plan
    use lc_profiles_random, only: splitmix64_uniform

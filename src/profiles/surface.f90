@@ -1,7 +1,7 @@
 !> Areal (doubly periodic) rigid surfaces on an nx x ny grid of periods lx, ly: a random
 !> isotropic self-affine surface (power spectrum C(q) ~ |q|^(-2-2H), random phases, scaled
 !> to an rms gradient or height), an oblique sinusoid and a spherical cap. Heights are
-!> returned as height(nx, ny), x fastest (lc_grid's layout; numpy height[ny, nx]).
+!> returned as height(nx, ny), x fastest (lc_base_grid's layout; numpy height[ny, nx]).
 !>
 !> Self-affine algorithm (tests/reference_profiles.py reproduces it up to roundoff; change
 !> both together):
@@ -43,9 +43,9 @@
 !> wavelength well below min(lx, ly) keeps them flat, where they carry little slope
 !> (tests/test_surfaces.py measures the rms slopes along x and y).
 module lc_profiles_surface
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, input_error, positive_finite
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, input_error, positive_finite
+   use lc_base_strings, only: to_string
    use lc_scene, only: not_set
    use lc_fft_plans, only: fft_plan
    use lc_profiles_random, only: splitmix64_uniform

@@ -4,8 +4,8 @@
 !> (path as first argument). Prints one line per check; error stop 1 on any failure.
 program test_greens_layer
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_positive_inf
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, code_input
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, code_input
    use lc_greens_layer, only: layer_coefficients, halfspace_coupling, layer_coefficients_lapack, &
       layer_mode_response, x_series, x_large, lapack_x_min, lapack_x_max
    implicit none (type, external)

@@ -4,11 +4,11 @@
 !> Run in a scratch directory: files are created under ./test_io_scratch/.
 program test_io
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, code_input, code_io
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, code_input, code_io
    use lc_scene, only: scene_type, not_set, companion_of
    use lc_result, only: contact_result, result_scalar, result_scalars
-   use lc_scene_text, only: solve_scene_text
+   use lc_application_scene_text, only: solve_scene_text
    use lc_io_namelist, only: read_scene, read_scene_text, write_scene_namelist
    use lc_io_hdf5, only: check_output, write_results
    use lc_profiles_measured, only: measured_heights

@@ -7,8 +7,8 @@
 !> - tol_solve = 1e-10: the flow across stripes is solved by CG stopped at tol = 1e-12 on
 !>   k_eff; its energy-error estimate lags a few iterations, so two orders above it.
 program test_leakage
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type
    use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
    implicit none (type, external)
 

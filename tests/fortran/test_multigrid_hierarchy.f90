@@ -11,9 +11,9 @@
 !> Tolerance: tol_identity = 1e-12 of the largest entry: the two sides are the same sums in
 !> another order (transforms of a few hundred points against explicit stencils).
 program test_multigrid_hierarchy
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type
-   use lc_grid, only: line_grid, surface_grid
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type
+   use lc_base_grid, only: line_grid, surface_grid
    use lc_contact_operator, only: compliance_operator
    use lc_contact_multigrid_hierarchy, only: hierarchy, build_hierarchy, set_grid, set_contact, level_operator, &
       & penalty, solve_rows, worst_row_smoothing

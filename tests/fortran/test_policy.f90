@@ -3,8 +3,8 @@
 !> owns, that refused methods are refused with exit code 2, and that the reason names the
 !> rule. Prints one line per check; error stop 1 on any failure.
 program test_policy
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, code_input
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, code_input
    use lc_contact_policy, only: problem_indicators, solve_plan, plan_solve, may_take_multigrid
    implicit none (type, external)
    integer :: failures

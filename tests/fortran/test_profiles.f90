@@ -12,8 +12,8 @@
 !> - tol_closed = 1e-13 (times the amplitude): closed forms evaluated by the same formula,
 !>   differing only in the rounding of the cosine's argument (up to ~2 pi (mode+mode_y)).
 program test_profiles
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, code_input
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, code_input
    use lc_scene, only: scene_type, not_set, check_scene
    use lc_fft_plans, only: fft_plan
    use lc_profiles_random, only: splitmix64, splitmix64_uniform
@@ -245,7 +245,7 @@ contains
    end subroutine check_make_profile
 
    !> Rms height and gradient of a surface: the height from the grid values, the gradient by
-   !> Parseval over the half spectrum (lc_grid's mode weights: 1 in the column mx = 0 and
+   !> Parseval over the half spectrum (lc_base_grid's mode weights: 1 in the column mx = 0 and
    !> the Nyquist column, 2 elsewhere).
    subroutine surface_statistics(nx, ny, lx, ly, height, rms_height, rms_gradient, mean)
       integer, intent(in) :: nx, ny

@@ -3,9 +3,9 @@
 !>
 !> Codes follow the executable's exit codes: 2 = bad input, 3 = not converged (used as a
 !> status, not an error), 4 = I/O failure, 5 = internal/numerical failure.
-module lc_errors
+module lc_base_errors
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp
+   use lc_base_kinds, only: wp
    implicit none (type, external)
    private
    public :: error_type, fatal_error, input_error, positive_finite, status_of
@@ -61,4 +61,4 @@ contains
       real(wp), intent(in) :: x
       positive_finite = ieee_is_finite(x) .and. x > 0.0_wp
    end function positive_finite
-end module lc_errors
+end module lc_base_errors

@@ -8,11 +8,11 @@
 !> (cgroup v2 memory.max: batch schedulers such as Slurm confine jobs so), and the address
 !> space limit (ulimit -v) less this process's address space. Where none of these can be
 !> read (not Linux) the check passes.
-module lc_memory
+module lc_base_memory
    use, intrinsic :: iso_c_binding, only: c_int, c_long_long
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type, fatal_error, code_internal
-   use lc_strings, only: to_string
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type, fatal_error, code_internal
+   use lc_base_strings, only: to_string
    implicit none (type, external)
    private
    public :: check_memory, solve_bytes, available_bytes
@@ -173,4 +173,4 @@ contains
       read (text, *, iostat=stat) bytes
       if (stat /= 0) bytes = -1
    end function cgroup_limit
-end module lc_memory
+end module lc_base_memory

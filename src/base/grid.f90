@@ -8,8 +8,8 @@
 !> my - ny), stored flat with mx fastest. A mode with 0 < mx < nx/2 stands for itself and
 !> its mirror image -q; the columns mx = 0 and (for even nx) mx = nx/2 hold their own
 !> mirror images, so in sums over the whole spectrum they count once (`mode_weight`).
-module lc_grid
-   use lc_kinds, only: wp
+module lc_base_grid
+   use lc_base_kinds, only: wp
    implicit none (type, external)
    private
    public :: grid_type, line_grid, surface_grid
@@ -111,4 +111,4 @@ contains
       grid%nx = self%nx/2
       if (self%ny > 1) grid%ny = self%ny/2
    end function coarse
-end module lc_grid
+end module lc_base_grid

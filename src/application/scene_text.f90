@@ -4,15 +4,15 @@
 !> the scene's default. What a solve returns is described by name, with the names of the
 !> result file (lc_io_hdf5): /results attributes, /fields, /spots or /patches datasets,
 !> /convergence/residual, and the same under companion/ for the frictionless companion.
-module lc_scene_text
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, code_internal
-   use lc_strings, only: to_string
+module lc_application_scene_text
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, code_internal
+   use lc_base_strings, only: to_string
    use lc_scene, only: scene_type, profile_spec, companion_of, is_areal, material_of, not_set, grid_of, &
       & kernel_of, default_rms_gradient
    use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_io_namelist, only: read_scene_text
-   use lc_scene_solve, only: solve_scene
+   use lc_application_scene_solve, only: solve_scene
    use lc_profiles_profile, only: make_profile
    use lc_greens_viscoelastic, only: material_law, max_prony_terms
    use lc_greens_kernel, only: layer_kernel
@@ -278,4 +278,4 @@ contains
       write (buffer, real_format) x
       text = trim(adjustl(buffer))
    end function real_text
-end module lc_scene_text
+end module lc_application_scene_text

@@ -20,14 +20,14 @@
 !> surface and on a second one. On a surface the rule leaves out the largest tension: its
 !> grid value converges more slowly (the trailing-edge cusp is resolved sub-grid on lines
 !> only; docs/accuracy.md), so it is reported, not targeted.
-module lc_accuracy
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, input_error, code_input
-   use lc_strings, only: to_string
+module lc_application_accuracy
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, input_error, code_input
+   use lc_base_strings, only: to_string
    use lc_scene, only: scene_type, not_set, is_areal
    use lc_result, only: contact_result
    use lc_profiles_profile, only: make_profile
-   use lc_scene_solve, only: solve_scene
+   use lc_application_scene_solve, only: solve_scene
    implicit none (type, external)
    private
    public :: choose_resolution
@@ -177,4 +177,4 @@ contains
       n = ppw*ceiling(wavelengths)
       if (n > 0 .and. 2*nint(wavelengths) >= n) n = 2*nint(wavelengths) + 1
    end function grid_points
-end module lc_accuracy
+end module lc_application_accuracy

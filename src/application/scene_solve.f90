@@ -1,9 +1,9 @@
 !> One solve of a scene and its observables: the contact solve (lc_contact_solve), then
 !> what the scene asks to be computed from the solution (lc_observables). The executable,
 !> the Python driver and the resolution pilot all solve through it.
-module lc_scene_solve
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type
+module lc_application_scene_solve
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type
    use lc_scene, only: scene_type
    use lc_result, only: contact_result
    use lc_contact_operator, only: compliance_operator
@@ -30,4 +30,4 @@ contains
       call observe(scene, op, height, result)
    end subroutine solve_scene
 
-end module lc_scene_solve
+end module lc_application_scene_solve

@@ -1,7 +1,7 @@
 !> Text helpers: numbers as text for messages (one `to_string` for every kind the code
 !> prints) and ASCII lower case.
-module lc_strings
-   use lc_kinds, only: wp
+module lc_base_strings
+   use lc_base_kinds, only: wp
    use, intrinsic :: iso_fortran_env, only: int32, int64
    implicit none (type, external)
    private
@@ -56,4 +56,4 @@ contains
          if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') low(i:i) = achar(iachar(text(i:i)) + 32)
       end do
    end function lower_case
-end module lc_strings
+end module lc_base_strings

@@ -4,22 +4,22 @@
 !> Order matters for "bad input loses nothing": the input is read and validated and the
 !> output checked (an existing result is never overwritten unless &output overwrite) before
 !> anything is computed; the result file appears only when it is complete.
-module lc_run
+module lc_application_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type
+   use lc_base_kinds, only: wp, i8
+   use lc_base_errors, only: error_type
    use lc_scene, only: scene_type, not_set, is_areal, check_scene, grid_of, companion_of
-   use lc_grid, only: grid_type
+   use lc_base_grid, only: grid_type
    use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
    use lc_profiles_profile, only: make_profile
    use lc_profiles_measured, only: measured_grid
-   use lc_scene_solve, only: solve_scene
+   use lc_application_scene_solve, only: solve_scene
    use lc_greens_viscoelastic, only: is_viscoelastic
-   use lc_accuracy, only: choose_resolution
-   use lc_version, only: version_string, build_isa
+   use lc_application_accuracy, only: choose_resolution
+   use lc_base_version, only: version_string, build_isa
    implicit none (type, external)
    private
    public :: run_scene_file
@@ -214,4 +214,4 @@ contains
       end if
       write (unit, '(2x, a, t34, a)') 'result file', output_file
    end subroutine print_summary
-end module lc_run
+end module lc_application_run
