@@ -8,15 +8,13 @@ module lc_application_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type
-   use lc_scene, only: scene_type, not_set, is_areal, check_scene, grid_of, companion_of
-   use lc_base_grid, only: grid_type
-   use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
+   use lc_scene, only: scene_type, not_set, is_areal, check_scene
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
    use lc_profiles_profile, only: make_profile
    use lc_profiles_measured, only: measured_grid
-   use lc_application_scene_solve, only: solve_scene
+   use lc_application_scene_solve, only: solve_runs
    use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_application_accuracy, only: choose_resolution
    use lc_base_version, only: version_string, build_isa
@@ -74,27 +72,15 @@ contains
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
 
-      call solve_scene(scene, height, scene%friction, result, error)
+      call solve_runs(scene, height, result, companion, error)
       if (allocated(error)) return
       converged = result%converged
-      if (scene%leakage) then
-         call leakage_of(scene, result, error)
-         if (allocated(error)) return
-      end if
+      if (scene%companion) converged = converged .and. companion%converged
+      call system_clock(finish)
+      run%seconds = real(finish - start, wp)/real(rate, wp)
       if (scene%companion) then
-         call solve_scene(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
-         if (allocated(error)) return
-         if (scene%leakage) then
-            call leakage_of(scene, companion, error)
-            if (allocated(error)) return
-         end if
-         converged = converged .and. companion%converged
-         call system_clock(finish)
-         run%seconds = real(finish - start, wp)/real(rate, wp)
          call write_results(output_file, scene, text, height, result, companion, version_string, error, run)
       else
-         call system_clock(finish)
-         run%seconds = real(finish - start, wp)/real(rate, wp)
          call write_results(output_file, scene, text, height, result, version=version_string, error=error, run=run)
       end if
       if (allocated(error)) return
@@ -106,19 +92,6 @@ contains
          end if
       end if
    end subroutine run_scene_file
-
-   !> The Reynolds leakage of the solved gap along x and y; contact is where p > 0 (and gaps
-   !> at the rounding of a converged solve, lc_leakage_reynolds).
-   subroutine leakage_of(scene, result, error)
-      type(scene_type), intent(in) :: scene
-      type(contact_result), intent(inout) :: result
-      type(error_type), allocatable, intent(out) :: error
-      type(grid_type) :: grid
-      grid = grid_of(scene)
-      allocate (result%leakage)
-      call reynolds_leakage(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
-         & scene%leakage_tol, leakage_max_iter, result%leakage, error)
-   end subroutine leakage_of
 
    !> The largest |dw/dx| of the surface displacement along the sliding direction.
    pure real(wp) function largest_slope(w, scene) result(slope)

@@ -1,17 +1,20 @@
-!> One solve of a scene and its observables: the contact solve (lc_contact_solve), then
-!> what the scene asks to be computed from the solution (lc_observables). The executable,
-!> the Python driver and the resolution pilot all solve through it.
+!> The solves of a scene and what is computed from them: the contact solve
+!> (lc_contact_solve), the observables the scene asks for (lc_observables), the Reynolds
+!> leakage of the gap (lc_leakage_reynolds), and the frictionless companion. The
+!> executable's run, the Python driver and the resolution pilot all solve through it.
 module lc_application_scene_solve
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
-   use lc_scene, only: scene_type
+   use lc_scene, only: scene_type, grid_of, companion_of
+   use lc_base_grid, only: grid_type
+   use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
    use lc_result, only: contact_result
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solve, only: solve_contact
    use lc_observables, only: observe
    implicit none (type, external)
    private
-   public :: solve_scene
+   public :: solve_scene, solve_runs
 
 contains
 
@@ -29,5 +32,40 @@ contains
       if (allocated(error)) return
       call observe(scene, op, height, result)
    end subroutine solve_scene
+
+   !> The runs the scene asks for: the scene with its Coulomb coefficient and, with
+   !> &friction companion, its frictionless companion at the mean pressure the first found
+   !> (`companion` is left as it is otherwise); each with its observables and, with &output
+   !> leakage, the Reynolds leakage of its gap.
+   subroutine solve_runs(scene, height, result, companion, error)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in), target :: height(:)
+      type(contact_result), intent(out) :: result
+      type(contact_result), intent(inout) :: companion
+      type(error_type), allocatable, intent(out) :: error
+      call solve_scene(scene, height, scene%friction, result, error)
+      if (allocated(error)) return
+      if (scene%leakage) then
+         call leakage_of(scene, result, error)
+         if (allocated(error)) return
+      end if
+      if (.not. scene%companion) return
+      call solve_scene(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
+      if (allocated(error)) return
+      if (scene%leakage) call leakage_of(scene, companion, error)
+   end subroutine solve_runs
+
+   !> The Reynolds leakage of the solved gap along x and y; contact is where p > 0 (and gaps
+   !> at the rounding of a converged solve, lc_leakage_reynolds).
+   subroutine leakage_of(scene, result, error)
+      type(scene_type), intent(in) :: scene
+      type(contact_result), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(grid_type) :: grid
+      grid = grid_of(scene)
+      allocate (result%leakage)
+      call reynolds_leakage(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
+         & scene%leakage_tol, leakage_max_iter, result%leakage, error)
+   end subroutine leakage_of
 
 end module lc_application_scene_solve

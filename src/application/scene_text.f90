@@ -8,11 +8,11 @@ module lc_application_scene_text
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_base_strings, only: to_string
-   use lc_scene, only: scene_type, profile_spec, companion_of, is_areal, material_of, not_set, grid_of, &
+   use lc_scene, only: scene_type, profile_spec, is_areal, material_of, not_set, grid_of, &
       & kernel_of, default_rms_gradient
    use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_io_namelist, only: read_scene_text
-   use lc_application_scene_solve, only: solve_scene
+   use lc_application_scene_solve, only: solve_runs
    use lc_profiles_profile, only: make_profile
    use lc_greens_viscoelastic, only: material_law, max_prony_terms
    use lc_greens_kernel, only: layer_kernel
@@ -68,14 +68,12 @@ contains
       scene%profile%kind = 'file'
       scene%profile%file = '(heights given as an array)'
       scene%gap_bins = 0
-      call solve_scene(scene, height, scene%friction, result, error)
+      call solve_runs(scene, height, result, companion, error)
       if (allocated(error)) return
       ! the cell, as /input of a result file has it (period_y resolved)
       description = 'input/period = ' // real_text(scene%period) // newline // 'input/period_y = ' // &
          & real_text(merge(scene%period_y, scene%period, scene%period_y /= not_set)) // newline
       if (scene%companion) then
-         call solve_scene(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
-         if (allocated(error)) return
          call describe_run(result, is_areal(scene), '', fields(:, :, 1), spots(:, :, 1), history(:, 1), &
             & description, result%contact_fraction/companion%contact_fraction)
          call describe_run(companion, is_areal(scene), 'companion/', fields(:, :, 2), spots(:, :, 2), &
