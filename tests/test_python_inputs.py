@@ -29,13 +29,20 @@ def test_prepare_heights_refuses_what_is_not_real_heights(heights, word):
     assert err.value.code == 2 and isinstance(err.value, ValueError) and "height" in str(err.value)
 
 
-@pytest.mark.parametrize("n", [16.7, True, "16", -8, 2])
+@pytest.mark.parametrize("n", [16.7, True, "16"])
 def test_a_generator_refuses_a_grid_that_is_not_an_integer_of_points(n):
-    with refused("allowed: an integer >= 4") as err:
+    with refused("allowed: an integer number of points") as err:
         lc.self_affine_surface(n)
     assert err.value.code == 2
-    with refused("allowed: an integer >= 4"):
+    with refused("allowed: an integer number of points"):
         lc.self_affine_profile(n)
+
+
+@pytest.mark.parametrize("n", [-8, 2])
+def test_the_library_checks_the_range_of_an_integer_grid(n):
+    with pytest.raises(lc.LayercontactError, match="&scene: ") as err:
+        lc.self_affine_surface(n)
+    assert err.value.code == 2
 
 
 def test_a_whole_float_is_a_number_of_points():

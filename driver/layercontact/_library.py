@@ -82,16 +82,13 @@ def _input_error(name: str, value, allowed: str) -> InputError:
     return InputError(f"{name} = {value!r} is not allowed; allowed: {allowed}", 2)
 
 
-def grid_points(value, name: str, *, smallest: int = 4) -> int:
-    """A number of grid points given in Python: an integer (not a bool, not 16.7) from
-    ``smallest`` on, else :class:`InputError` naming it."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        if not (isinstance(value, (float, np.floating)) and float(value).is_integer()):
-            raise _input_error(name, value, f"an integer >= {smallest}")
-    points = int(value)
-    if points < smallest:
-        raise _input_error(name, value, f"an integer >= {smallest}")
-    return points
+def grid_points(value, name: str) -> int:
+    """A number of grid points given in Python: an integer (not a bool, not 16.7; 16.0 is
+    16), else :class:`InputError` naming it. Its range is the library's to check."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer, float, np.floating)) \
+            or not float(value).is_integer():
+        raise _input_error(name, value, "an integer number of points")
+    return int(value)
 
 
 def grid_size(nx: int, ny: int) -> None:
