@@ -7,7 +7,8 @@
 module lc_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_kinds, only: wp, i8
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, fatal_error, code_input
+   use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
    use lc_scene, only: scene_type, not_set, is_areal, check_scene, grid_of, companion_of
    use lc_grid, only: grid_type
    use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
@@ -44,6 +45,8 @@ contains
       call system_clock(start, rate)
       run%input_file = input
       run%started = utc_now()
+      call check_input_file(input, error)
+      if (allocated(error)) return
       call read_scene(input, scene, text, error)
       if (allocated(error)) return
       output_file = trim(scene%output_file)
@@ -105,6 +108,19 @@ contains
          end if
       end if
    end subroutine run_scene_file
+
+   !> A namelist file that is there must be a regular file: a FIFO would block the read
+   !> until a writer comes (bad input, code 2; a missing file is the reader's to report).
+   subroutine check_input_file(input, error)
+      character(len=*), intent(in) :: input
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: detail
+      integer :: kind
+      call path_kind(input, kind, detail)
+      if (kind /= kind_regular .and. kind /= kind_missing .and. kind /= kind_unknown) &
+         & call fatal_error(error, "namelist file '" // input // "' is " // kind_name(kind) // &
+         & '; allowed: a regular file', code_input)
+   end subroutine check_input_file
 
    !> The Reynolds leakage of the solved gap along x and y; contact is where p > 0 (and gaps
    !> at the rounding of a converged solve, lc_leakage_reynolds).

@@ -5,6 +5,7 @@ file; its messages become exceptions; results come back by name as plain datacla
 from __future__ import annotations
 
 import os
+import stat as _stat
 from dataclasses import dataclass, field
 from dataclasses import fields as dataclass_fields
 
@@ -48,6 +49,23 @@ def _check(stat: int, errmsg: bytes | str) -> None:
     if stat != 0:
         text = errmsg.decode() if isinstance(errmsg, bytes) else str(errmsg)
         raise (InputError if int(stat) == 2 else LayercontactError)(text.strip(), int(stat))
+
+
+def regular_file(filename: str | os.PathLike, what: str) -> str:
+    """``filename`` as a string, refused (:class:`InputError`, code 2) when it names
+    something other than a regular file: a FIFO would block the read until a writer comes,
+    a directory or a device holds no input. A missing file passes (its reader says so)."""
+    path = os.fspath(filename)
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return path
+    if not _stat.S_ISREG(mode):
+        kind = ("a directory" if _stat.S_ISDIR(mode) else "a FIFO (named pipe)" if _stat.S_ISFIFO(mode)
+                else "a device" if _stat.S_ISCHR(mode) or _stat.S_ISBLK(mode)
+                else "a socket" if _stat.S_ISSOCK(mode) else "not a regular file")
+        raise InputError(f"{what} '{path}' is {kind}; allowed: a regular file", 2)
+    return path
 
 
 def _namelist_value(value) -> str:
@@ -633,16 +651,16 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
 def check_scene_file(filename: str | os.PathLike) -> None:
     """Read and validate a namelist file without solving; raises :class:`LayercontactError`
     with the message the executable would print."""
-    stat, errmsg = _core.py_check_scene_file(os.fspath(filename))
-    _check(stat, errmsg)
+    code, errmsg = _core.py_check_scene_file(regular_file(filename, "namelist file"))
+    _check(code, errmsg)
 
 
 def choose_resolution(filename: str | os.PathLike) -> tuple[int | tuple[int, int], float]:
     """The grid and tolerance ``tol`` that a scene file with ``&solver target_error`` will be
     solved with (the accuracy rule of docs/accuracy.md; runs the pilot solve, writes
     nothing): ``(n, tol)`` for a line, ``((nx, ny), tol)`` for an areal scene."""
-    n, ny, tol, stat, errmsg = _core.py_choose_resolution(os.fspath(filename))
-    _check(stat, errmsg)
+    n, ny, tol, code, errmsg = _core.py_choose_resolution(regular_file(filename, "namelist file"))
+    _check(code, errmsg)
     return (int(n) if ny == 1 else (int(n), int(ny))), float(tol)
 
 
@@ -656,6 +674,6 @@ def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult | Area
 def run_to_file(filename: str | os.PathLike, verbose: bool = False) -> str:
     """Run a namelist file like :func:`run`, without reading the result back; returns the
     result file's path (for sweeps, which read only the scalars they tabulate)."""
-    out, converged, stat, errmsg = _core.py_run(os.fspath(filename), 1 if verbose else 0)
-    _check(stat, errmsg)
+    out, converged, code, errmsg = _core.py_run(regular_file(filename, "namelist file"), 1 if verbose else 0)
+    _check(code, errmsg)
     return out.decode().strip() if isinstance(out, bytes) else str(out).strip()
