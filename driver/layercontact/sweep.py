@@ -52,7 +52,7 @@ import numpy as np
 
 from . import provenance
 from .api import LayercontactError, check_scene_file, run_to_file
-from .slurm import SWEEP_VARIABLES, options_from_sweep
+from .slurm import CONTROL_CHARACTERS, NO_CONTROL, SWEEP_VARIABLES, options_from_sweep
 
 SWEEP_GROUP = "sweep"
 SUMMARY_GROUP = "summary"
@@ -206,8 +206,10 @@ def _positive_int(source: Path, variable: str, raw: object) -> int:
 
 
 def _name_setting(source: Path, variable: str, raw: object) -> str:
-    if not isinstance(raw, str) or not raw.strip():
-        raise _sweep_error(source, variable, f"{raw!r} is not allowed; allowed: a non-empty string")
+    # a control character (a value spanning two lines) would reach file names, scene files
+    # and a Slurm job script
+    if not isinstance(raw, str) or not raw.strip() or CONTROL_CHARACTERS.search(raw):
+        raise _sweep_error(source, variable, f"{raw!r} is not allowed; allowed: a non-empty string, {NO_CONTROL}")
     return raw.strip()
 
 
