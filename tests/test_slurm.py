@@ -640,3 +640,37 @@ def test_the_test_slurm_refuses_a_directory_it_would_write_into_its_configuratio
     assert "is not allowed; allowed: letters, digits and . _ / + -" in done.stderr
     assert not Path(directory).exists() and not list(tmp_path.iterdir())
 
+
+def test_a_task_removes_only_temporary_files_of_ended_runs_of_its_host(tmp_path, monkeypatch):
+    """Before a scene runs, its task removes STEM.h5.HOST.PID.tmp only where HOST is this
+    one and PID has ended (and STEM.h5.tmp of earlier versions); another run's file in
+    flight, here or elsewhere, is left alone."""
+    import socket
+
+    monkeypatch.chdir(tmp_path)
+    path = write_sweep(tmp_path)
+    assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 0
+    results = tmp_path / "out/s/results"
+    results.mkdir(parents=True)
+    ended = subprocess.Popen(["true"])
+    ended.wait()
+    alive = subprocess.Popen(["sleep", "60"])
+    host = socket.gethostname()
+    files = {
+        "ended": results / f"s_0000.h5.{host}.{ended.pid}.tmp",
+        "earlier version": results / "s_0000.h5.tmp",
+        "alive here": results / f"s_0000.h5.{host}.{alive.pid}.tmp",
+        "elsewhere": results / f"s_0000.h5.other-node.{ended.pid}.tmp",
+    }
+    for file in files.values():
+        file.write_bytes(b"partial")
+    try:
+        task = run_task(tmp_path / "out/s/slurm/s_001.sbatch", 0)
+        output, _ = task.communicate(timeout=120)
+    finally:
+        alive.kill()
+        alive.wait()
+    assert task.returncode == 0, output
+    assert not files["ended"].exists() and not files["earlier version"].exists()
+    assert files["alive here"].read_bytes() == b"partial" and files["elsewhere"].read_bytes() == b"partial"
+    assert (results / "s_0000.h5").is_file()

@@ -543,8 +543,19 @@ for scene in "${{scenes[@]}}"; do
   start_ms=$REPLY
   current=$scene code=""
   write_record "$scene" running "" "$started" "" ""
-  # temporary result files that a killed run of this scene left (this task alone runs it)
-  rm -f "$sweep_directory/results/$scene".h5.*tmp
+  # temporary result files (STEM.h5.HOST.PID.tmp) that killed runs of this scene on this
+  # host left, and those of earlier versions (STEM.h5.tmp); a run still writing one, here or
+  # on another host, keeps its file
+  for left in "$sweep_directory/results/$scene".h5.*tmp; do
+    [ -e "$left" ] || continue
+    writer=${{left#"$sweep_directory/results/$scene.h5."}}
+    writer=${{writer%.tmp}}
+    pid=${{writer##*.}}
+    if [[ $writer != *.* || ! $pid =~ ^[0-9]+$ ]] \
+      || {{ [ "${{writer%.*}}" = "$HOSTNAME" ] && ! kill -0 "$pid" 2>/dev/null; }}; then
+      rm -f "$left"
+    fi
+  done
   # in the background, so that the trap runs at once when a signal arrives
   "$executable" "$sweep_directory/scenes/$scene.nml" >"$sweep_directory/{logs}/$scene.log" 2>&1 &
   child=$!

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import copy
 import csv
+import fcntl
 import io
 import itertools
 import json
@@ -39,6 +40,7 @@ import signal
 import threading
 import multiprocessing
 import os
+import socket
 import sys
 import time
 from collections.abc import Iterator
@@ -510,17 +512,70 @@ def _failure(message: str) -> dict[str, object]:
 
 
 def temporary_results(results: Path, stem: str) -> list[Path]:
-    """The temporary files of a scene's result that a killed write left behind: the
-    program writes ``STEM.h5.HOST.PID.tmp`` and moves it to ``STEM.h5`` when complete."""
+    """The temporary files of a scene's result: the program writes ``STEM.h5.HOST.PID.tmp``
+    and moves it to ``STEM.h5`` when complete."""
     return [p for p in results.glob(f"{stem}.h5.*tmp") if p.name.endswith(".tmp")]
+
+
+def _writer_is_gone(path: Path, stem: str) -> bool:
+    """True if the temporary result ``STEM.h5.HOST.PID.tmp`` was left by a run of this host
+    that has ended (killed while writing), or has a name no run writes now (``STEM.h5.tmp``
+    of earlier versions); a run elsewhere, or still alive, may be writing it."""
+    writer = path.name[len(f"{stem}.h5.") :].removesuffix(".tmp")
+    host, _, pid = writer.rpartition(".")
+    if not host or not pid.isdigit():
+        return True
+    if host != socket.gethostname():
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return True
+    except PermissionError:  # another user's process: alive
+        return False
+    return False
+
+
+def stale_temporary_results(results: Path, stem: str) -> list[Path]:
+    """The temporary files of a scene's result that killed runs of this host left (those of
+    runs still writing, here or on another host, are not stale)."""
+    return [p for p in temporary_results(results, stem) if _writer_is_gone(p, stem)]
+
+
+@contextmanager
+def _scene_lock(record_file: Path) -> Iterator[None]:
+    """Hold ``runs/.STEM.lock`` while the scene runs: two sweeps of one directory run a
+    scene one after the other (the second finds its result), never at once."""
+    lock_file = record_file.with_name(f".{record_file.stem}.lock")
+    lock_file.parent.mkdir(parents=True, exist_ok=True)
+    with open(lock_file, "a") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+        except OSError:  # a parallel file system mounted without locks: go on unlocked
+            yield
+            return
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def _solve(scene_file: str, result_file: str, record_file: str) -> dict[str, object]:
     """Worker: run one scene file, return its result columns (or its error); its run
-    record says it is running, then how it ended. Temporary files that a killed run of
-    the same scene left are removed first (the sweep runs each scene once at a time)."""
-    for left in temporary_results(Path(result_file).parent, Path(scene_file).stem):
-        left.unlink(missing_ok=True)
+    record says it is running, then how it ended. The scene's lock is held throughout: a
+    scene that another sweep of the same directory completed meanwhile is not run again,
+    and only temporary files of killed runs of this host are removed first (another
+    sweep's write in flight is left alone)."""
+    with _scene_lock(Path(record_file)):
+        if result_matches(Path(result_file), Path(scene_file).read_text()):
+            return _outcome(_result_columns(Path(result_file)))
+        for left in stale_temporary_results(Path(result_file).parent, Path(scene_file).stem):
+            left.unlink(missing_ok=True)
+        return _run_scene(scene_file, result_file, record_file)
+
+
+def _run_scene(scene_file: str, result_file: str, record_file: str) -> dict[str, object]:
+    """Run one scene file with its run record (see :func:`_solve`)."""
     record = provenance.start_record(Path(scene_file).stem)
     provenance.write_record(Path(record_file), record)
     start = time.monotonic()
