@@ -332,6 +332,7 @@ def test_workers_end_when_the_sweep_process_is_killed(tmp_path):
     left = [pid for pid in tree if Path(f"/proc/{pid}").exists()]
     assert not left, [Path(f"/proc/{pid}/cmdline").read_bytes()[:80] for pid in left]
 
+
 def test_two_concurrent_sweeps_of_one_directory_report_every_scene_converged(tmp_path):
     """Two sweeps of the same file and directory at once (two workers each): a scene runs
     under its lock, so the second sweep to reach it waits and finds its result; neither
@@ -389,3 +390,42 @@ def test_a_worker_removes_only_temporary_files_of_ended_runs_of_its_host(tmp_pat
     assert files["alive here"].read_bytes() == b"partial" and files["elsewhere"].read_bytes() == b"partial"
     assert lc.read_result(scene.result_file).converged
 
+
+def test_a_sweep_beyond_the_scene_limit_is_refused_before_anything_is_planned(tmp_path, monkeypatch, capsys):
+    """1.7 million scenes are counted, not planned: refused at once (exit 2) with the count,
+    the lists and how to allow more; max_scenes (or --max-scenes) raises the limit."""
+    import time
+
+    monkeypatch.chdir(tmp_path)
+    many = ", ".join(str(0.01 * k) for k in range(1, 101))
+    path = write_sweep(tmp_path, lists=f"friction = {many}\n thickness = {many}\n realisations = 170\n")
+    start = time.monotonic()
+    assert main(["sweep", str(path), "--no-progress"]) == 2
+    assert time.monotonic() - start < 10
+    err = capsys.readouterr().err
+    assert "&sweep: the lists give 1700000 scenes (100 friction x 100 thickness x 170 seed), more than 20000" in err
+    assert "allowed: at most 20000 scenes, or more with &sweep max_scenes = N (or --max-scenes N)" in err
+    assert not (tmp_path / "out").exists()
+    assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 2
+    assert "1700000 scenes" in capsys.readouterr().err and not (tmp_path / "out").exists()
+    # a lower limit from the command line or the file; a higher one lets the sweep through
+    small = write_sweep(tmp_path, lists="seed = 1, 2, 3\n", name="small")
+    assert main(["sweep", str(small), "--dry-run", "--max-scenes", "2"]) == 2
+    assert "the lists give 3 scenes (3 seed), more than 2" in capsys.readouterr().err
+    small.write_text(small.read_text().replace("processes = 2", "processes = 2\n max_scenes = 2"))
+    with pytest.raises(ValueError, match="the lists give 3 scenes"):
+        lc.sweep(small, dry_run=True)
+    assert len(lc.sweep(small, dry_run=True, max_scenes=3)) == 3
+    assert main(["sweep", str(small), "--dry-run", "--max-scenes", "0"]) == 2
+    assert "--max-scenes: 0 is not allowed; allowed: an integer >= 1" in capsys.readouterr().err
+
+
+def test_a_fifo_given_as_the_sweep_file_is_refused_at_once(tmp_path):
+    import subprocess
+
+    fifo = tmp_path / "s.nml"
+    os.mkfifo(fifo)
+    done = subprocess.run([sys.executable, "-m", "layercontact", "sweep", str(fifo)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert f"sweep file '{fifo}' is a FIFO (named pipe); allowed: a regular file" in done.stderr

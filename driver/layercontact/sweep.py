@@ -14,6 +14,7 @@ A sweep file holds the usual groups (``&scene &layer &material &friction &profil
        speed = 0.01, 0.1, 1              ! -> &material speed (viscoelastic layers)
        seed = 1, 2, 3                    ! -> &profile seed (or realisations = N: 1..N)
        processes = 2                     ! worker processes (default: the CPUs allocated)
+       max_scenes = 50000                ! the most scenes allowed (default: MAX_SCENES, 20000)
        slurm_time = '0:30:00'            ! slurm_*: options of a Slurm job array
     /                                    ! (layercontact.slurm, docs/clusters.md)
 
@@ -36,6 +37,7 @@ import fcntl
 import io
 import itertools
 import json
+import math
 import signal
 import threading
 import multiprocessing
@@ -53,12 +55,17 @@ import f90nml
 import numpy as np
 
 from . import provenance
-from .api import LayercontactError, check_scene_file, run_to_file
+from .api import LayercontactError, check_scene_file, regular_file, run_to_file
 from .slurm import CONTROL_CHARACTERS, NO_CONTROL, SWEEP_VARIABLES, options_from_sweep
 
 SWEEP_GROUP = "sweep"
 SUMMARY_GROUP = "summary"
-_SETTINGS = ("name", "directory", "realisations", "processes")
+_SETTINGS = ("name", "directory", "realisations", "processes", "max_scenes")
+#: The most scenes a sweep may have unless ``&sweep max_scenes`` (or ``--max-scenes``)
+#: allows more: writing and checking a scene takes about 5 ms and planning holds about
+#: 1.3 kB per scene (so 20000 scenes take under two minutes before the first one runs), and
+#: each scene leaves a scene file and a result (docs/sweeps.md).
+MAX_SCENES = 20000
 #: Format of ``NAME_sweep.json`` (raised when its meaning changes).
 PLAN_RECORD_FORMAT = 1
 _PRESSURES = ("mean_pressure", "normalised_pressure")
@@ -146,6 +153,12 @@ class SweepPlan:
     values: dict[str, list]
     processes: int | None
     slurm: dict[str, object] | None = None
+    max_scenes: int = MAX_SCENES
+
+    @property
+    def scene_count(self) -> int:
+        """The number of scenes: the product of the lists' lengths (1 without lists)."""
+        return math.prod(len(values) for values in self.values.values())
 
     def plan_record_file(self) -> Path:
         """``DIRECTORY/NAME_sweep.json``: the scenes, for ``status`` and ``collect``."""
@@ -272,14 +285,17 @@ def _swept_values(source: Path, group: f90nml.Namelist) -> dict[str, list]:
     return values
 
 
-def read_sweep(path: str | os.PathLike) -> SweepPlan:
+def read_sweep(path: str | os.PathLike, max_scenes: int | None = None) -> SweepPlan:
     """Read and check a sweep file (the &sweep group only; the scenes are checked by the
-    library once written).
+    library once written). The number of scenes is counted first: beyond the limit the
+    sweep is refused before anything is planned.
 
     Parameters
     ----------
     path : str or os.PathLike
         The sweep namelist file.
+    max_scenes : int, optional
+        The most scenes allowed; default: ``&sweep max_scenes``, else :data:`MAX_SCENES`.
 
     Returns
     -------
@@ -288,9 +304,10 @@ def read_sweep(path: str | os.PathLike) -> SweepPlan:
     Raises
     ------
     ValueError
-        For a missing &sweep group or a bad &sweep variable (named in the message).
+        For a missing &sweep group, a bad &sweep variable (named in the message) or more
+        scenes than allowed.
     """
-    source = Path(path)
+    source = Path(regular_file(path, "sweep file"))
     nml = _read_namelist(source)
     if SWEEP_GROUP not in nml:
         raise ValueError(f"{source}: no &sweep group (a sweep file is a scene plus a &sweep group)")
@@ -306,7 +323,29 @@ def read_sweep(path: str | os.PathLike) -> SweepPlan:
     directory = _name_setting(source, "directory", group.get("directory", f"out/{name}"))
     processes = _positive_int(source, "processes", group["processes"]) if "processes" in group else None
     slurm = options_from_sweep(source, {var: group[var] for var in SWEEP_VARIABLES if var in group})
-    return SweepPlan(source, name, Path(directory), nml, _swept_values(source, group), processes, slurm)
+    if max_scenes is None:
+        limit = _positive_int(source, "max_scenes", group["max_scenes"]) if "max_scenes" in group else MAX_SCENES
+    elif isinstance(max_scenes, bool) or not isinstance(max_scenes, int) or max_scenes < 1:
+        raise ValueError(f"--max-scenes: {max_scenes!r} is not allowed; allowed: an integer >= 1")
+    else:
+        limit = max_scenes
+    plan = SweepPlan(source, name, Path(directory), nml, _swept_values(source, group), processes, slurm, limit)
+    check_scene_count(plan)
+    return plan
+
+
+def check_scene_count(plan: SweepPlan) -> None:
+    """Refuse a sweep with more scenes than ``plan.max_scenes`` (ValueError naming the
+    count, the lists and how to allow more); nothing is planned before this."""
+    if plan.scene_count <= plan.max_scenes:
+        return
+    lists = " x ".join(f"{len(values)} {name}" for name, values in plan.values.items())
+    raise ValueError(
+        f"{plan.source}: &sweep: the lists give {plan.scene_count} scenes ({lists}), more than "
+        f"{plan.max_scenes}; allowed: at most {plan.max_scenes} scenes, or more with &sweep max_scenes = N "
+        "(or --max-scenes N); each scene takes about 5 ms to write and check before any runs, and "
+        "leaves a scene file and a result file"
+    )
 
 
 # ---------------------------------------------------------------------------------------
@@ -333,8 +372,23 @@ def _scene_text(plan: SweepPlan, index: int, values: dict, result_file: Path) ->
     return out.getvalue()
 
 
+def iter_scenes(plan: SweepPlan) -> Iterator[Scene]:
+    """The scenes of a sweep one at a time (the product is never held whole): the cartesian
+    product of its lists (none: the base alone), in product order (the last swept variable
+    varies fastest), numbered from 0. Refuses a sweep beyond its scene limit first
+    (:func:`check_scene_count`)."""
+    check_scene_count(plan)
+    width = max(4, len(str(plan.scene_count - 1)))
+    for index, combo in enumerate(itertools.product(*plan.values.values())):
+        values = dict(zip(plan.values, combo))
+        stem = f"{plan.name}_{index:0{width}d}"
+        scene_file = plan.directory / "scenes" / f"{stem}.nml"
+        result_file = plan.directory / "results" / f"{stem}.h5"
+        yield Scene(index, values, scene_file, result_file, _scene_text(plan, index, values, result_file))
+
+
 def plan_scenes(plan: SweepPlan) -> list[Scene]:
-    """The scenes of a sweep: the cartesian product of its lists (none: the base alone).
+    """The scenes of a sweep as a list (see :func:`iter_scenes`).
 
     Parameters
     ----------
@@ -345,17 +399,7 @@ def plan_scenes(plan: SweepPlan) -> list[Scene]:
     list of Scene
         In product order (the last swept variable varies fastest), numbered from 0.
     """
-    combos = list(itertools.product(*plan.values.values()))
-    width = max(4, len(str(len(combos) - 1)))
-    scenes = []
-    for index, combo in enumerate(combos):
-        values = dict(zip(plan.values, combo))
-        stem = f"{plan.name}_{index:0{width}d}"
-        scene_file = plan.directory / "scenes" / f"{stem}.nml"
-        result_file = plan.directory / "results" / f"{stem}.h5"
-        text = _scene_text(plan, index, values, result_file)
-        scenes.append(Scene(index, values, scene_file, result_file, text))
-    return scenes
+    return list(iter_scenes(plan))
 
 
 def _temporary(path: Path) -> Path:
@@ -412,10 +456,10 @@ def write_scenes(plan: SweepPlan) -> list[Scene]:
     """
     import tempfile
 
-    scenes = plan_scenes(plan)
     with tempfile.TemporaryDirectory(prefix="layercontact-sweep-") as scratch:
-        for scene in scenes:
+        for scene in iter_scenes(plan):
             _check_scene(plan, scene, Path(scratch))
+    scenes = plan_scenes(plan)
     for scene in scenes:
         _write_scene(scene)
     return scenes
@@ -755,7 +799,7 @@ def summary_row(planned: dict[str, object], outcome: dict[str, object],
 
 
 def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool = True,
-          dry_run: bool = False) -> list[dict[str, object]]:
+          dry_run: bool = False, max_scenes: int | None = None) -> list[dict[str, object]]:
     """Run a parameter sweep file (a scene plus a ``&sweep`` group).
 
     Every scene is written to ``DIRECTORY/scenes/NAME_XXXX.nml`` and checked by the
@@ -776,6 +820,9 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     dry_run : bool
         Only write and check the scenes; return the planned rows (swept values and file
         names), solve nothing, write no summary.
+    max_scenes : int, optional
+        The most scenes allowed (default: ``&sweep max_scenes``, else
+        :data:`MAX_SCENES`); a sweep with more is refused before anything is planned.
 
     Returns
     -------
@@ -791,11 +838,12 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     Raises
     ------
     ValueError
-        A bad ``&sweep`` group (the message names the variable).
+        A bad ``&sweep`` group (the message names the variable), or more scenes than
+        allowed.
     LayercontactError
         A scene the library refuses (the message names the scene file and the variable).
     """
-    return execute(read_sweep(path), processes=processes, progress=progress, dry_run=dry_run)
+    return execute(read_sweep(path, max_scenes), processes=processes, progress=progress, dry_run=dry_run)
 
 
 def failed(rows: list[dict[str, object]]) -> list[dict[str, object]]:
