@@ -463,15 +463,18 @@ def test_a_fifo_is_refused_at_once_and_creates_nothing(which, tmp_path):
     fifo = tmp_path / ("heights.txt" if which == "height file" else "fifo.nml")
     os.mkfifo(fifo)
     given = nml if which == "height file" else fifo
-    proc = subprocess.run([executable(), str(given)], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    proc = subprocess.run([executable(), str(given)], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=60)
     named = "&profile: file = 'heights.txt'" if which == "height file" else f"namelist file '{fifo}'"
     assert proc.returncode == 2, proc.stderr
     assert f"{named} is a FIFO (named pipe); allowed: a regular file" in proc.stderr
     # the same from Python (in a process of its own: a regression would block it, not the tests)
     script = ("import layercontact as lc\n"
               f"try:\n    lc.run({str(given)!r})\nexcept lc.InputError as err:\n    print(err.code, err)\n")
-    py = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=60)
-    assert py.stdout.startswith("2 ") and "is a FIFO (named pipe); allowed: a regular file" in py.stdout, py.stderr
+    py = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True,
+                        timeout=60)
+    assert py.stdout.startswith("2 "), py.stderr
+    assert "is a FIFO (named pipe); allowed: a regular file" in py.stdout
     assert not (tmp_path / "deep").exists()
 
 

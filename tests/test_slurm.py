@@ -566,7 +566,8 @@ REFUSED_NAMES = [
 
 
 @pytest.mark.parametrize("settings, arguments, workdir, words", REFUSED_NAMES,
-                         ids=["directory", "name", "working-directory", "setup-line", "sbatch-line", "executable"])
+                         ids=["directory", "name", "working-directory", "setup-line", "sbatch-line",
+                              "executable"])
 def test_a_control_character_in_a_name_is_refused_before_anything_is_written(
     settings, arguments, workdir, words, tmp_path, monkeypatch, capsys
 ):
@@ -593,7 +594,8 @@ def test_spaces_quotes_and_substitutions_in_paths_stay_paths(tmp_path, monkeypat
     work.mkdir()
     monkeypatch.chdir(work)
     path = work / "s.nml"
-    path.write_text(BASE + f"&sweep\n directory = 'out/{ODD_DIRECTORY.replace(chr(39), chr(39) * 2)}'\n{LISTS}/\n")
+    quoted = ODD_DIRECTORY.replace("'", "''")
+    path.write_text(BASE + f"&sweep\n directory = 'out/{quoted}'\n{LISTS}/\n")
     assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 0
     out = work / "out" / ODD_DIRECTORY
     script = out / "slurm/s_001.sbatch"
@@ -634,8 +636,8 @@ def test_the_test_slurm_refuses_a_directory_it_would_write_into_its_configuratio
     """tools/local_slurm.sh puts DIR in slurm.conf and the daemons' command lines: anything
     but a plain path is refused (exit 2) before anything is written or run."""
     script = Path(__file__).resolve().parents[1] / "tools" / "local_slurm.sh"
-    done = subprocess.run(["bash", str(script), "start", directory], cwd=tmp_path, capture_output=True, text=True,
-                          timeout=60)
+    done = subprocess.run(["bash", str(script), "start", directory], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=60)
     assert done.returncode == 2
     assert "is not allowed; allowed: letters, digits and . _ / + -" in done.stderr
     assert not Path(directory).exists() and not list(tmp_path.iterdir())

@@ -343,14 +343,17 @@ def test_two_concurrent_sweeps_of_one_directory_report_every_scene_converged(tmp
     path = write_sweep(tmp_path, lists="seed = " + ", ".join(map(str, range(1, 13))) + "\n",
                        base=BASE.replace("n = 256", "n = 65536"))
     command = [sys.executable, "-m", "layercontact", "sweep", str(path), "--no-progress"]
-    sweeps = [subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-              for _ in range(2)]
+    sweeps = [
+        subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        for _ in range(2)
+    ]
     for proc in sweeps:
         out, err = proc.communicate(timeout=600)
         assert proc.returncode == 0, (out, err)
         assert "12 scenes, 0 failed" in out
     summary = lc.read_summary(tmp_path / "out/s/s_summary.csv")
-    assert len(summary["error"]) == 12 and (summary["error"] == "").all() and (summary["converged"] == 1).all()
+    assert len(summary["error"]) == 12
+    assert (summary["error"] == "").all() and (summary["converged"] == 1).all()
     for result in (tmp_path / "out/s/results").glob("*.h5"):
         assert lc.read_result(result).converged
     assert not [p for p in (tmp_path / "out/s").rglob("*") if p.name.endswith(".tmp")]
@@ -382,7 +385,8 @@ def test_a_worker_removes_only_temporary_files_of_ended_runs_of_its_host(tmp_pat
     for file in files.values():
         file.write_bytes(b"partial")
     try:
-        sweep_module._solve(str(scene.scene_file), str(scene.result_file), str(sweep_module._record_file(scene)))
+        record_file = sweep_module._record_file(scene)
+        sweep_module._solve(str(scene.scene_file), str(scene.result_file), str(record_file))
     finally:
         alive.kill()
         alive.wait()
@@ -403,7 +407,8 @@ def test_a_sweep_beyond_the_scene_limit_is_refused_before_anything_is_planned(tm
     assert main(["sweep", str(path), "--no-progress"]) == 2
     assert time.monotonic() - start < 10
     err = capsys.readouterr().err
-    assert "&sweep: the lists give 1700000 scenes (100 friction x 100 thickness x 170 seed), more than 20000" in err
+    lists = "100 friction x 100 thickness x 170 seed"
+    assert f"&sweep: the lists give 1700000 scenes ({lists}), more than 20000" in err
     assert "allowed: at most 20000 scenes, or more with &sweep max_scenes = N (or --max-scenes N)" in err
     assert not (tmp_path / "out").exists()
     assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 2

@@ -627,8 +627,11 @@ def job_script(
     plain_text("&sweep directory", str(directory))
     plain_text("the executable", executable)
     files = submission_files(directory, name, submission)
-    output = _sbatch_path("the working directory and &sweep directory",
-                          (workdir / slurm_directory(directory)).resolve(), f"/{name}_{submission:03d}_%A_%a.out")
+    output = _sbatch_path(
+        "the working directory and &sweep directory",
+        (workdir / slurm_directory(directory)).resolve(),
+        f"/{name}_{submission:03d}_%A_%a.out",
+    )
     array = f"0-{tasks - 1}" + (f"%{options.array_limit}" if options.array_limit else "")
     sbatch = [
         f"--job-name={options.job_name or 'lc-' + name}",

@@ -224,7 +224,8 @@ def _name_setting(source: Path, variable: str, raw: object) -> str:
     # a control character (a value spanning two lines) would reach file names, scene files
     # and a Slurm job script
     if not isinstance(raw, str) or not raw.strip() or CONTROL_CHARACTERS.search(raw):
-        raise _sweep_error(source, variable, f"{raw!r} is not allowed; allowed: a non-empty string, {NO_CONTROL}")
+        allowed = f"a non-empty string, {NO_CONTROL}"
+        raise _sweep_error(source, variable, f"{raw!r} is not allowed; allowed: {allowed}")
     return raw.strip()
 
 
@@ -324,12 +325,15 @@ def read_sweep(path: str | os.PathLike, max_scenes: int | None = None) -> SweepP
     processes = _positive_int(source, "processes", group["processes"]) if "processes" in group else None
     slurm = options_from_sweep(source, {var: group[var] for var in SWEEP_VARIABLES if var in group})
     if max_scenes is None:
-        limit = _positive_int(source, "max_scenes", group["max_scenes"]) if "max_scenes" in group else MAX_SCENES
+        limit = MAX_SCENES
+        if "max_scenes" in group:
+            limit = _positive_int(source, "max_scenes", group["max_scenes"])
     elif isinstance(max_scenes, bool) or not isinstance(max_scenes, int) or max_scenes < 1:
         raise ValueError(f"--max-scenes: {max_scenes!r} is not allowed; allowed: an integer >= 1")
     else:
         limit = max_scenes
-    plan = SweepPlan(source, name, Path(directory), nml, _swept_values(source, group), processes, slurm, limit)
+    values = _swept_values(source, group)
+    plan = SweepPlan(source, name, Path(directory), nml, values, processes, slurm, limit)
     check_scene_count(plan)
     return plan
 
