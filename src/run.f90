@@ -11,7 +11,7 @@ module lc_run
    use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
    use lc_scene, only: scene_type, not_set, is_areal, check_scene, grid_of, companion_of
    use lc_grid, only: grid_type
-   use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
+   use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter, leakage_memory_check
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
@@ -76,6 +76,13 @@ contains
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
 
+      ! the leakage runs after the solve, next to the solution's fields (and the companion's):
+      ! a grid whose leakage would not fit ends here, before the solve
+      if (scene%leakage) then
+         call leakage_memory_check(int(scene%n, i8)*max(scene%ny, 1), &
+            & merge(2, 1, scene%companion)*merge(10, 4, scene%stress), error)
+         if (allocated(error)) return
+      end if
       call solve_contact(scene, height, scene%friction, result, error)
       if (allocated(error)) return
       converged = result%converged
