@@ -2,6 +2,7 @@
 result; bad input gives a clear error naming group and variable, exit code 2, and
 writes nothing; an existing result is not overwritten unless the input says so."""
 
+import os
 import shutil
 import subprocess
 import sys
@@ -448,6 +449,44 @@ def test_a_missing_profile_file_is_bad_input_and_creates_nothing(tmp_path):
     proc = run_exe(nml, tmp_path)
     assert proc.returncode == 2 and "&profile: file = 'measured.npy' is not found" in proc.stderr
     assert not (tmp_path / "deep").exists()
+
+
+#: A line scene whose heights come from the file 'heights.txt', result in 'deep/er/r.h5'.
+FILE_SCENE = ("&profile\n kind = 'file'\n file = 'heights.txt'\n/\n&loading\n normalised_pressure = 1.0\n/\n"
+              "&output\n file = 'deep/er/r.h5'\n/\n")
+
+
+@pytest.mark.parametrize("which", ["height file", "namelist file"])
+def test_a_fifo_is_refused_at_once_and_creates_nothing(which, tmp_path):
+    """A FIFO (named pipe) would block the read until a writer comes: refused at once as
+    something that is not a regular file, exit 2 / InputError, nothing created."""
+    nml = tmp_path / "scene.nml"
+    nml.write_text(FILE_SCENE)
+    fifo = tmp_path / ("heights.txt" if which == "height file" else "fifo.nml")
+    os.mkfifo(fifo)
+    given = nml if which == "height file" else fifo
+    proc = subprocess.run([executable(), str(given)], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=60)
+    named = "&profile: file = 'heights.txt'" if which == "height file" else f"namelist file '{fifo}'"
+    assert proc.returncode == 2, proc.stderr
+    assert f"{named} is a FIFO (named pipe); allowed: a regular file" in proc.stderr
+    # the same from Python (in a process of its own: a regression would block it, not the tests)
+    script = ("import layercontact as lc\n"
+              f"try:\n    lc.run({str(given)!r})\nexcept lc.InputError as err:\n    print(err.code, err)\n")
+    py = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True,
+                        timeout=60)
+    assert py.stdout.startswith("2 "), py.stderr
+    assert "is a FIFO (named pipe); allowed: a regular file" in py.stdout
+    assert not (tmp_path / "deep").exists()
+
+
+def test_a_directory_given_as_the_height_file_is_refused_as_bad_input(tmp_path):
+    nml = tmp_path / "scene.nml"
+    nml.write_text(FILE_SCENE)
+    (tmp_path / "heights.txt").mkdir()
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2
+    assert "&profile: file = 'heights.txt' is a directory; allowed: a regular file" in proc.stderr
 
 
 def test_every_result_attribute_has_its_unit(default_result):

@@ -166,3 +166,69 @@ def test_sweep_workers_compute_the_leakage(tmp_path, monkeypatch):
     # a larger load closes the gap: less leakage
     assert k[0] > k[1] > 0
     assert [row["leakage_k_eff_x"] for row in rows] == k
+
+
+# ---------------------------------------------------------------------------------------
+# memory: the leakage's needs are in the memory check (exit 5 / code 5, never a crash)
+
+def _address_space(gib: float):
+    """A preexec_fn: the child may map at most ``gib`` GiB (ulimit -v)."""
+    import resource
+
+    def limit():
+        size = int(gib * 2**30)
+        resource.setrlimit(resource.RLIMIT_AS, (size, size))
+    return limit
+
+
+#: A frictionless 1024^2 scene with the leakage: its solve fits in 586 MiB of address
+#: space, its leakage (about 0.6 GiB with MPI's start) does not.
+LEAKY_1024 = (AREAL.replace("n = 64", "n = 1024").replace("coefficient = 0.5", "coefficient = 0.0")
+              .replace("tol = 1e-10", "tol = 1e-8") + "&output\n file = 'leak.h5'\n leakage = .true.\n/\n")
+
+
+def test_a_leakage_too_large_for_the_memory_ends_with_code_5_before_the_solve(tmp_path):
+    """1024^2 cells with the leakage under ulimit -v 600000 (586 MiB), a scene whose solve
+    fits: the leakage's needs (36 doubles per cell, and the address space that starting MPI
+    maps) are checked before the solve, so the run ends at once with exit 5 and a message,
+    no result and no crash (it used to solve, then die in the leakage with SIGSEGV)."""
+    import subprocess
+    import time
+
+    from test_inputs import executable
+
+    nml = tmp_path / "leak.nml"
+    nml.write_text(LEAKY_1024)
+    start = time.monotonic()
+    proc = subprocess.run([executable(), str(nml)], cwd=tmp_path, capture_output=True, text=True, timeout=600,
+                          preexec_fn=_address_space(600000 / 2**20))
+    assert proc.returncode == 5, proc.stderr
+    assert "not enough memory: the leakage of 1048576 cells needs about" in proc.stderr
+    assert "the address space limit (ulimit -v)" in proc.stderr and "&output leakage = .false." in proc.stderr
+    assert time.monotonic() - start < 30   # before the solve (about 20 s here)
+    assert not (tmp_path / "leak.h5").exists() and not list(tmp_path.glob("*.tmp"))
+
+
+def test_python_raises_code_5_for_a_leakage_too_large_and_lives_on(tmp_path):
+    """lc.core_leakage of 8192^2 cells under 3 GiB and lc.run of the 1024^2 leakage scene
+    under 900 MiB raise LayercontactError with code 5; the interpreter goes on and ends
+    normally."""
+    import subprocess
+    import sys
+
+    (tmp_path / "leak.nml").write_text(LEAKY_1024)
+    cases = ((3.0, "lc.core_leakage(np.ones((8192, 8192)))", "the leakage of 67108864 cells"),
+             (900 / 1024, "lc.run('leak.nml')", "the leakage of 1048576 cells"))
+    for limit, call, words in cases:
+        script = (
+            "import numpy as np, layercontact as lc\n"
+            f"try:\n    {call}\nexcept lc.LayercontactError as err:\n    print(err.code, err)\n"
+            "print(lc.core_leakage(np.ones((8, 8))).k_eff_x)\n"
+        )
+        proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True,
+                              timeout=600, preexec_fn=_address_space(limit))
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+        first, last = proc.stdout.splitlines()[0], proc.stdout.splitlines()[-1]
+        assert first.startswith(f"5 not enough memory: {words} needs about"), proc.stdout
+        assert float(last) == pytest.approx(1.0)   # a uniform gap of 1: k_eff = g^3
+        assert not (tmp_path / "leak.h5").exists()

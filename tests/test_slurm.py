@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import shutil
 import signal
 import subprocess
@@ -533,3 +534,145 @@ def test_a_leakage_scene_runs_in_a_slurm_array_task(slurm_cluster, tmp_path, mon
         # of the direct solve its share
         assert k == pytest.approx(ref.k_eff, rel=2e-6)
     assert summary["leakage_k_eff_x"][0] > summary["leakage_k_eff_x"][1] > 0
+
+
+# ---------------------------------------------------------------------------------------
+# hostile names: nothing from an input reaches a shell as a command (docs/clusters.md)
+
+#: A directory name with a space, both quotes, a command substitution, a variable, a '#'
+#: (sbatch's comment) and a '%' (sbatch's filename pattern): legal, and kept as it is.
+ODD_DIRECTORY = "it's a \"dir\" $(touch pwned) `touch pwned` $HOME #x 100%"
+
+
+def pwned(root: Path) -> list[Path]:
+    return list(root.rglob("pwned")) + list(Path.cwd().rglob("pwned"))
+
+
+REFUSED_NAMES = [
+    # (sweep settings, command-line arguments, working directory, words of the message)
+    (" directory = 'w\ntouch pwned\n'\n", [], "work",
+     ["&sweep directory: 'w\\ntouch pwned\\n' is not allowed",
+      "allowed: a non-empty string, text without control characters"]),
+    (" name = 's\ntouch pwned'\n", [], "work", ["&sweep name: 's\\ntouch pwned' is not allowed"]),
+    ("", [], "w\ntouch pwned\n", ["the working directory (submit from another one)", "w\\ntouch pwned\\n'",
+                                  "allowed: text without control characters"]),
+    (" slurm_setup_lines = 'module load hdf5\ttouch pwned'\n", [], "work",
+     ["&sweep slurm_setup_lines: 'module load hdf5\\ttouch pwned' is not allowed",
+      "text without control characters"]),
+    ("", ["--sbatch", "qos=low\ntouch pwned"], "work",
+     ["--sbatch: 'qos=low\\ntouch pwned' is not allowed", "text without control characters"]),
+    ("", ["--executable", "/bin/true\ntouch pwned"], "work", ["--executable", "is not allowed"]),
+]
+
+
+@pytest.mark.parametrize("settings, arguments, workdir, words", REFUSED_NAMES,
+                         ids=["directory", "name", "working-directory", "setup-line", "sbatch-line",
+                              "executable"])
+def test_a_control_character_in_a_name_is_refused_before_anything_is_written(
+    settings, arguments, workdir, words, tmp_path, monkeypatch, capsys
+):
+    work = tmp_path / workdir
+    work.mkdir()
+    monkeypatch.chdir(work)
+    path = write_sweep(work, settings)
+    assert main(["sweep", str(path), "--slurm", "--dry-run", *arguments]) == 2
+    err = capsys.readouterr().err
+    for word in words:
+        assert word in err, err
+    assert not list(work.rglob("*.sbatch")) and not pwned(tmp_path)
+    # a local sweep refuses the names that reach its files too
+    if settings and "slurm_" not in settings:
+        assert main(["sweep", str(path), "--dry-run"]) == 2
+        assert words[0] in capsys.readouterr().err
+
+
+def test_spaces_quotes_and_substitutions_in_paths_stay_paths(tmp_path, monkeypatch):
+    """A working directory and a sweep directory with every character a shell would read
+    (spaces, quotes, $(...), backquotes, $VAR, #, %): the job script passes bash -n, its
+    task runs the scenes and writes their results in those directories, and nothing runs."""
+    work = tmp_path / ODD_DIRECTORY
+    work.mkdir()
+    monkeypatch.chdir(work)
+    path = work / "s.nml"
+    quoted = ODD_DIRECTORY.replace("'", "''")
+    path.write_text(BASE + f"&sweep\n directory = 'out/{quoted}'\n{LISTS}/\n")
+    assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 0
+    out = work / "out" / ODD_DIRECTORY
+    script = out / "slurm/s_001.sbatch"
+    text = script.read_text()
+    assert subprocess.run(["bash", "-n", str(script)]).returncode == 0
+    task = run_task(script, 0)
+    output, _ = task.communicate(timeout=300)
+    assert task.returncode == 0, output
+    assert (out / "results/s_0000.h5").is_file() and (out / "results/s_0001.h5").is_file()
+    assert record(out, "s_0000")["exit_code"] == 0
+    assert not pwned(tmp_path)
+    # sbatch reads quotes in #SBATCH lines ('...' and "'"), a doubled % as one %
+    assert f"#SBATCH --chdir={shlex.quote(str(work))}" in text
+    assert "100%%" in text and "_%A_%a.out" in text
+
+
+def test_sbatch_takes_the_quoted_paths_of_a_hostile_directory(slurm_cluster, tmp_path, monkeypatch, capsys):
+    """The real sbatch reads the quoted --chdir and --output: the task runs in the odd
+    working directory and its output file appears in the odd sweep directory."""
+    monkeypatch.setenv("SLURM_CONF", str(slurm_cluster))
+    work = tmp_path / ODD_DIRECTORY
+    work.mkdir()
+    monkeypatch.chdir(work)
+    path = work / "s.nml"
+    path.write_text(BASE + "&sweep\n directory = 'out'\n seed = 1, 2\n/\n")
+    assert main(["sweep", str(path), "--slurm"]) == 0
+    assert "submitted Slurm job" in capsys.readouterr().out
+    out = work / "out"
+    wait_for(lambda: sweep_status.sweep_status(out).finished, "the two scenes")
+    assert sorted(p.name for p in (out / "results").glob("*.h5")) == ["s_0000.h5", "s_0001.h5"]
+    job = slurm.read_submissions(out, "s")[0].job_id
+    assert slurm.task_output_file(out, "s", 1, job, 0).is_file()
+    assert not pwned(tmp_path)
+
+
+@pytest.mark.parametrize("directory", ["/tmp/lc w\ntouch pwned", "/tmp/lc $(touch pwned)", "/tmp/lc slurm"])
+def test_the_test_slurm_refuses_a_directory_it_would_write_into_its_configuration(directory, tmp_path):
+    """tools/local_slurm.sh puts DIR in slurm.conf and the daemons' command lines: anything
+    but a plain path is refused (exit 2) before anything is written or run."""
+    script = Path(__file__).resolve().parents[1] / "tools" / "local_slurm.sh"
+    done = subprocess.run(["bash", str(script), "start", directory], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=60)
+    assert done.returncode == 2
+    assert "is not allowed; allowed: letters, digits and . _ / + -" in done.stderr
+    assert not Path(directory).exists() and not list(tmp_path.iterdir())
+
+
+def test_a_task_removes_only_temporary_files_of_ended_runs_of_its_host(tmp_path, monkeypatch):
+    """Before a scene runs, its task removes STEM.h5.HOST.PID.tmp only where HOST is this
+    one and PID has ended (and STEM.h5.tmp of earlier versions); another run's file in
+    flight, here or elsewhere, is left alone."""
+    import socket
+
+    monkeypatch.chdir(tmp_path)
+    path = write_sweep(tmp_path)
+    assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 0
+    results = tmp_path / "out/s/results"
+    results.mkdir(parents=True)
+    ended = subprocess.Popen(["true"])
+    ended.wait()
+    alive = subprocess.Popen(["sleep", "60"])
+    host = socket.gethostname()
+    files = {
+        "ended": results / f"s_0000.h5.{host}.{ended.pid}.tmp",
+        "earlier version": results / "s_0000.h5.tmp",
+        "alive here": results / f"s_0000.h5.{host}.{alive.pid}.tmp",
+        "elsewhere": results / f"s_0000.h5.other-node.{ended.pid}.tmp",
+    }
+    for file in files.values():
+        file.write_bytes(b"partial")
+    try:
+        task = run_task(tmp_path / "out/s/slurm/s_001.sbatch", 0)
+        output, _ = task.communicate(timeout=120)
+    finally:
+        alive.kill()
+        alive.wait()
+    assert task.returncode == 0, output
+    assert not files["ended"].exists() and not files["earlier version"].exists()
+    assert files["alive here"].read_bytes() == b"partial" and files["elsewhere"].read_bytes() == b"partial"
+    assert (results / "s_0000.h5").is_file()

@@ -7,6 +7,7 @@ full)."""
 from __future__ import annotations
 
 import itertools
+import os
 import shutil
 import sys
 from pathlib import Path
@@ -330,3 +331,106 @@ def test_workers_end_when_the_sweep_process_is_killed(tmp_path):
         time.sleep(0.2)
     left = [pid for pid in tree if Path(f"/proc/{pid}").exists()]
     assert not left, [Path(f"/proc/{pid}/cmdline").read_bytes()[:80] for pid in left]
+
+
+def test_two_concurrent_sweeps_of_one_directory_report_every_scene_converged(tmp_path):
+    """Two sweeps of the same file and directory at once (two workers each): a scene runs
+    under its lock, so the second sweep to reach it waits and finds its result; neither
+    removes the other's result in flight. Both summaries say every scene converged, every
+    result is complete, and no temporary file is left."""
+    import subprocess
+
+    path = write_sweep(tmp_path, lists="seed = " + ", ".join(map(str, range(1, 13))) + "\n",
+                       base=BASE.replace("n = 256", "n = 65536"))
+    command = [sys.executable, "-m", "layercontact", "sweep", str(path), "--no-progress"]
+    sweeps = [
+        subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        for _ in range(2)
+    ]
+    for proc in sweeps:
+        out, err = proc.communicate(timeout=600)
+        assert proc.returncode == 0, (out, err)
+        assert "12 scenes, 0 failed" in out
+    summary = lc.read_summary(tmp_path / "out/s/s_summary.csv")
+    assert len(summary["error"]) == 12
+    assert (summary["error"] == "").all() and (summary["converged"] == 1).all()
+    for result in (tmp_path / "out/s/results").glob("*.h5"):
+        assert lc.read_result(result).converged
+    assert not [p for p in (tmp_path / "out/s").rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_a_worker_removes_only_temporary_files_of_ended_runs_of_its_host(tmp_path, monkeypatch):
+    """Before a scene runs, its temporary results STEM.h5.HOST.PID.tmp are removed only
+    when HOST is this one and process PID has ended (and STEM.h5.tmp of earlier versions);
+    a live run's file (here or on another host) is left alone."""
+    import socket
+    import subprocess
+
+    monkeypatch.chdir(tmp_path)
+    path = write_sweep(tmp_path, lists="seed = 1\n")
+    plan = sweep_module.read_sweep(path)
+    scene = sweep_module.write_scenes(plan)[0]
+    results = scene.result_file.parent
+    results.mkdir(parents=True)
+    ended = subprocess.Popen(["true"])
+    ended.wait()
+    alive = subprocess.Popen(["sleep", "60"])   # another run of this host, writing
+    host = socket.gethostname()
+    files = {
+        "ended": results / f"{scene.stem}.h5.{host}.{ended.pid}.tmp",
+        "earlier version": results / f"{scene.stem}.h5.tmp",
+        "alive here": results / f"{scene.stem}.h5.{host}.{alive.pid}.tmp",
+        "elsewhere": results / f"{scene.stem}.h5.other-node.{ended.pid}.tmp",
+    }
+    for file in files.values():
+        file.write_bytes(b"partial")
+    try:
+        record_file = sweep_module._record_file(scene)
+        sweep_module._solve(str(scene.scene_file), str(scene.result_file), str(record_file))
+    finally:
+        alive.kill()
+        alive.wait()
+    assert not files["ended"].exists() and not files["earlier version"].exists()
+    assert files["alive here"].read_bytes() == b"partial" and files["elsewhere"].read_bytes() == b"partial"
+    assert lc.read_result(scene.result_file).converged
+
+
+def test_a_sweep_beyond_the_scene_limit_is_refused_before_anything_is_planned(tmp_path, monkeypatch, capsys):
+    """1.7 million scenes are counted, not planned: refused at once (exit 2) with the count,
+    the lists and how to allow more; max_scenes (or --max-scenes) raises the limit."""
+    import time
+
+    monkeypatch.chdir(tmp_path)
+    many = ", ".join(str(0.01 * k) for k in range(1, 101))
+    path = write_sweep(tmp_path, lists=f"friction = {many}\n thickness = {many}\n realisations = 170\n")
+    start = time.monotonic()
+    assert main(["sweep", str(path), "--no-progress"]) == 2
+    assert time.monotonic() - start < 10
+    err = capsys.readouterr().err
+    lists = "100 friction x 100 thickness x 170 seed"
+    assert f"&sweep: the lists give 1700000 scenes ({lists}), more than 20000" in err
+    assert "allowed: at most 20000 scenes, or more with &sweep max_scenes = N (or --max-scenes N)" in err
+    assert not (tmp_path / "out").exists()
+    assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 2
+    assert "1700000 scenes" in capsys.readouterr().err and not (tmp_path / "out").exists()
+    # a lower limit from the command line or the file; a higher one lets the sweep through
+    small = write_sweep(tmp_path, lists="seed = 1, 2, 3\n", name="small")
+    assert main(["sweep", str(small), "--dry-run", "--max-scenes", "2"]) == 2
+    assert "the lists give 3 scenes (3 seed), more than 2" in capsys.readouterr().err
+    small.write_text(small.read_text().replace("processes = 2", "processes = 2\n max_scenes = 2"))
+    with pytest.raises(ValueError, match="the lists give 3 scenes"):
+        lc.sweep(small, dry_run=True)
+    assert len(lc.sweep(small, dry_run=True, max_scenes=3)) == 3
+    assert main(["sweep", str(small), "--dry-run", "--max-scenes", "0"]) == 2
+    assert "--max-scenes: 0 is not allowed; allowed: an integer >= 1" in capsys.readouterr().err
+
+
+def test_a_fifo_given_as_the_sweep_file_is_refused_at_once(tmp_path):
+    import subprocess
+
+    fifo = tmp_path / "s.nml"
+    os.mkfifo(fifo)
+    done = subprocess.run([sys.executable, "-m", "layercontact", "sweep", str(fifo)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert f"sweep file '{fifo}' is a FIFO (named pipe); allowed: a regular file" in done.stderr

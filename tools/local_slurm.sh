@@ -15,7 +15,7 @@
 #       stop the daemons started in DIR (by the PIDs in DIR/run/*.pid) and the guard
 #
 # Exit codes: 0 done; 1 failure (the message and the tail of the failing daemon's log on
-# stderr); 2 usage.
+# stderr); 2 usage, or a DIR with other characters than letters, digits and . _ / + -.
 set -euo pipefail
 
 packages=(slurmctld slurmd slurm-client munge)
@@ -201,6 +201,12 @@ case "$command" in
     [ $# -ge 1 ] || usage
     dir=$1
     shift
+    # DIR goes into slurm.conf and the daemons' command lines: one plain path, nothing a
+    # configuration line or a shell would split or read
+    if [[ ! $dir =~ ^[A-Za-z0-9._/+-]+$ ]]; then
+      echo "local_slurm: DIR '$dir' is not allowed; allowed: letters, digits and . _ / + -" >&2
+      exit 2
+    fi
     ports=6817,6818
     watch=""
     while [ $# -gt 0 ]; do

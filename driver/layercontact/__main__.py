@@ -66,6 +66,11 @@ def _parser() -> argparse.ArgumentParser:
     )
     sweep_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep_p.add_argument(
+        "--max-scenes",
+        type=int,
+        help="the most scenes allowed (default: &sweep max_scenes, or 20000); a larger sweep is refused",
+    )
+    sweep_p.add_argument(
         "--dry-run",
         action="store_true",
         help="write and check the scenes (with --slurm also the job script, printed); run nothing",
@@ -122,7 +127,7 @@ def main(argv: list[str] | None = None) -> int:
             flag = OPTIONS[next(iter(given))].flag
             print(f"layercontact: error: {flag} applies only with --slurm", file=sys.stderr)
             return 2
-        return sweep_command(args.nml, args.processes, not args.no_progress, args.dry_run)
+        return sweep_command(args.nml, args.processes, not args.no_progress, args.dry_run, args.max_scenes)
     if args.command == "status":
         return status_command(args.directory, args.all)
     if args.command == "collect":
@@ -160,14 +165,15 @@ def run_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def sweep_command(nml: str, processes: int | None, progress: bool, dry_run: bool = False) -> int:
+def sweep_command(nml: str, processes: int | None, progress: bool, dry_run: bool = False,
+                  max_scenes: int | None = None) -> int:
     """``python -m layercontact sweep``: run the sweep, print where the summary is and
     which scenes failed. Exit code 0 all converged, 1 some scene failed or did not
     converge (the others ran), 2 bad sweep (nothing ran)."""
     from .sweep import execute, failed, read_sweep
 
     try:
-        plan = read_sweep(nml)
+        plan = read_sweep(nml, max_scenes)
         rows = execute(plan, processes=processes, progress=progress, dry_run=dry_run)
     except _BAD_SWEEP as err:
         print(f"layercontact: error: {err}", file=sys.stderr)
@@ -222,7 +228,7 @@ def slurm_command(args: argparse.Namespace) -> int:
         )
         return 2
     try:
-        plan = read_sweep(args.nml)
+        plan = read_sweep(args.nml, args.max_scenes)
         options = resolve_options(plan.slurm, _slurm_values(args))
         outcome = submit_sweep(plan, options, dry_run=args.dry_run)
     except _BAD_SWEEP as err:

@@ -4,6 +4,9 @@ public names are re-exported by the package."""
 
 from __future__ import annotations
 
+import os
+import stat as _stat
+
 import numpy as np
 
 from .native import core as _core
@@ -131,3 +134,20 @@ def real_array(value, name: str, *, ndim: tuple[int, ...], finite: bool = True) 
         bad = int(np.count_nonzero(~np.isfinite(out)))
         raise InputError(f"{name}: {bad} NaN or infinite values are not allowed; allowed: finite values", 2)
     return out
+
+
+def regular_file(filename: str | os.PathLike, what: str) -> str:
+    """``filename`` as a string, refused (:class:`InputError`, code 2) when it names
+    something other than a regular file: a FIFO would block the read until a writer comes,
+    a directory or a device holds no input. A missing file passes (its reader says so)."""
+    path = os.fspath(filename)
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return path
+    if not _stat.S_ISREG(mode):
+        kind = ("a directory" if _stat.S_ISDIR(mode) else "a FIFO (named pipe)" if _stat.S_ISFIFO(mode)
+                else "a device" if _stat.S_ISCHR(mode) or _stat.S_ISBLK(mode)
+                else "a socket" if _stat.S_ISSOCK(mode) else "not a regular file")
+        raise InputError(f"{what} '{path}' is {kind}; allowed: a regular file", 2)
+    return path

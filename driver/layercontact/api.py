@@ -11,7 +11,7 @@ from dataclasses import fields as dataclass_fields
 import numpy as np
 
 from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError, _check,  # noqa: F401
-                       _lines, _namelist)
+                       _lines, _namelist, regular_file)
 from .leakage import CoreLeakage
 from .native import core as _core
 
@@ -577,16 +577,16 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
 def check_scene_file(filename: str | os.PathLike) -> None:
     """Read and validate a namelist file without solving; raises :class:`LayercontactError`
     with the message the executable would print."""
-    stat, errmsg = _core.py_check_scene_file(os.fspath(filename))
-    _check(stat, errmsg)
+    code, errmsg = _core.py_check_scene_file(regular_file(filename, "namelist file"))
+    _check(code, errmsg)
 
 
 def choose_resolution(filename: str | os.PathLike) -> tuple[int | tuple[int, int], float]:
     """The grid and tolerance ``tol`` that a scene file with ``&solver target_error`` will be
     solved with (the accuracy rule of docs/accuracy.md; runs the pilot solve, writes
     nothing): ``(n, tol)`` for a line, ``((nx, ny), tol)`` for an areal scene."""
-    n, ny, tol, stat, errmsg = _core.py_choose_resolution(os.fspath(filename))
-    _check(stat, errmsg)
+    n, ny, tol, code, errmsg = _core.py_choose_resolution(regular_file(filename, "namelist file"))
+    _check(code, errmsg)
     return (int(n) if ny == 1 else (int(n), int(ny))), float(tol)
 
 
@@ -600,6 +600,6 @@ def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult | Area
 def run_to_file(filename: str | os.PathLike, verbose: bool = False) -> str:
     """Run a namelist file like :func:`run`, without reading the result back; returns the
     result file's path (for sweeps, which read only the scalars they tabulate)."""
-    out, converged, stat, errmsg = _core.py_run(os.fspath(filename), 1 if verbose else 0)
-    _check(stat, errmsg)
+    out, converged, code, errmsg = _core.py_run(regular_file(filename, "namelist file"), 1 if verbose else 0)
+    _check(code, errmsg)
     return out.decode().strip() if isinstance(out, bytes) else str(out).strip()

@@ -127,6 +127,31 @@ def _not_allowed(where: str, value: object, allowed: str) -> ValueError:
     return ValueError(f"{where}: {value!r} is not allowed; allowed: {allowed}")
 
 
+#: Characters no name or path may carry into a job script: a newline would end an #SBATCH
+#: line or a comment and start a command.
+CONTROL_CHARACTERS = re.compile(r"[\x00-\x1f\x7f]")
+NO_CONTROL = "text without control characters (newline, carriage return, tab, ...)"
+
+
+def plain_text(where: str, value: str) -> str:
+    """``value`` unchanged, or ValueError naming ``where``, the value and what is allowed
+    when it holds a control character (anything that reaches a job script passes here)."""
+    if CONTROL_CHARACTERS.search(value):
+        raise _not_allowed(where, value, NO_CONTROL)
+    return value
+
+
+def _sbatch_path(where: str, path: Path, pattern: str = "") -> str:
+    """A path as the value of an #SBATCH option, quoted as sbatch reads quotes (a space or
+    a '#' stays in the path); with a filename ``pattern`` appended (``%A``: the job id), a
+    '%' of the path is doubled (sbatch reads '%%' as one '%'). A backslash, which sbatch
+    takes as an escape, is refused."""
+    text = plain_text(where, str(path))
+    if "\\" in text:
+        raise _not_allowed(where, text, "a path without a backslash (sbatch reads it as an escape)")
+    return shlex.quote(text.replace("%", "%%") + pattern if pattern else text)
+
+
 def _name(where: str, value: object) -> str:
     if not isinstance(value, str) or not _SLURM_NAME.match(value.strip()):
         raise _not_allowed(where, value, "a Slurm name: letters, digits and . _ + , : @ -")
@@ -160,8 +185,8 @@ def _lines(where: str, value: object) -> tuple[str, ...]:
     for line in values:
         if line is None:  # f90nml's empty list entries
             continue
-        if not isinstance(line, str) or "\n" in line or not line.strip():
-            raise _not_allowed(where, line, "non-empty strings of one line each")
+        if not isinstance(line, str) or CONTROL_CHARACTERS.search(line) or not line.strip():
+            raise _not_allowed(where, line, f"non-empty strings of one line each, {NO_CONTROL}")
         lines.append(line.strip())
     return tuple(lines)
 
@@ -182,8 +207,8 @@ def _sbatch_lines(where: str, value: object) -> tuple[str, ...]:
 
 
 def _executable(where: str, value: object) -> str:
-    if not isinstance(value, str) or not value.strip():
-        raise _not_allowed(where, value, "the path of the layercontact executable")
+    if not isinstance(value, str) or not value.strip() or CONTROL_CHARACTERS.search(value):
+        raise _not_allowed(where, value, f"the path of the layercontact executable, {NO_CONTROL}")
     return value.strip()
 
 
@@ -518,8 +543,19 @@ for scene in "${{scenes[@]}}"; do
   start_ms=$REPLY
   current=$scene code=""
   write_record "$scene" running "" "$started" "" ""
-  # temporary result files that a killed run of this scene left (this task alone runs it)
-  rm -f "$sweep_directory/results/$scene".h5.*tmp
+  # temporary result files (STEM.h5.HOST.PID.tmp) that killed runs of this scene on this
+  # host left, and those of earlier versions (STEM.h5.tmp); a run still writing one, here or
+  # on another host, keeps its file
+  for left in "$sweep_directory/results/$scene".h5.*tmp; do
+    [ -e "$left" ] || continue
+    writer=${{left#"$sweep_directory/results/$scene.h5."}}
+    writer=${{writer%.tmp}}
+    pid=${{writer##*.}}
+    if [[ $writer != *.* || ! $pid =~ ^[0-9]+$ ]] \
+      || {{ [ "${{writer%.*}}" = "$HOSTNAME" ] && ! kill -0 "$pid" 2>/dev/null; }}; then
+      rm -f "$left"
+    fi
+  done
   # in the background, so that the trap runs at once when a signal arrives
   "$executable" "$sweep_directory/scenes/$scene.nml" >"$sweep_directory/{logs}/$scene.log" 2>&1 &
   child=$!
@@ -583,15 +619,26 @@ def job_script(
             f"array tasks for {scenes} scenes, more than this cluster's MaxArraySize = {max_array_size}; "
             f"allowed: scenes per task >= {least}"
         )
+    # nothing from an input reaches a shell as a command: every name and path is checked
+    # for control characters, and quoted
+    plain_text("the working directory (submit from another one)", str(workdir))
+    plain_text("the sweep name", name)
+    plain_text("the sweep file", str(sweep_file))
+    plain_text("&sweep directory", str(directory))
+    plain_text("the executable", executable)
     files = submission_files(directory, name, submission)
-    output = (workdir / slurm_directory(directory) / f"{name}_{submission:03d}_%A_%a.out").resolve()
+    output = _sbatch_path(
+        "the working directory and &sweep directory",
+        (workdir / slurm_directory(directory)).resolve(),
+        f"/{name}_{submission:03d}_%A_%a.out",
+    )
     array = f"0-{tasks - 1}" + (f"%{options.array_limit}" if options.array_limit else "")
     sbatch = [
         f"--job-name={options.job_name or 'lc-' + name}",
         f"--array={array}",
         "--ntasks=1",
         f"--cpus-per-task={options.cpus_per_task}",
-        f"--chdir={workdir}",
+        f"--chdir={_sbatch_path('the working directory (submit from another one)', workdir)}",
         f"--output={output}",
     ]
     sbatch += [f"--time={options.time}"] if options.time else []

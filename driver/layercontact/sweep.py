@@ -14,6 +14,7 @@ A sweep file holds the usual groups (``&scene &layer &material &friction &profil
        speed = 0.01, 0.1, 1              ! -> &material speed (viscoelastic layers)
        seed = 1, 2, 3                    ! -> &profile seed (or realisations = N: 1..N)
        processes = 2                     ! worker processes (default: the CPUs allocated)
+       max_scenes = 50000                ! the most scenes allowed (default: MAX_SCENES, 20000)
        slurm_time = '0:30:00'            ! slurm_*: options of a Slurm job array
     /                                    ! (layercontact.slurm, docs/clusters.md)
 
@@ -32,13 +33,16 @@ from __future__ import annotations
 
 import copy
 import csv
+import fcntl
 import io
 import itertools
 import json
+import math
 import signal
 import threading
 import multiprocessing
 import os
+import socket
 import sys
 import time
 from collections.abc import Iterator
@@ -51,12 +55,17 @@ import f90nml
 import numpy as np
 
 from . import provenance
-from .api import LayercontactError, check_scene_file, run_to_file
-from .slurm import SWEEP_VARIABLES, options_from_sweep
+from .api import LayercontactError, check_scene_file, regular_file, run_to_file
+from .slurm import CONTROL_CHARACTERS, NO_CONTROL, SWEEP_VARIABLES, options_from_sweep
 
 SWEEP_GROUP = "sweep"
 SUMMARY_GROUP = "summary"
-_SETTINGS = ("name", "directory", "realisations", "processes")
+_SETTINGS = ("name", "directory", "realisations", "processes", "max_scenes")
+#: The most scenes a sweep may have unless ``&sweep max_scenes`` (or ``--max-scenes``)
+#: allows more: writing and checking a scene takes about 5 ms and planning holds about
+#: 1.3 kB per scene (so 20000 scenes take under two minutes before the first one runs), and
+#: each scene leaves a scene file and a result (docs/sweeps.md).
+MAX_SCENES = 20000
 #: Format of ``NAME_sweep.json`` (raised when its meaning changes).
 PLAN_RECORD_FORMAT = 1
 _PRESSURES = ("mean_pressure", "normalised_pressure")
@@ -144,6 +153,12 @@ class SweepPlan:
     values: dict[str, list]
     processes: int | None
     slurm: dict[str, object] | None = None
+    max_scenes: int = MAX_SCENES
+
+    @property
+    def scene_count(self) -> int:
+        """The number of scenes: the product of the lists' lengths (1 without lists)."""
+        return math.prod(len(values) for values in self.values.values())
 
     def plan_record_file(self) -> Path:
         """``DIRECTORY/NAME_sweep.json``: the scenes, for ``status`` and ``collect``."""
@@ -206,8 +221,11 @@ def _positive_int(source: Path, variable: str, raw: object) -> int:
 
 
 def _name_setting(source: Path, variable: str, raw: object) -> str:
-    if not isinstance(raw, str) or not raw.strip():
-        raise _sweep_error(source, variable, f"{raw!r} is not allowed; allowed: a non-empty string")
+    # a control character (a value spanning two lines) would reach file names, scene files
+    # and a Slurm job script
+    if not isinstance(raw, str) or not raw.strip() or CONTROL_CHARACTERS.search(raw):
+        allowed = f"a non-empty string, {NO_CONTROL}"
+        raise _sweep_error(source, variable, f"{raw!r} is not allowed; allowed: {allowed}")
     return raw.strip()
 
 
@@ -268,14 +286,17 @@ def _swept_values(source: Path, group: f90nml.Namelist) -> dict[str, list]:
     return values
 
 
-def read_sweep(path: str | os.PathLike) -> SweepPlan:
+def read_sweep(path: str | os.PathLike, max_scenes: int | None = None) -> SweepPlan:
     """Read and check a sweep file (the &sweep group only; the scenes are checked by the
-    library once written).
+    library once written). The number of scenes is counted first: beyond the limit the
+    sweep is refused before anything is planned.
 
     Parameters
     ----------
     path : str or os.PathLike
         The sweep namelist file.
+    max_scenes : int, optional
+        The most scenes allowed; default: ``&sweep max_scenes``, else :data:`MAX_SCENES`.
 
     Returns
     -------
@@ -284,9 +305,10 @@ def read_sweep(path: str | os.PathLike) -> SweepPlan:
     Raises
     ------
     ValueError
-        For a missing &sweep group or a bad &sweep variable (named in the message).
+        For a missing &sweep group, a bad &sweep variable (named in the message) or more
+        scenes than allowed.
     """
-    source = Path(path)
+    source = Path(regular_file(path, "sweep file"))
     nml = _read_namelist(source)
     if SWEEP_GROUP not in nml:
         raise ValueError(f"{source}: no &sweep group (a sweep file is a scene plus a &sweep group)")
@@ -302,7 +324,32 @@ def read_sweep(path: str | os.PathLike) -> SweepPlan:
     directory = _name_setting(source, "directory", group.get("directory", f"out/{name}"))
     processes = _positive_int(source, "processes", group["processes"]) if "processes" in group else None
     slurm = options_from_sweep(source, {var: group[var] for var in SWEEP_VARIABLES if var in group})
-    return SweepPlan(source, name, Path(directory), nml, _swept_values(source, group), processes, slurm)
+    if max_scenes is None:
+        limit = MAX_SCENES
+        if "max_scenes" in group:
+            limit = _positive_int(source, "max_scenes", group["max_scenes"])
+    elif isinstance(max_scenes, bool) or not isinstance(max_scenes, int) or max_scenes < 1:
+        raise ValueError(f"--max-scenes: {max_scenes!r} is not allowed; allowed: an integer >= 1")
+    else:
+        limit = max_scenes
+    values = _swept_values(source, group)
+    plan = SweepPlan(source, name, Path(directory), nml, values, processes, slurm, limit)
+    check_scene_count(plan)
+    return plan
+
+
+def check_scene_count(plan: SweepPlan) -> None:
+    """Refuse a sweep with more scenes than ``plan.max_scenes`` (ValueError naming the
+    count, the lists and how to allow more); nothing is planned before this."""
+    if plan.scene_count <= plan.max_scenes:
+        return
+    lists = " x ".join(f"{len(values)} {name}" for name, values in plan.values.items())
+    raise ValueError(
+        f"{plan.source}: &sweep: the lists give {plan.scene_count} scenes ({lists}), more than "
+        f"{plan.max_scenes}; allowed: at most {plan.max_scenes} scenes, or more with &sweep max_scenes = N "
+        "(or --max-scenes N); each scene takes about 5 ms to write and check before any runs, and "
+        "leaves a scene file and a result file"
+    )
 
 
 # ---------------------------------------------------------------------------------------
@@ -329,8 +376,23 @@ def _scene_text(plan: SweepPlan, index: int, values: dict, result_file: Path) ->
     return out.getvalue()
 
 
+def iter_scenes(plan: SweepPlan) -> Iterator[Scene]:
+    """The scenes of a sweep one at a time (the product is never held whole): the cartesian
+    product of its lists (none: the base alone), in product order (the last swept variable
+    varies fastest), numbered from 0. Refuses a sweep beyond its scene limit first
+    (:func:`check_scene_count`)."""
+    check_scene_count(plan)
+    width = max(4, len(str(plan.scene_count - 1)))
+    for index, combo in enumerate(itertools.product(*plan.values.values())):
+        values = dict(zip(plan.values, combo))
+        stem = f"{plan.name}_{index:0{width}d}"
+        scene_file = plan.directory / "scenes" / f"{stem}.nml"
+        result_file = plan.directory / "results" / f"{stem}.h5"
+        yield Scene(index, values, scene_file, result_file, _scene_text(plan, index, values, result_file))
+
+
 def plan_scenes(plan: SweepPlan) -> list[Scene]:
-    """The scenes of a sweep: the cartesian product of its lists (none: the base alone).
+    """The scenes of a sweep as a list (see :func:`iter_scenes`).
 
     Parameters
     ----------
@@ -341,17 +403,7 @@ def plan_scenes(plan: SweepPlan) -> list[Scene]:
     list of Scene
         In product order (the last swept variable varies fastest), numbered from 0.
     """
-    combos = list(itertools.product(*plan.values.values()))
-    width = max(4, len(str(len(combos) - 1)))
-    scenes = []
-    for index, combo in enumerate(combos):
-        values = dict(zip(plan.values, combo))
-        stem = f"{plan.name}_{index:0{width}d}"
-        scene_file = plan.directory / "scenes" / f"{stem}.nml"
-        result_file = plan.directory / "results" / f"{stem}.h5"
-        text = _scene_text(plan, index, values, result_file)
-        scenes.append(Scene(index, values, scene_file, result_file, text))
-    return scenes
+    return list(iter_scenes(plan))
 
 
 def _temporary(path: Path) -> Path:
@@ -408,10 +460,10 @@ def write_scenes(plan: SweepPlan) -> list[Scene]:
     """
     import tempfile
 
-    scenes = plan_scenes(plan)
     with tempfile.TemporaryDirectory(prefix="layercontact-sweep-") as scratch:
-        for scene in scenes:
+        for scene in iter_scenes(plan):
             _check_scene(plan, scene, Path(scratch))
+    scenes = plan_scenes(plan)
     for scene in scenes:
         _write_scene(scene)
     return scenes
@@ -508,17 +560,70 @@ def _failure(message: str) -> dict[str, object]:
 
 
 def temporary_results(results: Path, stem: str) -> list[Path]:
-    """The temporary files of a scene's result that a killed write left behind: the
-    program writes ``STEM.h5.HOST.PID.tmp`` and moves it to ``STEM.h5`` when complete."""
+    """The temporary files of a scene's result: the program writes ``STEM.h5.HOST.PID.tmp``
+    and moves it to ``STEM.h5`` when complete."""
     return [p for p in results.glob(f"{stem}.h5.*tmp") if p.name.endswith(".tmp")]
+
+
+def _writer_is_gone(path: Path, stem: str) -> bool:
+    """True if the temporary result ``STEM.h5.HOST.PID.tmp`` was left by a run of this host
+    that has ended (killed while writing), or has a name no run writes now (``STEM.h5.tmp``
+    of earlier versions); a run elsewhere, or still alive, may be writing it."""
+    writer = path.name[len(f"{stem}.h5.") :].removesuffix(".tmp")
+    host, _, pid = writer.rpartition(".")
+    if not host or not pid.isdigit():
+        return True
+    if host != socket.gethostname():
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return True
+    except PermissionError:  # another user's process: alive
+        return False
+    return False
+
+
+def stale_temporary_results(results: Path, stem: str) -> list[Path]:
+    """The temporary files of a scene's result that killed runs of this host left (those of
+    runs still writing, here or on another host, are not stale)."""
+    return [p for p in temporary_results(results, stem) if _writer_is_gone(p, stem)]
+
+
+@contextmanager
+def _scene_lock(record_file: Path) -> Iterator[None]:
+    """Hold ``runs/.STEM.lock`` while the scene runs: two sweeps of one directory run a
+    scene one after the other (the second finds its result), never at once."""
+    lock_file = record_file.with_name(f".{record_file.stem}.lock")
+    lock_file.parent.mkdir(parents=True, exist_ok=True)
+    with open(lock_file, "a") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+        except OSError:  # a parallel file system mounted without locks: go on unlocked
+            yield
+            return
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def _solve(scene_file: str, result_file: str, record_file: str) -> dict[str, object]:
     """Worker: run one scene file, return its result columns (or its error); its run
-    record says it is running, then how it ended. Temporary files that a killed run of
-    the same scene left are removed first (the sweep runs each scene once at a time)."""
-    for left in temporary_results(Path(result_file).parent, Path(scene_file).stem):
-        left.unlink(missing_ok=True)
+    record says it is running, then how it ended. The scene's lock is held throughout: a
+    scene that another sweep of the same directory completed meanwhile is not run again,
+    and only temporary files of killed runs of this host are removed first (another
+    sweep's write in flight is left alone)."""
+    with _scene_lock(Path(record_file)):
+        if result_matches(Path(result_file), Path(scene_file).read_text()):
+            return _outcome(_result_columns(Path(result_file)))
+        for left in stale_temporary_results(Path(result_file).parent, Path(scene_file).stem):
+            left.unlink(missing_ok=True)
+        return _run_scene(scene_file, result_file, record_file)
+
+
+def _run_scene(scene_file: str, result_file: str, record_file: str) -> dict[str, object]:
+    """Run one scene file with its run record (see :func:`_solve`)."""
     record = provenance.start_record(Path(scene_file).stem)
     provenance.write_record(Path(record_file), record)
     start = time.monotonic()
@@ -698,7 +803,7 @@ def summary_row(planned: dict[str, object], outcome: dict[str, object],
 
 
 def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool = True,
-          dry_run: bool = False) -> list[dict[str, object]]:
+          dry_run: bool = False, max_scenes: int | None = None) -> list[dict[str, object]]:
     """Run a parameter sweep file (a scene plus a ``&sweep`` group).
 
     Every scene is written to ``DIRECTORY/scenes/NAME_XXXX.nml`` and checked by the
@@ -719,6 +824,9 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     dry_run : bool
         Only write and check the scenes; return the planned rows (swept values and file
         names), solve nothing, write no summary.
+    max_scenes : int, optional
+        The most scenes allowed (default: ``&sweep max_scenes``, else
+        :data:`MAX_SCENES`); a sweep with more is refused before anything is planned.
 
     Returns
     -------
@@ -734,11 +842,12 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     Raises
     ------
     ValueError
-        A bad ``&sweep`` group (the message names the variable).
+        A bad ``&sweep`` group (the message names the variable), or more scenes than
+        allowed.
     LayercontactError
         A scene the library refuses (the message names the scene file and the variable).
     """
-    return execute(read_sweep(path), processes=processes, progress=progress, dry_run=dry_run)
+    return execute(read_sweep(path, max_scenes), processes=processes, progress=progress, dry_run=dry_run)
 
 
 def failed(rows: list[dict[str, object]]) -> list[dict[str, object]]:

@@ -7,8 +7,10 @@
 module lc_application_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp, i8
-   use lc_base_errors, only: error_type
+   use lc_base_errors, only: error_type, fatal_error, code_input
+   use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
    use lc_scene, only: scene_type, not_set, is_areal, check_scene
+   use lc_leakage_reynolds, only: leakage_memory_check
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
@@ -43,6 +45,8 @@ contains
       call system_clock(start, rate)
       run%input_file = input
       run%started = utc_now()
+      call check_input_file(input, error)
+      if (allocated(error)) return
       call read_scene(input, scene, text, error)
       if (allocated(error)) return
       output_file = trim(scene%output_file)
@@ -72,6 +76,13 @@ contains
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
 
+      ! the leakage runs after the solve, next to the solution's fields (and the companion's):
+      ! a grid whose leakage would not fit ends here, before the solve
+      if (scene%leakage) then
+         call leakage_memory_check(int(scene%n, i8)*max(scene%ny, 1), &
+            & merge(2, 1, scene%companion)*merge(10, 4, scene%stress), error)
+         if (allocated(error)) return
+      end if
       call solve_runs(scene, height, result, companion, error)
       if (allocated(error)) return
       converged = result%converged
@@ -92,6 +103,19 @@ contains
          end if
       end if
    end subroutine run_scene_file
+
+   !> A namelist file that is there must be a regular file: a FIFO would block the read
+   !> until a writer comes (bad input, code 2; a missing file is the reader's to report).
+   subroutine check_input_file(input, error)
+      character(len=*), intent(in) :: input
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: detail
+      integer :: kind
+      call path_kind(input, kind, detail)
+      if (kind /= kind_regular .and. kind /= kind_missing .and. kind /= kind_unknown) &
+         & call fatal_error(error, "namelist file '" // input // "' is " // kind_name(kind) // &
+         & '; allowed: a regular file', code_input)
+   end subroutine check_input_file
 
    !> The largest |dw/dx| of the surface displacement along the sliding direction.
    pure real(wp) function largest_slope(w, scene) result(slope)

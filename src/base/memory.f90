@@ -15,7 +15,7 @@ module lc_base_memory
    use lc_base_strings, only: to_string
    implicit none (type, external)
    private
-   public :: check_memory, solve_bytes, available_bytes
+   public :: check_memory, solve_bytes, available_bytes, leakage_bytes, check_leakage_memory
 
    integer(i8), parameter :: unlimited = huge(1_i8)
    !> Linux's RLIMIT_AS
@@ -110,6 +110,38 @@ contains
          & // gib(needed) // ' GiB, and ' // gib(available) // ' GiB are left under ' // limit // &
          & '; allowed: a smaller grid, or a machine or job with more memory (Slurm: --mem)', code_internal)
    end subroutine check_memory
+
+   !> Bytes the Reynolds leakage of `points` cells needs at its peak: 36 doubles per cell
+   !> (the Fortran arrays, hypre's matrix and BoomerAMG hierarchy; 268 bytes per cell measured
+   !> from 256^2 to 1024^2 with 79 % of the cells open, resident and address space alike) and,
+   !> where MPI does not run yet, the 200 MiB of address space its start maps (196 measured;
+   !> bench/leakage_memory.py).
+   pure integer(i8) function leakage_bytes(points, mpi_started) result(bytes)
+      integer(i8), intent(in) :: points
+      !> whether MPI already runs in this process
+      logical, intent(in) :: mpi_started
+      bytes = 8_i8*36*points
+      if (.not. mpi_started) bytes = bytes + 200_i8*2_i8**20
+   end function leakage_bytes
+
+   !> Error code 5 if the leakage of `points` cells, with `resident` more doubles per cell
+   !> allocated meanwhile (the solution's fields, when checked before the solve), needs more
+   !> than this process may use.
+   subroutine check_leakage_memory(points, resident, mpi_started, error)
+      integer(i8), intent(in) :: points
+      integer, intent(in) :: resident
+      logical, intent(in) :: mpi_started
+      type(error_type), allocatable, intent(out) :: error
+      integer(i8) :: needed, available
+      character(len=:), allocatable :: limit
+      needed = leakage_bytes(points, mpi_started) + 8_i8*resident*points
+      call available_bytes(available, limit)
+      if (needed <= available) return
+      call fatal_error(error, 'not enough memory: the leakage of ' // to_string(points) // ' cells needs about ' &
+         & // gib(needed) // ' GiB, and ' // gib(available) // ' GiB are left under ' // limit // &
+         & '; allowed: a smaller grid, &output leakage = .false., or a machine or job with more memory (Slurm: --mem)', &
+         & code_internal)
+   end subroutine check_leakage_memory
 
    !> Bytes in GiB with one decimal.
    function gib(bytes) result(text)

@@ -14,9 +14,10 @@
 !> (h5open_f/h5close_f) and switches off HDF5's own error printing: failures come back as
 !> `error_type` messages naming the file and the object instead.
 module lc_io_hdf5
-   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_loc, c_size_t
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_char, c_null_char, c_ptr, c_loc, c_size_t
    use hdf5, only: hid_t, hsize_t, size_t, h5kind_to_type, H5_INTEGER_KIND, h5open_f, h5close_f, h5eset_auto_f, &
-      & h5fis_hdf5_f, h5fcreate_f, h5fopen_f, h5fclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5F_CLOSE_STRONG_F, &
+      & h5fis_hdf5_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5fget_filesize_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
+      & H5F_CLOSE_STRONG_F, &
       & h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, H5P_DATASET_CREATE_F, h5pset_chunk_f, &
       & h5pset_deflate_f, &
       & h5gcreate_f, h5gclose_f, h5iget_name_f, &
@@ -33,6 +34,7 @@ module lc_io_hdf5
    use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_leakage_reynolds, only: leakage_result
    use lc_base_version, only: build_isa
+   use lc_io_files, only: sync_path, reserve_space, free_bytes
    implicit none (type, external)
    private
    public :: check_output, write_results, run_record, utc_now
@@ -59,6 +61,7 @@ module lc_io_hdf5
    type :: h5_status
       integer :: hdferr = 0
       character(len=:), allocatable :: object   !< path of the object that failed
+      integer(i8) :: free = -1                  !< bytes free on the file system then (-1: unknown)
    end type h5_status
 
    interface
@@ -95,6 +98,12 @@ module lc_io_hdf5
          import :: c_int, c_char
          character(kind=c_char), intent(in) :: old(*), new(*)
       end function c_link
+      !> Point an open file's descriptor at memory before a close that cannot succeed
+      integer(c_int) function lc_hdf5_discard_file(file) bind(C, name='lc_hdf5_discard_file')
+         import :: c_int, c_int64_t
+         !> hid_t, int64_t in HDF5 1.10
+         integer(c_int64_t), value, intent(in) :: file
+      end function lc_hdf5_discard_file
       !> pid_t getpid(void)
       integer(c_int) function c_getpid() bind(C, name='getpid')
          import :: c_int
@@ -141,14 +150,7 @@ contains
          return
       end if
 
-      k = index(filename, '/', back=.true.)
-      if (k == 0) then
-         parent = '.'
-      else if (k == 1) then
-         parent = '/'
-      else
-         parent = filename(:k - 1)
-      end if
+      parent = parent_of(filename)
       ! mkdir -p: create every prefix; failures for existing prefixes are expected, so the
       ! result is judged once, by whether the parent is now a writable directory.
       do k = 2, len(parent)
@@ -162,12 +164,14 @@ contains
    end subroutine check_output
 
    !> Write a complete, self-describing result file atomically: write a temporary file of
-   !> this run's own (filename.HOST.PID.tmp, so that two runs never share it), close, then
-   !> move it to filename: with &output overwrite by rename (which replaces atomically),
+   !> this run's own (filename.HOST.PID.tmp, so that two runs never share it), with every
+   !> HDF5 call checked; reserve its disk space, close, reopen it (complete?) and fsync it,
+   !> then move it to filename: with &output overwrite by rename (which replaces atomically),
    !> otherwise by link + remove, which never replaces a file that another run wrote
    !> meanwhile (on a file system without hard links: rename after checking that filename
-   !> is still absent). On any failure: delete the temporary file, return error code_io
-   !> naming file and object.
+   !> is still absent). On any failure (a full disk): delete the temporary file, keep the
+   !> file that was there, return error code_io naming the file, the object and the space
+   !> left.
    subroutine write_results(filename, scene, namelist_text, height, result, companion, version, error, run)
       character(len=*), intent(in) :: filename
       type(scene_type), intent(in) :: scene
@@ -186,7 +190,9 @@ contains
       character(len=:), allocatable :: tmp
       type(h5_status) :: st
       integer(hid_t) :: fapl, file, group
+      character(len=:), allocatable :: reason
       integer :: ignore, j, n
+      logical :: synced
 
       n = size(height)
       call check_sizes(result, n, 'result', error)
@@ -248,7 +254,7 @@ contains
          else
             call write_solution(file, result, scene, st)
          end if
-         call h5fclose_f(file, ignore)
+         call close_file(file, tmp, st)
       end if
       call h5pclose_f(fapl, ignore)
       call h5close_f(ignore)
@@ -256,11 +262,121 @@ contains
       if (st%hdferr /= 0) then
          ignore = c_remove(tmp // c_null_char)
          if (.not. allocated(st%object)) st%object = 'the HDF5 library'
-         call fatal_error(error, "cannot write result file '" // filename // "': HDF5 failed at " // st%object, code_io)
+         if (st%free < 0) st%free = free_bytes(parent_of(filename))
+         call fatal_error(error, "cannot write result file '" // filename // "': the write failed at " // &
+            & st%object // space_note(filename, st%free), code_io)
          return
       end if
+      call check_on_disk(tmp, filename, error)
+      if (allocated(error)) return
       call move_into_place(tmp, filename, scene%overwrite, error)
+      if (allocated(error)) return
+      ! the new name on the disk too (a file system that cannot sync a directory has done it)
+      call sync_path(parent_of(filename), .true., synced, reason)
    end subroutine write_results
+
+   !> Close a written file so that none of HDF5's writes can fail: HDF5 1.10 writes the
+   !> metadata it caches when the file closes, and a failed write of it leaves the library
+   !> holding a file it can neither close nor forget (the process then crashes at exit). So
+   !> the disk blocks up to the file's end are reserved first. When they cannot be (a full
+   !> disk), or an earlier write failed, the file is lost anyway and the writes of its close
+   !> go to memory (hdf5_discard.c).
+   subroutine close_file(file, tmp, st)
+      integer(hid_t), intent(in) :: file
+      !> the file's name
+      character(len=*), intent(in) :: tmp
+      type(h5_status), intent(inout) :: st
+      integer(hsize_t) :: size
+      character(len=:), allocatable :: reason
+      integer :: hdferr, ignore
+      logical :: ok
+      if (st%hdferr == 0) then
+         call h5fget_filesize_f(file, size, st%hdferr)
+         if (st%hdferr /= 0) st%object = 'the size of the file'
+      end if
+      if (st%hdferr == 0) then
+         call reserve_space(tmp, int(size, i8), ok, reason)
+         if (.not. ok) then
+            st%hdferr = -1
+            st%object = 'reserving the disk space of its ' // to_string(int(size, i8)) // ' bytes (' // reason // ')'
+         end if
+      end if
+      if (st%hdferr /= 0) then
+         st%free = free_bytes(tmp)
+         ignore = lc_hdf5_discard_file(int(file, c_int64_t))
+      end if
+      call h5fclose_f(file, hdferr)
+      if (st%hdferr == 0 .and. hdferr /= 0) then
+         st%hdferr = hdferr
+         st%object = 'the closing of the file'
+      end if
+   end subroutine close_file
+
+   !> The closed temporary file `tmp` is complete (HDF5 opens it: it refuses a file shorter
+   !> than the end it records) and on the disk (fsync: a file system may accept writes that
+   !> it cannot keep, and say so only here); else it is deleted and the error names
+   !> `filename` and the reason.
+   subroutine check_on_disk(tmp, filename, error)
+      character(len=*), intent(in) :: tmp, filename
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: reason
+      integer(hid_t) :: file
+      integer(i8) :: free
+      integer :: hdferr, ignore
+      logical :: ok
+      call h5open_f(hdferr)
+      call h5eset_auto_f(0, ignore)
+      if (hdferr == 0) call h5fopen_f(tmp, H5F_ACC_RDONLY_F, file, hdferr)
+      if (hdferr == 0) call h5fclose_f(file, hdferr)
+      call h5close_f(ignore)
+      ok = hdferr == 0
+      reason = 'its temporary file does not open as a complete HDF5 file'
+      if (ok) then
+         call sync_path(tmp, .false., ok, reason)
+         if (.not. ok) reason = 'its data did not reach the disk (' // reason // ')'
+      end if
+      if (.not. ok) then
+         free = free_bytes(tmp)
+         ignore = c_remove(tmp // c_null_char)
+         call fatal_error(error, "cannot write result file '" // filename // "': " // reason // &
+            & space_note(filename, free), code_io)
+      end if
+   end subroutine check_on_disk
+
+   !> The end of a write failure's message: the space that was free when it failed (a full
+   !> file system is named so) and whether an older result file is kept.
+   function space_note(filename, free) result(note)
+      character(len=*), intent(in) :: filename
+      !> bytes free on the file system when the write failed (-1: unknown)
+      integer(i8), intent(in) :: free
+      character(len=:), allocatable :: note
+      !> below this, a file system is called full (a few HDF5 chunks)
+      integer(i8), parameter :: nearly_full = 2_i8**20
+      logical :: exists
+      note = ''
+      if (free >= 0 .and. free < nearly_full) then
+         note = '; its file system is full (' // to_string(free) // ' bytes free)'
+      else if (free >= 0) then
+         note = '; ' // to_string(free) // ' bytes were free on its file system'
+      end if
+      inquire (file=filename, exist=exists)
+      if (exists) note = note // '; the file that was there is kept'
+   end function space_note
+
+   !> The directory of `filename` ('.' for a bare name).
+   pure function parent_of(filename) result(parent)
+      character(len=*), intent(in) :: filename
+      character(len=:), allocatable :: parent
+      integer :: k
+      k = index(filename, '/', back=.true.)
+      if (k == 0) then
+         parent = '.'
+      else if (k == 1) then
+         parent = '/'
+      else
+         parent = filename(:k - 1)
+      end if
+   end function parent_of
 
    !> Move the complete temporary file `tmp` to `filename` (see write_results); on failure
    !> `tmp` is deleted and the error names both.
@@ -563,6 +679,15 @@ contains
       call write_attr(loc, name, h5kind_to_type(i8, H5_INTEGER_KIND), c_loc(value), st)
    end subroutine write_attr_int64
 
+   !> Close a written dataset, checked: HDF5 writes the chunks it cached now.
+   subroutine close_dataset(dset, st)
+      integer(hid_t), intent(in) :: dset
+      type(h5_status), intent(inout) :: st
+      integer :: hdferr
+      call h5dclose_f(dset, hdferr)
+      if (st%hdferr == 0) st%hdferr = hdferr
+   end subroutine close_dataset
+
    !> Null-terminated fixed-length string attribute (h5py reads it as bytes).
    subroutine write_attr_string(loc, name, value, st)
       integer(hid_t), intent(in) :: loc
@@ -618,7 +743,7 @@ contains
             call h5dcreate_f(loc, name, stype, space, dset, st%hdferr)
             if (st%hdferr == 0) then
                call h5dwrite_f(dset, stype, value // c_null_char, [1_hsize_t], st%hdferr)
-               call h5dclose_f(dset, ignore)
+               call close_dataset(dset, st)
             end if
             call h5sclose_f(space, ignore)
          end if
@@ -646,7 +771,7 @@ contains
             ! nothing to transfer for an empty history (and no element to point the C call at)
             if (size(values) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, st%hdferr)
             if (st%hdferr == 0) call write_attr_string(dset, 'units', units, st)
-            call h5dclose_f(dset, ignore)
+            call close_dataset(dset, st)
          end if
          call h5sclose_f(space, ignore)
       end if
@@ -684,7 +809,7 @@ contains
             if (st%hdferr == 0) then
                call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, st%hdferr)
                if (st%hdferr == 0) call write_attr_string(dset, 'units', units, st)
-               call h5dclose_f(dset, ignore)
+               call close_dataset(dset, st)
             end if
             call h5pclose_f(dcpl, ignore)
          end if

@@ -41,6 +41,13 @@ static void finish_at_exit(void) {
     if (mpi_started_here && !finalized) MPI_Finalize();
 }
 
+/* 1 if MPI runs in this process (started by a first preconditioner, or by the caller). */
+int lc_hypre_mpi_started(void) {
+    int initialized = 0;
+    MPI_Initialized(&initialized);
+    return initialized;
+}
+
 /* Start MPI (if nobody did) and hypre, once per process; 0 on success. */
 static int start(void) {
     int initialized = 0, provided = 0;

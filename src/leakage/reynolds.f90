@@ -24,10 +24,11 @@ module lc_leakage_reynolds
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, input_error, code_internal
    use lc_base_strings, only: to_string
+   use lc_base_memory, only: check_leakage_memory
    implicit none (type, external)
    private
    public :: leakage_flow, leakage_result, reynolds_leakage, leakage_tol_allowed, leakage_tol_range, &
-      & leakage_max_iter, leakage_solver, smallest_leakage_tol, largest_leakage_tol
+      & leakage_max_iter, leakage_solver, leakage_memory_check, smallest_leakage_tol, largest_leakage_tol
    !> The tolerances allowed for &output leakage_tol (the relative accuracy of k_eff).
    real(wp), parameter :: smallest_leakage_tol = 1.0e-14_wp, largest_leakage_tol = 1.0e-2_wp
    character(len=*), parameter :: leakage_tol_range = '1e-14 <= leakage_tol <= 1e-2'
@@ -79,6 +80,9 @@ module lc_leakage_reynolds
          real(c_double), intent(in) :: value(*)
          real(c_double), value :: strength
       end function lc_hypre_setup_boomeramg
+      integer(c_int) function lc_hypre_mpi_started() bind(C)
+         import :: c_int
+      end function lc_hypre_mpi_started
       integer(c_int) function lc_hypre_apply(r, z) bind(C)
          import :: c_int, c_double
          real(c_double), intent(in) :: r(*)
@@ -116,6 +120,10 @@ contains
             & code_internal)
          return
       end if
+      ! a gap too large for the memory left ends here (code 5), before MPI starts or
+      ! anything is allocated
+      call leakage_memory_check(size(g, kind=i8), 0, error)
+      if (allocated(error)) return
       result%tol = tol
       result%solver = leakage_solver
       hx = lx/nx
@@ -157,6 +165,15 @@ contains
             & prepared, flow, error)
       end subroutine solve_direction
    end subroutine reynolds_leakage
+
+   !> Error code 5 if the leakage of `points` cells, with `resident` more doubles per cell
+   !> allocated meanwhile, needs more memory than this process may use (lc_base_memory).
+   subroutine leakage_memory_check(points, resident, error)
+      integer(i8), intent(in) :: points
+      integer, intent(in) :: resident
+      type(error_type), allocatable, intent(out) :: error
+      call check_leakage_memory(points, resident, lc_hypre_mpi_started() /= 0, error)
+   end subroutine leakage_memory_check
 
    !> True for a tolerance in leakage_tol_range (false for NaN).
    pure logical function leakage_tol_allowed(tol)

@@ -14,7 +14,8 @@
 !>
 !> A line profile is a file of one row or one column: a 1D dataset or array, a 2D one of
 !> shape (1, n) or (n, 1), a text file of one line or of one number per line (what
-!> numpy.savetxt writes for a 1D array). Every height must be finite. Errors name
+!> numpy.savetxt writes for a 1D array). The file must be a regular file (not a FIFO, a
+!> directory or a device). Every height must be finite. Errors name
 !> &profile file and the value found, with code code_io when the file cannot be opened or
 !> read and code_input when its content is not heights.
 module lc_profiles_height_file
@@ -27,6 +28,7 @@ module lc_profiles_height_file
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input, code_io, code_internal
    use lc_base_strings, only: to_string, lower_case
+   use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
    implicit none (type, external)
    private
    public :: read_height_file, named, shape_text
@@ -49,15 +51,23 @@ contains
       !> Heights (L): (nx, ny) of a surface, (n, 1) of a 1D array
       real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
-      integer :: ix, iy
-      logical :: found
+      integer :: ix, iy, kind
+      character(len=:), allocatable :: detail
 
-      ! a file that is not there is bad input (exit 2), from every route; one that is there
-      ! but cannot be read is an I/O failure (4)
-      inquire (file=filename, exist=found)
-      if (.not. found) then
+      ! a file that is not there, or not a regular file (a FIFO would block the read until
+      ! a writer comes, a directory or a device holds no heights), is bad input (exit 2),
+      ! from every route; one that is there but cannot be read is an I/O failure (4)
+      call path_kind(filename, kind, detail)
+      if (kind == kind_missing) then
          call fatal_error(error, named(filename) // ' is not found; allowed: an existing file (HDF5, .npy or ' // &
             & 'text), relative to the working directory', code_input)
+         return
+      else if (kind == kind_unknown) then
+         call fatal_error(error, named(filename) // ' cannot be examined: ' // detail, code_io)
+         return
+      else if (kind /= kind_regular) then
+         call fatal_error(error, named(filename) // ' is ' // kind_name(kind) // '; allowed: a regular file ' // &
+            & '(HDF5, .npy or text)', code_input)
          return
       end if
       if (ends_with(filename, '.h5') .or. ends_with(filename, '.hdf5')) then

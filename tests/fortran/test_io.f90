@@ -326,7 +326,7 @@ contains
       call check(.not. allocated(error), 'write_results succeeds a second time')
 
       call write_results(dir // '/no_such_dir/result.h5', scene, '', height, result, version='x', error=error)
-      call check_error(error, code_io, [character(len=40) :: 'no_such_dir/result.h5', 'HDF5 failed at'], &
+      call check_error(error, code_io, [character(len=40) :: 'no_such_dir/result.h5', 'the write failed at'], &
          & 'write into a missing directory')
       call check(no_temporary_files(dir), 'no temporary file after a failure')
 
