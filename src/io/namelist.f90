@@ -15,22 +15,11 @@ module lc_io_namelist
    use lc_greens_viscoelastic, only: max_prony_terms
    implicit none (type, external)
    private
-   public :: read_scene, read_scene_text, write_scene_namelist, read_prony_file
+   public :: read_scene, read_scene_text, write_scene_namelist, read_prony_file, default_scene
 
-   integer, parameter :: n_groups = 8
-   character(len=*), parameter :: group_names(n_groups) = [character(len=8) :: &
-      & 'scene', 'layer', 'material', 'friction', 'profile', 'loading', 'solver', 'output']
-   !> Variables allowed in each group, in the order of `group_names` (for messages).
-   character(len=*), parameter :: group_variables(n_groups) = [character(len=192) :: &
-      & 'geometry, title, period, n, period_x, period_y, nx, ny', &
-      & 'thickness, young, poisson', &
-      & 'model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, prony_values, prony_file', &
-      & 'coefficient, companion', &
-      & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
-      & 'amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, resample', &
-      & 'control, mean_pressure, normalised_pressure, penetration', &
-      & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose', &
-      & 'file, overwrite, stress, gap_bins, fields, leakage, leakage_tol']
+   ! n_groups, group_names, group_variables and the variables of each type (for messages),
+   ! from the scene schema
+   include 'scene_groups.inc'
 
    character(len=*), parameter :: newline = new_line('a')
    !> The status of a string variable too long for the scene (not an iostat value: those
@@ -124,80 +113,28 @@ contains
       call check_scene(scene, error)
    end subroutine read_scene_text
 
-   !> The scene as a complete namelist text with all eight groups; `read_scene_text` of it
-   !> gives the same scene back (reals are written with 17 significant digits).
+   !> The scene as a complete namelist text with all eight groups and every variable of the
+   !> scene schema; `read_scene_text` of it gives the same scene back (reals are written with
+   !> 17 significant digits, a variable that is not set as a comment).
    subroutine write_scene_namelist(scene, text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable, intent(out) :: text
 
-      associate (p => scene%profile, s => scene%solver)
-         text = '! layercontact scene: every value as parsed (values not given are marked ! not set)' // newline &
-            & // '&scene' // newline &
-            & // entry('geometry', str_value(scene%geometry)) &
-            & // entry('title', str_value(scene%title)) &
-            & // entry('period', real_value(scene%period)) &
-            & // entry('n', to_string(scene%n)) &
-            & // entry('ny', to_string(scene%ny)) &
-            & // entry('period_y', real_value(scene%period_y)) &
-            & // '/' // newline // '&layer' // newline &
-            & // entry('thickness', real_value(scene%thickness)) &
-            & // entry('young', real_value(scene%young)) &
-            & // entry('poisson', real_value(scene%poisson)) &
-            & // '/' // newline // '&material' // newline &
-            & // entry('model', str_value(scene%material%model)) &
-            & // entry('e0', real_value(scene%material%e0)) &
-            & // entry('e_inf', real_value(scene%material%e_inf)) &
-            & // entry('tau', real_value(scene%material%tau)) &
-            & // entry('speed', real_value(scene%speed)) &
-            & // entry('prony_form', str_value(scene%material%form)) &
-            & // entry('prony_equilibrium', real_value(scene%material%equilibrium)) &
-            & // prony_entries(scene%material%times, scene%material%values) &
-            & // '/' // newline // '&friction' // newline &
-            & // entry('coefficient', real_value(scene%friction)) &
-            & // entry('companion', logical_value(scene%companion)) &
-            & // '/' // newline // '&profile' // newline &
-            & // entry('kind', str_value(p%kind)) &
-            & // entry('hurst', real_value(p%hurst)) &
-            & // entry('seed', to_string(p%seed)) &
-            & // entry('rolloff_wavelength', real_value(p%rolloff_wavelength)) &
-            & // entry('short_wavelength', real_value(p%short_wavelength)) &
-            & // entry('rms_gradient', real_value(p%rms_gradient)) &
-            & // entry('rms_height', real_value(p%rms_height)) &
-            & // entry('amplitude', real_value(p%amplitude)) &
-            & // entry('mode', to_string(p%mode)) &
-            & // entry('mode_y', to_string(p%mode_y)) &
-            & // entry('radius', real_value(p%radius)) &
-            & // entry('file', str_value(p%file)) &
-            & // entry('dataset', str_value(p%dataset)) &
-            & // entry('detrend', str_value(p%detrend)) &
-            & // entry('boundary', str_value(p%boundary)) &
-            & // entry('resample', str_value(p%resample)) &
-            & // '/' // newline // '&loading' // newline &
-            & // entry('control', str_value(scene%control)) &
-            & // entry('mean_pressure', real_value(scene%mean_pressure)) &
-            & // entry('normalised_pressure', real_value(scene%normalised_pressure)) &
-            & // entry('penetration', real_value(scene%penetration)) &
-            & // '/' // newline // '&solver' // newline &
-            & // entry('method', str_value(s%method)) &
-            & // entry('tol', real_value(s%tol)) &
-            & // entry('max_iter', to_string(s%max_iter)) &
-            & // entry('memory', to_string(s%memory)) &
-            & // entry('precondition', logical_value(s%precondition)) &
-            & // entry('coarse_start', logical_value(s%coarse_start)) &
-            & // entry('threads', to_string(s%threads)) &
-            & // entry('target_error', real_value(s%target_error)) &
-            & // entry('verbose', logical_value(s%verbose)) &
-            & // '/' // newline // '&output' // newline &
-            & // entry('file', str_value(scene%output_file)) &
-            & // entry('overwrite', logical_value(scene%overwrite)) &
-            & // entry('stress', logical_value(scene%stress)) &
-            & // entry('gap_bins', to_string(scene%gap_bins)) &
-            & // entry('fields', logical_value(scene%fields)) &
-            & // entry('leakage', logical_value(scene%leakage)) &
-            & // entry('leakage_tol', real_value(scene%leakage_tol)) &
-            & // '/' // newline
-      end associate
+      include 'scene_namelist_writer.inc'
    end subroutine write_scene_namelist
+
+   !> The default scene of a geometry ('line' or 'areal': its grid of
+   !> default_areal_n x default_areal_n points), as a file that sets only the geometry
+   !> reads it (not checked: a default scene has no load).
+   pure function default_scene(geometry) result(scene)
+      character(len=*), intent(in) :: geometry
+      type(scene_type) :: scene
+      scene%geometry = geometry
+      if (trim(geometry) == 'areal') then
+         scene%n = default_areal_n
+         scene%ny = default_areal_n
+      end if
+   end function default_scene
 
    !> Read one group from its piece of text (one record per line); on failure `line` is the
    !> line within the piece of the entry that failed.
@@ -279,9 +216,6 @@ contains
    logical function wrong_type(code, msg)
       character(len=*), intent(in) :: code   !< one line, lower case, without its comment
       character(len=*), intent(inout) :: msg
-      character(len=*), parameter :: reals = ' period period_x period_y thickness young poisson e0 e_inf tau ' // &
-         & 'speed prony_equilibrium coefficient hurst rolloff_wavelength short_wavelength rms_gradient rms_height ' // &
-         & 'amplitude radius mean_pressure normalised_pressure penetration tol target_error leakage_tol '
       character(len=:), allocatable :: name, value, kind
       integer :: k, stat
       integer(i8) :: as_integer   ! (the widest integer variable, &profile seed)
@@ -298,7 +232,7 @@ contains
          read (value, *, iostat=stat) as_logical
       else if (kind(1:4) == 'an i') then
          read (value, *, iostat=stat) as_integer
-      else if (index(reals, ' ' // name // ' ') > 0) then
+      else if (index(real_variables, ' ' // name // ' ') > 0) then
          read (value, *, iostat=stat) as_real
       else
          return
@@ -312,15 +246,11 @@ contains
    pure function value_kind(name) result(kind)
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: kind
-      character(len=*), parameter :: integers = ' n nx ny seed mode mode_y max_iter memory threads gap_bins '
-      character(len=*), parameter :: logicals = ' companion precondition coarse_start verbose overwrite stress fields leakage '
-      character(len=*), parameter :: strings = ' geometry title model prony_form prony_file kind file dataset ' // &
-         & 'detrend boundary resample control method '
-      if (index(integers, ' ' // name // ' ') > 0) then
+      if (index(integer_variables, ' ' // name // ' ') > 0) then
          kind = 'an integer (no decimal point or exponent)'
-      else if (index(logicals, ' ' // name // ' ') > 0) then
+      else if (index(logical_variables, ' ' // name // ' ') > 0) then
          kind = '.true. or .false.'
-      else if (index(strings, ' ' // name // ' ') > 0) then
+      else if (index(string_variables, ' ' // name // ' ') > 0) then
          kind = "a quoted string ('...')"
       else
          kind = 'a number (e.g. 0.16 or 1.6e-1)'
@@ -946,35 +876,23 @@ contains
          write (buffer, '(es24.16e3)') x
          s = trim(adjustl(buffer))
       end if
-      if (x == not_set) s = s // '  ! not set'
    end function real_value
 
-   !> The Prony terms as `prony_times = ...` and `prony_values = ...` (nothing if none); the
-   !> echo carries the terms themselves, never the file they came from.
-   pure function prony_entries(times, values) result(s)
-      real(wp), allocatable, intent(in) :: times(:), values(:)
+   !> A list variable as `name = v1, v2, ...` (nothing if it has no entries).
+   pure function list_entry(name, values) result(s)
+      character(len=*), intent(in) :: name
+      real(wp), allocatable, intent(in) :: values(:)
       character(len=:), allocatable :: s
       integer :: i
       s = ''
-      if (allocated(times)) then
-         if (size(times) > 0) then
-            s = '   prony_times = ' // real_value(times(1))
-            do i = 2, size(times)
-               s = s // ', ' // real_value(times(i))
-            end do
-            s = s // newline
-         end if
-      end if
-      if (allocated(values)) then
-         if (size(values) > 0) then
-            s = s // '   prony_values = ' // real_value(values(1))
-            do i = 2, size(values)
-               s = s // ', ' // real_value(values(i))
-            end do
-            s = s // newline
-         end if
-      end if
-   end function prony_entries
+      if (.not. allocated(values)) return
+      if (size(values) == 0) return
+      s = '   ' // name // ' = ' // real_value(values(1))
+      do i = 2, size(values)
+         s = s // ', ' // real_value(values(i))
+      end do
+      s = s // newline
+   end function list_entry
 
    !> A quoted string, inner apostrophes doubled.
    pure function str_value(word) result(s)
