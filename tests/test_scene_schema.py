@@ -3,8 +3,10 @@ variables: the library reads exactly its variables, the generated docs table is 
 and its columns are complete."""
 
 import re
+import shutil
 import subprocess
 import sys
+import sysconfig
 from pathlib import Path
 
 import pytest
@@ -13,6 +15,8 @@ import layercontact as lc
 from layercontact import scene_schema as schema
 
 ROOT = Path(__file__).resolve().parent.parent
+# the executable installed with the package that runs the tests
+EXECUTABLE = shutil.which("layercontact", path=sysconfig.get_path("scripts")) or "layercontact"
 
 
 def test_the_docs_table_is_current():
@@ -123,7 +127,7 @@ def results(tmp_path_factory):
     out = {}
     for name, text in SCENES.items():
         (directory / f"{name}.nml").write_text(text)
-        done = subprocess.run([str(ROOT / ".venv" / "bin" / "layercontact"), f"{name}.nml"], cwd=directory,
+        done = subprocess.run([EXECUTABLE, f"{name}.nml"], cwd=directory,
                               capture_output=True, text=True)
         assert done.returncode in (0, 3), done.stderr
         with h5py.File(directory / f"{name}.h5") as f:
@@ -178,9 +182,9 @@ def test_namelist_input_keywords_give_the_same_scene(results, name):
 def test_the_defaults_are_the_schemas(tmp_path):
     """`layercontact --defaults` prints every variable of the schema (the aliases aside),
     with the schema's default; the areal scene differs in its geometry and grid only."""
-    line = subprocess.run([str(ROOT / ".venv" / "bin" / "layercontact"), "--defaults"], capture_output=True,
+    line = subprocess.run([EXECUTABLE, "--defaults"], capture_output=True,
                           text=True, check=True).stdout
-    areal = subprocess.run([str(ROOT / ".venv" / "bin" / "layercontact"), "--defaults", "areal"],
+    areal = subprocess.run([EXECUTABLE, "--defaults", "areal"],
                            capture_output=True, text=True, check=True).stdout
     assert line == lc.default_scene() and areal == lc.default_scene("areal")
     values = {}
@@ -229,3 +233,43 @@ def test_the_python_keywords_are_scene_variables():
         assert set(names) - {"material", "method", "progress"} <= set(schema.by_key()), function
     assert list(lc.sweep.__globals__["PARAMETERS"]) == [
         "friction", "normalised_pressure", "mean_pressure", "thickness", "poisson", "speed", "hurst", "n", "seed"]
+
+
+def _outside(variable) -> list[str]:
+    """Values just outside a variable's interval (as namelist text), or a word not among
+    its choices."""
+    if variable.choices is not None:
+        return ["'none_of_them'"]
+    bounds = [part.strip() for part in variable.interval[1:-1].split(",")]
+    closed = (variable.interval[0] == "[", variable.interval[-1] == "]")
+    values = []
+    for bound, is_closed, step in ((bounds[0], closed[0], -1), (bounds[1], closed[1], 1)):
+        if bound == "inf":
+            if not is_closed:
+                values.append("Inf")
+        elif not is_closed:
+            values.append(bound)   # an open end is itself outside
+        elif variable.type == "integer":
+            values.append(str(int(float(bound)) + step))
+        else:
+            x = float(bound)
+            values.append(repr(x + step * abs(x) * 1e-9) if x else repr(step * 1e-300))
+    return values
+
+
+@pytest.mark.parametrize("variable", [v for v in schema.VARIABLES if v.interval or v.choices],
+                         ids=lambda v: v.name)
+def test_values_outside_the_schemas_range_are_refused(variable, tmp_path):
+    """Each variable with an interval or a list of words in the schema: a value just outside
+    is refused with the schema's `allowed` text and the exit code of bad input."""
+    nml = tmp_path / "scene.nml"
+    load = "&loading normalised_pressure = 0.5 /\n" if variable.group != "loading" else ""
+    values = _outside(variable)
+    assert values
+    for value in values:
+        nml.write_text(f"{load}&{variable.group} {variable.name} = {value} /\n")
+        with pytest.raises(lc.InputError) as err:
+            lc.check_scene_file(nml)
+        assert f"&{variable.group}: {variable.name} = " in str(err.value), (value, str(err.value))
+        assert str(err.value).endswith(f"is not allowed; allowed: {variable.allowed}"), value
+        assert err.value.code == 2

@@ -174,10 +174,133 @@ def input_writer(schema) -> str:
     return "\n".join(out) + "\n"
 
 
+_DECLARATION = {"real": "real(wp)", "integer": "integer", "integer8": "integer(i8)", "logical": "logical",
+                "string": "character(len=max_string + 1)", "reals": "real(wp)"}
+
+
+def _hooked(v) -> bool:
+    """Read through the group's hooks (before_GROUP, after_GROUP in lc_io_namelist), not
+    copied: the grid's variables and the lists."""
+    return v.read == "hook" or v.type == "reals"
+
+
+def group_readers(schema) -> str:
+    """One reader per group, and read_named_group that calls the one of a group. Each
+    declares the group's variables locally, starts them from the scene (so the defaults stay
+    in scene_type), reads, refuses strings longer than the scene keeps and copies them back;
+    a group with hooked variables calls before_GROUP and after_GROUP for them. The dummy is
+    called `config` because a namelist group may not share a local's name."""
+    out = ["   !> Read the namelist group `name` from `lines` into `config` (stat, msg: as a namelist read).",
+           "   subroutine read_named_group(name, lines, config, stat, msg)",
+           "      character(len=*), intent(in) :: name",
+           "      character(len=*), intent(in) :: lines(:)",
+           "      type(scene_type), intent(inout) :: config",
+           "      integer, intent(out) :: stat",
+           "      character(len=*), intent(inout) :: msg",
+           "      stat = 0",
+           "      select case (name)"]
+    for group in schema.GROUPS:
+        out += [f"      case ('{group}')", f"         call read_group_{group}(lines, config, stat, msg)"]
+    out += ["      end select", "   end subroutine read_named_group", ""]
+    for group in schema.GROUPS:
+        variables = schema.group_variables(group)
+        hooked = [v.name for v in variables if _hooked(v)]
+        out += [f"   subroutine read_group_{group}(lines, config, stat, msg)",
+                "      character(len=*), intent(in) :: lines(:)",
+                "      type(scene_type), intent(inout) :: config",
+                "      integer, intent(out) :: stat",
+                "      character(len=*), intent(inout) :: msg"]
+        for v in variables:
+            shape = "(max_prony_terms)" if v.type == "reals" else ""
+            out.append(f"      {_DECLARATION[v.type]} :: {v.name}{shape}")
+        out.append(f"      namelist /{group}/ " + _continued([v.name for v in variables], "         & ")
+                   .replace(" // ", ", "))
+        out.append("")
+        for v in variables:
+            if not _hooked(v):
+                out.append(f"      {v.name} = {v.fortran.replace('scene%', 'config%', 1)}")
+        if hooked:
+            out.append(f"      call before_{group}(config, {', '.join(hooked)})")
+        out += [f"      read (lines, nml={group}, iostat=stat, iomsg=msg)", "      if (stat /= 0) return"]
+        for v in variables:
+            if v.type == "string":
+                out.append(f"      if (too_long('{v.name}', {v.name}, stat, msg)) return")
+        for v in variables:
+            if not _hooked(v):
+                # (a string is read one character longer than the scene keeps: too_long)
+                value = f"{v.name}(:max_string)" if v.type == "string" else v.name
+                out.append(f"      {v.fortran.replace('scene%', 'config%', 1)} = {value}")
+        if hooked:
+            # a list may have gaps, which its group's hook refuses (stat, msg)
+            fails = ", stat, msg" if any(v.type == "reals" for v in variables) else ""
+            out.append(f"      call after_{group}(config, {', '.join(hooked)}{fails})")
+        out += [f"   end subroutine read_group_{group}", ""]
+    return "\n".join(out)
+
+
+def _fortran_number(text: str, integer: bool) -> str:
+    return str(int(float(text))) if integer else repr(float(text)) + "_wp"
+
+
+def _wrapped(line: str, indent: str = "         & ") -> str:
+    """A Fortran line of at most ~110 columns, broken after its logical operators."""
+    if len(line) <= 110:
+        return line
+    out, current = [], ""
+    for piece in line.replace(" .and. ", " .and.\0").replace(" .or. ", " .or.\0").split("\0"):
+        if current and len(current) + len(piece) > 100:
+            out.append(current)
+            current = ""
+        current += (" " if current else "") + piece
+    out.append(current)
+    return (" &\n" + indent).join(out)
+
+
+def _interval_test(v) -> str:
+    """The Fortran test that the variable lies in its interval ('(0, inf)': > 0 and finite)."""
+    low, high = (part.strip() for part in v.interval[1:-1].split(","))
+    integer = v.type in ("integer", "integer8")
+    tests = []
+    if low != "-inf":
+        tests.append(f"{v.fortran} {'>=' if v.interval[0] == '[' else '>'} {_fortran_number(low, integer)}")
+    if high == "inf":
+        if v.interval[-1] == ")":
+            tests.append(f"ieee_is_finite({v.fortran})")
+    else:
+        tests.append(f"{v.fortran} {'<=' if v.interval[-1] == ']' else '<'} {_fortran_number(high, integer)}")
+    return " .and. ".join(tests)
+
+
+def range_checks(schema) -> str:
+    """The body of check_ranges (lc_scene): every variable's interval or choices, in the
+    table's order, the first failure reported with the schema's `allowed` text."""
+    out = []
+    for v in schema.VARIABLES:
+        if v.alias_of is not None or (v.interval is None and v.choices is None):
+            continue
+        if v.choices is not None:
+            words = ", ".join(f"'{w}'" for w in v.choices)
+            test = f"one_of({v.fortran}, [character(len={max(map(len, v.choices))}) :: &\n         & {words}])"
+            shown = f"trim({v.fortran})"
+        else:
+            test = _interval_test(v)
+            shown = f"to_string({v.fortran})"
+        if v.unset is not None:
+            test = f"{v.fortran} == {v.unset} .or. ({test})"
+        out += [_wrapped(f"      if (.not. ({test})) then"),
+                f"         call input_error(error, '{v.group}', '{v.name}', {shown}, &",
+                f"            & {_fortran_string(v.allowed)})",
+                "         return",
+                "      end if"]
+    return "\n".join(out) + "\n"
+
+
 FORTRAN_FILES = {
     "scene_groups.inc": group_lists,
     "scene_namelist_writer.inc": namelist_writer,
     "scene_input_writer.inc": input_writer,
+    "scene_readers.inc": group_readers,
+    "scene_checks.inc": range_checks,
 }
 
 

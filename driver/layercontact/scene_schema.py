@@ -11,6 +11,14 @@ contacts use it (lines, surfaces or both) and its meaning, and where it lives:
 - ``unset``: the Fortran value that marks "not given" (None: the variable always has a
   value); a variable that is not given is absent from ``/input``;
 - ``alias_of``: another name of that variable (``period_x`` for ``period``);
+- ``read``: ``'copy'`` (the reader copies it between the scene and the namelist) or
+  ``'hook'`` (the group's hand-written hooks in ``lc_io_namelist`` set it up and take it
+  over: the grid's variables); lists always go through the hooks;
+- ``interval`` (numbers) or ``choices`` (words): the values allowed whatever the other
+  variables, checked by ``check_scene`` (``lc_scene``) with ``allowed`` as the message:
+  ``'(0, inf)'`` is ``> 0 and finite``, ``'(0, inf]'`` admits ``Inf``, ``'[a, b]'``
+  includes both ends; a variable that is not set is not checked. Ranges that depend on
+  other variables stay code there;
 - ``echo``: False for a variable whose values the scene holds under other names (a Prony
   file's terms): the scene written back as text gives those, and this one as a comment.
 
@@ -39,8 +47,6 @@ TYPE_WORDS = {
     "string": "a quoted string ('...')",
 }
 
-#: The units of /input: L and S are the input's length and stress units, T its time unit.
-UNIT_WORDS = {"L": "length", "S": "stress", "T": "time", "1": "dimensionless", "": "none (a word, a flag, a count)"}
 
 
 @dataclass(frozen=True)
@@ -61,6 +67,9 @@ class Variable:
     unset: str | None = None
     alias_of: str | None = None
     echo: bool = True
+    read: str = "copy"
+    interval: str | None = None
+    choices: tuple[str, ...] | None = None
 
     @property
     def result_name(self) -> str:
@@ -74,29 +83,32 @@ _NOT_SET = "not_set"
 VARIABLES: tuple[Variable, ...] = (
     # &scene
     Variable("scene", "geometry", "string", "'line'", "", "both", "'line' or 'areal'",
-             "a line contact or an areal (surface) contact", "scene%geometry"),
+             "a line contact or an areal (surface) contact", "scene%geometry", choices=("line", "areal")),
     Variable("scene", "title", "string", "''", "", "both", "free text", "free text, echoed", "scene%title"),
     Variable("scene", "period", "real", "1.0", "L", "both", "> 0 and finite",
-             "period `lambda` along `x`, the sliding direction (also `period_x`)", "scene%period"),
+             "period `lambda` along `x`, the sliding direction (also `period_x`)", "scene%period",
+             read="hook", interval="(0, inf)"),
     Variable("scene", "period_x", "real", "`period`", "L", "both", "> 0 and finite",
-             "the same as `period`", "scene%period", alias_of="period"),
+             "the same as `period`", "scene%period", alias_of="period", read="hook"),
     Variable("scene", "period_y", "real", "`period`", "L", "areal", "> 0 and finite", "period along `y`",
-             "scene%period_y", unset=_NOT_SET),
+             "scene%period_y", unset=_NOT_SET, interval="(0, inf)"),
     Variable("scene", "n", "integer", "`4096` (line), `256` (areal); a profile file's size", "", "both",
              "line: 8 to 2^26; areal: 4 to 65536",
              "grid points per period (line: odd allowed; areal: `nx = ny = n`); with `&profile kind = 'file'` "
              "and none of `n`, `nx`, `ny` given, the file's size (twice it with `boundary = 'mirror'`)",
-             "scene%n", sweep=8),
+             "scene%n", sweep=8, read="hook"),
     Variable("scene", "nx", "integer", "`n`", "", "areal", "4 to 65536, `nx*ny` at most 2^28",
-             "grid points along `x` (the same as `n`)", "scene%n", alias_of="n"),
-    Variable("scene", "ny", "integer", "`n` (areal), 1 (line)", "", "areal", "4 to 65536, `nx*ny` at most 2^28",
-             "grid points along `y`", "scene%ny"),
+             "grid points along `x` (the same as `n`)", "scene%n", alias_of="n", read="hook"),
+    Variable("scene", "ny", "integer", "`n` (areal), 1 (line)", "", "areal",
+             "4 to 65536, `nx*ny` at most 2^28",
+             "grid points along `y`", "scene%ny", read="hook"),
     # &layer
     Variable("layer", "thickness", "real", "Inf", "L", "both", "> 0, or Inf for a half-space",
-             "`h`; `Inf` for a half-space (the default)", "scene%thickness", sweep=4),
-    Variable("layer", "young", "real", "1.0", "S", "both", "> 0 and finite", "Young's modulus `E`", "scene%young"),
+             "`h`; `Inf` for a half-space (the default)", "scene%thickness", sweep=4, interval="(0, inf]"),
+    Variable("layer", "young", "real", "1.0", "S", "both", "> 0 and finite", "Young's modulus `E`",
+             "scene%young", interval="(0, inf)"),
     Variable("layer", "poisson", "real", "0.5", "1", "both", "-1 < poisson <= 0.5", "Poisson's ratio `nu`",
-             "scene%poisson", sweep=5),
+             "scene%poisson", sweep=5, interval="(-1, 0.5]"),
     # &material
     Variable("material", "model", "string", "'elastic'", "", "both", "'elastic', 'sls' or 'prony'",
              "the material law: `'elastic'` (uses `young`), `'sls'` or `'prony'`", "scene%material%model",
@@ -107,8 +119,8 @@ VARIABLES: tuple[Variable, ...] = (
              "`'sls'`: high-frequency (glassy) modulus", "scene%material%e_inf", unset="-1.0_wp"),
     Variable("material", "tau", "real", "not set", "T", "both", "> 0 and finite", "`'sls'`: retardation time",
              "scene%material%tau", unset="-1.0_wp"),
-    Variable("material", "speed", "real", "0.0", "L/T", "both", ">= 0 and finite (0 with model = 'elastic')",
-             "sliding speed `V`", "scene%speed", sweep=6),
+    Variable("material", "speed", "real", "0.0", "L/T", "both", ">= 0 and finite",
+             "sliding speed `V` (0 with `model = 'elastic'`)", "scene%speed", sweep=6, interval="[0, inf)"),
     Variable("material", "prony_form", "string", "'relaxation'", "", "both", "'relaxation' or 'creep'",
              "`'relaxation'`: `E(t) = E_r + sum E_i exp(-t/tau_i)`; `'creep'`: "
              "`J(t) = J_g + sum J_i (1 - exp(-t/tau_i))`", "scene%material%form"),
@@ -126,7 +138,8 @@ VARIABLES: tuple[Variable, ...] = (
              "the result holds the terms it gave", "scene%prony_file", echo=False),
     # &friction
     Variable("friction", "coefficient", "real", "0.0", "1", "both", "0 <= coefficient <= 10",
-             "Coulomb friction coefficient `mu_c`", "scene%friction", key="friction", sweep=1),
+             "Coulomb friction coefficient `mu_c`", "scene%friction", key="friction", sweep=1,
+             interval="[0, 10]"),
     Variable("friction", "companion", "logical", ".false.", "", "both", ".true. or .false.",
              "also solve the frictionless companion at the same load (for `a/a0`): the scene's load, or under "
              "displacement control the load its solve found", "scene%companion"),
@@ -134,10 +147,12 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("profile", "kind", "string", "'self_affine'", "", "both",
              "'self_affine', 'sinusoid', 'file'; areal also 'sphere'", "how the rigid profile is made",
              "scene%profile%kind", key="profile_kind"),
-    Variable("profile", "hurst", "real", "0.8", "1", "both", "0 < hurst < 1", "self-affine: Hurst exponent `H`",
+    Variable("profile", "hurst", "real", "0.8", "1", "both", "0 < hurst < 1",
+             "self-affine: Hurst exponent `H`",
              "scene%profile%hurst", sweep=7),
     Variable("profile", "seed", "integer8", "1", "", "both", ">= 0",
-             "self-affine: SplitMix64 seed (same seed, same profile in Fortran and Python)", "scene%profile%seed",
+             "self-affine: SplitMix64 seed (same seed, same profile in Fortran and Python)",
+             "scene%profile%seed",
              sweep=9),
     Variable("profile", "rolloff_wavelength", "real", "`period`", "L", "both",
              "0 < rolloff_wavelength <= period (areal: max(period, period_y))",
@@ -145,7 +160,8 @@ VARIABLES: tuple[Variable, ...] = (
              unset=_NOT_SET),
     Variable("profile", "short_wavelength", "real", "`period`/128", "L", "both",
              "at least 2 grid spacings, at most the period",
-             "self-affine: no roughness below this wavelength", "scene%profile%short_wavelength", unset=_NOT_SET),
+             "self-affine: no roughness below this wavelength", "scene%profile%short_wavelength",
+             unset=_NOT_SET),
     Variable("profile", "rms_gradient", "real", "not set (then 0.1 unless rms_height is given)", "1", "both",
              "> 0 and finite; at most one of rms_gradient and rms_height",
              "self-affine: the scale as the rms gradient of the heights", "scene%profile%rms_gradient",
@@ -155,7 +171,8 @@ VARIABLES: tuple[Variable, ...] = (
              "self-affine: the scale as the rms height", "scene%profile%rms_height", unset=_NOT_SET),
     Variable("profile", "amplitude", "real", "not set", "L", "both", "> 0 and finite",
              "sinusoid: `amplitude cos(2 pi mode x/lambda)`", "scene%profile%amplitude", unset=_NOT_SET),
-    Variable("profile", "mode", "integer", "1", "", "both", "line: 1 <= mode <= (n-1)/2; areal: 0 to (nx-1)/2",
+    Variable("profile", "mode", "integer", "1", "", "both",
+             "line: 1 <= mode <= (n-1)/2; areal: 0 to (nx-1)/2",
              "sinusoid: wavenumber along `x` (periods per cell)", "scene%profile%mode"),
     Variable("profile", "mode_y", "integer", "0", "", "areal", "|mode_y| <= (ny-1)/2, not 0 with mode = 0",
              "sinusoid on a surface: `amplitude cos(2 pi (mode x/period_x + mode_y y/period_y))`",
@@ -176,7 +193,8 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("profile", "boundary", "string", "'periodic'", "", "both",
              "'periodic' or 'mirror'; not set unless kind = 'file'",
              "file: `'periodic'` (the file is one period) or `'mirror'` (a non-periodic patch and its mirror "
-             "images: `period`, `n` are twice the patch's)", "scene%profile%boundary", key="profile_boundary"),
+             "images: `period`, `n` are twice the patch's)", "scene%profile%boundary",
+             key="profile_boundary"),
     Variable("profile", "resample", "string", "'none'", "", "both",
              "'none' or 'fourier'; not set unless kind = 'file'",
              "file: `'none'` (the file has the grid's size) or `'fourier'` (Fourier interpolation/truncation "
@@ -184,7 +202,7 @@ VARIABLES: tuple[Variable, ...] = (
     # &loading
     Variable("loading", "control", "string", "'load'", "", "both", "'load' or 'displacement'",
              "load control (give `mean_pressure` or `normalised_pressure`) or displacement control "
-             "(give `penetration`)", "scene%control"),
+             "(give `penetration`)", "scene%control", choices=("load", "displacement")),
     Variable("loading", "mean_pressure", "real", "not set", "S", "both",
              "> 0 and finite; exactly one of mean_pressure and normalised_pressure with control = 'load'",
              "the mean pressure `p_m`", "scene%mean_pressure", sweep=3, unset=_NOT_SET),
@@ -195,7 +213,8 @@ VARIABLES: tuple[Variable, ...] = (
              "except on an areal scene on a layer: `p_s = E* h/lambda`; `E*` with the static modulus; "
              "`/input@normalised_pressure_scale` names the one a result used",
              "scene%normalised_pressure", sweep=2, unset=_NOT_SET),
-    Variable("loading", "penetration", "real", "not set", "L", "both", "> 0 and finite with control = 'displacement'",
+    Variable("loading", "penetration", "real", "not set", "L", "both",
+             "> 0 and finite with control = 'displacement'",
              "`Delta`, displacement control (and only then)", "scene%penetration", unset=_NOT_SET),
     # &solver
     Variable("solver", "method", "string", "'auto'", "", "both",
@@ -203,25 +222,28 @@ VARIABLES: tuple[Variable, ...] = (
              "the solver; `'auto'` chooses (see [numerics.md](numerics.md)); `'cg'` (symmetric scenes only), "
              "`'gcr'`, `'anderson'`, `'gfmd'` (damped dynamics), `'newton'` (dense semismooth Newton, grids of at "
              "most 2048 points) or `'multigrid'` (nonsmooth Newton multigrid; where it applies, "
-             "docs/decisions/009 to 015)", "scene%solver%method", key="solver_method"),
+             "docs/decisions/009 to 015)", "scene%solver%method", key="solver_method", choices=("auto", "cg",
+             "gcr", "anderson", "gfmd", "newton", "multigrid")),
     Variable("solver", "tol", "real", "1e-10", "1", "both", "1e-14 <= tol <= 1e-2",
-             "tolerance on the complementarity residual", "scene%solver%tol"),
+             "tolerance on the complementarity residual", "scene%solver%tol", interval="[1e-14, 1e-2]"),
     Variable("solver", "max_iter", "integer", "100000", "", "both", "1 <= max_iter <= 10000000",
              "budget of CG or GCR iterations (Anderson: all inner CG iterations together; gfmd, newton, "
-             "multigrid: their steps)", "scene%solver%max_iter"),
+             "multigrid: their steps)", "scene%solver%max_iter", interval="[1, 10000000]"),
     Variable("solver", "memory", "integer", "12", "", "both", "1 <= memory <= 100",
-             "history length of GCR (directions kept) and of the Anderson mixing", "scene%solver%memory"),
+             "history length of GCR (directions kept) and of the Anderson mixing", "scene%solver%memory",
+             interval="[1, 100]"),
     Variable("solver", "precondition", "logical", ".true.", "", "both", ".true. or .false.",
              "Fourier-preconditioned CG", "scene%solver%precondition"),
     Variable("solver", "coarse_start", "logical", ".true.", "", "both", ".true. or .false.",
              "start from the solution on the grid of every second point (recursively, down to 512)",
              "scene%solver%coarse_start"),
     Variable("solver", "threads", "integer", "1", "", "both", "1 <= threads <= 1024",
-             "FFTW threads (build with `-Dopenmp=true`)", "scene%solver%threads"),
-    Variable("solver", "target_error", "real", "not set", "1", "both", "1e-4 <= target_error <= 0.3",
+             "FFTW threads (build with `-Dopenmp=true`)", "scene%solver%threads", interval="[1, 1024]"),
+    Variable("solver", "target_error", "real", "not set", "1", "both",
+             "1e-4 <= target_error <= 0.3 (the rule was measured for 1e-3 .. 1e-1)",
              "instead of `n` (`nx`, `ny`) and `tol`: the accuracy rule picks them (see "
              "[accuracy.md](accuracy.md)); generated rough profiles only", "scene%solver%target_error",
-             unset=_NOT_SET),
+             unset=_NOT_SET, interval="[1e-4, 0.3]"),
     Variable("solver", "verbose", "logical", ".false.", "", "both", ".true. or .false.",
              "progress on standard error: a line per grid level solved and every 2 s within one; Python: "
              "`progress=True`", "scene%solver%verbose"),
@@ -234,7 +256,7 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("output", "stress", "logical", ".true.", "", "both", ".true. or .false.",
              "compute the in-plane surface fields (displacements, shear, surface stresses)", "scene%stress"),
     Variable("output", "gap_bins", "integer", "64", "", "both", "0 <= gap_bins <= 100000",
-             "bins of the gap histogram (0: none)", "scene%gap_bins"),
+             "bins of the gap histogram (0: none)", "scene%gap_bins", interval="[0, 100000]"),
     Variable("output", "fields", "logical", ".true.", "", "both", ".true. or .false.",
              "write the maps (`/profile` and `/fields`); `.false.`: scalars, histograms, spots and patches only",
              "scene%fields"),

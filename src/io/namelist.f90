@@ -2,9 +2,12 @@
 !> &friction, &profile, &loading, &solver, &output) -> `scene_type`, and back (`write_scene_namelist`).
 !>
 !> Defaults live only in `scene_type`: each group is read into local variables that start
-!> from the scene's current (default) values. A Fortran namelist read silently skips groups
-!> it does not know, so the text is pre-scanned for `&name` tokens first; unknown or
-!> repeated groups are errors that name the line.
+!> from the scene's current (default) values. The group readers, the writer and the lists
+!> of variables in messages are generated from the scene schema
+!> (driver/layercontact/scene_schema.py, tools/scene_codegen.py) as include files; the
+!> hooks of the grid's variables and of the Prony terms are here. A Fortran namelist read
+!> silently skips groups it does not know, so the text is pre-scanned for `&name` tokens
+!> first; unknown or repeated groups are errors that name the line.
 module lc_io_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
@@ -157,24 +160,7 @@ contains
             return
          end if
       end do
-      select case (trim(group_names(group)))
-      case ('scene')
-         call read_group_scene(lines, config, stat, msg)
-      case ('layer')
-         call read_group_layer(lines, config, stat, msg)
-      case ('material')
-         call read_group_material(lines, config, stat, msg)
-      case ('friction')
-         call read_group_friction(lines, config, stat, msg)
-      case ('profile')
-         call read_group_profile(lines, config, stat, msg)
-      case ('loading')
-         call read_group_loading(lines, config, stat, msg)
-      case ('solver')
-         call read_group_solver(lines, config, stat, msg)
-      case ('output')
-         call read_group_output(lines, config, stat, msg)
-      end select
+      call read_named_group(trim(group_names(group)), lines, config, stat, msg)
       line = 1
       if (stat /= 0) then
          line = offending_line(lines, msg)
@@ -258,112 +244,71 @@ contains
    end function value_kind
 
    ! ---------------------------------------------------------------------------------------
-   ! One reader per group. Each declares the group's variables locally, starts them from the
-   ! scene (so the defaults stay in scene_type) and copies them back only after a clean read.
-   ! The dummy is called `config` because a namelist group may not share a local's name.
+   ! One reader per group, generated from the scene schema (read_named_group calls them),
+   ! and the hooks of the groups whose variables are not plain copies: the grid's variables
+   ! of &scene and the Prony terms of &material.
 
-   subroutine read_group_scene(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: geometry, title
-      real(wp) :: period, period_x, period_y
-      integer :: n, nx, ny
-      namelist /scene/ geometry, title, period, n, period_x, period_y, nx, ny
+   include 'scene_readers.inc'
 
-      geometry = config%geometry
-      title = config%title
+   !> &scene before the read: unset_count and not_set mark the grid variables the text does
+   !> not give (areal grids: n for nx = ny = n, or nx and ny; period = period_x).
+   pure subroutine before_scene(config, period, period_x, n, nx, ny)
+      type(scene_type), intent(in) :: config
+      real(wp), intent(out) :: period, period_x
+      integer, intent(out) :: n, nx, ny
       period = config%period
+      period_x = not_set
       n = unset_count
-      ! areal grids: n (nx = ny = n) or nx and ny; period (= period_x) and period_y
-      ! (default: the same); unset_count marks what the file does not give
       nx = unset_count
       ny = unset_count
-      period_x = not_set
-      period_y = config%period_y
-      read (lines, nml=scene, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      if (too_long('geometry', geometry, stat, msg)) return
-      if (too_long('title', title, stat, msg)) return
-      config%geometry = geometry
-      config%title = title
+   end subroutine before_scene
+
+   !> &scene after the read: the period and the grid, with the defaults of the geometry
+   !> (without n, an areal grid of default_areal_n points per side); `grid_given` says
+   !> whether the text sets the grid (else a profile file may).
+   pure subroutine after_scene(config, period, period_x, n, nx, ny)
+      type(scene_type), intent(inout) :: config
+      real(wp), intent(in) :: period, period_x
+      integer, intent(in) :: n, nx, ny
+      integer :: points
       config%period = merge(period_x, period, period_x /= not_set)
-      config%period_y = period_y
       config%grid_given = n /= unset_count .or. nx /= unset_count .or. ny /= unset_count
-      if (n == unset_count) n = merge(default_areal_n, config%n, trim(geometry) == 'areal')
-      config%n = merge(nx, n, nx /= unset_count)
-      config%ny = merge(ny, merge(n, 1, trim(geometry) == 'areal'), ny /= unset_count)
-   end subroutine read_group_scene
+      points = n
+      if (points == unset_count) points = merge(default_areal_n, config%n, trim(config%geometry) == 'areal')
+      config%n = merge(nx, points, nx /= unset_count)
+      config%ny = merge(ny, merge(points, 1, trim(config%geometry) == 'areal'), ny /= unset_count)
+   end subroutine after_scene
 
-   subroutine read_group_layer(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
+   !> &material before the read: the terms the scene holds, the other entries marked unset.
+   pure subroutine before_material(config, prony_times, prony_values)
+      type(scene_type), intent(in) :: config
+      real(wp), intent(out) :: prony_times(:), prony_values(:)
+      prony_times = unset_entry
+      prony_values = unset_entry
+      if (allocated(config%material%times)) prony_times(:size(config%material%times)) = config%material%times
+      if (allocated(config%material%values)) prony_values(:size(config%material%values)) = config%material%values
+   end subroutine before_material
+
+   !> &material after the read: the terms given are the leading entries that were set; a gap
+   !> is refused.
+   pure subroutine after_material(config, prony_times, prony_values, stat, msg)
       type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
+      real(wp), intent(in) :: prony_times(:), prony_values(:)
+      integer, intent(inout) :: stat
       character(len=*), intent(inout) :: msg
-      real(wp) :: thickness, young, poisson
-      namelist /layer/ thickness, young, poisson
-
-      thickness = config%thickness
-      young = config%young
-      poisson = config%poisson
-      read (lines, nml=layer, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      config%thickness = thickness
-      config%young = young
-      config%poisson = poisson
-   end subroutine read_group_layer
-
-   subroutine read_group_material(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: model, prony_form, prony_file
-      real(wp) :: e0, e_inf, tau, speed, prony_equilibrium
-      real(wp) :: prony_times(max_prony_terms), prony_values(max_prony_terms)
-      namelist /material/ model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, &
-         & prony_values, prony_file
-
+      if (count_set(prony_times) /= count(prony_times /= unset_entry) .or. &
+         & count_set(prony_values) /= count(prony_values /= unset_entry)) then
+         stat = -1
+         msg = 'prony_times/prony_values: give the entries in order from the first, without gaps'
+         return
+      end if
       associate (m => config%material)
-         model = m%model
-         prony_form = m%form
-         prony_file = config%prony_file
-         e0 = m%e0
-         e_inf = m%e_inf
-         tau = m%tau
-         speed = config%speed
-         prony_equilibrium = m%equilibrium
-         prony_times = unset_entry
-         prony_values = unset_entry
-         if (allocated(m%times)) prony_times(:size(m%times)) = m%times
-         if (allocated(m%values)) prony_values(:size(m%values)) = m%values
-         read (lines, nml=material, iostat=stat, iomsg=msg)
-         if (stat /= 0) return
-      if (too_long('model', model, stat, msg)) return
-      if (too_long('prony_form', prony_form, stat, msg)) return
-      if (too_long('prony_file', prony_file, stat, msg)) return
-         if (count_set(prony_times) /= count(prony_times /= unset_entry) .or. &
-            & count_set(prony_values) /= count(prony_values /= unset_entry)) then
-            stat = -1
-            msg = 'prony_times/prony_values: give the entries in order from the first, without gaps'
-            return
-         end if
-         m%model = model
-         m%form = prony_form
-         config%prony_file = prony_file
-         m%e0 = e0
-         m%e_inf = e_inf
-         m%tau = tau
-         config%speed = speed
-         m%equilibrium = prony_equilibrium
-         ! the terms given are the leading entries that were set
          if (allocated(m%times)) deallocate (m%times)
          if (allocated(m%values)) deallocate (m%values)
          if (count_set(prony_times) > 0) m%times = prony_times(:count_set(prony_times))
          if (count_set(prony_values) > 0) m%values = prony_values(:count_set(prony_values))
       end associate
-   end subroutine read_group_material
+   end subroutine after_material
 
    !> A string variable read into a buffer one character longer than the scene keeps: if it
    !> fills more than max_string characters it would be cut, so it is refused
@@ -451,166 +396,6 @@ contains
             & "'tau_i value_i', 1 to " // to_string(max_prony_terms), code_input)
       end if
    end subroutine read_prony_file
-
-   subroutine read_group_friction(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      real(wp) :: coefficient
-      logical :: companion
-      namelist /friction/ coefficient, companion
-
-      coefficient = config%friction
-      companion = config%companion
-      read (lines, nml=friction, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      config%friction = coefficient
-      config%companion = companion
-   end subroutine read_group_friction
-
-   subroutine read_group_profile(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: kind, file, dataset, detrend, boundary, resample
-      real(wp) :: hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, amplitude, radius
-      integer(i8) :: seed
-      integer :: mode, mode_y
-      namelist /profile/ kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
-         & rms_height, amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, resample
-
-      associate (p => config%profile)
-         kind = p%kind
-         hurst = p%hurst
-         seed = p%seed
-         rolloff_wavelength = p%rolloff_wavelength
-         short_wavelength = p%short_wavelength
-         rms_gradient = p%rms_gradient
-         rms_height = p%rms_height
-         amplitude = p%amplitude
-         mode = p%mode
-         mode_y = p%mode_y
-         radius = p%radius
-         file = p%file
-         dataset = p%dataset
-         detrend = p%detrend
-         boundary = p%boundary
-         resample = p%resample
-         read (lines, nml=profile, iostat=stat, iomsg=msg)
-         if (stat /= 0) return
-      if (too_long('kind', kind, stat, msg)) return
-      if (too_long('file', file, stat, msg)) return
-      if (too_long('dataset', dataset, stat, msg)) return
-      if (too_long('detrend', detrend, stat, msg)) return
-      if (too_long('boundary', boundary, stat, msg)) return
-      if (too_long('resample', resample, stat, msg)) return
-         p%kind = kind
-         p%hurst = hurst
-         p%seed = seed
-         p%rolloff_wavelength = rolloff_wavelength
-         p%short_wavelength = short_wavelength
-         p%rms_gradient = rms_gradient
-         p%rms_height = rms_height
-         p%amplitude = amplitude
-         p%mode = mode
-         p%mode_y = mode_y
-         p%radius = radius
-         p%file = file
-         p%dataset = dataset
-         p%detrend = detrend
-         p%boundary = boundary
-         p%resample = resample
-      end associate
-   end subroutine read_group_profile
-
-   subroutine read_group_loading(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: control
-      real(wp) :: mean_pressure, normalised_pressure, penetration
-      namelist /loading/ control, mean_pressure, normalised_pressure, penetration
-
-      control = config%control
-      mean_pressure = config%mean_pressure
-      normalised_pressure = config%normalised_pressure
-      penetration = config%penetration
-      read (lines, nml=loading, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      if (too_long('control', control, stat, msg)) return
-      config%control = control
-      config%mean_pressure = mean_pressure
-      config%normalised_pressure = normalised_pressure
-      config%penetration = penetration
-   end subroutine read_group_loading
-
-   subroutine read_group_solver(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: method
-      real(wp) :: tol
-      integer :: max_iter, memory, threads
-      real(wp) :: target_error
-      logical :: precondition, coarse_start, verbose
-      namelist /solver/ method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose
-
-      method = config%solver%method
-      tol = config%solver%tol
-      max_iter = config%solver%max_iter
-      memory = config%solver%memory
-      precondition = config%solver%precondition
-      coarse_start = config%solver%coarse_start
-      target_error = config%solver%target_error
-      threads = config%solver%threads
-      verbose = config%solver%verbose
-      read (lines, nml=solver, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      if (too_long('method', method, stat, msg)) return
-      config%solver%method = method
-      config%solver%tol = tol
-      config%solver%max_iter = max_iter
-      config%solver%memory = memory
-      config%solver%precondition = precondition
-      config%solver%coarse_start = coarse_start
-      config%solver%target_error = target_error
-      config%solver%threads = threads
-      config%solver%verbose = verbose
-   end subroutine read_group_solver
-
-   subroutine read_group_output(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: file
-      logical :: overwrite, stress, fields, leakage
-      integer :: gap_bins
-      real(wp) :: leakage_tol
-      namelist /output/ file, overwrite, stress, gap_bins, fields, leakage, leakage_tol
-
-      file = config%output_file
-      overwrite = config%overwrite
-      stress = config%stress
-      gap_bins = config%gap_bins
-      fields = config%fields
-      leakage = config%leakage
-      leakage_tol = config%leakage_tol
-      read (lines, nml=output, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      if (too_long('file', file, stat, msg)) return
-      config%output_file = file
-      config%overwrite = overwrite
-      config%stress = stress
-      config%gap_bins = gap_bins
-      config%fields = fields
-      config%leakage = leakage
-      config%leakage_tol = leakage_tol
-   end subroutine read_group_output
 
    ! ---------------------------------------------------------------------------------------
    ! Scanning the text.
