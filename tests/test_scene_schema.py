@@ -273,3 +273,12 @@ def test_values_outside_the_schemas_range_are_refused(variable, tmp_path):
         assert f"&{variable.group}: {variable.name} = " in str(err.value), (value, str(err.value))
         assert str(err.value).endswith(f"is not allowed; allowed: {variable.allowed}"), value
         assert err.value.code == 2
+
+
+def test_defaults_of_an_unknown_geometry_are_a_usage_error():
+    done = subprocess.run([EXECUTABLE, "--defaults", "sphere"], capture_output=True, text=True)
+    assert done.returncode == 1 and "--defaults takes 'line' (the default) or 'areal', not 'sphere'" in done.stderr
+    done = subprocess.run([EXECUTABLE, "scene.nml", "areal"], capture_output=True, text=True)
+    assert done.returncode == 1 and done.stderr.startswith("usage: layercontact FILE.nml")
+    with pytest.raises(ValueError, match="allowed: 'line' or 'areal'"):
+        lc.default_scene("sphere")
