@@ -41,14 +41,15 @@ def _cell(text: str) -> str:
 
 def docs_table(schema) -> str:
     """The Markdown table of every variable, group by group."""
-    rows = ["| group | variable | type | default | unit | allowed | used by | meaning |",
-            "|---|---|---|---|---|---|---|---|"]
+    rows = ["| group | variable | type | default | unit | allowed | used by | `/input` | meaning |",
+            "|---|---|---|---|---|---|---|---|---|"]
     for group in schema.GROUPS:
         for i, v in enumerate(schema.group_variables(group)):
             default = v.default if v.default.startswith(("`", "not set", "none")) else f"`{v.default}`"
             rows.append("| " + " | ".join([
                 f"`&{group}`" if i == 0 else "", f"`{v.name}`", v.type, _cell(default), v.unit or "–",
-                _cell(v.allowed), USES[v.uses], _cell(v.meaning)]) + " |")
+                _cell(v.allowed), USES[v.uses], f"`{v.result_name}`" if v.alias_of is None else f"(`{v.alias_of}`)",
+                _cell(v.meaning)]) + " |")
     return "\n".join(rows) + "\n"
 
 
