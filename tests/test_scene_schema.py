@@ -187,6 +187,10 @@ def test_the_defaults_are_the_schemas(tmp_path):
     areal = subprocess.run([EXECUTABLE, "--defaults", "areal"],
                            capture_output=True, text=True, check=True).stdout
     assert line == lc.default_scene() and areal == lc.default_scene("areal")
+    for geometry, text in (("line", line), ("areal", areal)):
+        printed = subprocess.run([sys.executable, "-m", "layercontact", "defaults", geometry], capture_output=True,
+                                 text=True, check=True).stdout
+        assert printed == text
     values = {}
     group = None
     for row in line.splitlines():

@@ -28,7 +28,8 @@ the exit code the executable would have given (`err.code`).
 The command line: `.venv/bin/python -m layercontact run FILE.nml` (a scene and its
 picture), `... sweep FILE.nml [--slurm]`, `... status DIR`, `... collect DIR`, `... convert
 INPUT OUTPUT.h5 [--unit U] [--channel N]` (an instrument file to the height file a scene
-reads; needs `layercontact[topography]`); the same commands are installed as the script
+reads; needs `layercontact[topography]`), `... defaults [areal]` (the default scene, as
+`layercontact --defaults` prints it); the same commands are installed as the script
 `layercontact-py`. `--help` lists the options.
 
 The scene's variables are one table, `lc.scene_schema.VARIABLES` (group, name, type,
