@@ -45,7 +45,7 @@ def test_every_row_is_complete():
     group; the sweep's positions are 1, 2, ..."""
     units = {"", "1", "L", "S", "T", "L/T", "S or 1/S"}
     for v in schema.VARIABLES:
-        assert v.group in schema.GROUPS and v.type in schema.TYPE_WORDS, v
+        assert v.group in schema.GROUPS and v.type in schema.TYPES, v
         assert v.uses in ("both", "line", "areal") and v.unit in units, v
         assert v.meaning and v.allowed and v.default and v.fortran.startswith("scene%"), v
     keys = [v.result_name for v in schema.VARIABLES if v.alias_of is None]

@@ -22,9 +22,10 @@ contacts use it (lines, surfaces or both) and its meaning, and where it lives:
 - ``echo``: False for a variable whose values the scene holds under other names (a Prony
   file's terms): the scene written back as text gives those, and this one as a comment.
 
-From this table come, at build time, the Fortran namelist reader's declarations, the writer
-of a scene as namelist text, the lists of allowed variables in messages, the ``/input``
-writer of the result file (``tools/scene_codegen.py``); in Python the keyword groups of
+From this table come, at build time, the Fortran namelist group readers, the lists of
+allowed variables in messages, the checks of ``interval`` and ``choices``, the writer of a
+scene as namelist text and the ``/input`` writer of the result file
+(``tools/scene_codegen.py``); in Python the keyword groups of
 :func:`layercontact.solve_line` and :func:`layercontact.solve_areal`, the sweep's parameters
 (:mod:`layercontact.sweep`); and the tables of ``docs/namelist.md``. This module is plain
 data and standard-library Python: the build runs it before the package exists.
@@ -37,16 +38,9 @@ from dataclasses import dataclass
 #: The namelist groups, in the order of a scene file.
 GROUPS = ("scene", "layer", "material", "friction", "profile", "loading", "solver", "output")
 
-#: The types a variable takes, as a message names them.
-TYPE_WORDS = {
-    "real": "a number (e.g. 0.16 or 1.6e-1)",
-    "reals": "a number (e.g. 0.16 or 1.6e-1)",
-    "integer": "an integer (no decimal point or exponent)",
-    "integer8": "an integer (no decimal point or exponent)",
-    "logical": ".true. or .false.",
-    "string": "a quoted string ('...')",
-}
-
+#: The types of the variables: reals, integers (integer8: 64 bits), flags, words and lists
+#: of reals.
+TYPES = ("real", "integer", "integer8", "logical", "string", "reals")
 
 
 @dataclass(frozen=True)
