@@ -146,6 +146,32 @@ subroutine py_run(input, verbose, output_file, converged, stat, errmsg)
    flush (output_unit)
 end subroutine py_run
 
+!> The scene of the namelist `text` written back as a complete namelist (every variable of
+!> the scene schema; lc_io_namelist's write_scene_namelist), or of the default scene of
+!> `geometry` ('line' or 'areal') when `text` is blank.
+subroutine py_scene_namelist(text, geometry, echo, stat, errmsg)
+   use lc_base_errors, only: error_type, status_of
+   use lc_scene, only: scene_type
+   use lc_io_namelist, only: read_scene_text, write_scene_namelist, default_scene
+   implicit none (type, external)
+   character(len=*), intent(in) :: text, geometry
+   character(len=65536), intent(out) :: echo
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   type(scene_type) :: scene
+   character(len=:), allocatable :: written
+   echo = ''
+   if (len_trim(text) == 0) then
+      scene = default_scene(geometry)
+   else
+      call read_scene_text(text, 'keywords', scene, error)
+   end if
+   if (.not. allocated(error)) call write_scene_namelist(scene, written)
+   if (allocated(written)) echo = written
+   call status_of(error, stat, errmsg)
+end subroutine py_scene_namelist
+
 !> Read and validate a namelist file without solving (what the executable checks first).
 subroutine py_check_scene_file(input, stat, errmsg)
    use lc_base_errors, only: error_type, status_of

@@ -30,8 +30,6 @@ module lc_scene
    real(wp), parameter :: default_rms_gradient = 0.1_wp
    !> +Inf (the bits of IEEE double +Inf): the thickness of a half-space.
    real(wp), parameter :: half_space = transfer(int(z'7FF0000000000000', i8), 1.0_wp)
-   !> Largest solver iteration budget (the residual history is kept for every iteration).
-   integer, parameter :: max_iterations = 10000000
    !> Length of the fixed-size character components (file names, keywords).
    integer, parameter :: max_string = 512
 
@@ -215,12 +213,10 @@ contains
       type(scene_type), intent(in) :: scene
       type(error_type), allocatable, intent(out) :: error
 
+      call check_ranges(scene, error)
+      if (allocated(error)) return
       associate (p => scene%profile, s => scene%solver)
-         if (.not. one_of(scene%geometry, [character(len=8) :: 'line', 'areal'])) then
-            call input_error(error, 'scene', 'geometry', trim(scene%geometry), "'line' or 'areal'")
-         else if (.not. positive_finite(scene%period)) then
-            call input_error(error, 'scene', 'period', to_string(scene%period), '> 0 and finite')
-         else if (.not. is_areal(scene) .and. (scene%n < 8 .or. scene%n > 2**26)) then
+         if (.not. is_areal(scene) .and. (scene%n < 8 .or. scene%n > 2**26)) then
             call input_error(error, 'scene', 'n', to_string(scene%n), '8 <= n <= 2**26')
          else if (.not. is_areal(scene) .and. scene%ny /= 1) then
             call input_error(error, 'scene', 'ny', to_string(scene%ny), "1 with geometry = 'line'")
@@ -231,18 +227,6 @@ contains
          else if (is_areal(scene) .and. int(scene%n, i8)*scene%ny > 2_i8**28) then
             call input_error(error, 'scene', 'nx*ny', to_string(int(scene%n, i8)*scene%ny), &
                & '<= 2**28 (16384 x 16384) grid points')
-         else if (scene%period_y /= not_set .and. .not. positive_finite(scene%period_y)) then
-            call input_error(error, 'scene', 'period_y', to_string(scene%period_y), '> 0 and finite')
-         else if (ieee_is_nan(scene%thickness) .or. scene%thickness <= 0.0_wp) then
-            call input_error(error, 'layer', 'thickness', to_string(scene%thickness), '> 0, or Inf for a half-space')
-         else if (.not. positive_finite(scene%young)) then
-            call input_error(error, 'layer', 'young', to_string(scene%young), '> 0 and finite')
-         else if (.not. (scene%poisson > -1.0_wp .and. scene%poisson <= 0.5_wp)) then
-            call input_error(error, 'layer', 'poisson', to_string(scene%poisson), '-1 < poisson <= 0.5')
-         else if (.not. (ieee_is_finite(scene%speed) .and. scene%speed >= 0.0_wp)) then
-            call input_error(error, 'material', 'speed', to_string(scene%speed), '>= 0 and finite')
-         else if (.not. (scene%friction >= 0.0_wp .and. scene%friction <= 10.0_wp)) then
-            call input_error(error, 'friction', 'coefficient', to_string(scene%friction), '0 <= coefficient <= 10')
          else if (.not. is_areal(scene) .and. .not. one_of(p%kind, [character(len=16) :: 'self_affine', 'sinusoid', &
             & 'file'])) then
             call input_error(error, 'profile', 'kind', trim(p%kind), "'self_affine', 'sinusoid' or 'file'")
@@ -332,9 +316,7 @@ contains
             if (allocated(error)) return
          end if
 
-         if (.not. one_of(scene%control, [character(len=16) :: 'load', 'displacement'])) then
-            call input_error(error, 'loading', 'control', trim(scene%control), "'load' or 'displacement'")
-         else if (trim(scene%control) == 'load' .and. &
+         if (trim(scene%control) == 'load' .and. &
             & count([scene%mean_pressure /= not_set, scene%normalised_pressure /= not_set]) /= 1) then
             call input_error(error, 'loading', 'mean_pressure/normalised_pressure', 'both or neither given', &
                & "exactly one of them with control = 'load'")
@@ -354,33 +336,23 @@ contains
          else if (trim(scene%control) == 'displacement' .and. .not. positive_finite(scene%penetration)) then
             call input_error(error, 'loading', 'penetration', to_string(scene%penetration), &
                & "> 0 and finite with control = 'displacement'")
-         else if (.not. one_of(s%method, [character(len=16) :: 'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton', &
-            & 'multigrid'])) then
-            call input_error(error, 'solver', 'method', trim(s%method), &
-               & "'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton' or 'multigrid'")
-         else if (.not. (s%tol >= 1.0e-14_wp .and. s%tol <= 1.0e-2_wp)) then
-            call input_error(error, 'solver', 'tol', to_string(s%tol), '1e-14 <= tol <= 1e-2')
          else if (scene%leakage .and. .not. is_areal(scene)) then
             call input_error(error, 'output', 'leakage', '.true.', &
                & ".false. with geometry = 'line' (the Reynolds leakage needs the gap of an areal contact)")
          else if (.not. leakage_tol_allowed(scene%leakage_tol)) then
             call input_error(error, 'output', 'leakage_tol', to_string(scene%leakage_tol), leakage_tol_range)
-         else if (scene%gap_bins < 0 .or. scene%gap_bins > 100000) then
-            call input_error(error, 'output', 'gap_bins', to_string(scene%gap_bins), '0 <= gap_bins <= 100000')
-         else if (s%max_iter < 1 .or. s%max_iter > max_iterations) then
-            call input_error(error, 'solver', 'max_iter', to_string(s%max_iter), '1 <= max_iter <= 10000000')
-         else if (s%memory < 1 .or. s%memory > 100) then
-            call input_error(error, 'solver', 'memory', to_string(s%memory), '1 <= memory <= 100')
-         else if (s%threads < 1 .or. s%threads > 1024) then
-            call input_error(error, 'solver', 'threads', to_string(s%threads), '1 <= threads <= 1024')
-         else if (s%target_error /= not_set .and. .not. (s%target_error >= 1.0e-4_wp .and. &
-               & s%target_error <= 0.3_wp)) then
-            call input_error(error, 'solver', 'target_error', to_string(s%target_error), &
-               & '1e-4 <= target_error <= 0.3 (the rule was measured for 1e-3 .. 1e-1)')
          end if
       end associate
    end subroutine check_scene
 
+
+   !> The values every scene variable with a range or a list of words in the scene schema
+   !> may take, whatever the other variables (the first one outside is reported).
+   subroutine check_ranges(scene, error)
+      type(scene_type), intent(in) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      include 'scene_checks.inc'
+   end subroutine check_ranges
 
    pure logical function one_of(word, words)
       character(len=*), intent(in) :: word

@@ -13,10 +13,12 @@ from .api import (
     LineResult,
     check_scene_file,
     choose_resolution,
+    default_scene,
     layer_multipliers,
     layer_multipliers_lapack,
     read_result,
     run,
+    scene_namelist,
     solve_areal,
     solve_line,
     surface_fields,
@@ -26,6 +28,7 @@ from .api import (
 from .leakage import CoreLeakage, LeakageResult, core_leakage, reynolds_leakage
 from .materials import Prony, StandardLinearSolid, creep_compliance
 from .native import BUILD
+from . import scene_schema
 from .profiles import (
     load_profile,
     load_surface,
@@ -55,6 +58,7 @@ __all__ = [
     "check_scene_file",
     "choose_resolution",
     "core_leakage",
+    "default_scene",
     "layer_multipliers",
     "layer_multipliers_lapack",
     "load_profile",
@@ -67,6 +71,7 @@ __all__ = [
     "read_summary",
     "reynolds_leakage",
     "run",
+    "scene_namelist",
     "self_affine_profile",
     "self_affine_surface",
     "sinusoid_profile",

@@ -6,6 +6,7 @@
     python -m layercontact status DIR [--all]
     python -m layercontact collect DIR
     python -m layercontact convert INPUT OUTPUT.h5 [--unit UNIT] [--channel N]
+    python -m layercontact defaults [line|areal]
 
 ``run`` runs a scene like the ``layercontact`` executable (same library routine, same
 HDF5 file, same summary and exit codes) and draws the seed's Fig. 2(a) view next to the
@@ -14,7 +15,8 @@ submits it as a Slurm job array (layercontact.submit). ``status`` and ``collect`
 sweep directory (or a sweep file): where each scene stands, and the summary. ``convert``
 reads an instrument topography file (with the optional SurfaceTopography package) and
 writes the HDF5 height file that ``&profile kind = 'file'`` reads, printing the &scene and
-&profile lines that run it.
+&profile lines that run it. ``defaults`` prints the default scene as a complete namelist,
+as ``layercontact --defaults`` does.
 
 Exit codes:
     run       0 converged, 2 bad input, 3 not converged, 4 I/O failure, 5 internal failure
@@ -112,6 +114,8 @@ def _parser() -> argparse.ArgumentParser:
     convert_p.add_argument("output", help="HDF5 file to write (/profile/height)")
     convert_p.add_argument("--unit", help="length unit of heights and sizes, e.g. um (default: the file's)")
     convert_p.add_argument("--channel", type=int, help="data channel (default: the file's default)")
+    defaults_p = sub.add_parser("defaults", help="print the default scene as a complete namelist")
+    defaults_p.add_argument("geometry", nargs="?", default="line", choices=("line", "areal"))
     return parser
 
 
@@ -134,6 +138,11 @@ def main(argv: list[str] | None = None) -> int:
         return collect_command(args.directory)
     if args.command == "convert":
         return convert_command(args.input, args.output, args.unit, args.channel)
+    if args.command == "defaults":
+        from .api import default_scene
+
+        print(default_scene(args.geometry), end="")
+        return 0
     return run_command(args)
 
 

@@ -10,6 +10,7 @@ from dataclasses import fields as dataclass_fields
 
 import numpy as np
 
+from . import scene_schema
 from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError, _check,  # noqa: F401
                        _lines, _namelist, regular_file)
 from .leakage import CoreLeakage
@@ -236,22 +237,17 @@ def solve_line(
     return results[0]
 
 
-def _keyword_groups(*, thickness, young, poisson, friction, companion, mean_pressure, normalised_pressure,
-                    penetration, material, speed, method, precondition, coarse_start, progress, tol, max_iter,
-                    memory, threads, stress) -> dict[str, dict]:
+def _keyword_groups(*, material, method, progress, penetration, **keywords) -> dict[str, dict]:
     """The namelist groups and variables that the keywords of solve_line and solve_areal set
-    (None: not given)."""
-    return {
-        "layer": {"thickness": thickness, "young": young, "poisson": poisson},
-        "material": {**(material._namelist() if material is not None else {}), "speed": speed},
-        "friction": {"coefficient": friction, "companion": companion},
-        "loading": {"control": None if penetration is None else "displacement", "mean_pressure": mean_pressure,
-                    "normalised_pressure": normalised_pressure, "penetration": penetration},
-        "solver": {"method": method, "tol": tol, "max_iter": max_iter, "memory": memory,
-                   "precondition": precondition, "coarse_start": coarse_start, "threads": threads,
-                   "verbose": progress},
-        "output": {"stress": stress},
-    }
+    (None: not given): the scene schema's variables of the same names, ``method`` and
+    ``progress`` for ``solver_method`` and ``verbose``, a penetration with displacement
+    control, and the variables of ``material``."""
+    groups = scene_schema.keyword_groups(
+        **keywords, solver_method=method, verbose=progress, penetration=penetration,
+        control=None if penetration is None else "displacement")
+    if material is not None:
+        groups.setdefault("material", {}).update(material._namelist())
+    return groups
 
 
 def _solve_scene(h, groups: dict, *, areal: bool, companion: bool, stress) -> list[dict]:
@@ -542,7 +538,8 @@ def _profile(f):
 
 
 def _periods(attrs) -> tuple[float, float]:
-    """(period, period_y) of a result file's /input (period_y not set: the period)."""
+    """(period, period_y) of a result file's /input (period_y not set, absent: the period;
+    files of earlier versions hold a negative number for it)."""
     lx = float(attrs["period"])
     ly = float(attrs["period_y"]) if "period_y" in attrs and float(attrs["period_y"]) > 0 else lx
     return lx, ly
@@ -572,6 +569,38 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
         if companion and "companion" in f:
             result.companion = one(f, f["companion"], builder)
         return result
+
+
+def scene_namelist(text: str = "", **keywords) -> str:
+    """A scene as the library reads it, written back as a complete namelist: every variable
+    of the scene schema (docs/namelist.md) with its value, a variable that is not set as a
+    comment. The scene is the namelist ``text`` or the keywords of
+    :func:`layercontact.scene_schema.keyword_groups` (the names of a result's ``/input``;
+    :func:`layercontact.scene_schema.input_keywords` reads them from a result). It is
+    checked as a namelist file is: a bad scene raises :class:`InputError`."""
+    if keywords:
+        if text:
+            raise TypeError("give the scene as text or as keywords, not both")
+        text = _namelist(scene_schema.keyword_groups(**keywords))
+    if not text.strip():
+        raise ValueError("no scene given (default_scene gives the default one)")
+    return _scene_text(text, "line")
+
+
+def default_scene(geometry: str = "line") -> str:
+    """The default scene of ``geometry`` (``'line'`` or ``'areal'``) as a complete namelist,
+    as ``layercontact --defaults [line|areal]`` prints it: every variable with its default,
+    one without a default value as a comment. It is not a scene that runs as it is: a scene
+    gives its load."""
+    if geometry not in ("line", "areal"):
+        raise ValueError(f"geometry = {geometry!r} is not allowed; allowed: 'line' or 'areal'")
+    return _scene_text("", geometry)
+
+
+def _scene_text(text: str, geometry: str) -> str:
+    echo, stat, errmsg = _core.py_scene_namelist(text, geometry)
+    _check(stat, errmsg)
+    return (echo.decode() if isinstance(echo, bytes) else str(echo)).rstrip() + "\n"
 
 
 def check_scene_file(filename: str | os.PathLike) -> None:

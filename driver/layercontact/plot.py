@@ -77,8 +77,10 @@ def _plot_areal(f, png, plt) -> None:
     """Pressure and gap maps of an areal result (x, the sliding direction, to the right)."""
     import numpy as np
 
-    lx = float(f["input"].attrs["period"])
-    ly = float(f["input"].attrs["period_y"])
+    inp = f["input"].attrs
+    lx = float(inp["period"])
+    # period_y is absent when not set (a negative number in files of earlier versions)
+    ly = float(inp.get("period_y", lx))
     ly = ly if ly > 0 else lx
     p = f["fields/pressure"][()]
     g = f["fields/gap"][()]

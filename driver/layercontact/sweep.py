@@ -54,7 +54,7 @@ from pathlib import Path
 import f90nml
 import numpy as np
 
-from . import provenance
+from . import provenance, scene_schema
 from .api import LayercontactError, check_scene_file, regular_file, run_to_file
 from .slurm import CONTROL_CHARACTERS, NO_CONTROL, SWEEP_VARIABLES, options_from_sweep
 
@@ -105,20 +105,19 @@ class _Parameter:
         group[self.variable] = value
 
 
-_LOAD = (("control", "load"),)
-_LOADING = ("mean_pressure", "normalised_pressure", "penetration")
-#: The &sweep lists, in the order of the product (the last one varies fastest).
-PARAMETERS: dict[str, _Parameter] = {
-    "friction": _Parameter("friction", "coefficient", float),
-    "normalised_pressure": _Parameter("loading", "normalised_pressure", float, _LOADING, _LOAD),
-    "mean_pressure": _Parameter("loading", "mean_pressure", float, _LOADING, _LOAD),
-    "thickness": _Parameter("layer", "thickness", float),
-    "poisson": _Parameter("layer", "poisson", float),
-    "speed": _Parameter("material", "speed", float),
-    "hurst": _Parameter("profile", "hurst", float),
-    "n": _Parameter("scene", "n", int),
-    "seed": _Parameter("profile", "seed", int),
-}
+def _parameter(variable: scene_schema.Variable) -> _Parameter:
+    """The sweep parameter of a scene variable: a load replaces the other loads and sets load
+    control."""
+    kind = float if variable.type == "real" else int
+    if variable.group != "loading":
+        return _Parameter(variable.group, variable.name, kind)
+    loads = tuple(v.name for v in scene_schema.group_variables("loading") if v.type == "real")
+    return _Parameter(variable.group, variable.name, kind, loads, (("control", "load"),))
+
+
+#: The &sweep lists, in the order of the product (the last one varies fastest): the scene
+#: variables the schema marks as sweep parameters, by their /input names.
+PARAMETERS: dict[str, _Parameter] = {v.result_name: _parameter(v) for v in scene_schema.sweep_parameters()}
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 !>
 !> Layout written by `write_results` (units: lengths L, stresses S, as in the input):
 !>   /                     attrs layercontact_version, layercontact_build, geometry, convention, units
-!>   /input/namelist       the namelist text; /input attrs: every parsed scene value
+!>   /input/namelist       the namelist text; /input attrs: every scene variable that is set
 !>   /profile/x, height    grid positions j*period/n and the rigid profile r(x)
 !>   /fields/pressure, gap, displacement_z
 !>                         (/profile and /fields only with &output fields, the default)
@@ -30,7 +30,7 @@ module lc_io_hdf5
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input, code_io, code_internal
    use lc_base_strings, only: to_string, lower_case
-   use lc_scene, only: scene_type, is_areal
+   use lc_scene, only: scene_type, is_areal, is_halfspace, not_set
    use lc_result, only: contact_result, result_scalar, result_scalars
    use lc_leakage_reynolds, only: leakage_result
    use lc_base_version, only: build_isa
@@ -421,75 +421,21 @@ contains
    ! ---------------------------------------------------------------------------------------
    ! Pieces of the layout.
 
-   !> Every parsed scene value as an attribute of /input.
+   !> Every scene variable that is set as an attribute of /input (a list as a dataset),
+   !> named and ordered as the scene schema (driver/layercontact/scene_schema.py) gives
+   !> them; a variable that is not set is absent. @units gives their units, and
+   !> @normalised_pressure_scale the seed's pressure scale that normalised values use.
    subroutine write_scene_attrs(loc, scene, st)
       integer(hid_t), intent(in) :: loc
       type(scene_type), intent(in) :: scene
       type(h5_status), intent(inout) :: st
 
-      call write_attr_string(loc, 'geometry', trim(scene%geometry), st)
-      call write_attr_string(loc, 'title', trim(scene%title), st)
-      call write_attr_real(loc, 'period', scene%period, st)
-      call write_attr_int(loc, 'n', scene%n, st)
-      call write_attr_int(loc, 'ny', scene%ny, st)
-      call write_attr_real(loc, 'period_y', scene%period_y, st)
-      call write_attr_real(loc, 'thickness', scene%thickness, st)
-      call write_attr_real(loc, 'young', scene%young, st)
-      call write_attr_real(loc, 'poisson', scene%poisson, st)
-      associate (m => scene%material)
-         call write_attr_string(loc, 'material_model', trim(m%model), st)
-         call write_attr_real(loc, 'speed', scene%speed, st)
-         if (trim(m%model) == 'sls') then
-            call write_attr_real(loc, 'e0', m%e0, st)
-            call write_attr_real(loc, 'e_inf', m%e_inf, st)
-            call write_attr_real(loc, 'tau', m%tau, st)
-         else if (trim(m%model) == 'prony') then
-            call write_attr_string(loc, 'prony_form', trim(m%form), st)
-            call write_attr_real(loc, 'prony_equilibrium', m%equilibrium, st)
-            call write_attr_string(loc, 'prony_file', trim(scene%prony_file), st)
-            call write_dataset_1d(loc, 'prony_times', m%times, 'T', st)
-            call write_dataset_1d(loc, 'prony_values', m%values, merge('S  ', '1/S', trim(m%form) == 'relaxation'), st)
-         end if
-      end associate
-      call write_attr_real(loc, 'friction', scene%friction, st)
-      call write_attr_int(loc, 'companion', merge(1, 0, scene%companion), st)
-      associate (p => scene%profile)
-         call write_attr_string(loc, 'profile_kind', trim(p%kind), st)
-         call write_attr_real(loc, 'hurst', p%hurst, st)
-         call write_attr_int64(loc, 'seed', p%seed, st)
-         call write_attr_real(loc, 'rolloff_wavelength', p%rolloff_wavelength, st)
-         call write_attr_real(loc, 'short_wavelength', p%short_wavelength, st)
-         call write_attr_real(loc, 'rms_gradient', p%rms_gradient, st)
-         call write_attr_real(loc, 'rms_height', p%rms_height, st)
-         call write_attr_real(loc, 'amplitude', p%amplitude, st)
-         call write_attr_int(loc, 'mode', p%mode, st)
-         call write_attr_string(loc, 'profile_file', trim(p%file), st)
-         call write_attr_string(loc, 'profile_dataset', trim(p%dataset), st)
-         call write_attr_string(loc, 'profile_detrend', trim(p%detrend), st)
-         call write_attr_string(loc, 'profile_boundary', trim(p%boundary), st)
-         call write_attr_string(loc, 'profile_resample', trim(p%resample), st)
-      end associate
-      call write_attr_string(loc, 'control', trim(scene%control), st)
-      call write_attr_real(loc, 'mean_pressure', scene%mean_pressure, st)
-      call write_attr_real(loc, 'normalised_pressure', scene%normalised_pressure, st)
-      call write_attr_real(loc, 'penetration', scene%penetration, st)
-      associate (s => scene%solver)
-         call write_attr_string(loc, 'solver_method', trim(s%method), st)
-         call write_attr_real(loc, 'tol', s%tol, st)
-         call write_attr_int(loc, 'max_iter', s%max_iter, st)
-         call write_attr_int(loc, 'memory', s%memory, st)
-         call write_attr_int(loc, 'precondition', merge(1, 0, s%precondition), st)
-         call write_attr_int(loc, 'coarse_start', merge(1, 0, s%coarse_start), st)
-         call write_attr_real(loc, 'target_error', s%target_error, st)
-         call write_attr_int(loc, 'threads', s%threads, st)
-      end associate
-      call write_attr_string(loc, 'output_file', trim(scene%output_file), st)
-      call write_attr_int(loc, 'overwrite', merge(1, 0, scene%overwrite), st)
-      call write_attr_int(loc, 'stress', merge(1, 0, scene%stress), st)
-      call write_attr_int(loc, 'gap_bins', scene%gap_bins, st)
-      call write_attr_int(loc, 'fields', merge(1, 0, scene%fields), st)
-      call write_attr_int(loc, 'leakage', merge(1, 0, scene%leakage), st)
-      call write_attr_real(loc, 'leakage_tol', scene%leakage_tol, st)
+      include 'scene_input_writer.inc'
+      if (is_areal(scene) .and. .not. is_halfspace(scene)) then
+         call write_attr_string(loc, 'normalised_pressure_scale', 'E* thickness/period (an areal scene on a layer)', st)
+      else
+         call write_attr_string(loc, 'normalised_pressure_scale', 'E* Lambda0/period (Lambda0 = max r - mean r)', st)
+      end if
    end subroutine write_scene_attrs
 
    !> fields/, results (attributes) and convergence/ of one solve, under `loc`.
@@ -603,6 +549,16 @@ contains
       call write_attr_real(group, 'wall_time', leakage%wall_time, st)
       call close_group(group, st)
    end subroutine write_leakage
+
+   !> A unit of the scene schema for this scene: 'S or 1/S' (Prony values) as the Prony
+   !> form gives it.
+   pure function resolved_unit(unit, scene) result(resolved)
+      character(len=*), intent(in) :: unit
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: resolved
+      resolved = unit
+      if (unit == 'S or 1/S') resolved = trim(merge('S  ', '1/S', trim(scene%material%form) == 'relaxation'))
+   end function resolved_unit
 
    !> The /results@units text: the unit of every dimensional attribute (L and S: the input's
    !> length and stress units), then a word on the others.

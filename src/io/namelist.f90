@@ -2,9 +2,12 @@
 !> &friction, &profile, &loading, &solver, &output) -> `scene_type`, and back (`write_scene_namelist`).
 !>
 !> Defaults live only in `scene_type`: each group is read into local variables that start
-!> from the scene's current (default) values. A Fortran namelist read silently skips groups
-!> it does not know, so the text is pre-scanned for `&name` tokens first; unknown or
-!> repeated groups are errors that name the line.
+!> from the scene's current (default) values. The group readers, the writer and the lists
+!> of variables in messages are generated from the scene schema
+!> (driver/layercontact/scene_schema.py, tools/scene_codegen.py) as include files; the
+!> hooks of the grid's variables and of the Prony terms are here. A Fortran namelist read
+!> silently skips groups it does not know, so the text is pre-scanned for `&name` tokens
+!> first; unknown or repeated groups are errors that name the line.
 module lc_io_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
@@ -15,22 +18,11 @@ module lc_io_namelist
    use lc_greens_viscoelastic, only: max_prony_terms
    implicit none (type, external)
    private
-   public :: read_scene, read_scene_text, write_scene_namelist, read_prony_file
+   public :: read_scene, read_scene_text, write_scene_namelist, read_prony_file, default_scene
 
-   integer, parameter :: n_groups = 8
-   character(len=*), parameter :: group_names(n_groups) = [character(len=8) :: &
-      & 'scene', 'layer', 'material', 'friction', 'profile', 'loading', 'solver', 'output']
-   !> Variables allowed in each group, in the order of `group_names` (for messages).
-   character(len=*), parameter :: group_variables(n_groups) = [character(len=192) :: &
-      & 'geometry, title, period, n, period_x, period_y, nx, ny', &
-      & 'thickness, young, poisson', &
-      & 'model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, prony_values, prony_file', &
-      & 'coefficient, companion', &
-      & 'kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, ' // &
-      & 'amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, resample', &
-      & 'control, mean_pressure, normalised_pressure, penetration', &
-      & 'method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose', &
-      & 'file, overwrite, stress, gap_bins, fields, leakage, leakage_tol']
+   ! n_groups, group_names, group_variables and the variables of each type (for messages),
+   ! from the scene schema
+   include 'scene_groups.inc'
 
    character(len=*), parameter :: newline = new_line('a')
    !> The status of a string variable too long for the scene (not an iostat value: those
@@ -124,80 +116,28 @@ contains
       call check_scene(scene, error)
    end subroutine read_scene_text
 
-   !> The scene as a complete namelist text with all eight groups; `read_scene_text` of it
-   !> gives the same scene back (reals are written with 17 significant digits).
+   !> The scene as a complete namelist text with all eight groups and every variable of the
+   !> scene schema; `read_scene_text` of it gives the same scene back (reals are written with
+   !> 17 significant digits, a variable that is not set as a comment).
    subroutine write_scene_namelist(scene, text)
       type(scene_type), intent(in) :: scene
       character(len=:), allocatable, intent(out) :: text
 
-      associate (p => scene%profile, s => scene%solver)
-         text = '! layercontact scene: every value as parsed (values not given are marked ! not set)' // newline &
-            & // '&scene' // newline &
-            & // entry('geometry', str_value(scene%geometry)) &
-            & // entry('title', str_value(scene%title)) &
-            & // entry('period', real_value(scene%period)) &
-            & // entry('n', to_string(scene%n)) &
-            & // entry('ny', to_string(scene%ny)) &
-            & // entry('period_y', real_value(scene%period_y)) &
-            & // '/' // newline // '&layer' // newline &
-            & // entry('thickness', real_value(scene%thickness)) &
-            & // entry('young', real_value(scene%young)) &
-            & // entry('poisson', real_value(scene%poisson)) &
-            & // '/' // newline // '&material' // newline &
-            & // entry('model', str_value(scene%material%model)) &
-            & // entry('e0', real_value(scene%material%e0)) &
-            & // entry('e_inf', real_value(scene%material%e_inf)) &
-            & // entry('tau', real_value(scene%material%tau)) &
-            & // entry('speed', real_value(scene%speed)) &
-            & // entry('prony_form', str_value(scene%material%form)) &
-            & // entry('prony_equilibrium', real_value(scene%material%equilibrium)) &
-            & // prony_entries(scene%material%times, scene%material%values) &
-            & // '/' // newline // '&friction' // newline &
-            & // entry('coefficient', real_value(scene%friction)) &
-            & // entry('companion', logical_value(scene%companion)) &
-            & // '/' // newline // '&profile' // newline &
-            & // entry('kind', str_value(p%kind)) &
-            & // entry('hurst', real_value(p%hurst)) &
-            & // entry('seed', to_string(p%seed)) &
-            & // entry('rolloff_wavelength', real_value(p%rolloff_wavelength)) &
-            & // entry('short_wavelength', real_value(p%short_wavelength)) &
-            & // entry('rms_gradient', real_value(p%rms_gradient)) &
-            & // entry('rms_height', real_value(p%rms_height)) &
-            & // entry('amplitude', real_value(p%amplitude)) &
-            & // entry('mode', to_string(p%mode)) &
-            & // entry('mode_y', to_string(p%mode_y)) &
-            & // entry('radius', real_value(p%radius)) &
-            & // entry('file', str_value(p%file)) &
-            & // entry('dataset', str_value(p%dataset)) &
-            & // entry('detrend', str_value(p%detrend)) &
-            & // entry('boundary', str_value(p%boundary)) &
-            & // entry('resample', str_value(p%resample)) &
-            & // '/' // newline // '&loading' // newline &
-            & // entry('control', str_value(scene%control)) &
-            & // entry('mean_pressure', real_value(scene%mean_pressure)) &
-            & // entry('normalised_pressure', real_value(scene%normalised_pressure)) &
-            & // entry('penetration', real_value(scene%penetration)) &
-            & // '/' // newline // '&solver' // newline &
-            & // entry('method', str_value(s%method)) &
-            & // entry('tol', real_value(s%tol)) &
-            & // entry('max_iter', to_string(s%max_iter)) &
-            & // entry('memory', to_string(s%memory)) &
-            & // entry('precondition', logical_value(s%precondition)) &
-            & // entry('coarse_start', logical_value(s%coarse_start)) &
-            & // entry('threads', to_string(s%threads)) &
-            & // entry('target_error', real_value(s%target_error)) &
-            & // entry('verbose', logical_value(s%verbose)) &
-            & // '/' // newline // '&output' // newline &
-            & // entry('file', str_value(scene%output_file)) &
-            & // entry('overwrite', logical_value(scene%overwrite)) &
-            & // entry('stress', logical_value(scene%stress)) &
-            & // entry('gap_bins', to_string(scene%gap_bins)) &
-            & // entry('fields', logical_value(scene%fields)) &
-            & // entry('leakage', logical_value(scene%leakage)) &
-            & // entry('leakage_tol', real_value(scene%leakage_tol)) &
-            & // '/' // newline
-      end associate
+      include 'scene_namelist_writer.inc'
    end subroutine write_scene_namelist
+
+   !> The default scene of a geometry ('line' or 'areal': its grid of
+   !> default_areal_n x default_areal_n points), as a file that sets only the geometry
+   !> reads it (not checked: a default scene has no load).
+   pure function default_scene(geometry) result(scene)
+      character(len=*), intent(in) :: geometry
+      type(scene_type) :: scene
+      scene%geometry = geometry
+      if (trim(geometry) == 'areal') then
+         scene%n = default_areal_n
+         scene%ny = default_areal_n
+      end if
+   end function default_scene
 
    !> Read one group from its piece of text (one record per line); on failure `line` is the
    !> line within the piece of the entry that failed.
@@ -220,24 +160,7 @@ contains
             return
          end if
       end do
-      select case (trim(group_names(group)))
-      case ('scene')
-         call read_group_scene(lines, config, stat, msg)
-      case ('layer')
-         call read_group_layer(lines, config, stat, msg)
-      case ('material')
-         call read_group_material(lines, config, stat, msg)
-      case ('friction')
-         call read_group_friction(lines, config, stat, msg)
-      case ('profile')
-         call read_group_profile(lines, config, stat, msg)
-      case ('loading')
-         call read_group_loading(lines, config, stat, msg)
-      case ('solver')
-         call read_group_solver(lines, config, stat, msg)
-      case ('output')
-         call read_group_output(lines, config, stat, msg)
-      end select
+      call read_named_group(trim(group_names(group)), lines, config, stat, msg)
       line = 1
       if (stat /= 0) then
          line = offending_line(lines, msg)
@@ -279,9 +202,6 @@ contains
    logical function wrong_type(code, msg)
       character(len=*), intent(in) :: code   !< one line, lower case, without its comment
       character(len=*), intent(inout) :: msg
-      character(len=*), parameter :: reals = ' period period_x period_y thickness young poisson e0 e_inf tau ' // &
-         & 'speed prony_equilibrium coefficient hurst rolloff_wavelength short_wavelength rms_gradient rms_height ' // &
-         & 'amplitude radius mean_pressure normalised_pressure penetration tol target_error leakage_tol '
       character(len=:), allocatable :: name, value, kind
       integer :: k, stat
       integer(i8) :: as_integer   ! (the widest integer variable, &profile seed)
@@ -298,7 +218,7 @@ contains
          read (value, *, iostat=stat) as_logical
       else if (kind(1:4) == 'an i') then
          read (value, *, iostat=stat) as_integer
-      else if (index(reals, ' ' // name // ' ') > 0) then
+      else if (index(real_variables, ' ' // name // ' ') > 0) then
          read (value, *, iostat=stat) as_real
       else
          return
@@ -312,15 +232,11 @@ contains
    pure function value_kind(name) result(kind)
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: kind
-      character(len=*), parameter :: integers = ' n nx ny seed mode mode_y max_iter memory threads gap_bins '
-      character(len=*), parameter :: logicals = ' companion precondition coarse_start verbose overwrite stress fields leakage '
-      character(len=*), parameter :: strings = ' geometry title model prony_form prony_file kind file dataset ' // &
-         & 'detrend boundary resample control method '
-      if (index(integers, ' ' // name // ' ') > 0) then
+      if (index(integer_variables, ' ' // name // ' ') > 0) then
          kind = 'an integer (no decimal point or exponent)'
-      else if (index(logicals, ' ' // name // ' ') > 0) then
+      else if (index(logical_variables, ' ' // name // ' ') > 0) then
          kind = '.true. or .false.'
-      else if (index(strings, ' ' // name // ' ') > 0) then
+      else if (index(string_variables, ' ' // name // ' ') > 0) then
          kind = "a quoted string ('...')"
       else
          kind = 'a number (e.g. 0.16 or 1.6e-1)'
@@ -328,112 +244,71 @@ contains
    end function value_kind
 
    ! ---------------------------------------------------------------------------------------
-   ! One reader per group. Each declares the group's variables locally, starts them from the
-   ! scene (so the defaults stay in scene_type) and copies them back only after a clean read.
-   ! The dummy is called `config` because a namelist group may not share a local's name.
+   ! One reader per group, generated from the scene schema (read_named_group calls them),
+   ! and the hooks of the groups whose variables are not plain copies: the grid's variables
+   ! of &scene and the Prony terms of &material.
 
-   subroutine read_group_scene(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: geometry, title
-      real(wp) :: period, period_x, period_y
-      integer :: n, nx, ny
-      namelist /scene/ geometry, title, period, n, period_x, period_y, nx, ny
+   include 'scene_readers.inc'
 
-      geometry = config%geometry
-      title = config%title
+   !> &scene before the read: unset_count and not_set mark the grid variables the text does
+   !> not give (areal grids: n for nx = ny = n, or nx and ny; period = period_x).
+   pure subroutine before_scene(config, period, period_x, n, nx, ny)
+      type(scene_type), intent(in) :: config
+      real(wp), intent(out) :: period, period_x
+      integer, intent(out) :: n, nx, ny
       period = config%period
+      period_x = not_set
       n = unset_count
-      ! areal grids: n (nx = ny = n) or nx and ny; period (= period_x) and period_y
-      ! (default: the same); unset_count marks what the file does not give
       nx = unset_count
       ny = unset_count
-      period_x = not_set
-      period_y = config%period_y
-      read (lines, nml=scene, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      if (too_long('geometry', geometry, stat, msg)) return
-      if (too_long('title', title, stat, msg)) return
-      config%geometry = geometry
-      config%title = title
+   end subroutine before_scene
+
+   !> &scene after the read: the period and the grid, with the defaults of the geometry
+   !> (without n, an areal grid of default_areal_n points per side); `grid_given` says
+   !> whether the text sets the grid (else a profile file may).
+   pure subroutine after_scene(config, period, period_x, n, nx, ny)
+      type(scene_type), intent(inout) :: config
+      real(wp), intent(in) :: period, period_x
+      integer, intent(in) :: n, nx, ny
+      integer :: points
       config%period = merge(period_x, period, period_x /= not_set)
-      config%period_y = period_y
       config%grid_given = n /= unset_count .or. nx /= unset_count .or. ny /= unset_count
-      if (n == unset_count) n = merge(default_areal_n, config%n, trim(geometry) == 'areal')
-      config%n = merge(nx, n, nx /= unset_count)
-      config%ny = merge(ny, merge(n, 1, trim(geometry) == 'areal'), ny /= unset_count)
-   end subroutine read_group_scene
+      points = n
+      if (points == unset_count) points = merge(default_areal_n, config%n, trim(config%geometry) == 'areal')
+      config%n = merge(nx, points, nx /= unset_count)
+      config%ny = merge(ny, merge(points, 1, trim(config%geometry) == 'areal'), ny /= unset_count)
+   end subroutine after_scene
 
-   subroutine read_group_layer(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
+   !> &material before the read: the terms the scene holds, the other entries marked unset.
+   pure subroutine before_material(config, prony_times, prony_values)
+      type(scene_type), intent(in) :: config
+      real(wp), intent(out) :: prony_times(:), prony_values(:)
+      prony_times = unset_entry
+      prony_values = unset_entry
+      if (allocated(config%material%times)) prony_times(:size(config%material%times)) = config%material%times
+      if (allocated(config%material%values)) prony_values(:size(config%material%values)) = config%material%values
+   end subroutine before_material
+
+   !> &material after the read: the terms given are the leading entries that were set; a gap
+   !> is refused.
+   pure subroutine after_material(config, prony_times, prony_values, stat, msg)
       type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
+      real(wp), intent(in) :: prony_times(:), prony_values(:)
+      integer, intent(inout) :: stat
       character(len=*), intent(inout) :: msg
-      real(wp) :: thickness, young, poisson
-      namelist /layer/ thickness, young, poisson
-
-      thickness = config%thickness
-      young = config%young
-      poisson = config%poisson
-      read (lines, nml=layer, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      config%thickness = thickness
-      config%young = young
-      config%poisson = poisson
-   end subroutine read_group_layer
-
-   subroutine read_group_material(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: model, prony_form, prony_file
-      real(wp) :: e0, e_inf, tau, speed, prony_equilibrium
-      real(wp) :: prony_times(max_prony_terms), prony_values(max_prony_terms)
-      namelist /material/ model, e0, e_inf, tau, speed, prony_form, prony_equilibrium, prony_times, &
-         & prony_values, prony_file
-
+      if (count_set(prony_times) /= count(prony_times /= unset_entry) .or. &
+         & count_set(prony_values) /= count(prony_values /= unset_entry)) then
+         stat = -1
+         msg = 'prony_times/prony_values: give the entries in order from the first, without gaps'
+         return
+      end if
       associate (m => config%material)
-         model = m%model
-         prony_form = m%form
-         prony_file = config%prony_file
-         e0 = m%e0
-         e_inf = m%e_inf
-         tau = m%tau
-         speed = config%speed
-         prony_equilibrium = m%equilibrium
-         prony_times = unset_entry
-         prony_values = unset_entry
-         if (allocated(m%times)) prony_times(:size(m%times)) = m%times
-         if (allocated(m%values)) prony_values(:size(m%values)) = m%values
-         read (lines, nml=material, iostat=stat, iomsg=msg)
-         if (stat /= 0) return
-      if (too_long('model', model, stat, msg)) return
-      if (too_long('prony_form', prony_form, stat, msg)) return
-      if (too_long('prony_file', prony_file, stat, msg)) return
-         if (count_set(prony_times) /= count(prony_times /= unset_entry) .or. &
-            & count_set(prony_values) /= count(prony_values /= unset_entry)) then
-            stat = -1
-            msg = 'prony_times/prony_values: give the entries in order from the first, without gaps'
-            return
-         end if
-         m%model = model
-         m%form = prony_form
-         config%prony_file = prony_file
-         m%e0 = e0
-         m%e_inf = e_inf
-         m%tau = tau
-         config%speed = speed
-         m%equilibrium = prony_equilibrium
-         ! the terms given are the leading entries that were set
          if (allocated(m%times)) deallocate (m%times)
          if (allocated(m%values)) deallocate (m%values)
          if (count_set(prony_times) > 0) m%times = prony_times(:count_set(prony_times))
          if (count_set(prony_values) > 0) m%values = prony_values(:count_set(prony_values))
       end associate
-   end subroutine read_group_material
+   end subroutine after_material
 
    !> A string variable read into a buffer one character longer than the scene keeps: if it
    !> fills more than max_string characters it would be cut, so it is refused
@@ -521,166 +396,6 @@ contains
             & "'tau_i value_i', 1 to " // to_string(max_prony_terms), code_input)
       end if
    end subroutine read_prony_file
-
-   subroutine read_group_friction(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      real(wp) :: coefficient
-      logical :: companion
-      namelist /friction/ coefficient, companion
-
-      coefficient = config%friction
-      companion = config%companion
-      read (lines, nml=friction, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      config%friction = coefficient
-      config%companion = companion
-   end subroutine read_group_friction
-
-   subroutine read_group_profile(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: kind, file, dataset, detrend, boundary, resample
-      real(wp) :: hurst, rolloff_wavelength, short_wavelength, rms_gradient, rms_height, amplitude, radius
-      integer(i8) :: seed
-      integer :: mode, mode_y
-      namelist /profile/ kind, hurst, seed, rolloff_wavelength, short_wavelength, rms_gradient, &
-         & rms_height, amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, resample
-
-      associate (p => config%profile)
-         kind = p%kind
-         hurst = p%hurst
-         seed = p%seed
-         rolloff_wavelength = p%rolloff_wavelength
-         short_wavelength = p%short_wavelength
-         rms_gradient = p%rms_gradient
-         rms_height = p%rms_height
-         amplitude = p%amplitude
-         mode = p%mode
-         mode_y = p%mode_y
-         radius = p%radius
-         file = p%file
-         dataset = p%dataset
-         detrend = p%detrend
-         boundary = p%boundary
-         resample = p%resample
-         read (lines, nml=profile, iostat=stat, iomsg=msg)
-         if (stat /= 0) return
-      if (too_long('kind', kind, stat, msg)) return
-      if (too_long('file', file, stat, msg)) return
-      if (too_long('dataset', dataset, stat, msg)) return
-      if (too_long('detrend', detrend, stat, msg)) return
-      if (too_long('boundary', boundary, stat, msg)) return
-      if (too_long('resample', resample, stat, msg)) return
-         p%kind = kind
-         p%hurst = hurst
-         p%seed = seed
-         p%rolloff_wavelength = rolloff_wavelength
-         p%short_wavelength = short_wavelength
-         p%rms_gradient = rms_gradient
-         p%rms_height = rms_height
-         p%amplitude = amplitude
-         p%mode = mode
-         p%mode_y = mode_y
-         p%radius = radius
-         p%file = file
-         p%dataset = dataset
-         p%detrend = detrend
-         p%boundary = boundary
-         p%resample = resample
-      end associate
-   end subroutine read_group_profile
-
-   subroutine read_group_loading(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: control
-      real(wp) :: mean_pressure, normalised_pressure, penetration
-      namelist /loading/ control, mean_pressure, normalised_pressure, penetration
-
-      control = config%control
-      mean_pressure = config%mean_pressure
-      normalised_pressure = config%normalised_pressure
-      penetration = config%penetration
-      read (lines, nml=loading, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      if (too_long('control', control, stat, msg)) return
-      config%control = control
-      config%mean_pressure = mean_pressure
-      config%normalised_pressure = normalised_pressure
-      config%penetration = penetration
-   end subroutine read_group_loading
-
-   subroutine read_group_solver(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: method
-      real(wp) :: tol
-      integer :: max_iter, memory, threads
-      real(wp) :: target_error
-      logical :: precondition, coarse_start, verbose
-      namelist /solver/ method, tol, max_iter, memory, precondition, coarse_start, threads, target_error, verbose
-
-      method = config%solver%method
-      tol = config%solver%tol
-      max_iter = config%solver%max_iter
-      memory = config%solver%memory
-      precondition = config%solver%precondition
-      coarse_start = config%solver%coarse_start
-      target_error = config%solver%target_error
-      threads = config%solver%threads
-      verbose = config%solver%verbose
-      read (lines, nml=solver, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      if (too_long('method', method, stat, msg)) return
-      config%solver%method = method
-      config%solver%tol = tol
-      config%solver%max_iter = max_iter
-      config%solver%memory = memory
-      config%solver%precondition = precondition
-      config%solver%coarse_start = coarse_start
-      config%solver%target_error = target_error
-      config%solver%threads = threads
-      config%solver%verbose = verbose
-   end subroutine read_group_solver
-
-   subroutine read_group_output(lines, config, stat, msg)
-      character(len=*), intent(in) :: lines(:)
-      type(scene_type), intent(inout) :: config
-      integer, intent(out) :: stat
-      character(len=*), intent(inout) :: msg
-      character(len=max_string + 1) :: file
-      logical :: overwrite, stress, fields, leakage
-      integer :: gap_bins
-      real(wp) :: leakage_tol
-      namelist /output/ file, overwrite, stress, gap_bins, fields, leakage, leakage_tol
-
-      file = config%output_file
-      overwrite = config%overwrite
-      stress = config%stress
-      gap_bins = config%gap_bins
-      fields = config%fields
-      leakage = config%leakage
-      leakage_tol = config%leakage_tol
-      read (lines, nml=output, iostat=stat, iomsg=msg)
-      if (stat /= 0) return
-      if (too_long('file', file, stat, msg)) return
-      config%output_file = file
-      config%overwrite = overwrite
-      config%stress = stress
-      config%gap_bins = gap_bins
-      config%fields = fields
-      config%leakage = leakage
-      config%leakage_tol = leakage_tol
-   end subroutine read_group_output
 
    ! ---------------------------------------------------------------------------------------
    ! Scanning the text.
@@ -946,35 +661,23 @@ contains
          write (buffer, '(es24.16e3)') x
          s = trim(adjustl(buffer))
       end if
-      if (x == not_set) s = s // '  ! not set'
    end function real_value
 
-   !> The Prony terms as `prony_times = ...` and `prony_values = ...` (nothing if none); the
-   !> echo carries the terms themselves, never the file they came from.
-   pure function prony_entries(times, values) result(s)
-      real(wp), allocatable, intent(in) :: times(:), values(:)
+   !> A list variable as `name = v1, v2, ...` (nothing if it has no entries).
+   pure function list_entry(name, values) result(s)
+      character(len=*), intent(in) :: name
+      real(wp), allocatable, intent(in) :: values(:)
       character(len=:), allocatable :: s
       integer :: i
       s = ''
-      if (allocated(times)) then
-         if (size(times) > 0) then
-            s = '   prony_times = ' // real_value(times(1))
-            do i = 2, size(times)
-               s = s // ', ' // real_value(times(i))
-            end do
-            s = s // newline
-         end if
-      end if
-      if (allocated(values)) then
-         if (size(values) > 0) then
-            s = s // '   prony_values = ' // real_value(values(1))
-            do i = 2, size(values)
-               s = s // ', ' // real_value(values(i))
-            end do
-            s = s // newline
-         end if
-      end if
-   end function prony_entries
+      if (.not. allocated(values)) return
+      if (size(values) == 0) return
+      s = '   ' // name // ' = ' // real_value(values(1))
+      do i = 2, size(values)
+         s = s // ', ' // real_value(values(i))
+      end do
+      s = s // newline
+   end function list_entry
 
    !> A quoted string, inner apostrophes doubled.
    pure function str_value(word) result(s)
