@@ -6,7 +6,7 @@
 !> Prints one line per check; error stop 1 on any failure.
 program test_greens_stack
    use lc_kinds, only: wp
-   use lc_errors, only: error_type
+   use lc_errors, only: error_type, code_input
    use lc_greens_layer, only: layer_coefficients, halfspace_coupling
    use lc_greens_stack, only: stack_layer, stack_base, stack_compliance, stack_compliance_lapack, &
       base_rigid, base_halfspace
@@ -35,6 +35,7 @@ program test_greens_stack
    call check_frictionless_base()
    call check_mode_solver()
    call check_symmetry_positivity()
+   call check_invalid_input()
    if (failures > 0) then
       print '(a, i0, a)', 'test_greens_stack: ', failures, ' check(s) FAILED'
       error stop 1
@@ -447,4 +448,35 @@ contains
       call report('elastic stacks: real 1-A, 1-B, c, t', worst_im <= 0.0_wp, worst_im)
       call report('elastic stacks: Re(1-A) > 0 and positive-definite 2x2 (smallest ratio)', lowest > 0.0_wp, lowest)
    end subroutine check_symmetry_positivity
+
+   !> Invalid stacks are errors with code_input, never NaN.
+   subroutine check_invalid_input()
+      type(stack_layer) :: layer(1), none(0)
+      type(stack_base) :: base
+      type(error_type), allocatable :: error
+      complex(wp) :: plane(2, 2), anti
+      integer :: caught
+
+      caught = 0
+      call stack_compliance(none, base, 1.0_wp, plane, anti, error)
+      if (allocated(error)) caught = caught + merge(1, 0, error%code == code_input)
+      call stack_compliance(layer, base, 0.0_wp, plane, anti, error)
+      if (allocated(error)) caught = caught + merge(1, 0, error%code == code_input)
+      layer(1)%poisson = 0.6_wp
+      call stack_compliance(layer, base, 1.0_wp, plane, anti, error)
+      if (allocated(error)) caught = caught + merge(1, 0, error%code == code_input)
+      layer(1)%poisson = 0.3_wp
+      layer(1)%thickness = -1.0_wp
+      call stack_compliance(layer, base, 1.0_wp, plane, anti, error)
+      if (allocated(error)) caught = caught + merge(1, 0, error%code == code_input)
+      layer(1)%thickness = 1.0_wp
+      base%kind = base_halfspace
+      base%young = -1.0_wp
+      call stack_compliance(layer, base, 1.0_wp, plane, anti, error)
+      if (allocated(error)) caught = caught + merge(1, 0, error%code == code_input)
+      base%young = 1.0_wp
+      call stack_compliance_lapack(layer, base, 1.0e-4_wp, plane, anti, error)
+      if (allocated(error)) caught = caught + merge(1, 0, error%code == code_input)
+      call report('invalid stacks and mode-solve ranges are input errors (6 of 6)', caught == 6, real(caught, wp))
+   end subroutine check_invalid_input
 end program test_greens_stack
