@@ -24,8 +24,8 @@
 !> `stack_compliance_lapack` solves the same boundary-value problem as one dense linear system
 !> (4 Papkovich-Neuber coefficients per layer), as a test oracle.
 module lc_greens_stack
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, fatal_error, code_input, code_internal
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, code_input, code_internal
    use lc_greens_layer, only: mode_field_rows
    implicit none (type, external)
    private
@@ -35,13 +35,14 @@ module lc_greens_stack
    !> Kinds of base below the last layer.
    integer, parameter :: base_rigid = 1, base_halfspace = 2
    !> Below this |q| h a layer is applied through its transfer matrix (entries within a factor
-   !> ~2 of 1), above through its stiffness matrix (entries O(1) in units of 2G|q|).
+   !> ~2 of 1), above through its stiffness matrix (entries O(1) in units of 2G|q|); the two
+   !> agree across the switch (docs/decisions/017-layered-stacks.md).
    real(wp), parameter :: x_thin = 1.0_wp
    !> Above this |q| h the stiffness is evaluated with numerator and denominator times
    !> 4 exp(-2|q|h): sinh^2 would overflow past |q|h ~ 355 and at 20 both forms are exact.
    real(wp), parameter :: x_large = 20.0_wp
-   !> Range of |q| h_i per layer where the mode solver is accurate to ~1e-10 (its potentials
-   !> lose digits like eps/(|q|h)^2 in thin layers, as in lc_greens_layer).
+   !> Range of |q| h_i per layer accepted by the mode solver: its potentials lose digits like
+   !> eps/(|q|h)^2 in thin layers, as in lc_greens_layer (measured: docs/decisions/017-layered-stacks.md).
    real(wp), parameter :: lapack_layer_x_min = 1.0e-2_wp
    real(wp), parameter :: lapack_layer_x_max = 30.0_wp
    !> Depth parameter of the mode solver's half-space columns: its decaying family exp(-|q| z)

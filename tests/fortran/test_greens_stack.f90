@@ -5,8 +5,8 @@
 !> (bonded and slipping, elastic and viscoelastic), reciprocity and positivity.
 !> Prints one line per check; error stop 1 on any failure.
 program test_greens_stack
-   use lc_kinds, only: wp
-   use lc_errors, only: error_type, code_input
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, code_input
    use lc_greens_layer, only: layer_coefficients, halfspace_coupling
    use lc_greens_stack, only: stack_layer, stack_base, stack_compliance, stack_compliance_lapack, &
       base_rigid, base_halfspace
