@@ -22,7 +22,7 @@ module lc_greens_layer
    implicit none (type, external)
    private
    public :: layer_coefficients, halfspace_coupling
-   public :: layer_coefficients_lapack, layer_mode_response
+   public :: layer_coefficients_lapack, layer_mode_response, mode_field_rows
    public :: x_series, x_large, lapack_x_min, lapack_x_max
 
    !> Below this argument y, sinh(y) - y is summed as a series: the direct difference
