@@ -182,7 +182,7 @@ run_sweep.reaped = 0.0
 
 
 def summary(directory: Path, name: str) -> dict[str, np.ndarray]:
-    from layercontact.sweep import read_summary
+    from layercontact.sweeps.sweep import read_summary
 
     return read_summary(directory / "out" / f"{name}_summary.h5")
 
@@ -203,7 +203,7 @@ def per_scene_steps(directory: Path, name: str, sample: int) -> dict[str, float]
 
     import layercontact as lc
     from layercontact.native import core as _core
-    from layercontact.sweep import _result_columns
+    from layercontact.sweeps.sweep import _result_columns
 
     scenes = sorted((directory / "out" / "scenes").glob(f"{name}_*.nml"))
     picks = [scenes[i] for i in np.linspace(0, len(scenes) - 1, sample).round().astype(int)]
@@ -251,7 +251,7 @@ def fixed_costs(directory: Path, name: str, python: Path) -> dict[str, float]:
     """The sweep command's costs that do not scale with the solves: writing and checking
     every scene file (a dry run into a fresh directory) and a resumed run of the finished
     sweep (interpreter start, scene check, completeness check of every result, summary)."""
-    from layercontact.sweep import execute, read_sweep
+    from layercontact.sweeps.sweep import execute, read_sweep
 
     sweep_file = directory / f"{name}.nml"
     plan = read_sweep(sweep_file)

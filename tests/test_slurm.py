@@ -1,4 +1,4 @@
-"""Sweeps on clusters (layercontact.slurm, .submit, .sweep_status, .provenance): the job
+"""Sweeps on clusters (layercontact.sweeps: slurm, submit, status, provenance): the job
 script written from the &sweep group and the command line, bad options refused by name,
 the script's tasks run by hand (a failing scene and a killed task lose nothing else, run
 records hold the provenance), status and collect of local and batch sweeps, local workers
@@ -21,10 +21,11 @@ import numpy as np
 import pytest
 
 import layercontact as lc
-from layercontact import provenance, slurm, sweep_status
+from layercontact.sweeps import provenance, slurm
+from layercontact.sweeps import status as sweep_status
+from layercontact.sweeps import sweep as sweep_module
 from layercontact.__main__ import main
 
-sweep_module = sys.modules["layercontact.sweep"]  # `layercontact.sweep` is the function
 
 BASE = """\
 &scene
@@ -135,7 +136,7 @@ def test_local_workers_follow_the_cpus_allocated(tmp_path, monkeypatch):
             "0",
             sys.executable,
             "-c",
-            "from layercontact.sweep import allocated_cpus; print(allocated_cpus())",
+            "from layercontact.sweeps.sweep import allocated_cpus; print(allocated_cpus())",
         ],
         capture_output=True,
         text=True,

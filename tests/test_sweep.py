@@ -1,4 +1,4 @@
-"""Parameter sweeps (layercontact.sweep): the product of the &sweep lists, results equal to
+"""Parameter sweeps (layercontact.sweeps.sweep): the product of the &sweep lists, results equal to
 running each scene alone, resume after an interruption or a change, fail-fast checks of
 the base scene and the lists, CSV and HDF5 summaries that agree, failing scenes reported
 while the others complete, and every sweep in inputs/sweeps/ (dry run; example.nml in
@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 import layercontact as lc
+from layercontact.sweeps import sweep as sweep_module
 from layercontact.__main__ import main
 from conftest import ROOT
 
-sweep_module = sys.modules["layercontact.sweep"]  # `layercontact.sweep` is the function
 SWEEPS = sorted((ROOT / "inputs" / "sweeps").glob("*.nml"))
 
 BASE = """\

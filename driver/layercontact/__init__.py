@@ -41,7 +41,7 @@ from .profiles import (
     sinusoid_surface,
     spherical_cap,
 )
-from .sweep import read_summary, sweep
+from .sweeps.sweep import read_summary, sweep
 from .topography import Topography, read_topography, write_height_file
 
 __all__ = [

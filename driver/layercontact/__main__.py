@@ -11,7 +11,7 @@
 ``run`` runs a scene like the ``layercontact`` executable (same library routine, same
 HDF5 file, same summary and exit codes) and draws the seed's Fig. 2(a) view next to the
 result file. ``sweep`` runs a parameter sweep here in worker processes, or with ``--slurm``
-submits it as a Slurm job array (layercontact.submit). ``status`` and ``collect`` read a
+submits it as a Slurm job array (layercontact.sweeps.submit). ``status`` and ``collect`` read a
 sweep directory (or a sweep file): where each scene stands, and the summary. ``convert``
 reads an instrument topography file (with the optional SurfaceTopography package) and
 writes the HDF5 height file that ``&profile kind = 'file'`` reads, printing the &scene and
@@ -45,7 +45,7 @@ _BAD_SWEEP = (ValueError, LayercontactError, OSError)
 
 
 def _parser() -> argparse.ArgumentParser:
-    from .slurm import OPTIONS
+    from .sweeps.slurm import OPTIONS
 
     parser = argparse.ArgumentParser(
         prog="python -m layercontact",
@@ -126,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
             return slurm_command(args)
         given = _slurm_values(args)
         if given:
-            from .slurm import OPTIONS
+            from .sweeps.slurm import OPTIONS
 
             flag = OPTIONS[next(iter(given))].flag
             print(f"layercontact: error: {flag} applies only with --slurm", file=sys.stderr)
@@ -179,7 +179,7 @@ def sweep_command(nml: str, processes: int | None, progress: bool, dry_run: bool
     """``python -m layercontact sweep``: run the sweep, print where the summary is and
     which scenes failed. Exit code 0 all converged, 1 some scene failed or did not
     converge (the others ran), 2 bad sweep (nothing ran)."""
-    from .sweep import execute, failed, read_sweep
+    from .sweeps.sweep import execute, failed, read_sweep
 
     try:
         plan = read_sweep(nml, max_scenes)
@@ -209,7 +209,7 @@ def sweep_command(nml: str, processes: int | None, progress: bool, dry_run: bool
 def _slurm_values(args: argparse.Namespace) -> dict[str, object]:
     """The Slurm options given on the command line, by attribute (numbers converted; a
     value that is not one is left for the option's check to name)."""
-    from .slurm import INTEGER_OPTIONS, OPTIONS
+    from .sweeps.slurm import INTEGER_OPTIONS, OPTIONS
 
     values = {}
     for attribute in OPTIONS:
@@ -225,9 +225,9 @@ def _slurm_values(args: argparse.Namespace) -> dict[str, object]:
 def slurm_command(args: argparse.Namespace) -> int:
     """``python -m layercontact sweep FILE --slurm``: submit (or with --dry-run show) the
     job array of the scenes that are missing or failed; record the job id."""
-    from .slurm import SlurmError, resolve_options
-    from .submit import submit_sweep
-    from .sweep import read_sweep
+    from .sweeps.slurm import SlurmError, resolve_options
+    from .sweeps.submit import submit_sweep
+    from .sweeps.sweep import read_sweep
 
     if args.processes is not None:
         print(
@@ -284,7 +284,7 @@ def slurm_command(args: argparse.Namespace) -> int:
 
 def status_command(directory: str, list_all: bool = False) -> int:
     """``python -m layercontact status DIR``: 0 every scene done, 1 not (yet), 2 no sweep."""
-    from .sweep_status import report, sweep_status
+    from .sweeps.status import report, sweep_status
 
     try:
         status = sweep_status(directory)
@@ -298,7 +298,7 @@ def status_command(directory: str, list_all: bool = False) -> int:
 def collect_command(directory: str) -> int:
     """``python -m layercontact collect DIR``: write the summary; 0 every scene converged,
     1 not, 2 no sweep."""
-    from .sweep_status import DONE, collect
+    from .sweeps.status import DONE, collect
 
     try:
         status, rows = collect(directory)

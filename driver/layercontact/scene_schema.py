@@ -27,7 +27,7 @@ allowed variables in messages, the checks of ``interval`` and ``choices``, the w
 scene as namelist text and the ``/input`` writer of the result file
 (``tools/scene_codegen.py``); in Python the keyword groups of
 :func:`layercontact.solve_line` and :func:`layercontact.solve_areal`, the sweep's parameters
-(:mod:`layercontact.sweep`); and the tables of ``docs/namelist.md``. This module is plain
+(:mod:`layercontact.sweeps.sweep`); and the tables of ``docs/namelist.md``. This module is plain
 data and standard-library Python: the build runs it before the package exists.
 """
 

@@ -64,7 +64,7 @@ class SceneState:
     rerun : bool
         Submitting the sweep again runs it (missing, or failed without a result).
     record : dict or None
-        Its run record (:mod:`layercontact.provenance`).
+        Its run record (:mod:`layercontact.sweeps.provenance`).
     outcome : dict or None
         The summary columns of its result, when the result is complete.
     """

@@ -16,17 +16,14 @@ A sweep file holds the usual groups (``&scene &layer &material &friction &profil
        processes = 2                     ! worker processes (default: the CPUs allocated)
        max_scenes = 50000                ! the most scenes allowed (default: MAX_SCENES, 20000)
        slurm_time = '0:30:00'            ! slurm_*: options of a Slurm job array
-    /                                    ! (layercontact.slurm, docs/clusters.md)
+    /                                    ! (layercontact.sweeps.slurm, docs/clusters.md)
 
 Layout of ``DIRECTORY``: ``scenes/NAME_XXXX.nml`` (one complete scene each),
 ``results/NAME_XXXX.h5`` (written by the library, complete or absent), ``runs/NAME_XXXX.json``
-(the run record: host, Slurm ids, times, exit code; :mod:`layercontact.provenance`),
+(the run record: host, Slurm ids, times, exit code; :mod:`layercontact.sweeps.provenance`),
 ``NAME_sweep.json`` (the list of scenes, read by ``status`` and ``collect``) and
 ``NAME_summary.csv`` / ``NAME_summary.h5`` (one row per scene). A Slurm sweep adds
 ``logs/`` (the executable's output per scene) and ``slurm/`` (job scripts and submissions).
-
-Note: ``layercontact.sweep`` is the function :func:`sweep`; this module is
-``sys.modules['layercontact.sweep']``.
 """
 
 from __future__ import annotations
@@ -54,8 +51,9 @@ from pathlib import Path
 import f90nml
 import numpy as np
 
-from . import provenance, scene_schema
-from .api import LayercontactError, check_scene_file, regular_file, run_to_file
+from .. import scene_schema
+from . import provenance
+from ..api import LayercontactError, check_scene_file, regular_file, run_to_file
 from .slurm import CONTROL_CHARACTERS, NO_CONTROL, SWEEP_VARIABLES, options_from_sweep
 
 SWEEP_GROUP = "sweep"
@@ -141,8 +139,8 @@ class SweepPlan:
         Worker processes asked for in the file.
     slurm : dict of str to object, or None
         The ``slurm_*`` variables of the &sweep group, checked, by
-        :class:`layercontact.slurm.SlurmOptions` attribute (see
-        :func:`layercontact.slurm.options_from_sweep`).
+        :class:`layercontact.sweeps.slurm.SlurmOptions` attribute (see
+        :func:`layercontact.sweeps.slurm.options_from_sweep`).
     """
 
     source: Path

@@ -4,7 +4,7 @@
 The scenes are written and checked as for a local sweep; then the scenes that have no
 complete result and are not already queued or running (all of them the first time;
 those missing or failed afterwards) go into a scene list and one sbatch script
-(:func:`layercontact.slurm.job_script`), which is submitted (or only written and shown,
+(:func:`layercontact.sweeps.slurm.job_script`), which is submitted (or only written and shown,
 with ``dry_run``). The job id is recorded in ``slurm/NAME_NNN.json``. Submitting again is
 safe at any time: scenes that are done, queued or running are left alone.
 """
@@ -23,7 +23,7 @@ from pathlib import Path
 from . import slurm
 from .provenance import utc_now
 from .sweep import SweepPlan, plan_scenes, write_plan_record, write_scenes
-from .sweep_status import QUEUED, RUNNING, SceneState, scene_states
+from .status import QUEUED, RUNNING, SceneState, scene_states
 
 
 @dataclass(frozen=True)
@@ -87,10 +87,10 @@ def submit_sweep(plan: SweepPlan, options: slurm.SlurmOptions, dry_run: bool = F
     Parameters
     ----------
     plan : SweepPlan
-        The sweep (:func:`layercontact.sweep.read_sweep`); the tasks run in the current
+        The sweep (:func:`layercontact.sweeps.sweep.read_sweep`); the tasks run in the current
         working directory, where the scene files name their results.
     options : SlurmOptions
-        See :func:`layercontact.slurm.resolve_options`.
+        See :func:`layercontact.sweeps.slurm.resolve_options`.
     dry_run : bool
         Write the scenes, the scene list and the script; submit nothing.
 

@@ -2,10 +2,10 @@
 the records of submissions.
 
 A sweep submitted to Slurm (``python -m layercontact sweep FILE --slurm``, see
-:mod:`layercontact.submit`) is one job array. Each array task runs a chunk of consecutive
+:mod:`layercontact.sweeps.submit`) is one job array. Each array task runs a chunk of consecutive
 scenes of a scene list one after the other with the ``layercontact`` executable (no Python
 on the compute nodes) and leaves, per scene, the result file (written atomically by the
-executable), a run record (:mod:`layercontact.provenance`) and a log. Files, under the
+executable), a run record (:mod:`layercontact.sweeps.provenance`) and a log. Files, under the
 sweep directory ``DIRECTORY``::
 
     slurm/NAME_NNN.sbatch     the job script of submission NNN (001, 002, ...)
@@ -483,7 +483,7 @@ seconds_since() {{  # the wall time since $1 (milliseconds), as seconds with 3 d
   printf -v REPLY '%d.%03d' $(( elapsed / 1000 )) $(( elapsed % 1000 ))
 }}
 
-# The run record of a scene (layercontact.provenance), replaced atomically:
+# The run record of a scene (layercontact.sweeps.provenance), replaced atomically:
 # $1 scene, $2 state, $3 exit code, $4 started, $5 finished, $6 wall time (empty: null).
 # Its locals shadow none of the loop's variables: the trap may run while the loop is in
 # here and then passes those variables, which must not read as this function's locals.

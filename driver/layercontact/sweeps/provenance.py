@@ -10,7 +10,7 @@ the whole run (input, solve and output) and the exit code.
 
 Two writers produce the same fields: the local sweep (Python, :func:`start_record` and
 :func:`finish_record`) and the Slurm array job script (bash, see
-:mod:`layercontact.slurm`), so status and summaries read local and batch runs alike.
+:mod:`layercontact.sweeps.slurm`), so status and summaries read local and batch runs alike.
 
 Fields
 ------
