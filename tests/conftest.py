@@ -27,6 +27,13 @@ from reference_operator import apply, g_eff  # noqa: F401 (shared with the tests
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def first_method(res) -> str:
+    """The method a solve started with (the policy's choice): the path's first name. Which
+    methods went on after it where it stalled may differ with rounding from one processor
+    to another; tests assert the solution, not that path."""
+    return res.solver.split("+")[0]
+
+
 def contact_violation(res: lc.LineResult, thickness: float, young: float, poisson: float, material=None,
                       speed: float = 0.0) -> dict:
     """Contact conditions of a result, recomputed independently: returns the worst
