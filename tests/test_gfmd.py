@@ -16,7 +16,7 @@ def surface(n=64, seed=2):
     return lc.self_affine_surface(n=n, hurst=0.8, seed=seed, short_wavelength=8 / n, rms_gradient=0.1)
 
 
-def pressure_bound(heights, thickness, poisson, friction, tol):
+def pressure_bound(heights, thickness, poisson, friction, tol, mean_pressure=P_M):
     """What a residual tol allows the pressure to differ by: a gap off by tol g_ref moves the
     pressure by at most the largest stiffness |1/G_eff| times it, a pressure off by tol p_m
     directly (two solutions, each within its tolerance)."""
@@ -27,7 +27,7 @@ def pressure_bound(heights, thickness, poisson, friction, tol):
     g = t[..., 2, 2] + friction * t[..., 2, 0]
     stiffness = np.max(1 / np.abs(g[np.abs(g) > 0]))
     g_ref = np.ptp(heights)
-    return 2 * tol * (stiffness * g_ref + P_M)
+    return 2 * tol * (stiffness * g_ref + mean_pressure)
 
 
 @pytest.mark.parametrize(
@@ -82,22 +82,12 @@ def test_gfmd_on_fig3_scenes(n, thickness, friction, load):
     ref = lc.solve_areal(h, tol=1e-13, **keys)
     dyn = lc.solve_areal(h, tol=TOL, method="gfmd", max_iter=20000, **keys)
     assert dyn.solver == "gfmd" and dyn.converged and dyn.residual <= TOL
-    bound = 2 * (TOL + 1e-13) * (np.ptp(h) * stiffness(h, thickness, 0.5, friction) + ref.mean_pressure)
+    bound = pressure_bound(h, thickness, 0.5, friction, TOL + 1e-13, ref.mean_pressure)
     assert np.max(np.abs(dyn.pressure - ref.pressure)) <= bound
     differ = (dyn.pressure > 0) != (ref.pressure > 0)
     assert np.count_nonzero(differ) <= 2 and np.all(ref.pressure[differ] <= bound)
     assert abs(dyn.delta_mu - ref.delta_mu) <= 1e-6 * max(abs(ref.delta_mu), 1e-3)
     assert dyn.penetration == pytest.approx(ref.penetration, rel=1e-6)
-
-
-def stiffness(heights, thickness, poisson, friction):
-    """The largest |1/G_eff| over the grid's modes."""
-    ny, nx = heights.shape
-    qx = 2 * np.pi * np.fft.rfftfreq(nx, 1 / nx)
-    qy = 2 * np.pi * np.fft.fftfreq(ny, 1 / ny)
-    t = lc.surface_tensor(*np.meshgrid(qx, qy), thickness=thickness, poisson=poisson)
-    g = t[..., 2, 2] + friction * t[..., 2, 0]
-    return np.max(1 / np.abs(g[np.abs(g) > 0]))
 
 
 @pytest.mark.parametrize(
@@ -114,3 +104,10 @@ def test_gfmd_refuses_what_its_dynamics_cannot_relax(thickness, friction):
     with pytest.raises(lc.InputError, match="'gfmd' cannot solve this scene.*'auto' \\(the default method\\)"):
         lc.solve_areal(h, thickness=thickness, poisson=0.5, friction=friction, mean_pressure=P_M, tol=TOL,
                        method="gfmd", max_iter=3000)
+
+
+def test_gfmd_refuses_a_strongly_coupled_line():
+    """A line is a grid of one row: the same measure of the operator refuses it."""
+    r = lc.self_affine_profile(n=256, hurst=0.8, seed=1)
+    with pytest.raises(lc.InputError, match="'gfmd' cannot solve this scene"):
+        lc.solve_line(r, thickness=0.05, poisson=0.5, friction=0.5, mean_pressure=P_M, method="gfmd")
