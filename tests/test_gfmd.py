@@ -69,7 +69,8 @@ def fig3_surface(n):
 @pytest.mark.parametrize(
     "thickness, friction, load",
     [(0.05, 0.0, 0.02154), (0.05, 0.0, 1.0), (0.16, 0.0, 0.02154), (0.16, 0.2, 0.02154), (0.16, 0.2, 1.0)],
-    ids=["h005-frictionless-2%", "h005-frictionless-26%", "h016-frictionless-8%", "h016-mu02-8%", "h016-mu02-97%"],
+    ids=["h005-frictionless-2%", "h005-frictionless-26%", "h016-frictionless-8%", "h016-mu02-8%",
+         "h016-mu02-97%"],
 )
 def test_gfmd_on_fig3_scenes(n, thickness, friction, load):
     """Fig. 3 scenes (incompressible layer, p_m/(E* h/lambda) = load): the contact of the
@@ -101,7 +102,8 @@ def test_gfmd_refuses_what_its_dynamics_cannot_relax(thickness, friction):
     measured to relax; the solve is refused before any step, and the message names the
     default method."""
     h = fig3_surface(32)
-    with pytest.raises(lc.InputError, match="'gfmd' cannot solve this scene.*'auto' \\(the default method\\)"):
+    refusal = "'gfmd' cannot solve this scene.*'auto' \\(the default method\\)"
+    with pytest.raises(lc.InputError, match=refusal):
         lc.solve_areal(h, thickness=thickness, poisson=0.5, friction=friction, mean_pressure=P_M, tol=TOL,
                        method="gfmd", max_iter=3000)
 
