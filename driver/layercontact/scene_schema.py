@@ -214,7 +214,8 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("solver", "method", "string", "'auto'", "", "both",
              "'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton' or 'multigrid'",
              "the solver; `'auto'` chooses (see [numerics.md](numerics.md)); `'cg'` (symmetric scenes only), "
-             "`'gcr'`, `'anderson'`, `'gfmd'` (damped dynamics), `'newton'` (dense semismooth Newton, grids of at "
+             "`'gcr'`, `'anderson'`, `'gfmd'` (damped dynamics; refused before any step where |Im G_eff|/Re G_eff "
+             "exceeds 0.5, docs/decisions/001), `'newton'` (dense semismooth Newton, grids of at "
              "most 2048 points) or `'multigrid'` (nonsmooth Newton multigrid; where it applies, "
              "docs/decisions/009 to 015)", "scene%solver%method", key="solver_method", choices=("auto", "cg",
              "gcr", "anderson", "gfmd", "newton", "multigrid")),

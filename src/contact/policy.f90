@@ -25,6 +25,7 @@ module lc_contact_policy
    use lc_base_strings, only: to_string, formatted
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_newton, only: dense_points
+   use lc_contact_solver_gfmd, only: gfmd_refusal
    use lc_contact_solver_multigrid, only: multigrid_refusal, metric_refusal, coupled_refusal, rows_ahead_of_gcr, &
       & loss_among_short_waves, short_loss_limit
    implicit none (type, external)
@@ -67,6 +68,8 @@ module lc_contact_policy
       logical :: rising = .false.
       !> why no multigrid form can solve the scene ('' if one can)
       character(len=:), allocatable :: refusal
+      !> why the GFMD dynamics cannot relax the scene ('' if it can; measured for method 'gfmd' only)
+      character(len=:), allocatable :: gfmd_refusal
       !> the metric's hierarchy would precondition it (metric_refusal is empty)
       logical :: metric_admitted = .true.
       !> the coarse start (where it ran): its iterations and whether it took the multigrid
@@ -105,6 +108,8 @@ contains
       ind%viscoelastic = op%kernel%viscoelastic
       ind%monotone = op%monotone
       ind%refusal = multigrid_refusal(op)
+      ind%gfmd_refusal = ''
+      if (trim(method) == 'gfmd') ind%gfmd_refusal = gfmd_refusal(op)
       if (op%coupled .or. (len(ind%refusal) > 0 .and. .not. op%kernel%viscoelastic)) then
          ind%refusal = coupled_refusal(op, load_control)
          ind%rising = .not. op%coupled .and. len(ind%refusal) == 0
@@ -162,6 +167,14 @@ contains
                & 'h/lambda >~ 0.07), with friction or sliding viscoelastic, and lines on thinner layers down ' // &
                & 'to h/lambda ~ 0.01 at nu = 0.5; allowed here: ' // allowed, code_input)
             return
+         end if
+      case ('gfmd')
+         if (allocated(ind%gfmd_refusal)) then
+            if (len(ind%gfmd_refusal) > 0) then
+               call fatal_error(error, "&solver: method = 'gfmd' cannot solve this scene: " // ind%gfmd_refusal // &
+                  & "; allowed here: 'auto' (the default method), 'gcr' or 'anderson'", code_input)
+               return
+            end if
          end if
       case ('newton')
          if (ind%points > dense_points) then

@@ -18,9 +18,14 @@
 !>
 !> Convergence is judged, as for the other solvers, on the complementarity residual of the
 !> pressure the wall carries (p = lambda, w = G_eff p, gap = w - b - s), not on an energy.
-!> A step costs one transform pair, a check one more. Strongly coupled thin layers (the
-!> stiffness far from symmetric) can make the dynamics unstable: the solve then stops and
-!> reports that it did not converge.
+!> A step costs one transform pair, a check one more.
+!>
+!> The stiffness 1/G_eff of a coupled scene has a phase on each mode: the friction (or the
+!> loss of a sliding viscoelastic layer) makes it a follower force, and FIRE's damping
+!> relaxes the dynamics only while |Im G_eff|/Re G_eff stays small. gfmd_refusal measures
+!> that ratio on the operator before any step and refuses the scenes beyond the measured
+!> limit max_stiffness_phase (docs/decisions/001-gfmd-masses.md), naming the methods that
+!> solve them.
 module lc_contact_solver_gfmd
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp
@@ -28,11 +33,12 @@ module lc_contact_solver_gfmd
    use lc_contact_residual, only: complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
    use lc_base_errors, only: error_type
+   use lc_base_strings, only: formatted
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
    implicit none (type, external)
    private
-   public :: gfmd, gfmd_outcome, gfmd_solver
+   public :: gfmd, gfmd_outcome, gfmd_solver, gfmd_refusal
 
    !> FIRE's parameters (Bitzek et al.): steps with positive power before the step grows,
    !> growth and shrink factors of the step, the initial and the decay of the mixing.
@@ -44,6 +50,10 @@ module lc_contact_solver_gfmd
    real(wp), parameter :: dt_start = 0.25_wp, dt_max = 1.0_wp
    !> Steps between two convergence checks (a check costs one transform pair).
    integer, parameter :: check_interval = 10
+   !> The largest |Im G_eff|/Re G_eff over the modes that the dynamics is given: measured
+   !> between the scenes that relax (ratio up to 0.47) and those that creep, stall or grow
+   !> (from 0.61) (docs/decisions/001-gfmd-masses.md).
+   real(wp), parameter :: max_stiffness_phase = 0.5_wp
 
    !> What one GFMD solve did.
    type :: gfmd_outcome
@@ -193,6 +203,41 @@ contains
          if (load_control) res = max(res, abs(sum(pressure)/n - mean_pressure)/mean_pressure)
       end subroutine check
    end subroutine gfmd
+
+   !> Why the damped dynamics cannot relax the scene of `op` ('' if it can): the ratio
+   !> |Im G_eff|/Re G_eff of some mode exceeds max_stiffness_phase.
+   function gfmd_refusal(op) result(refusal)
+      type(compliance_operator), intent(in) :: op
+      character(len=:), allocatable :: refusal
+      real(wp) :: ratio
+      refusal = ''
+      if (.not. op%coupled) return
+      ratio = stiffness_phase(op%full)
+      if (ratio <= max_stiffness_phase) return
+      if (ratio < huge(1.0_wp)) then
+         refusal = 'its stiffness 1/G_eff is far from symmetric, |Im G_eff|/Re G_eff reaches ' // &
+            & formatted(ratio, '(g0.3)') // ' on a mode'
+      else
+         refusal = 'its stiffness 1/G_eff is far from symmetric, Re G_eff <= 0 on a mode'
+      end if
+      refusal = refusal // ' (the friction or the loss acts as a follower force; the damped dynamics relaxes up to ' // &
+         & formatted(max_stiffness_phase, '(g0.2)') // ')'
+   end function gfmd_refusal
+
+   !> The largest |Im g|/Re g over the multipliers g /= 0 (huge where Re g <= 0).
+   pure real(wp) function stiffness_phase(g) result(ratio)
+      complex(wp), intent(in) :: g(:)
+      integer :: i
+      ratio = 0.0_wp
+      do i = 1, size(g)
+         if (g(i) == (0.0_wp, 0.0_wp)) cycle
+         if (real(g(i), wp) <= 0.0_wp) then
+            ratio = huge(1.0_wp)
+            return
+         end if
+         ratio = max(ratio, abs(aimag(g(i)))/real(g(i), wp))
+      end do
+   end function stiffness_phase
 
    !> s = the mean of w - b over the contact set (p > 0): the wall position the contact
    !> points agree on (unchanged without contact).
