@@ -95,3 +95,39 @@ def test_the_leakage_refuses_a_gap_that_is_not_a_real_map(gap, word):
         lc.reynolds_leakage(gap)
     with refused(word):
         lc.core_leakage(gap)
+
+
+@pytest.mark.parametrize("pressure, word", [
+    (np.full((8, 8), np.nan), "NaN"),
+    (np.ones((8, 8), dtype=complex), "complex"),
+    (np.ones((2, 8, 8)), "shape"),
+])
+def test_surface_stress_refuses_a_pressure_that_is_not_a_real_map(pressure, word):
+    with refused(word):
+        lc.surface_stress(pressure)
+
+
+def test_reading_a_file_that_is_not_a_result_names_it(tmp_path):
+    text = tmp_path / "notes.h5"
+    text.write_text("not HDF5\n")
+    with pytest.raises(lc.LayercontactError, match="cannot read result file '.*notes.h5'") as err:
+        lc.read_result(text)
+    assert err.value.code == 4
+    import h5py
+
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f["x"] = np.ones(3)
+    with pytest.raises(lc.LayercontactError, match="not a layercontact result") as err:
+        lc.read_result(other)
+    assert err.value.code == 4
+
+
+def test_the_module_says_its_version_and_core():
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "layercontact", "--version"], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0
+    assert proc.stdout.strip() == f"layercontact {lc.__version__} ({lc.BUILD})"

@@ -53,6 +53,10 @@ def _parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="Exit codes:" + __doc__.split("Exit codes:")[1],
     )
+    from . import BUILD, __version__
+
+    # the executable's `layercontact --version`, with the core this interpreter runs
+    parser.add_argument("--version", action="version", version=f"layercontact {__version__} ({BUILD})")
     sub = parser.add_subparsers(dest="command", required=True)
     run_p = sub.add_parser("run", help="run a namelist scene, write HDF5 and a PNG")
     run_p.add_argument("nml", help="namelist input file")

@@ -12,7 +12,7 @@ import numpy as np
 
 from . import scene_schema
 from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError, _check,  # noqa: F401
-                       _lines, _namelist, regular_file)
+                       _lines, _namelist, real_array, regular_file)
 from .leakage import CoreLeakage
 from .native import core as _core
 
@@ -476,7 +476,7 @@ def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson
     positive) of the layer under a prescribed pressure (S) and shear ``friction * p``,
     without solving a contact problem. The keywords and their defaults are those of
     :func:`solve_line`."""
-    p = np.ascontiguousarray(np.asarray(pressure, dtype=np.float64))
+    p = np.ascontiguousarray(real_array(pressure, "pressure", ndim=(1,)))
     fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction)
     return fields[:, 0].copy(), fields[:, 2].copy()
 
@@ -511,14 +511,12 @@ def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson
     for a surface, x = axis 1) and the shear ``friction * p`` along x, without solving a
     contact problem. ``period`` is one length or, for a surface, a pair ``(period_x,
     period_y)``; the keywords and their defaults are those of :func:`solve_areal`."""
-    p = np.asarray(pressure, dtype=np.float64)
+    p = real_array(pressure, "pressure", ndim=(1, 2))
     if p.ndim == 1:
         lx = period if np.ndim(period) == 0 else float(period[0])
         ux, sxx = surface_fields(p, period=lx, thickness=thickness, young=young, poisson=poisson,
                                  friction=friction)
         return SurfaceStress(displacement_x=ux, stress_xx=sxx)
-    if p.ndim != 2:
-        raise ValueError(f"pressure must be 1D (line) or (ny, nx) (surface); got shape {p.shape}")
     lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
     ny, nx = p.shape
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
@@ -561,7 +559,16 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             result.leakage = CoreLeakage.from_attributes(base["leakage"].attrs)
         return result
 
-    with h5py.File(filename, "r") as f:
+    path = regular_file(filename, "result file")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as err:
+        # (h5py's message does not name the file; a missing file or one that is not HDF5)
+        raise LayercontactError(f"cannot read result file '{path}': {err}", 4) from err
+    with f:
+        if "results" not in f or "input" not in f:
+            raise LayercontactError(f"cannot read result file '{path}': it is an HDF5 file but not a layercontact "
+                                    "result (no /results or /input)", 4)
         geometry = f.attrs.get("geometry", b"line")
         geometry = geometry.decode() if isinstance(geometry, bytes) else str(geometry)
         builder = _areal_result if geometry == "areal" else _line_result
