@@ -215,6 +215,17 @@ contains
 
       call check_ranges(scene, error)
       if (allocated(error)) return
+      ! a file name holds no control character: a newline would be read back as another name
+      ! (or another line of a job script)
+      if (has_control(scene%output_file)) then
+         call input_error(error, 'output', 'file', 'a name with a control character', &
+            & 'a file name without control characters (newline, tab, ...)')
+         return
+      else if (has_control(scene%profile%file)) then
+         call input_error(error, 'profile', 'file', 'a name with a control character', &
+            & 'a file name without control characters (newline, tab, ...)')
+         return
+      end if
       associate (p => scene%profile, s => scene%solver)
          if (.not. is_areal(scene) .and. (scene%n < 8 .or. scene%n > 2**26)) then
             call input_error(error, 'scene', 'n', to_string(scene%n), '8 <= n <= 2**26')
@@ -353,6 +364,16 @@ contains
       type(error_type), allocatable, intent(out) :: error
       include 'scene_checks.inc'
    end subroutine check_ranges
+
+   !> Whether `text` (trailing blanks aside) holds a control character.
+   pure logical function has_control(text)
+      character(len=*), intent(in) :: text
+      integer :: i
+      has_control = .false.
+      do i = 1, len_trim(text)
+         if (iachar(text(i:i)) < 32 .or. iachar(text(i:i)) == 127) has_control = .true.
+      end do
+   end function has_control
 
    pure logical function one_of(word, words)
       character(len=*), intent(in) :: word

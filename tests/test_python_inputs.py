@@ -131,3 +131,20 @@ def test_the_module_says_its_version_and_core():
                           timeout=120)
     assert proc.returncode == 0
     assert proc.stdout.strip() == f"layercontact {lc.__version__} ({lc.BUILD})"
+
+
+def test_a_name_across_two_lines_of_a_namelist_is_refused(tmp_path):
+    """A string that goes on to the next line would lose its newline (another file name):
+    the namelist file is refused, naming the line, and nothing is written."""
+    scene = tmp_path / "scene.nml"
+    scene.write_text("&scene\n n = 64\n/\n&loading\n normalised_pressure = 1.0\n/\n"
+                     "&output\n file = 'out\nput.h5'\n/\n")
+    with refused("line 8: a string goes on to the next line") as err:
+        lc.check_scene_file(scene)
+    assert err.value.code == 2 and not list(tmp_path.glob("*.h5"))
+
+
+@pytest.mark.parametrize("method", ["a\nb", "cg\t"])
+def test_a_keyword_with_a_control_character_is_refused(method, rough_profile):
+    with refused("control characters"):
+        lc.solve_line(rough_profile, mean_pressure=0.1, method=method)

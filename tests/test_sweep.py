@@ -434,3 +434,23 @@ def test_a_fifo_given_as_the_sweep_file_is_refused_at_once(tmp_path):
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 2
     assert f"sweep file '{fifo}' is a FIFO (named pipe); allowed: a regular file" in done.stderr
+
+
+@pytest.mark.parametrize("lists", [
+    "friction = 0.0, 0.5\n friction = 0.2\n",
+    "friction = 0.0, 0.5\n seed = 1\n friction(3) = 1.0\n",
+    "seed = 1, 2 ! seed = 3 in a comment is not an assignment\n friction = 0.0, 0.5, seed = 4\n",
+])
+def test_a_sweep_variable_given_twice_is_refused(tmp_path, lists):
+    """Two assignments of one &sweep variable (which the namelist parser would merge
+    element by element) are refused before anything is planned, naming the variable."""
+    name = "seed" if lists.startswith("seed") else "friction"
+    path = write_sweep(tmp_path, lists)
+    with pytest.raises(ValueError, match=f"&sweep {name}: given more than once"):
+        sweep_module.read_sweep(path)
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_sweep_variable_in_a_comment_or_a_string_is_not_counted(tmp_path):
+    path = write_sweep(tmp_path, "friction = 0.0, 0.5 ! friction = 1.0\n seed = 1, 2\n")
+    assert sweep_module.read_sweep(path).values["friction"] == [0.0, 0.5]

@@ -69,6 +69,10 @@ def _namelist(groups: dict[str, dict]) -> str:
     scene's default stays)."""
     text = []
     for group, variables in groups.items():
+        for name, value in variables.items():
+            if isinstance(value, str) and any(ord(c) < 32 or ord(c) == 127 for c in value):
+                raise InputError(f"&{group}: {name} = {value!r} is not allowed; allowed: text without control "
+                                 "characters (newline, tab, ...)", 2)
         given = [f" {name} = {_namelist_value(value)}" for name, value in variables.items() if value is not None]
         if given:
             text += [f"&{group}", *given, "/"]

@@ -421,6 +421,13 @@ contains
       i = 1
       do while (i <= len(text))
          if (text(i:i) == newline) then
+            ! (a string that goes on to the next line would silently lose its newline: a file
+            ! name 'out<newline>put.h5' would become another name)
+            if (quote /= ' ') then
+               call fatal_error(error, source // ', line ' // to_string(line) // ': a string goes on to the ' // &
+                  & "next line; allowed: a string on one line (no newline in a name)", code_input)
+               return
+            end if
             line = line + 1
          else if (quote /= ' ') then
             ! a doubled quote inside a string is an escaped quote, not the end of the string

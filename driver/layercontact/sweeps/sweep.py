@@ -39,6 +39,7 @@ import signal
 import threading
 import multiprocessing
 import os
+import re
 import socket
 import sys
 import time
@@ -267,7 +268,33 @@ def _read_namelist(source: Path) -> f90nml.Namelist:
     repeated = [name for name in dict.fromkeys(names) if names.count(name) > 1]
     if repeated:
         raise ValueError(f"{source}: &{repeated[0]} is given more than once; allowed: one &{repeated[0]} group")
+    # f90nml merges a variable given twice element by element: refused, as the lists of a
+    # sweep are read whole
+    twice = _repeated_sweep_variable(source.read_text()) if source.is_file() else None
+    if twice is not None:
+        raise _sweep_error(source, twice, "given more than once; allowed: one assignment with its whole list")
     return nml
+
+
+def _repeated_sweep_variable(text: str) -> str | None:
+    """The first variable assigned more than once in the &sweep group of a namelist text."""
+    seen = set()
+    inside = False
+    for line in text.splitlines():
+        code = re.sub(r"'[^']*'|\"[^\"]*\"", "''", line).split("!")[0]
+        if not inside:
+            match = re.match(r"\s*&sweep\b(.*)", code, flags=re.I)
+            if not match:
+                continue
+            inside, code = True, match.group(1)
+        for name in re.findall(r"(?:^|[\s,])([A-Za-z_]\w*)\s*(?:\([^)]*\))?\s*=", code):
+            name = name.lower()
+            if name in seen:
+                return name
+            seen.add(name)
+        if "/" in code:
+            inside = False
+    return None
 
 
 def _swept_values(source: Path, group: f90nml.Namelist) -> dict[str, list]:
