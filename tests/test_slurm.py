@@ -52,8 +52,11 @@ SLURM_TIMEOUT = 60
 
 
 def write_sweep(directory: Path, settings: str = "", lists: str = LISTS, name: str = "s") -> Path:
+    """A sweep file; its directory is out/NAME unless `settings` gives one (a variable is
+    assigned once in &sweep)."""
     path = directory / f"{name}.nml"
-    path.write_text(BASE + f"&sweep\n directory = 'out/{name}'\n{lists}{settings}/\n")
+    own = "" if "directory =" in settings else f" directory = 'out/{name}'\n"
+    path.write_text(BASE + f"&sweep\n{own}{lists}{settings}/\n")
     return path
 
 
