@@ -12,7 +12,7 @@ import numpy as np
 
 from . import scene_schema
 from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError, _check,  # noqa: F401
-                       _lines, _namelist, real_array, regular_file)
+                       _lines, _namelist, real_array, regular_file, stack_keywords)
 from .leakage import CoreLeakage
 from .native import core as _core
 
@@ -32,16 +32,21 @@ def layer_multipliers(kh, nu: float):
     return _core.py_layer_coefficients(kh, float(nu))
 
 
-def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None):
+def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None, **stack):
     """The layer's 3x3 surface compliance for in-plane wavevectors ``(qx, qy)`` (1/L,
     broadcast together): ``(u_x^, u_y^, w^) = T (tau_x^, tau_y^, p^)`` in convention P,
     shape ``broadcast.shape + (3, 3)``, complex. In the frame ``(l, t, z)`` with
     ``l = q/|q|`` it is the plane-strain multiplier with ``|k| -> |q|`` in ``(l, z)`` and the
-    antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t``; ``q = 0`` gives the uniform mode
-    ``(h/G, h/G, h/M)`` of a layer (zero for a half-space). The layer's keywords and their
-    defaults are those of :func:`solve_line` (``&layer``)."""
+    antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t`` (for one layer bonded to a rigid
+    base); ``q = 0`` gives the uniform mode ``(h/G, h/G, h/M)`` of a layer (summed over a
+    stack's layers; zero where a half-space lies below, and in-plane where an interface
+    slips). The layer's keywords and their defaults are those of :func:`solve_line`
+    (``&layer``), the stack keywords (``interface``, ``lower_thickness``, ``lower_young``,
+    ``lower_poisson``, ``lower_interfaces``, ``substrate_young``, ``substrate_poisson``)
+    included: see docs/namelist.md."""
     qx, qy = np.broadcast_arrays(np.asarray(qx, dtype=np.float64), np.asarray(qy, dtype=np.float64))
-    text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson}})
+    text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson,
+                                **stack_keywords("surface_tensor", stack)}})
     t, stat, errmsg = _core.py_surface_tensor(text, np.ascontiguousarray(qx.ravel()),
                                               np.ascontiguousarray(qy.ravel()))
     _check(stat, errmsg)
@@ -168,6 +173,7 @@ def solve_line(
     max_iter: int | None = None,
     memory: int | None = None,
     threads: int | None = None,
+    **stack,
 ) -> LineResult:
     """Solve the sliding line contact of the rigid profile ``heights`` (L, on a uniform
     periodic grid of one ``period``) on a layer of ``thickness`` (``inf``: half-space)
@@ -228,7 +234,8 @@ def solve_line(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress)
+        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
+        **stack_keywords("solve_line", stack))
     runs = _solve_scene(h, {"scene": {"n": h.size, "period": period}, **groups}, areal=False,
                         companion=bool(companion), stress=stress)
     results = [_line_result(**run, height=h.copy()) for run in runs]
@@ -441,6 +448,7 @@ def solve_areal(
     memory: int | None = None,
     threads: int | None = None,
     stress: bool | None = None,
+    **stack,
 ) -> ArealResult:
     """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
     a uniform periodic grid, axis 1 = x = the sliding direction) on a layer of
@@ -460,7 +468,8 @@ def solve_areal(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress)
+        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
+        **stack_keywords("solve_areal", stack))
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
     runs = _solve_scene(np.ascontiguousarray(h).ravel(), {"scene": scene, **groups}, areal=True,
                         companion=bool(companion), stress=stress)
@@ -471,20 +480,21 @@ def solve_areal(
     return results[0]
 
 
-def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None):
+def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None, **stack):
     """Surface displacement ``u_x`` (L) and in-plane stress ``sigma_xx`` (S, tension
     positive) of the layer under a prescribed pressure (S) and shear ``friction * p``,
     without solving a contact problem. The keywords and their defaults are those of
     :func:`solve_line`."""
     p = np.ascontiguousarray(real_array(pressure, "pressure", ndim=(1,)))
-    fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction)
+    fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction,
+                             stack_keywords("surface_fields", stack))
     return fields[:, 0].copy(), fields[:, 2].copy()
 
 
-def _surface_stress(p, scene: dict, thickness, young, poisson, friction) -> np.ndarray:
+def _surface_stress(p, scene: dict, thickness, young, poisson, friction, stack: dict) -> np.ndarray:
     """fields(n, 5) = u_x, u_y, sigma_xx, sigma_yy, sigma_xy of the layer under the flat
     pressure ``p`` (x fastest) on the grid of the &scene variables ``scene``."""
-    text = _namelist({"scene": scene, "layer": {"thickness": thickness, "young": young, "poisson": poisson},
+    text = _namelist({"scene": scene, "layer": {"thickness": thickness, "young": young, "poisson": poisson, **stack},
                       "friction": {"coefficient": friction}})
     fields, stat, errmsg = _core.py_surface_stress(text, p)
     _check(stat, errmsg)
@@ -505,7 +515,7 @@ class SurfaceStress:
 
 
 def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson=None,
-                   friction=None) -> SurfaceStress:
+                   friction=None, **stack) -> SurfaceStress:
     """Surface displacements and stresses of an elastic layer (``thickness=np.inf``:
     half-space, the default) under the prescribed pressure (S; 1D for a line, ``(ny, nx)``
     for a surface, x = axis 1) and the shear ``friction * p`` along x, without solving a
@@ -515,12 +525,13 @@ def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson
     if p.ndim == 1:
         lx = period if np.ndim(period) == 0 else float(period[0])
         ux, sxx = surface_fields(p, period=lx, thickness=thickness, young=young, poisson=poisson,
-                                 friction=friction)
+                                 friction=friction, **stack)
         return SurfaceStress(displacement_x=ux, stress_xx=sxx)
     lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
     ny, nx = p.shape
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
-    fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction)
+    fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction,
+                             stack_keywords("surface_stress", stack))
     ux, uy, sxx, syy, sxy = (fields[:, k].reshape(ny, nx).copy() for k in range(5))
     return SurfaceStress(displacement_x=ux, stress_xx=sxx, displacement_y=uy, stress_yy=syy, stress_xy=sxy)
 
