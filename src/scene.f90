@@ -20,7 +20,7 @@ module lc_scene
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
-      & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale, companion_of
+      & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale, companion_of, foundation
    public :: max_string, default_rms_gradient
 
    !> Sentinel for "not given" in optional positive quantities: a value nobody types, so
@@ -185,6 +185,26 @@ contains
       end if
       call place_on(kernel, trim(scene%interface) == 'slip', lower, base)
    end function kernel_of
+
+   !> What a finite layer rests on, in words for the summary ('' for the usual rigid base
+   !> bonded to it): the interface below it, the lower layers and the substrate.
+   function foundation(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      integer :: n
+      text = ''
+      n = 0
+      if (allocated(scene%lower_thickness)) n = size(scene%lower_thickness)
+      if (is_halfspace(scene) .or. (trim(scene%interface) == 'bonded' .and. n == 0 .and. &
+         & scene%substrate_young == not_set)) return
+      text = trim(scene%interface)
+      if (n > 0) text = text // ' on ' // to_string(n) // ' lower layer' // trim(merge('s', ' ', n > 1))
+      if (scene%substrate_young /= not_set) then
+         text = text // ' on a half-space, E_s = ' // to_string(scene%substrate_young) // ' (S)'
+      else
+         text = text // ' on a rigid base'
+      end if
+   end function foundation
 
    !> The scene's lower layers (none if it gives none); lower_poisson defaults to 0.5 each.
    pure subroutine lower_layers(scene, lower)
