@@ -177,7 +177,7 @@ def solve_line(
 ) -> LineResult:
     """Solve the sliding line contact of the rigid profile ``heights`` (L, on a uniform
     periodic grid of one ``period``) on a layer of ``thickness`` (``inf``: half-space)
-    bonded to a rigid base, with Coulomb friction ``tau = friction * p``.
+    bonded to a rigid base (or resting on a stack: below), with Coulomb friction ``tau = friction * p``.
 
     Every keyword sets the namelist variable of the same meaning (docs/namelist.md); one
     that is not given (None) takes that variable's default: ``period`` 1, ``thickness``
@@ -191,7 +191,13 @@ def solve_line(
     compressible layers only). ``material`` (a :class:`StandardLinearSolid` or
     :class:`Prony`; ``young`` is then ignored) makes the layer viscoelastic, sliding at
     ``speed`` (L/T); ``dissipated_power`` and ``monotone`` (``Re G_eff >= 0`` on every mode,
-    hence a unique solution) are reported. ``companion=True`` also solves the frictionless
+    hence a unique solution) are reported. The layer may rest on more than a rigid base bonded to it:
+    the stack keywords ``interface`` (``'bonded'`` or ``'slip'``, below the layer),
+    ``lower_thickness``, ``lower_young``, ``lower_poisson`` (elastic lower layers, from the top
+    down), ``lower_interfaces`` (a word or a list of words, one per lower layer),
+    ``substrate_young`` and ``substrate_poisson`` (an elastic half-space below them; not
+    given: rigid) are the ``&layer`` variables of those names (docs/theory.md, "Layered
+    stacks"). ``companion=True`` also solves the frictionless
     problem at the load of this one (its computed mean pressure, whatever the control) and
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
     and the surface stress ``stress_xx`` (one more FFT pair).
@@ -452,12 +458,13 @@ def solve_areal(
 ) -> ArealResult:
     """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
     a uniform periodic grid, axis 1 = x = the sliding direction) on a layer of
-    ``thickness`` (``inf``: half-space) bonded to a rigid base, with Coulomb friction
+    ``thickness`` (``inf``: half-space) bonded to a rigid base or resting on a stack, with Coulomb friction
     ``tau_x = friction * p``. ``period`` is one length or a pair ``(period_x, period_y)``.
     ``stress`` (default True) also computes the in-plane displacements and the surface
     stress tensor (five more transforms). ``normalised_pressure`` is the load in the scale
-    ``E* h/period_x`` on a layer, ``E* Lambda0/period_x`` on a half-space. Every other
-    keyword means what it means for :func:`solve_line`, with the same defaults.
+    ``E* h/period_x`` on a layer (the top layer's on a stack), ``E* Lambda0/period_x`` on a
+    half-space. Every other keyword, the stack keywords included, means what it means for
+    :func:`solve_line`, with the same defaults.
     """
     h = np.asarray(heights, dtype=np.float64)
     if h.ndim != 2:
@@ -483,8 +490,8 @@ def solve_areal(
 def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None, **stack):
     """Surface displacement ``u_x`` (L) and in-plane stress ``sigma_xx`` (S, tension
     positive) of the layer under a prescribed pressure (S) and shear ``friction * p``,
-    without solving a contact problem. The keywords and their defaults are those of
-    :func:`solve_line`."""
+    without solving a contact problem. The keywords (the stack keywords included) and their
+    defaults are those of :func:`solve_line`."""
     p = np.ascontiguousarray(real_array(pressure, "pressure", ndim=(1,)))
     fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction,
                              stack_keywords("surface_fields", stack))

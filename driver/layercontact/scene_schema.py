@@ -227,7 +227,8 @@ VARIABLES: tuple[Variable, ...] = (
              "> 0 and finite; exactly one of mean_pressure and normalised_pressure with control = 'load'",
              "`p_m/p_s`, the load in the seed's pressure scale `p_s`; one rule for lines and surfaces: "
              "`p_s = E* Lambda0/lambda` (`Lambda0 = max r - mean r`, the highest summit above the mean plane), "
-             "except on an areal scene on a layer: `p_s = E* h/lambda`; `E*` with the static modulus; "
+             "except on an areal scene on a layer: `p_s = E* h/lambda` (of the top layer on a stack); `E*` with the "
+             "static modulus; "
              "`/input@normalised_pressure_scale` names the one a result used",
              "scene%normalised_pressure", sweep=2, unset=_NOT_SET),
     Variable("loading", "penetration", "real", "not set", "L", "both",
