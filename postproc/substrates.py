@@ -65,6 +65,7 @@ def mean_error(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def draw(values: dict, out: Path) -> None:
     import matplotlib
+    import matplotlib.ticker
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), constrained_layout=True)
@@ -76,6 +77,8 @@ def draw(values: dict, out: Path) -> None:
                 ax.errorbar(LOADS, m, yerr=e, color=colour, linestyle=style, marker="o", ms=3, capsize=2,
                             label=f"{label(substrate)}, {interface}")
         ax.set_xscale("log")
+        ax.set_xticks(LOADS, [f"{load:g}" for load in LOADS])
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xlabel("p_m / (E* h/lambda)")
         ax.set_title(title)
     axes[0].legend(fontsize=7, ncol=1)

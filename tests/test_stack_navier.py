@@ -3,10 +3,11 @@
 ``lc.surface_tensor`` computes the surface compliance of a stack of layers with transfer and
 stiffness matrices (``src/greens/stack.f90``, docs/theory.md "Layered stacks"), and
 tests/fortran/test_greens_stack.f90 checks it against a dense mode solve. This file is a third,
-independent method: it never uses potentials, modes of a layer, transfer matrices or the
-closed forms of docs/theory.md. It discretises the displacement equations themselves,
+independent method: it uses no potentials, no modes of a layer, no transfer or stiffness
+matrices and none of the layer closed forms of docs/theory.md. It discretises the
+displacement equations themselves,
 
-    G u'' + (lambda + G) grad div u = 0,
+    G laplacian(u) + (lambda + G) grad div u = 0,
 
 for one wavevector ``q`` along ``x`` (``q_y = 0``; fields ``f(z) exp(i q x)``, ``z`` into the
 stack), by Chebyshev collocation in ``z`` in every layer, and imposes the surface tractions,
@@ -372,7 +373,7 @@ def test_one_bonded_layer_fixes_the_signs(nu):
         assert abs(t2[0, 1].real) <= rtol(q) * scale
         # convention P: for a thick compressible layer the surface moves toward a
         # compressive load (Dundurs' c > 0): Im T_xz > 0 for q > 0
-        if q * 1.0 > 3:
+        if q > 3:                          # |q| h = q here
             assert t2[0, 1].imag > 0
         t2m, _ = navier_stack(-q, layers, interfaces)
         assert np.abs(t2m - t2.conj()).max() <= rtol(q) * scale
@@ -384,7 +385,7 @@ def test_collocation_converges_spectrally():
     element until rounding: this is what sets N_FINE and shows N_COARSE is on the same
     converged branch for the tolerance of ``rtol``."""
     layers, interfaces, substrate = STACKS["soft_stiff_soft_half_space"]
-    q = QH_ELEMENT                         # the top layer is one element, the second one
+    q = QH_ELEMENT                         # |q| h_1 = QH_ELEMENT: one element at the limit
     ref = library_tensor(q, layers, interfaces, substrate)[XZ]
     errors = []
     for n in (12, 16, 20, 24, N_FINE):
