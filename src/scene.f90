@@ -112,6 +112,9 @@ module lc_scene
       !> (substrate_poisson not set: the layer's poisson).
       character(len=max_string) :: interface = 'bonded'
       real(wp), allocatable :: lower_thickness(:), lower_young(:), lower_poisson(:)
+      !> viscoelastic lower layers: a standard linear solid where lower_tau > 0 (lower_young
+      !> its low-frequency modulus, lower_e_inf its high-frequency one)
+      real(wp), allocatable :: lower_tau(:), lower_e_inf(:)
       character(len=max_string) :: lower_interfaces = ''
       real(wp) :: substrate_young = not_set
       real(wp) :: substrate_poisson = not_set
@@ -172,18 +175,17 @@ contains
       type(layer_kernel) :: kernel
       type(stack_layer), allocatable :: lower(:)
       type(stack_base) :: base
-      logical, allocatable :: slips(:)
-      integer :: i
+      real(wp), allocatable :: tau(:), e_inf(:)
       kernel = make_kernel(scene%thickness, material_of(scene), scene%poisson, scene%speed)
       if (is_halfspace(scene)) return
-      call lower_layers(scene, lower)
+      call lower_layers(scene, lower, tau, e_inf)
       if (scene%substrate_young /= not_set) then
          base = stack_base(kind=base_halfspace, young=cmplx(scene%substrate_young, 0.0_wp, wp), &
             & poisson=merge(scene%substrate_poisson, scene%poisson, scene%substrate_poisson /= not_set))
       else
          base = stack_base(kind=base_rigid)
       end if
-      call place_on(kernel, trim(scene%interface) == 'slip', lower, base)
+      call place_on(kernel, trim(scene%interface) == 'slip', lower, base, tau, e_inf)
    end function kernel_of
 
    !> What a finite layer rests on, in words for the summary ('' for the usual rigid base
@@ -207,15 +209,23 @@ contains
    end function foundation
 
    !> The scene's lower layers (none if it gives none); lower_poisson defaults to 0.5 each.
-   pure subroutine lower_layers(scene, lower)
+   pure subroutine lower_layers(scene, lower, tau, e_inf)
       type(scene_type), intent(in) :: scene
       type(stack_layer), allocatable, intent(out) :: lower(:)
+      !> per lower layer: retardation time (0: elastic) and high-frequency modulus
+      real(wp), allocatable, intent(out) :: tau(:), e_inf(:)
       character(len=8), allocatable :: words(:)
       integer :: i, n
       n = 0
       if (allocated(scene%lower_thickness)) n = size(scene%lower_thickness)
-      allocate (lower(n))
+      allocate (lower(n), tau(n), e_inf(n))
       if (n == 0) return
+      tau = 0.0_wp
+      e_inf = scene%lower_young
+      if (count_of(scene%lower_tau) == n) then
+         tau = scene%lower_tau
+         where (tau > 0.0_wp) e_inf = scene%lower_e_inf
+      end if
       words = interface_words(scene%lower_interfaces)
       do i = 1, n
          lower(i)%thickness = scene%lower_thickness(i)
@@ -334,9 +344,10 @@ contains
          if (allocated(error)) return
          call check_material(scene%material, error)
          if (allocated(error)) return
-         if (.not. is_viscoelastic(scene%material) .and. scene%speed /= 0.0_wp) then
+         if (.not. (is_viscoelastic(scene%material) .or. any_positive(scene%lower_tau)) .and. &
+            & scene%speed /= 0.0_wp) then
             call input_error(error, 'material', 'speed', to_string(scene%speed), &
-               & "0 with model = 'elastic' (an elastic layer does not depend on the speed)")
+               & "0 with model = 'elastic' and elastic lower layers (an elastic layer does not depend on the speed)")
             return
          end if
          call check_stack_below(scene, error)
@@ -497,6 +508,28 @@ contains
          end if
          if (allocated(error)) return
       end do
+      if (count_of(scene%lower_tau) /= 0 .and. count_of(scene%lower_tau) /= n) then
+         call input_error(error, 'layer', 'lower_tau', to_string(count_of(scene%lower_tau)) // ' values', &
+            & 'none (elastic lower layers) or one per lower layer: ' // to_string(n))
+         return
+      end if
+      if (count_of(scene%lower_e_inf) /= count_of(scene%lower_tau)) then
+         call input_error(error, 'layer', 'lower_e_inf', to_string(count_of(scene%lower_e_inf)) // ' values', &
+            & 'one per lower_tau value: ' // to_string(count_of(scene%lower_tau)))
+         return
+      end if
+      do i = 1, count_of(scene%lower_tau)
+         if (.not. (scene%lower_tau(i) >= 0.0_wp .and. ieee_is_finite(scene%lower_tau(i)))) then
+            call input_error(error, 'layer', 'lower_tau(' // to_string(i) // ')', to_string(scene%lower_tau(i)), &
+               & '>= 0 and finite (0: an elastic lower layer)')
+         else if (scene%lower_tau(i) > 0.0_wp .and. .not. (scene%lower_e_inf(i) >= scene%lower_young(i) .and. &
+            & ieee_is_finite(scene%lower_e_inf(i)))) then
+            call input_error(error, 'layer', 'lower_e_inf(' // to_string(i) // ')', to_string(scene%lower_e_inf(i)), &
+               & '>= lower_young(' // to_string(i) // ') = ' // to_string(scene%lower_young(i)) // &
+               & ' and finite (the glassy modulus is the larger one)')
+         end if
+         if (allocated(error)) return
+      end do
       words = interface_words(scene%lower_interfaces)
       if (size(words) /= 0 .and. size(words) /= n) then
          call input_error(error, 'layer', 'lower_interfaces', trim(scene%lower_interfaces), &
@@ -511,6 +544,13 @@ contains
          end if
       end do
    end subroutine check_stack_below
+
+   !> Whether a list holds a positive value (a viscoelastic lower layer).
+   pure logical function any_positive(values)
+      real(wp), allocatable, intent(in) :: values(:)
+      any_positive = .false.
+      if (allocated(values)) any_positive = any(values > 0.0_wp)
+   end function any_positive
 
    pure integer function count_of(values)
       real(wp), allocatable, intent(in) :: values(:)

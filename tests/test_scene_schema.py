@@ -85,7 +85,8 @@ SCENES = {
     "line_prony": """
 &scene n = 64, period = 0.5 /
 &layer thickness = 0.2, interface = 'slip', lower_thickness = 0.1, 0.3, lower_young = 2.0, 5.0,
-       lower_poisson = 0.3, 0.25, lower_interfaces = 'slip bonded', substrate_young = 20.0,
+       lower_poisson = 0.3, 0.25, lower_tau = 0.5, 0.0, lower_e_inf = 8.0, 5.0,
+       lower_interfaces = 'slip bonded', substrate_young = 20.0,
        substrate_poisson = 0.28 /
 &material model = 'prony', prony_form = 'creep', prony_equilibrium = 0.5, prony_times = 0.1, 1.0,
           prony_values = 0.2, 0.3, speed = 0.05 /

@@ -208,6 +208,32 @@ def test_a_viscoelastic_coating_on_an_elastic_substrate_balances_its_power(rough
         assert balance == pytest.approx(res.dissipated_power, rel=1e-9)
 
 
+def test_a_viscoelastic_lower_layer_between_its_limits_and_in_power_balance(rough_surface):
+    """A lower layer that is a standard linear solid: without dispersion (e_inf = young) it
+    is the elastic layer; sliding so fast that every mode is glassy it is the elastic layer
+    of modulus e_inf; in between it dissipates, and the power balance holds under an elastic
+    coating (the whole loss is in the lower layer)."""
+    stack = dict(thickness=0.05, poisson=0.45, friction=0.3, mean_pressure=0.01, lower_thickness=[0.1],
+                 lower_poisson=[0.4], substrate_young=50.0, substrate_poisson=0.3)
+    elastic = lc.solve_line(ROUGH_LINE, lower_young=[2.0], **stack)
+    flat = lc.solve_line(ROUGH_LINE, lower_young=[2.0], lower_tau=[1.0], lower_e_inf=[2.0], speed=0.3, **stack)
+    # the same kernel (J = 1/E exactly); the viscoelastic path solves it as coupled: both to
+    # tol = 1e-10
+    assert np.max(np.abs(flat.pressure - elastic.pressure)) <= 1e-8*elastic.pressure.max()
+    assert flat.dissipated_power == pytest.approx(0.0, abs=1e-14)
+    glassy = lc.solve_line(ROUGH_LINE, lower_young=[2.0], lower_tau=[1e7], lower_e_inf=[20.0], speed=1.0, **stack)
+    stiff = lc.solve_line(ROUGH_LINE, lower_young=[20.0], **stack)
+    # the modulus differs from e_inf by O((e_inf/e0 - 1)/(k V tau)) ~ 1.5e-6 at the longest
+    # wave (k = 2 pi): the pressures move by less than that
+    assert np.max(np.abs(glassy.pressure - stiff.pressure)) <= 1e-5*stiff.pressure.max()
+    for line in (True, False):
+        kw = dict(stack, lower_young=[2.0], lower_tau=[1.0], lower_e_inf=[20.0], speed=0.1)
+        res = (lc.solve_line(ROUGH_LINE, **kw) if line else lc.solve_areal(rough_surface, **kw))
+        assert res.converged and res.dissipated_power > 0.0
+        balance = 0.1*res.mean_pressure*(res.delta_mu - res.delta_mu_energy)
+        assert balance == pytest.approx(res.dissipated_power, rel=1e-9)
+
+
 def test_leakage_on_a_stack_runs_and_a_rigid_substrate_changes_nothing(tmp_path):
     text = """&scene geometry = 'areal', n = 64 /
 &layer thickness = 0.05, poisson = 0.45, {extra} /
@@ -244,6 +270,12 @@ def test_leakage_on_a_stack_runs_and_a_rigid_substrate_changes_nothing(tmp_path)
     ("thickness = 0.1, lower_thickness = 0.1, lower_young = 1.0, lower_interfaces = 'slip slip'",
      "lower_interfaces", "one word per lower layer"),
     ("thickness = 0.1, interface = 'welded'", "interface", "'bonded' or 'slip'"),
+    ("thickness = 0.1, lower_thickness = 0.1, 0.1, lower_young = 1.0, 1.0, lower_tau = 1.0, lower_e_inf = 2.0",
+     "lower_tau", "one per lower layer"),
+    ("thickness = 0.1, lower_thickness = 0.1, lower_young = 1.0, lower_tau = 1.0", "lower_e_inf",
+     "one per lower_tau value"),
+    ("thickness = 0.1, lower_thickness = 0.1, lower_young = 2.0, lower_tau = 1.0, lower_e_inf = 1.0",
+     "lower_e_inf(1)", ">= lower_young(1)"),
     ("thickness = 0.1, lower_thickness(2) = 0.1, lower_young(2) = 1.0", "lower_thickness", "without gaps"),
 ])
 def test_stack_errors_name_the_variable_and_write_nothing(tmp_path, layer, variable, allowed):

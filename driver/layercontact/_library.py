@@ -87,8 +87,8 @@ MAX_POINTS = 2**30
 
 #: The &layer keywords that say what a layer rests on (docs/theory.md, "Layered stacks"),
 #: taken by every function that takes a layer.
-STACK_KEYWORDS = ("interface", "lower_thickness", "lower_young", "lower_poisson", "lower_interfaces",
-                  "substrate_young", "substrate_poisson")
+STACK_KEYWORDS = ("interface", "lower_thickness", "lower_young", "lower_poisson", "lower_tau", "lower_e_inf",
+                  "lower_interfaces", "substrate_young", "substrate_poisson")
 
 
 def stack_keywords(function: str, given: dict) -> dict:
@@ -103,9 +103,10 @@ def stack_keywords(function: str, given: dict) -> dict:
     for name, value in given.items():
         if value is None:
             continue
-        if name == "lower_interfaces" and not isinstance(value, str):
-            value = " ".join(str(word) for word in value)
-        elif name in ("lower_thickness", "lower_young", "lower_poisson"):
+        if name == "lower_interfaces":
+            if not isinstance(value, str):
+                value = " ".join(str(word) for word in value)
+        elif name.startswith("lower_"):
             if np.size(value) == 0:
                 continue
             value = [float(x) for x in real_array(value, name, ndim=(0, 1)).ravel()]

@@ -41,9 +41,8 @@ def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None, **stack)
     base); ``q = 0`` gives the uniform mode ``(h/G, h/G, h/M)`` of a layer (summed over a
     stack's layers; zero where a half-space lies below, and in-plane where an interface
     slips). The layer's keywords and their defaults are those of :func:`solve_line`
-    (``&layer``), the stack keywords (``interface``, ``lower_thickness``, ``lower_young``,
-    ``lower_poisson``, ``lower_interfaces``, ``substrate_young``, ``substrate_poisson``)
-    included: see docs/namelist.md."""
+    (``&layer``), the stack keywords of :func:`solve_line` included (elastic: the tensor is
+    at rest)."""
     qx, qy = np.broadcast_arrays(np.asarray(qx, dtype=np.float64), np.asarray(qy, dtype=np.float64))
     text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson,
                                 **stack_keywords("surface_tensor", stack)}})
@@ -193,8 +192,9 @@ def solve_line(
     ``speed`` (L/T); ``dissipated_power`` and ``monotone`` (``Re G_eff >= 0`` on every mode,
     hence a unique solution) are reported. The layer may rest on more than a rigid base bonded to it:
     the stack keywords ``interface`` (``'bonded'`` or ``'slip'``, below the layer),
-    ``lower_thickness``, ``lower_young``, ``lower_poisson`` (elastic lower layers, from the top
-    down), ``lower_interfaces`` (a word or a list of words, one per lower layer),
+    ``lower_thickness``, ``lower_young``, ``lower_poisson`` (lower layers, from the top down;
+    ``lower_tau`` and ``lower_e_inf`` make them standard linear solids), ``lower_interfaces``
+    (a word or a list of words, one per lower layer),
     ``substrate_young`` and ``substrate_poisson`` (an elastic half-space below them; not
     given: rigid) are the ``&layer`` variables of those names (docs/theory.md, "Layered
     stacks"). ``companion=True`` also solves the frictionless

@@ -116,6 +116,14 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("layer", "lower_poisson", "reals", "0.5 each", "1", "both",
              "none or one per lower layer, each in (-1, 0.5]", "Poisson's ratios of the lower layers",
              "scene%lower_poisson"),
+    Variable("layer", "lower_tau", "reals", "none (elastic)", "T", "both",
+             "none or one per lower layer, each >= 0 and finite",
+             "a lower layer with `lower_tau > 0` is a standard linear solid (seed Eq. 15) of retardation time "
+             "`lower_tau`, low-frequency modulus `lower_young` and high-frequency modulus `lower_e_inf`, sliding "
+             "at `&material speed`; 0: elastic", "scene%lower_tau"),
+    Variable("layer", "lower_e_inf", "reals", "none", "S", "both",
+             "one per lower layer with lower_tau; each >= lower_young and finite",
+             "high-frequency (glassy) moduli of the viscoelastic lower layers", "scene%lower_e_inf"),
     Variable("layer", "lower_interfaces", "string", "''", "", "both",
              "'' or one word 'bonded' or 'slip' per lower layer, separated by blanks or commas",
              "the interface below each lower layer, from the top down (`''`: all bonded)", "scene%lower_interfaces"),

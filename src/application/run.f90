@@ -164,8 +164,10 @@ contains
       end if
       write (unit, real_fmt) 'penetration Delta', result%penetration, '(L)'
       if (present(companion)) write (unit, real_fmt) 'penetration Delta, mu_c = 0', companion%penetration, '(L)'
-      if (is_viscoelastic(scene%material)) then
-         write (unit, '(2x, a, t34, a)') 'material', trim(scene%material%model) // ' (viscoelastic)'
+      if (is_viscoelastic(scene%material)) &
+         & write (unit, '(2x, a, t34, a)') 'material', trim(scene%material%model) // ' (viscoelastic)'
+      ! (a speed is allowed only where a layer is viscoelastic: the top one or a lower one)
+      if (is_viscoelastic(scene%material) .or. scene%speed > 0.0_wp) then
          write (unit, real_fmt) 'sliding speed V', scene%speed, '(L/T)'
          write (unit, real_fmt) 'dissipated power', result%dissipated_power, '(S L/T)'
       end if

@@ -24,7 +24,7 @@ module lc_greens_kernel
    use lc_base_kinds, only: wp
    use lc_greens_layer, only: layer_coefficients, halfspace_coupling
    use lc_greens_stack, only: stack_layer, stack_base, condense_stack, base_rigid, base_halfspace
-   use lc_greens_viscoelastic, only: material_law, material_model, material_model_of
+   use lc_greens_viscoelastic, only: material_law, material_model, material_model_of, standard_linear_solid
    implicit none (type, external)
    private
    public :: layer_kernel, make_kernel, place_on
@@ -47,6 +47,10 @@ module lc_greens_kernel
       type(stack_layer), allocatable :: stack(:)
       !> What the stack rests on: rigid, or an elastic half-space.
       type(stack_base) :: base
+      !> Per layer of the stack below the top one: a standard linear solid where lower_tau > 0
+      !> (retardation time, T; its low-frequency modulus is the stack layer's young), with the
+      !> high-frequency modulus lower_e_inf (S); elastic where 0.
+      real(wp), allocatable :: lower_tau(:), lower_e_inf(:)
    contains
       procedure :: contact_compliance
       procedure :: factors
@@ -82,18 +86,23 @@ contains
    !> Rest the kernel's layer on `deeper` elastic layers (from the top down, each flagging a
    !> slipping interface below it) and a base: rigid or an elastic half-space. `slip`: the
    !> interface below the kernel's own layer slips (frictionless). Without deeper layers, on a
-   !> rigid bonded base, the kernel stays the closed-form single layer. The caller checks
-   !> the values (check_stack); the layer must be finite.
-   subroutine place_on(self, slip, deeper, base)
+   !> rigid bonded base, the kernel stays the closed-form single layer. A deeper layer with
+   !> tau(i) > 0 is a standard linear solid (its young the low-frequency modulus, e_inf(i)
+   !> the high-frequency one). The caller checks the values; the layer must be finite.
+   subroutine place_on(self, slip, deeper, base, tau, e_inf)
       class(layer_kernel), intent(inout) :: self
       logical, intent(in) :: slip
       type(stack_layer), intent(in) :: deeper(:)
       type(stack_base), intent(in) :: base
+      real(wp), intent(in) :: tau(:), e_inf(:)
       self%layered = slip .or. size(deeper) > 0 .or. base%kind == base_halfspace
       if (.not. self%layered) return
       self%stack = [stack_layer(thickness=self%thickness, young=(1.0_wp, 0.0_wp), poisson=self%poisson, &
          & slip_below=slip), deeper]
       self%base = base
+      self%lower_tau = tau
+      self%lower_e_inf = e_inf
+      if (self%speed > 0.0_wp .and. any(tau > 0.0_wp)) self%viscoelastic = .true.
    end subroutine place_on
 
    !> C = (1 - nu^2) J*(q_x V) (1/S) for the sliding wavenumbers q_x (1/L).
@@ -112,9 +121,10 @@ contains
       real(wp), intent(in) :: q, qx
       complex(wp), intent(out) :: one_minus_a, one_minus_b, c, t
       type(stack_layer), allocatable :: layers(:)
+      type(standard_linear_solid) :: lower_law
       complex(wp) :: plane(2, 2), compliance(1)
       real(wp) :: a, b, coupling
-      integer :: singular
+      integer :: singular, i
       if (.not. self%layered) then
          ! x = +Inf (half-space) gives 1-A = 1-B = 1 and Dundurs' c
          call layer_coefficients(q*self%thickness, self%poisson, a, b, coupling)
@@ -128,6 +138,14 @@ contains
       layers = self%stack
       compliance = self%material%compliance([qx*self%speed])
       layers(1)%young = 1.0_wp/compliance(1)
+      do i = 2, size(layers)
+         if (self%lower_tau(i - 1) > 0.0_wp) then
+            lower_law = standard_linear_solid(e0=real(layers(i)%young, wp), e_inf=self%lower_e_inf(i - 1), &
+               & tau=self%lower_tau(i - 1))
+            compliance = lower_law%compliance([qx*self%speed])
+            layers(i)%young = 1.0_wp/compliance(1)
+         end if
+      end do
       call condense_stack(layers, self%base, q, plane, t, singular)
       one_minus_a = plane(2, 2)
       one_minus_b = plane(1, 1)
