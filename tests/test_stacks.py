@@ -321,8 +321,8 @@ def test_a_stack_scene_round_trips_through_its_result(tmp_path, monkeypatch):
 
 
 def test_a_sweep_of_a_stack_scene_keeps_the_stack(tmp_path, monkeypatch):
-    """A sweep writes each scene back as text: the stack's lists and words go with it, and
-    each result equals the scene solved alone."""
+    """A sweep writes each scene back as text: the stack's lists and words go with it, the
+    substrate's modulus may be swept, and each result equals the scene solved alone."""
     monkeypatch.chdir(tmp_path)
     path = tmp_path / "stack_sweep.nml"
     path.write_text("""&scene n = 256 /
@@ -330,18 +330,20 @@ def test_a_sweep_of_a_stack_scene_keeps_the_stack(tmp_path, monkeypatch):
        lower_poisson = 0.3, lower_interfaces = 'bonded', substrate_young = 30.0, substrate_poisson = 0.3 /
 &profile short_wavelength = 0.03125 /
 &loading normalised_pressure = 0.5 /
-&sweep directory = 'out/stack', processes = 1, friction = 0.0, 0.5 /
+&sweep directory = 'out/stack', processes = 1, friction = 0.0, 0.5, substrate_young = 30.0, 3.0 /
 """)
-    lc.sweep(path, progress=False)
+    rows = lc.sweep(path, progress=False)
+    assert sorted((row["friction"], row["substrate_young"]) for row in rows) == [
+        (0.0, 3.0), (0.0, 30.0), (0.5, 3.0), (0.5, 30.0)]
     results = sorted((tmp_path / "out" / "stack" / "results").glob("*.h5"))
-    assert len(results) == 2
+    assert len(results) == 4
     for result in results:
         res = lc.read_result(result)
         with h5py.File(result) as f:
             friction = float(f["input"].attrs["friction"])
-            assert f["input"].attrs["substrate_young"] == 30.0
+            substrate = float(f["input"].attrs["substrate_young"])
         alone = lc.solve_line(res.height, thickness=0.1, poisson=0.45, interface="slip", lower_thickness=[0.05],
-                              lower_young=[3.0], lower_poisson=[0.3], substrate_young=30.0, substrate_poisson=0.3,
+                              lower_young=[3.0], lower_poisson=[0.3], substrate_young=substrate, substrate_poisson=0.3,
                               friction=friction, mean_pressure=res.mean_pressure)
         # the same scene solved twice to tol = 1e-10: equal to the solver's rounding
         np.testing.assert_allclose(alone.pressure, res.pressure, rtol=0, atol=1e-9*res.pressure.max())

@@ -130,7 +130,7 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("layer", "substrate_young", "real", "not set (a rigid base)", "S", "both",
              "> 0 and finite; a finite `thickness` only",
              "Young's modulus of an elastic half-space substrate below the layers; not set: a rigid base",
-             "scene%substrate_young", unset=_NOT_SET, interval="(0, inf)"),
+             "scene%substrate_young", sweep=10, unset=_NOT_SET, interval="(0, inf)"),
     Variable("layer", "substrate_poisson", "real", "`poisson`", "1", "both",
              "-1 < substrate_poisson <= 0.5; with substrate_young only", "Poisson's ratio of the substrate",
              "scene%substrate_poisson", unset=_NOT_SET, interval="(-1, 0.5]"),
