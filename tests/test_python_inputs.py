@@ -148,3 +148,24 @@ def test_a_name_across_two_lines_of_a_namelist_is_refused(tmp_path):
 def test_a_keyword_with_a_control_character_is_refused(method, rough_profile):
     with refused("control characters"):
         lc.solve_line(rough_profile, mean_pressure=0.1, method=method)
+
+
+@pytest.mark.parametrize("solve, heights", [
+    (lc.solve_line, np.cos(2 * np.pi * np.arange(64) / 64)),
+    (lc.solve_areal, np.cos(2 * np.pi * np.arange(16) / 16)[None, :] * np.ones((16, 1))),
+])
+def test_young_and_a_material_both_given_are_refused(solve, heights):
+    """``young`` and ``material`` both give the layer's modulus (the material's wins inside
+    the library): both given are refused, as a namelist variable given twice is."""
+    material = lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0)
+    with refused("young = 2.0 and material = .* both give the layer's modulus; allowed: one of them") as err:
+        solve(heights, young=2.0, material=material, speed=1.0, normalised_pressure=1.0, thickness=0.5)
+    assert err.value.code == 2
+
+
+def test_a_scene_text_with_a_variable_twice_is_refused_from_python():
+    """The text path of the keyword API refuses what a namelist file would."""
+    with refused("group &scene: period and period_x are both given"):
+        lc.scene_namelist("&scene\n period = 1.0\n period_x = 2.0\n/\n&loading\n normalised_pressure = 1.0\n/\n")
+    with refused("period_y applies to surfaces only"):
+        lc.scene_namelist(period_y=2.0, normalised_pressure=1.0)

@@ -213,11 +213,8 @@ VARIABLES: tuple[Variable, ...] = (
     # &solver
     Variable("solver", "method", "string", "'auto'", "", "both",
              "'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton' or 'multigrid'",
-             "the solver; `'auto'` chooses (see [numerics.md](numerics.md)); `'cg'` (symmetric scenes only), "
-             "`'gcr'`, `'anderson'`, `'gfmd'` (damped dynamics; refused before any step where |Im G_eff|/Re G_eff "
-             "exceeds 0.5, docs/decisions/001), `'newton'` (dense semismooth Newton, grids of at "
-             "most 2048 points) or `'multigrid'` (nonsmooth Newton multigrid; where it applies, "
-             "docs/decisions/009 to 015)", "scene%solver%method", key="solver_method", choices=("auto", "cg",
+             "the solver: `'auto'` chooses the methods from the scene, or one method; each is described "
+             "[below the table](#solver-method)", "scene%solver%method", key="solver_method", choices=("auto", "cg",
              "gcr", "anderson", "gfmd", "newton", "multigrid")),
     Variable("solver", "tol", "real", "1e-10", "1", "both", "1e-14 <= tol <= 1e-2",
              "tolerance on the complementarity residual", "scene%solver%tol", interval="[1e-14, 1e-2]"),
