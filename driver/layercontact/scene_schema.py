@@ -293,12 +293,15 @@ def input_keywords(attrs, datasets=None) -> dict[str, object]:
     """The keywords of :func:`keyword_groups` that give the scene of a result file back:
     from the attributes of its ``/input`` (and the list datasets there, e.g. the Prony terms;
     ``datasets`` maps names to arrays). Flags (1/0) become bools, byte strings text; a
-    variable that is not echoed (a Prony file whose terms are given) is left out."""
+    variable that is not echoed (a Prony file whose terms are given) is left out, and so are
+    the variables of surfaces in a line scene's (its ``ny = 1``: a line scene refuses them)."""
     table = by_key()
     out: dict[str, object] = {}
+    geometry = attrs.get("geometry", "line")
+    line = (geometry.decode() if isinstance(geometry, bytes) else str(geometry)) == "line"
     for key, variable in table.items():
         source = attrs if variable.type != "reals" else (datasets or {})
-        if key not in source or not variable.echo:
+        if key not in source or not variable.echo or (line and variable.uses == "areal"):
             continue
         value = source[key]
         if variable.type == "logical":

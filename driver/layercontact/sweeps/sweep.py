@@ -808,9 +808,10 @@ def _stop_workers(pool: ProcessPoolExecutor, running: list[Scene]) -> None:
     """End the pool's workers now (a scene in flight may take hours: Ctrl-C does not wait
     for it), then remove what their scenes left: the temporary result files, and a run record
     that says "running" becomes "interrupted" (the scene has no result: a resume runs it)."""
+    # (the executor keeps its worker processes by pid, until it shuts down; it offers no call
+    # that ends them)
+    workers = list((getattr(pool, "_processes", None) or {}).values())
     pool.shutdown(wait=False, cancel_futures=True)
-    # (the executor keeps its worker processes by pid; it offers no call that ends them)
-    workers = list(getattr(pool, "_processes", {}).values())
     for worker in workers:
         if worker.is_alive():
             worker.terminate()
