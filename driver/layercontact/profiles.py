@@ -314,7 +314,7 @@ def warn_if_not_periodic(height, file: str) -> None:
                       f"jump by {jump:.2f} rms heights across the edges of the cell and their slopes differ there "
                       f"by {kink:.2e} times their differences inside it: a tilted or non-periodic surface; set "
                       "&profile boundary = 'mirror' (a non-periodic patch, detrended by a plane) or detrend = "
-                      "'plane' (a tilt)", PeriodicityWarning, stacklevel=3)
+                      "'plane' (a tilt)", PeriodicityWarning, stacklevel=4)
 
 
 def _measured(path, dataset, areal, detrend, boundary, resample, nx, ny) -> np.ndarray:
