@@ -42,7 +42,7 @@ module lc_profiles_measured
    !> Heights taken as one period are suspect of not being periodic above these
    !> (periodicity_mismatch): a jump across the cell's edges of 2 rms heights (a tilted plane
    !> gives sqrt(12) = 3.46, the periodic self-affine surfaces measured at most 1.61), a kink
-   !> of 4 times the cell's own (those surfaces measured at most 3.12; docs/decisions/019).
+   !> of 4 times the cell's own (those surfaces measured at most 3.14; docs/decisions/019).
    real(wp), parameter :: edge_jump_limit = 2.0_wp, edge_kink_limit = 4.0_wp
 
 contains
