@@ -789,9 +789,11 @@ def _run_pending(
             bar.update()
     except KeyboardInterrupt:
         bar.close()
+        # (a scene queued for a worker counts as running too: it has not started, which its
+        # run record says)
         running = [s for f, s in futures.items() if f.running()]
-        print(f"\nlayercontact: Ctrl-C: stopping the sweep '{name}': ending the {len(running)} scene(s) in "
-              "flight (they run again on resume)", file=sys.stderr, flush=True)
+        print(f"\nlayercontact: Ctrl-C: stopping the sweep '{name}': ending the scenes in flight (they run "
+              "again on resume)", file=sys.stderr, flush=True)
         _stop_workers(pool, running)
         raise
     finally:
