@@ -108,19 +108,27 @@ def test_surface_stress_refuses_a_pressure_that_is_not_a_real_map(pressure, word
 
 
 def test_reading_a_file_that_is_not_a_result_names_it(tmp_path):
+    """What is there but is not a result is bad input (code 2), as for the height files;
+    so are a missing file and a loop of symbolic links, named as what they are."""
     text = tmp_path / "notes.h5"
     text.write_text("not HDF5\n")
-    with pytest.raises(lc.LayercontactError, match="cannot read result file '.*notes.h5'") as err:
+    with refused("cannot read result file '.*notes.h5': not an HDF5 file") as err:
         lc.read_result(text)
-    assert err.value.code == 4
+    assert err.value.code == 2
     import h5py
 
     other = tmp_path / "other.h5"
     with h5py.File(other, "w") as f:
         f["x"] = np.ones(3)
-    with pytest.raises(lc.LayercontactError, match="not a layercontact result") as err:
+    with refused("not a layercontact result") as err:
         lc.read_result(other)
-    assert err.value.code == 4
+    assert err.value.code == 2
+    with refused("result file '.*missing.h5' is not found"):
+        lc.read_result(tmp_path / "missing.h5")
+    (tmp_path / "a.h5").symlink_to("b.h5")
+    (tmp_path / "b.h5").symlink_to("a.h5")
+    with refused("result file '.*a.h5' is a loop of symbolic links"):
+        lc.read_result(tmp_path / "a.h5")
 
 
 def test_the_module_says_its_version_and_core():

@@ -565,16 +565,23 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             result.leakage = CoreLeakage.from_attributes(base["leakage"].attrs)
         return result
 
+    # as for the readers of input files: a file that is not there, or whose content is not
+    # a result, is bad input (code 2); one that is there but cannot be read an I/O failure (4)
     path = regular_file(filename, "result file")
+    if not os.path.exists(path):
+        raise InputError(f"result file '{path}' is not found; allowed: an existing result file", 2)
     try:
         f = h5py.File(path, "r")
     except OSError as err:
-        # (h5py's message does not name the file; a missing file or one that is not HDF5)
+        # (h5py's message does not name the file)
+        if os.access(path, os.R_OK) and not h5py.is_hdf5(path):
+            raise InputError(f"cannot read result file '{path}': not an HDF5 file (no HDF5 signature); allowed: "
+                             "a result file written by layercontact", 2) from err
         raise LayercontactError(f"cannot read result file '{path}': {err}", 4) from err
     with f:
         if "results" not in f or "input" not in f:
-            raise LayercontactError(f"cannot read result file '{path}': it is an HDF5 file but not a layercontact "
-                                    "result (no /results or /input)", 4)
+            raise InputError(f"cannot read result file '{path}': it is an HDF5 file but not a layercontact "
+                             "result (no /results or /input)", 2)
         geometry = f.attrs.get("geometry", b"line")
         geometry = geometry.decode() if isinstance(geometry, bytes) else str(geometry)
         builder = _areal_result if geometry == "areal" else _line_result
