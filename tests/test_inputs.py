@@ -718,3 +718,26 @@ def test_a_height_file_taken_as_periodic_that_is_not_gets_a_warning(surface, tmp
         (tmp_path / "r.h5").unlink()
         nml.write_text(nml.read_text().replace("file = 'heights.txt'", "file = 'heights.txt'\n detrend = 'plane'"))
         assert "warning" not in run_exe(nml, tmp_path).stderr
+
+
+@pytest.mark.parametrize("text, message", [
+    ("&scene\n n = 64\n n = 128\n/\n", "group &scene: n is given twice (lines 2 and 3)"),
+    ("&scene\n period_y = 2.0\n/\n", "period_y applies to surfaces only"),
+])
+def test_the_module_refuses_what_the_executable_refuses(text, message, tmp_path):
+    """`python -m layercontact run` reads the scene with the same routine: exit 2, the same
+    message, nothing written."""
+    nml = tmp_path / "bad.nml"
+    nml.write_text(text + "&loading\n normalised_pressure = 1.0\n/\n&output\n file = 'bad.h5'\n/\n")
+    proc = subprocess.run([sys.executable, "-m", "layercontact", "run", str(nml)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2 and message in proc.stderr, proc.stderr
+    assert not (tmp_path / "bad.h5").exists()
+
+
+def test_the_module_warns_of_a_tilted_height_file(tmp_path):
+    np.savetxt(tmp_path / "heights.txt", tilted(256))
+    proc = subprocess.run([sys.executable, "-m", "layercontact", "run", str(scene_reading(tmp_path, "heights.txt")),
+                           "--no-png"], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "layercontact: warning: &profile: file = 'heights.txt' is taken as one period" in proc.stderr
