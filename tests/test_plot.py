@@ -119,6 +119,10 @@ def test_an_areal_result_is_drawn_with_its_maps_and_a_profile(tmp_path, monkeypa
     np.testing.assert_array_equal(indenter, r.max() - r[row])
     np.testing.assert_array_equal(surface, delta - w[row])
     np.testing.assert_array_equal(lines_of(pressure)[0][1], p[row])
+    proc = subprocess.run([sys.executable, "-m", "layercontact", "plot", "areal.h5"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "areal.png").stat().st_size > 0
 
 
 SWEEP = """\
