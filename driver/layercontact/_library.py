@@ -94,6 +94,35 @@ def _namelist(groups: dict[str, dict]) -> str:
 MAX_POINTS = 2**30
 
 
+#: The &layer keywords that say what a layer rests on (docs/theory.md, "Layered stacks"),
+#: taken by every function that takes a layer.
+STACK_KEYWORDS = ("interface", "lower_thickness", "lower_young", "lower_poisson", "lower_tau", "lower_e_inf",
+                  "lower_interfaces", "substrate_young", "substrate_poisson")
+
+
+def stack_keywords(function: str, given: dict) -> dict:
+    """The stack keywords ``given`` to ``function`` as &layer variables: lists of reals for
+    the lower layers' values, one blank-separated word list for ``lower_interfaces``; None
+    and empty lists are not given. Another name raises TypeError, as Python does."""
+    unknown = sorted(set(given) - set(STACK_KEYWORDS))
+    if unknown:
+        raise TypeError(f"{function}() got unexpected keyword argument(s) {', '.join(map(repr, unknown))}; "
+                        f"the stack keywords are {', '.join(STACK_KEYWORDS)}")
+    out = {}
+    for name, value in given.items():
+        if value is None:
+            continue
+        if name == "lower_interfaces":
+            if not isinstance(value, str):
+                value = " ".join(str(word) for word in value)
+        elif name.startswith("lower_"):
+            if np.size(value) == 0:
+                continue
+            value = [float(x) for x in real_array(value, name, ndim=(0, 1)).ravel()]
+        out[name] = value
+    return out
+
+
 def _input_error(name: str, value, allowed: str) -> InputError:
     return InputError(f"{name} = {value!r} is not allowed; allowed: {allowed}", 2)
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from . import scene_schema
 from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError,  # noqa: F401
-                       PeriodicityWarning, _check, _lines, _namelist, real_array, regular_file)
+                       PeriodicityWarning, _check, _lines, _namelist, real_array, regular_file, stack_keywords)
 from .leakage import CoreLeakage
 from .native import core as _core
 
@@ -32,16 +32,20 @@ def layer_multipliers(kh, nu: float):
     return _core.py_layer_coefficients(kh, float(nu))
 
 
-def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None):
+def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None, **stack):
     """The layer's 3x3 surface compliance for in-plane wavevectors ``(qx, qy)`` (1/L,
     broadcast together): ``(u_x^, u_y^, w^) = T (tau_x^, tau_y^, p^)`` in convention P,
     shape ``broadcast.shape + (3, 3)``, complex. In the frame ``(l, t, z)`` with
     ``l = q/|q|`` it is the plane-strain multiplier with ``|k| -> |q|`` in ``(l, z)`` and the
-    antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t``; ``q = 0`` gives the uniform mode
-    ``(h/G, h/G, h/M)`` of a layer (zero for a half-space). The layer's keywords and their
-    defaults are those of :func:`solve_line` (``&layer``)."""
+    antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t`` (for one layer bonded to a rigid
+    base); ``q = 0`` gives the uniform mode ``(h/G, h/G, h/M)`` of a layer (summed over a
+    stack's layers; zero where a half-space lies below, and in-plane where an interface
+    slips). The layer's keywords and their defaults are those of :func:`solve_line`
+    (``&layer``), the stack keywords of :func:`solve_line` included (elastic: the tensor is
+    at rest)."""
     qx, qy = np.broadcast_arrays(np.asarray(qx, dtype=np.float64), np.asarray(qy, dtype=np.float64))
-    text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson}})
+    text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson,
+                                **stack_keywords("surface_tensor", stack)}})
     t, stat, errmsg = _core.py_surface_tensor(text, np.ascontiguousarray(qx.ravel()),
                                               np.ascontiguousarray(qy.ravel()))
     _check(stat, errmsg)
@@ -168,10 +172,11 @@ def solve_line(
     max_iter: int | None = None,
     memory: int | None = None,
     threads: int | None = None,
+    **stack,
 ) -> LineResult:
     """Solve the sliding line contact of the rigid profile ``heights`` (L, on a uniform
     periodic grid of one ``period``) on a layer of ``thickness`` (``inf``: half-space)
-    bonded to a rigid base, with Coulomb friction ``tau = friction * p``.
+    bonded to a rigid base (or resting on a stack: below), with Coulomb friction ``tau = friction * p``.
 
     Every keyword sets the namelist variable of the same meaning (docs/namelist.md); one
     that is not given (None) takes that variable's default: ``period`` 1, ``thickness``
@@ -185,7 +190,14 @@ def solve_line(
     compressible layers only). ``material`` (a :class:`StandardLinearSolid` or
     :class:`Prony`; not with ``young``) makes the layer viscoelastic, sliding at
     ``speed`` (L/T); ``dissipated_power`` and ``monotone`` (``Re G_eff >= 0`` on every mode,
-    hence a unique solution) are reported. ``companion=True`` also solves the frictionless
+    hence a unique solution) are reported. The layer may rest on more than a rigid base bonded to it:
+    the stack keywords ``interface`` (``'bonded'`` or ``'slip'``, below the layer),
+    ``lower_thickness``, ``lower_young``, ``lower_poisson`` (lower layers, from the top down;
+    ``lower_tau`` and ``lower_e_inf`` make them standard linear solids), ``lower_interfaces``
+    (a word or a list of words, one per lower layer),
+    ``substrate_young`` and ``substrate_poisson`` (an elastic half-space below them; not
+    given: rigid) are the ``&layer`` variables of those names (docs/theory.md, "Layered
+    stacks"). ``companion=True`` also solves the frictionless
     problem at the load of this one (its computed mean pressure, whatever the control) and
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
     and the surface stress ``stress_xx`` (one more FFT pair).
@@ -228,7 +240,8 @@ def solve_line(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress)
+        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
+        **stack_keywords("solve_line", stack))
     runs = _solve_scene(h, {"scene": {"n": h.size, "period": period}, **groups}, areal=False,
                         companion=bool(companion), stress=stress)
     results = [_line_result(**run, height=h.copy()) for run in runs]
@@ -447,15 +460,17 @@ def solve_areal(
     memory: int | None = None,
     threads: int | None = None,
     stress: bool | None = None,
+    **stack,
 ) -> ArealResult:
     """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
     a uniform periodic grid, axis 1 = x = the sliding direction) on a layer of
-    ``thickness`` (``inf``: half-space) bonded to a rigid base, with Coulomb friction
+    ``thickness`` (``inf``: half-space) bonded to a rigid base or resting on a stack, with Coulomb friction
     ``tau_x = friction * p``. ``period`` is one length or a pair ``(period_x, period_y)``.
     ``stress`` (default True) also computes the in-plane displacements and the surface
     stress tensor (five more transforms). ``normalised_pressure`` is the load in the scale
-    ``E* h/period_x`` on a layer, ``E* Lambda0/period_x`` on a half-space. Every other
-    keyword means what it means for :func:`solve_line`, with the same defaults.
+    ``E* h/period_x`` on a layer (the top layer's on a stack), ``E* Lambda0/period_x`` on a
+    half-space. Every other keyword, the stack keywords included, means what it means for
+    :func:`solve_line`, with the same defaults.
     """
     h = np.asarray(heights, dtype=np.float64)
     if h.ndim != 2:
@@ -466,7 +481,8 @@ def solve_areal(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress)
+        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
+        **stack_keywords("solve_areal", stack))
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
     runs = _solve_scene(np.ascontiguousarray(h).ravel(), {"scene": scene, **groups}, areal=True,
                         companion=bool(companion), stress=stress)
@@ -477,20 +493,21 @@ def solve_areal(
     return results[0]
 
 
-def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None):
+def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None, **stack):
     """Surface displacement ``u_x`` (L) and in-plane stress ``sigma_xx`` (S, tension
     positive) of the layer under a prescribed pressure (S) and shear ``friction * p``,
-    without solving a contact problem. The keywords and their defaults are those of
-    :func:`solve_line`."""
+    without solving a contact problem. The keywords (the stack keywords included) and their
+    defaults are those of :func:`solve_line`."""
     p = np.ascontiguousarray(real_array(pressure, "pressure", ndim=(1,)))
-    fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction)
+    fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction,
+                             stack_keywords("surface_fields", stack))
     return fields[:, 0].copy(), fields[:, 2].copy()
 
 
-def _surface_stress(p, scene: dict, thickness, young, poisson, friction) -> np.ndarray:
+def _surface_stress(p, scene: dict, thickness, young, poisson, friction, stack: dict) -> np.ndarray:
     """fields(n, 5) = u_x, u_y, sigma_xx, sigma_yy, sigma_xy of the layer under the flat
     pressure ``p`` (x fastest) on the grid of the &scene variables ``scene``."""
-    text = _namelist({"scene": scene, "layer": {"thickness": thickness, "young": young, "poisson": poisson},
+    text = _namelist({"scene": scene, "layer": {"thickness": thickness, "young": young, "poisson": poisson, **stack},
                       "friction": {"coefficient": friction}})
     fields, stat, errmsg = _core.py_surface_stress(text, p)
     _check(stat, errmsg)
@@ -511,7 +528,7 @@ class SurfaceStress:
 
 
 def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson=None,
-                   friction=None) -> SurfaceStress:
+                   friction=None, **stack) -> SurfaceStress:
     """Surface displacements and stresses of an elastic layer (``thickness=np.inf``:
     half-space, the default) under the prescribed pressure (S; 1D for a line, ``(ny, nx)``
     for a surface, x = axis 1) and the shear ``friction * p`` along x, without solving a
@@ -521,12 +538,13 @@ def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson
     if p.ndim == 1:
         lx = period if np.ndim(period) == 0 else float(period[0])
         ux, sxx = surface_fields(p, period=lx, thickness=thickness, young=young, poisson=poisson,
-                                 friction=friction)
+                                 friction=friction, **stack)
         return SurfaceStress(displacement_x=ux, stress_xx=sxx)
     lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
     ny, nx = p.shape
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
-    fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction)
+    fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction,
+                             stack_keywords("surface_stress", stack))
     ux, uy, sxx, syy, sxy = (fields[:, k].reshape(ny, nx).copy() for k in range(5))
     return SurfaceStress(displacement_x=ux, stress_xx=sxx, displacement_y=uy, stress_yy=syy, stress_xy=sxy)
 

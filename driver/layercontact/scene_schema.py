@@ -103,6 +103,37 @@ VARIABLES: tuple[Variable, ...] = (
              "scene%young", interval="(0, inf)"),
     Variable("layer", "poisson", "real", "0.5", "1", "both", "-1 < poisson <= 0.5", "Poisson's ratio `nu`",
              "scene%poisson", sweep=5, interval="(-1, 0.5]"),
+    Variable("layer", "interface", "string", "'bonded'", "", "both", "'bonded' or 'slip'",
+             "the interface below the layer (with the next layer, the substrate or the rigid base): bonded, or "
+             "slipping without friction (continuous normal displacement and traction, no shear traction); "
+             "a finite `thickness` only ([theory.md](theory.md#layered-stacks))", "scene%interface",
+             choices=("bonded", "slip")),
+    Variable("layer", "lower_thickness", "reals", "none", "L", "both",
+             "up to 64 layers, each > 0 and finite; a finite `thickness` only",
+             "elastic layers below the layer, from the top down: their thicknesses", "scene%lower_thickness"),
+    Variable("layer", "lower_young", "reals", "none", "S", "both", "one per lower layer, each > 0 and finite",
+             "Young's moduli of the lower layers", "scene%lower_young"),
+    Variable("layer", "lower_poisson", "reals", "0.5 each", "1", "both",
+             "none or one per lower layer, each in (-1, 0.5]", "Poisson's ratios of the lower layers",
+             "scene%lower_poisson"),
+    Variable("layer", "lower_tau", "reals", "none (elastic)", "T", "both",
+             "none or one per lower layer, each >= 0 and finite",
+             "a lower layer with `lower_tau > 0` is a standard linear solid (seed Eq. 15) of retardation time "
+             "`lower_tau`, low-frequency modulus `lower_young` and high-frequency modulus `lower_e_inf`, sliding "
+             "at `&material speed`; 0: elastic", "scene%lower_tau"),
+    Variable("layer", "lower_e_inf", "reals", "none", "S", "both",
+             "one per lower layer with lower_tau; each >= lower_young and finite",
+             "high-frequency (glassy) moduli of the viscoelastic lower layers", "scene%lower_e_inf"),
+    Variable("layer", "lower_interfaces", "string", "''", "", "both",
+             "'' or one word 'bonded' or 'slip' per lower layer, separated by blanks or commas",
+             "the interface below each lower layer, from the top down (`''`: all bonded)", "scene%lower_interfaces"),
+    Variable("layer", "substrate_young", "real", "not set (a rigid base)", "S", "both",
+             "> 0 and finite; a finite `thickness` only",
+             "Young's modulus of an elastic half-space substrate below the layers; not set: a rigid base",
+             "scene%substrate_young", unset=_NOT_SET, interval="(0, inf)"),
+    Variable("layer", "substrate_poisson", "real", "`poisson`", "1", "both",
+             "-1 < substrate_poisson <= 0.5; with substrate_young only", "Poisson's ratio of the substrate",
+             "scene%substrate_poisson", unset=_NOT_SET, interval="(-1, 0.5]"),
     # &material
     Variable("material", "model", "string", "'elastic'", "", "both", "'elastic', 'sls' or 'prony'",
              "the material law: `'elastic'` (uses `young`), `'sls'` or `'prony'`", "scene%material%model",
@@ -204,7 +235,8 @@ VARIABLES: tuple[Variable, ...] = (
              "> 0 and finite; exactly one of mean_pressure and normalised_pressure with control = 'load'",
              "`p_m/p_s`, the load in the seed's pressure scale `p_s`; one rule for lines and surfaces: "
              "`p_s = E* Lambda0/lambda` (`Lambda0 = max r - mean r`, the highest summit above the mean plane), "
-             "except on an areal scene on a layer: `p_s = E* h/lambda`; `E*` with the static modulus; "
+             "except on an areal scene on a layer: `p_s = E* h/lambda` (of the top layer on a stack); `E*` with the "
+             "static modulus; "
              "`/input@normalised_pressure_scale` names the one a result used",
              "scene%normalised_pressure", sweep=2, unset=_NOT_SET),
     Variable("loading", "penetration", "real", "not set", "L", "both",

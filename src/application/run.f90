@@ -10,7 +10,7 @@ module lc_application_run
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
-   use lc_scene, only: scene_type, not_set, is_areal, check_scene
+   use lc_scene, only: scene_type, not_set, is_areal, check_scene, foundation
    use lc_leakage_reynolds, only: leakage_memory_check
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
@@ -165,6 +165,7 @@ contains
       if (len_trim(scene%title) > 0) write (unit, '(2x, a)') trim(scene%title)
       if (scene%ny > 1) write (unit, '(2x, a, t34, i6, a, i6, a)') 'areal grid nx x ny', scene%n, ' x', scene%ny
       write (unit, real_fmt) 'thickness h/lambda', scene%thickness/scene%period
+      if (len(foundation(scene)) > 0) write (unit, '(2x, a, t34, a)') 'interface below the layer', foundation(scene)
       if (scene%solver%target_error /= not_set) then
          write (unit, real_fmt) 'target error', scene%solver%target_error
          write (unit, int_fmt) 'grid points n (chosen)', scene%n
@@ -183,8 +184,10 @@ contains
       end if
       write (unit, real_fmt) 'penetration Delta', result%penetration, '(L)'
       if (present(companion)) write (unit, real_fmt) 'penetration Delta, mu_c = 0', companion%penetration, '(L)'
-      if (is_viscoelastic(scene%material)) then
-         write (unit, '(2x, a, t34, a)') 'material', trim(scene%material%model) // ' (viscoelastic)'
+      if (is_viscoelastic(scene%material)) &
+         & write (unit, '(2x, a, t34, a)') 'material', trim(scene%material%model) // ' (viscoelastic)'
+      ! (a speed is allowed only where a layer is viscoelastic: the top one or a lower one)
+      if (is_viscoelastic(scene%material) .or. scene%speed > 0.0_wp) then
          write (unit, real_fmt) 'sliding speed V', scene%speed, '(L/T)'
          write (unit, real_fmt) 'dissipated power', result%dissipated_power, '(S L/T)'
       end if

@@ -209,6 +209,11 @@ contains
             & ' terms, indexed from 1)'
          return
       end if
+      if (index(msg, 'out of range for namelist variable lower_') > 0) then
+         msg = trim(msg) // ' (lower_thickness, lower_young and lower_poisson hold at most ' // &
+            & to_string(max_prony_terms) // ' layers, indexed from 1)'
+         return
+      end if
       k = index(msg, marker)
       if (k /= 1) return
       token = lower_case(trim(msg(len(marker) + 1:)))
@@ -304,6 +309,51 @@ contains
       config%n = merge(nx, points, nx /= unset_count)
       config%ny = merge(ny, merge(points, 1, trim(config%geometry) == 'areal'), ny /= unset_count)
    end subroutine after_scene
+
+   !> &layer before the read: the lower layers the scene holds, the other entries unset.
+   pure subroutine before_layer(config, lower_thickness, lower_young, lower_poisson, lower_tau, lower_e_inf)
+      type(scene_type), intent(in) :: config
+      real(wp), intent(out) :: lower_thickness(:), lower_young(:), lower_poisson(:), lower_tau(:), lower_e_inf(:)
+      call start_list(config%lower_thickness, lower_thickness)
+      call start_list(config%lower_young, lower_young)
+      call start_list(config%lower_poisson, lower_poisson)
+      call start_list(config%lower_tau, lower_tau)
+      call start_list(config%lower_e_inf, lower_e_inf)
+   end subroutine before_layer
+
+   !> &layer after the read: each list is its leading entries that were set; a gap is refused.
+   pure subroutine after_layer(config, lower_thickness, lower_young, lower_poisson, lower_tau, lower_e_inf, stat, msg)
+      type(scene_type), intent(inout) :: config
+      real(wp), intent(in) :: lower_thickness(:), lower_young(:), lower_poisson(:), lower_tau(:), lower_e_inf(:)
+      integer, intent(inout) :: stat
+      character(len=*), intent(inout) :: msg
+      if (gapped(lower_thickness) .or. gapped(lower_young) .or. gapped(lower_poisson) .or. gapped(lower_tau) .or. &
+         & gapped(lower_e_inf)) then
+         stat = -1
+         msg = 'lower_thickness/lower_young/lower_poisson/lower_tau/lower_e_inf: give the entries in order from the ' &
+            & // 'first, without gaps'
+         return
+      end if
+      config%lower_thickness = lower_thickness(:count_set(lower_thickness))
+      config%lower_young = lower_young(:count_set(lower_young))
+      config%lower_poisson = lower_poisson(:count_set(lower_poisson))
+      config%lower_tau = lower_tau(:count_set(lower_tau))
+      config%lower_e_inf = lower_e_inf(:count_set(lower_e_inf))
+   end subroutine after_layer
+
+   !> Whether a list has an unset entry before a set one.
+   pure logical function gapped(values)
+      real(wp), intent(in) :: values(:)
+      gapped = count_set(values) /= count(values /= unset_entry)
+   end function gapped
+
+   !> A list's local copy before a read: the scene's entries, the others unset.
+   pure subroutine start_list(held, local)
+      real(wp), allocatable, intent(in) :: held(:)
+      real(wp), intent(out) :: local(:)
+      local = unset_entry
+      if (allocated(held)) local(:size(held)) = held
+   end subroutine start_list
 
    !> &material before the read: the terms the scene holds, the other entries marked unset.
    pure subroutine before_material(config, prony_times, prony_values)
