@@ -1,7 +1,8 @@
 """The scene schema: one table of every namelist variable.
 
 Each row names a variable's group and name, its type, default, unit, allowed values, which
-contacts use it (lines, surfaces or both) and its meaning, and where it lives:
+contacts use it (lines, surfaces or both: a line scene refuses the variables of surfaces) and
+its meaning, and where it lives:
 
 - ``fortran``: the component of ``scene_type`` (``lc_scene``) that holds it;
 - ``key``: its name as an attribute of the result file's ``/input`` and as a keyword of
@@ -10,7 +11,8 @@ contacts use it (lines, surfaces or both) and its meaning, and where it lives:
 - ``sweep``: its position in the product of a ``&sweep`` (None: not a sweep parameter);
 - ``unset``: the Fortran value that marks "not given" (None: the variable always has a
   value); a variable that is not given is absent from ``/input``;
-- ``alias_of``: another name of that variable (``period_x`` for ``period``);
+- ``alias_of``: another name of that variable (``period_x`` for ``period``; a scene that
+  gives both is refused);
 - ``read``: ``'copy'`` (the reader copies it between the scene and the namelist) or
   ``'hook'`` (the group's hand-written hooks in ``lc_io_namelist`` set it up and take it
   over: the grid's variables); lists always go through the hooks;
