@@ -17,6 +17,7 @@ module lc_scene
    use lc_greens_stack, only: stack_layer, stack_base, base_rigid, base_halfspace
    use lc_leakage_reynolds, only: leakage_tol_allowed, leakage_tol_range
    use lc_profiles_measured, only: check_treatments
+   use lc_io_files, only: same_file
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
@@ -406,6 +407,11 @@ contains
             if (len_trim(p%file) == 0) then
                call input_error(error, 'profile', 'file', "''", &
                   & 'the name of a file holding the heights (.h5/.hdf5, .npy or text)')
+            else if (same_file(trim(p%file), trim(scene%output_file))) then
+               ! (through a symbolic link or `..` too: the result would replace the heights it
+               ! is computed from)
+               call input_error(error, 'output', 'file', "'" // trim(scene%output_file) // "'", &
+                  & "another file than &profile file = '" // trim(p%file) // "' (they name one file)")
             else
                call check_treatments(p%detrend, p%boundary, p%resample, error)
             end if

@@ -180,7 +180,9 @@ def test_namelist_input_keywords_give_the_same_scene(results, name):
     text, attrs, datasets = results[name]
     keywords = schema.input_keywords(attrs, datasets)
     assert lc.scene_namelist(**keywords) == lc.scene_namelist(text)
-    assert set(keywords) == {key for key, v in schema.by_key().items() if (key in attrs or key in datasets) and v.echo}
+    line = attrs["geometry"].decode() == "line"
+    assert set(keywords) == {key for key, v in schema.by_key().items()
+                             if (key in attrs or key in datasets) and v.echo and not (line and v.uses == "areal")}
 
 
 def test_the_defaults_are_the_schemas(tmp_path):
@@ -195,21 +197,33 @@ def test_the_defaults_are_the_schemas(tmp_path):
         printed = subprocess.run([sys.executable, "-m", "layercontact", "defaults", geometry], capture_output=True,
                                  text=True, check=True).stdout
         assert printed == text
-    values = {}
-    group = None
-    for row in line.splitlines():
-        row = row.strip()
-        if row.startswith("&"):
-            group = row[1:]
-        elif row.startswith("! ") and row.endswith(": not set"):
-            values[(group, row[2:-len(": not set")])] = "not set"
-        elif " = " in row and not row.startswith("!"):
-            name, value = row.split(" = ", 1)
-            values[(group, name)] = value
+    def shown_values(text: str) -> dict[tuple[str, str], str]:
+        values = {}
+        group = None
+        for row in text.splitlines():
+            row = row.strip()
+            if row.startswith("&"):
+                group = row[1:]
+            elif row.startswith("! ") and row.endswith((": not set", ": surfaces only")):
+                name, state = row[2:].split(": ")
+                values[(group, name)] = state
+            elif " = " in row and not row.startswith("!"):
+                name, value = row.split(" = ", 1)
+                values[(group, name)] = value
+        return values
+
+    # the variables of surfaces are comments in the line scene (a line scene refuses them):
+    # their defaults are shown by the areal scene
+    values, areal_values = shown_values(line), shown_values(areal)
     for v in schema.VARIABLES:
         if v.alias_of is not None or not v.echo or v.type == "reals":
             continue
         shown = values.pop((v.group, v.name))
+        if v.uses == "areal":
+            assert shown == "surfaces only", v.name
+            shown = areal_values[(v.group, v.name)]
+            if v.name == "ny":
+                continue   # the areal grid's, not the schema's line default
         if shown == "not set" or v.default.startswith("`"):
             # no value of its own, or a default that depends on other variables
             assert v.default.startswith(("not set", "`")), v.name
@@ -218,9 +232,14 @@ def test_the_defaults_are_the_schemas(tmp_path):
         else:
             assert shown == v.default, v.name
     assert set(values) == {("material", "prony_file")}   # written when empty, a comment when set
-    assert "n = 4096" in line and "ny = 1" in line and "n = 256" in areal and "ny = 256" in areal
-    assert [row for row in line.splitlines() if "geometry" not in row and " n = " not in row and "ny" not in row] \
-        == [row for row in areal.splitlines() if "geometry" not in row and " n = " not in row and "ny" not in row]
+    assert "n = 4096" in line and "! ny: surfaces only" in line and "n = 256" in areal and "ny = 256" in areal
+    surfaces = {v.name for v in schema.VARIABLES if v.uses == "areal"}
+
+    def common(text: str) -> list[str]:
+        return [row for row in text.splitlines() if "geometry" not in row and " n = " not in row
+                and row.strip().lstrip("! ").split(" ")[0].rstrip(":") not in surfaces]
+
+    assert common(line) == common(areal)
     # a default scene has no load: it is refused as it is, and runs with one
     nml = tmp_path / "defaults.nml"
     nml.write_text(line)
@@ -274,8 +293,12 @@ def test_values_outside_the_schemas_range_are_refused(variable, tmp_path):
     load = "&loading normalised_pressure = 0.5 /\n" if variable.group != "loading" else ""
     values = _outside(variable)
     assert values
+    # (a variable of surfaces is checked in an areal scene: a line scene refuses it whatever its value)
+    areal = variable.uses == "areal"
+    scene = "&scene geometry = 'areal' n = 16 /\n" if areal and variable.group != "scene" else ""
+    given = "geometry = 'areal' " if areal and variable.group == "scene" else ""
     for value in values:
-        nml.write_text(f"{load}&{variable.group} {variable.name} = {value} /\n")
+        nml.write_text(f"{load}{scene}&{variable.group} {given}{variable.name} = {value} /\n")
         with pytest.raises(lc.InputError) as err:
             lc.check_scene_file(nml)
         assert f"&{variable.group}: {variable.name} = " in str(err.value), (value, str(err.value))

@@ -4,6 +4,7 @@ public names are re-exported by the package."""
 
 from __future__ import annotations
 
+import errno
 import os
 import stat as _stat
 
@@ -40,6 +41,14 @@ class InputError(LayercontactError, ValueError):
     """Bad input (code 2): a value the library does not allow. The message is the one a
     namelist file with that value gets: it names the group, the variable, the value and
     the allowed range."""
+
+
+class PeriodicityWarning(UserWarning):
+    """Heights taken as one period (``&profile boundary = 'periodic'``) that jump or kink
+    across the cell's edges: most likely a tilted or non-periodic measurement, which the
+    solve takes as a periodic surface with a step at each edge. Set ``boundary = 'mirror'``
+    (a non-periodic patch) or ``detrend = 'plane'`` (a tilt); the measure and its limits are
+    :func:`layercontact.periodicity_mismatch` (docs/decisions/019)."""
 
 
 def _check(stat: int, errmsg: bytes | str) -> None:
@@ -172,11 +181,14 @@ def real_array(value, name: str, *, ndim: tuple[int, ...], finite: bool = True) 
 def regular_file(filename: str | os.PathLike, what: str) -> str:
     """``filename`` as a string, refused (:class:`InputError`, code 2) when it names
     something other than a regular file: a FIFO would block the read until a writer comes,
-    a directory or a device holds no input. A missing file passes (its reader says so)."""
+    a directory or a device holds no input, a loop of symbolic links names nothing. A missing
+    file passes (its reader says so)."""
     path = os.fspath(filename)
     try:
         mode = os.stat(path).st_mode
-    except OSError:
+    except OSError as err:
+        if err.errno == errno.ELOOP:
+            raise InputError(f"{what} '{path}' is a loop of symbolic links; allowed: a regular file", 2) from None
         return path
     if not _stat.S_ISREG(mode):
         kind = ("a directory" if _stat.S_ISDIR(mode) else "a FIFO (named pipe)" if _stat.S_ISFIFO(mode)

@@ -11,8 +11,8 @@ from dataclasses import fields as dataclass_fields
 import numpy as np
 
 from . import scene_schema
-from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError, _check,  # noqa: F401
-                       _lines, _namelist, real_array, regular_file, stack_keywords)
+from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError,  # noqa: F401
+                       PeriodicityWarning, _check, _lines, _namelist, real_array, regular_file, stack_keywords)
 from .leakage import CoreLeakage
 from .native import core as _core
 
@@ -188,7 +188,7 @@ def solve_line(
     Give ``mean_pressure`` (load control), ``normalised_pressure`` (the load in the seed's
     scale ``E* Lambda0/period``) or ``penetration`` (displacement control, finite
     compressible layers only). ``material`` (a :class:`StandardLinearSolid` or
-    :class:`Prony`; ``young`` is then ignored) makes the layer viscoelastic, sliding at
+    :class:`Prony`; not with ``young``) makes the layer viscoelastic, sliding at
     ``speed`` (L/T); ``dissipated_power`` and ``monotone`` (``Re G_eff >= 0`` on every mode,
     hence a unique solution) are reported. The layer may rest on more than a rigid base bonded to it:
     the stack keywords ``interface`` (``'bonded'`` or ``'slip'``, below the layer),
@@ -254,7 +254,13 @@ def _keyword_groups(*, material, method, progress, penetration, **keywords) -> d
     """The namelist groups and variables that the keywords of solve_line and solve_areal set
     (None: not given): the scene schema's variables of the same names, ``method`` and
     ``progress`` for ``solver_method`` and ``verbose``, a penetration with displacement
-    control, and the variables of ``material``."""
+    control, and the variables of ``material``. ``young`` and ``material`` both give the
+    layer's modulus: given together they are refused (:class:`InputError`), as a namelist
+    variable given twice is."""
+    if material is not None and keywords.get("young") is not None:
+        raise InputError(f"young = {keywords['young']!r} and material = {material!r} both give the layer's "
+                         "modulus; allowed: one of them: keep material (a viscoelastic layer) or young (an "
+                         "elastic one)", 2)
     groups = scene_schema.keyword_groups(
         **keywords, solver_method=method, verbose=progress, penetration=penetration,
         control=None if penetration is None else "displacement")
@@ -577,16 +583,23 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             result.leakage = CoreLeakage.from_attributes(base["leakage"].attrs)
         return result
 
+    # as for the readers of input files: a file that is not there, or whose content is not
+    # a result, is bad input (code 2); one that is there but cannot be read an I/O failure (4)
     path = regular_file(filename, "result file")
+    if not os.path.exists(path):
+        raise InputError(f"result file '{path}' is not found; allowed: an existing result file", 2)
     try:
         f = h5py.File(path, "r")
     except OSError as err:
-        # (h5py's message does not name the file; a missing file or one that is not HDF5)
+        # (h5py's message does not name the file)
+        if os.access(path, os.R_OK) and not h5py.is_hdf5(path):
+            raise InputError(f"cannot read result file '{path}': not an HDF5 file (no HDF5 signature); allowed: "
+                             "a result file written by layercontact", 2) from err
         raise LayercontactError(f"cannot read result file '{path}': {err}", 4) from err
     with f:
         if "results" not in f or "input" not in f:
-            raise LayercontactError(f"cannot read result file '{path}': it is an HDF5 file but not a layercontact "
-                                    "result (no /results or /input)", 4)
+            raise InputError(f"cannot read result file '{path}': it is an HDF5 file but not a layercontact "
+                             "result (no /results or /input)", 2)
         geometry = f.attrs.get("geometry", b"line")
         geometry = geometry.decode() if isinstance(geometry, bytes) else str(geometry)
         builder = _areal_result if geometry == "areal" else _line_result
@@ -647,8 +660,31 @@ def choose_resolution(filename: str | os.PathLike) -> tuple[int | tuple[int, int
 def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult | ArealResult:
     """Run a namelist file exactly as the ``layercontact`` executable does (same library
     routine): the HDF5 result is written where ``&output file`` says, and read back.
-    Raises :class:`LayercontactError` on bad input (nothing is written)."""
-    return read_result(run_to_file(filename, verbose))
+    Raises :class:`LayercontactError` on bad input (nothing is written). Heights from a
+    file taken as one period that jump or kink across the cell's edges give a
+    :class:`PeriodicityWarning` (the executable's warning on standard error)."""
+    result_file = run_to_file(filename, verbose)
+    result = read_result(result_file)
+    _warn_if_not_periodic(result, result_file)
+    return result
+
+
+def _warn_if_not_periodic(result, result_file: str) -> None:
+    """The executable's warning of a height file that is not periodic, as a warning."""
+    import h5py
+
+    from .profiles import warn_if_not_periodic
+
+    def text(value) -> str:
+        return value.decode() if isinstance(value, bytes) else str(value)
+
+    with h5py.File(result_file, "r") as f:
+        attrs = f["input"].attrs
+        if text(attrs.get("profile_kind", "")) != "file" or text(attrs.get("profile_boundary", "")) != "periodic":
+            return
+        file = text(attrs.get("profile_file", ""))
+    if result.height is not None and np.size(result.height) > 0:
+        warn_if_not_periodic(np.reshape(result.height, (-1, np.shape(result.height)[-1])), file)
 
 
 def run_to_file(filename: str | os.PathLike, verbose: bool = False) -> str:

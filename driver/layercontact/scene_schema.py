@@ -1,7 +1,8 @@
 """The scene schema: one table of every namelist variable.
 
 Each row names a variable's group and name, its type, default, unit, allowed values, which
-contacts use it (lines, surfaces or both) and its meaning, and where it lives:
+contacts use it (lines, surfaces or both: a line scene refuses the variables of surfaces) and
+its meaning, and where it lives:
 
 - ``fortran``: the component of ``scene_type`` (``lc_scene``) that holds it;
 - ``key``: its name as an attribute of the result file's ``/input`` and as a keyword of
@@ -10,7 +11,8 @@ contacts use it (lines, surfaces or both) and its meaning, and where it lives:
 - ``sweep``: its position in the product of a ``&sweep`` (None: not a sweep parameter);
 - ``unset``: the Fortran value that marks "not given" (None: the variable always has a
   value); a variable that is not given is absent from ``/input``;
-- ``alias_of``: another name of that variable (``period_x`` for ``period``);
+- ``alias_of``: another name of that variable (``period_x`` for ``period``; a scene that
+  gives both is refused);
 - ``read``: ``'copy'`` (the reader copies it between the scene and the namelist) or
   ``'hook'`` (the group's hand-written hooks in ``lc_io_namelist`` set it up and take it
   over: the grid's variables); lists always go through the hooks;
@@ -245,11 +247,8 @@ VARIABLES: tuple[Variable, ...] = (
     # &solver
     Variable("solver", "method", "string", "'auto'", "", "both",
              "'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton' or 'multigrid'",
-             "the solver; `'auto'` chooses (see [numerics.md](numerics.md)); `'cg'` (symmetric scenes only), "
-             "`'gcr'`, `'anderson'`, `'gfmd'` (damped dynamics; refused before any step where |Im G_eff|/Re G_eff "
-             "exceeds 0.5, docs/decisions/001), `'newton'` (dense semismooth Newton, grids of at "
-             "most 2048 points) or `'multigrid'` (nonsmooth Newton multigrid; where it applies, "
-             "docs/decisions/009 to 015)", "scene%solver%method", key="solver_method", choices=("auto", "cg",
+             "the solver: `'auto'` chooses the methods from the scene, or one method; each is described "
+             "[below the table](#solver-method)", "scene%solver%method", key="solver_method", choices=("auto", "cg",
              "gcr", "anderson", "gfmd", "newton", "multigrid")),
     Variable("solver", "tol", "real", "1e-10", "1", "both", "1e-14 <= tol <= 1e-2",
              "tolerance on the complementarity residual", "scene%solver%tol", interval="[1e-14, 1e-2]"),
@@ -328,12 +327,15 @@ def input_keywords(attrs, datasets=None) -> dict[str, object]:
     """The keywords of :func:`keyword_groups` that give the scene of a result file back:
     from the attributes of its ``/input`` (and the list datasets there, e.g. the Prony terms;
     ``datasets`` maps names to arrays). Flags (1/0) become bools, byte strings text; a
-    variable that is not echoed (a Prony file whose terms are given) is left out."""
+    variable that is not echoed (a Prony file whose terms are given) is left out, and so are
+    the variables of surfaces in a line scene's (its ``ny = 1``: a line scene refuses them)."""
     table = by_key()
     out: dict[str, object] = {}
+    geometry = attrs.get("geometry", "line")
+    line = (geometry.decode() if isinstance(geometry, bytes) else str(geometry)) == "line"
     for key, variable in table.items():
         source = attrs if variable.type != "reals" else (datasets or {})
-        if key not in source or not variable.echo:
+        if key not in source or not variable.echo or (line and variable.uses == "areal"):
             continue
         value = source[key]
         if variable.type == "logical":

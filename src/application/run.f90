@@ -6,6 +6,7 @@
 !> anything is computed; the result file appears only when it is complete.
 module lc_application_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: iso_fortran_env, only: error_unit
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
@@ -15,7 +16,7 @@ module lc_application_run
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
    use lc_profiles_profile, only: make_profile
-   use lc_profiles_measured, only: measured_grid
+   use lc_profiles_measured, only: measured_grid, periodicity_mismatch, edge_jump_limit, edge_kink_limit
    use lc_application_scene_solve, only: solve_runs
    use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_application_accuracy, only: choose_resolution
@@ -72,6 +73,7 @@ contains
       allocate (height(scene%n*scene%ny))
       call make_profile(scene, height, error)
       if (allocated(error)) return
+      if (unit >= 0) call warn_if_not_periodic(scene, height)
       ! bad input in the profile (a file's content) is found before anything is created
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
@@ -103,6 +105,24 @@ contains
          end if
       end if
    end subroutine run_scene_file
+
+   !> A height file taken as one period (&profile boundary = 'periodic') whose heights jump
+   !> or kink across the cell's edges is most likely a tilted or non-periodic measurement,
+   !> which the solve would take as a periodic surface with a step (or kink) at each edge:
+   !> a warning on standard error says so and what to set (limits: docs/decisions/019).
+   subroutine warn_if_not_periodic(scene, height)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:)
+      real(wp) :: jump, kink
+      if (trim(scene%profile%kind) /= 'file' .or. trim(scene%profile%boundary) /= 'periodic') return
+      call periodicity_mismatch(reshape(height, [scene%n, max(scene%ny, 1)]), jump, kink)
+      if (jump <= edge_jump_limit .and. kink <= edge_kink_limit) return
+      write (error_unit, '(a, f0.2, a, es9.2, a)') "layercontact: warning: &profile: file = '" // &
+         & trim(scene%profile%file) // "' is taken as one period (boundary = 'periodic'), but its heights jump by ", &
+         & jump, ' rms heights across the edges of the cell and their slopes differ there by ', kink, &
+         & " times their differences inside it: a tilted or non-periodic surface; set &profile boundary = " // &
+         & "'mirror' (a non-periodic patch, detrended by a plane) or detrend = 'plane' (a tilt)"
+   end subroutine warn_if_not_periodic
 
    !> A namelist file that is there must be a regular file: a FIFO would block the read
    !> until a writer comes (bad input, code 2; a missing file is the reader's to report).
