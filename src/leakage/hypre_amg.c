@@ -14,6 +14,7 @@
  */
 #define _GNU_SOURCE
 #include <ftw.h>
+#include <setjmp.h>
 #include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -144,11 +145,33 @@ static int failure(int flag) {
     return (flag & HYPRE_ERROR_MEMORY) ? OUT_OF_MEMORY : 4;
 }
 
+/* hypre does not return from a failed allocation: it sets HYPRE_ERROR_MEMORY and calls
+ * MPI_Abort, which ends the process (and a Python interpreter with it). MPI's profiling
+ * interface lets a library define MPI_Abort itself and pass on to PMPI_Abort; while hypre
+ * works for this file (abort_return set) an abort comes back to the caller instead, which
+ * reports hypre's error. What hypre held at that moment stays allocated (its half-made
+ * objects cannot be destroyed safely) until the process ends. */
+static sigjmp_buf *abort_return = NULL;
+
+__attribute__((visibility("default"))) int MPI_Abort(MPI_Comm comm, int errorcode) {
+    if (abort_return != NULL) {
+        sigjmp_buf *target = abort_return;
+        abort_return = NULL;
+        siglongjmp(*target, 1);
+    }
+    return PMPI_Abort(comm, errorcode);
+}
+
+/* After an abort inside hypre: forget its objects, and say why it gave up. */
+static int aborted(void) {
+    memset(&amg, 0, sizeof amg);
+    return failure(HYPRE_GetError());
+}
+
 /* Bytes of hypre's copy of the matrix, its vectors and the BoomerAMG hierarchy per unknown
- * (with HMIS, extended+i interpolation truncated to 3 entries and aggressive coarsening on
- * the first level: about 130 measured on 1024^2 gaps, bench/leakage_memory.py). hypre
- * itself does not stop on a failed allocation (it reports it and goes on with a null
- * pointer), so this much address space is made sure of before its setup starts. */
+ * (bench/leakage_memory.py). This much address space is made sure of before the setup
+ * starts, so that a leakage too large for what is left is refused before hypre holds
+ * anything; an allocation that fails all the same comes back through MPI_Abort above. */
 #define LC_HYPRE_BYTES_PER_UNKNOWN 160
 
 /* 1 if `bytes` more can be allocated now: a block that size is taken and given back
@@ -170,52 +193,22 @@ static int ij_vector(int n, HYPRE_IJVector *v, HYPRE_ParVector *par) {
     return status;
 }
 
-/* BoomerAMG of the symmetric matrix of n > 0 rows in CSR form (zero-based). 0 on success;
- * 1 or 2: MPI or hypre did not start; 3: not enough memory; 4: hypre failed otherwise.
- * On a failure nothing of this matrix is kept. */
-int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, const double *value,
-                             double strength) {
-    int i, status;
-    int *sizes, *rows;
-    if ((status = start()) != 0) return status;
-    lc_hypre_free();
-    if (!room_for((size_t)LC_HYPRE_BYTES_PER_UNKNOWN * (size_t)n)) return OUT_OF_MEMORY;
-    sizes = malloc(sizeof(int) * (size_t)n);
-    rows = malloc(sizeof(int) * (size_t)n);
-    if (!sizes || !rows) {
-        free(sizes);
-        free(rows);
-        return OUT_OF_MEMORY;
-    }
-    for (i = 0; i < n; i++) {
-        sizes[i] = row_start[i + 1] - row_start[i];
-        rows[i] = i;
-    }
-    amg.n = n;
-    /* hypre returns its error flag; every call is made (a destroy of a half-made object is
-     * safe) and the first failure decides */
-    HYPRE_ClearAllErrors();
-    amg.ij_a = NULL;
-    amg.ij_b = NULL;
-    amg.ij_x = NULL;
-    amg.solver = NULL;
-    status = HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, n - 1, 0, n - 1, &amg.ij_a);
+/* hypre's matrix of n rows (`sizes` entries each, rows numbered in `rows`), its vectors and
+ * BoomerAMG set up on it, into `amg`; 0 or hypre's error flag (the objects made so far are
+ * then in `amg` for lc_hypre_free). */
+static int build(int n, const int *sizes, const int *rows, const int *column, const double *value,
+                 double strength) {
+    int status = HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, n - 1, 0, n - 1, &amg.ij_a);
     if (status == 0) status = HYPRE_IJMatrixSetObjectType(amg.ij_a, HYPRE_PARCSR);
     if (status == 0) status = HYPRE_IJMatrixSetRowSizes(amg.ij_a, sizes);
     if (status == 0) status = HYPRE_IJMatrixInitialize(amg.ij_a);
-    if (status == 0) status = HYPRE_IJMatrixSetValues(amg.ij_a, n, sizes, rows, column, value);
+    if (status == 0) status = HYPRE_IJMatrixSetValues(amg.ij_a, n, (int *)sizes, rows, column, value);
     if (status == 0) status = HYPRE_IJMatrixAssemble(amg.ij_a);
     if (status == 0) status = HYPRE_IJMatrixGetObject(amg.ij_a, (void **)&amg.par_a);
-    free(sizes);
-    free(rows);
     if (status == 0) status = ij_vector(n, &amg.ij_b, &amg.par_b);
     if (status == 0) status = ij_vector(n, &amg.ij_x, &amg.par_x);
     if (status == 0) status = HYPRE_BoomerAMGCreate(&amg.solver);
-    amg.live = 1;
-    if (status != 0) {
-        lc_hypre_free();
-        return failure(status);
-    }
+    if (status != 0) return status;
     HYPRE_BoomerAMGSetPrintLevel(amg.solver, 0);
     HYPRE_BoomerAMGSetMaxIter(amg.solver, 1); /* one V-cycle: a preconditioner */
     HYPRE_BoomerAMGSetTol(amg.solver, 0.0);
@@ -235,7 +228,45 @@ int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, con
     HYPRE_BoomerAMGSetCycleRelaxType(amg.solver, 3, 1);
     HYPRE_BoomerAMGSetCycleRelaxType(amg.solver, 4, 2);
     HYPRE_BoomerAMGSetCycleRelaxType(amg.solver, 9, 3);
-    status = HYPRE_BoomerAMGSetup(amg.solver, amg.par_a, amg.par_b, amg.par_x);
+    return HYPRE_BoomerAMGSetup(amg.solver, amg.par_a, amg.par_b, amg.par_x);
+}
+
+/* BoomerAMG of the symmetric matrix of n > 0 rows in CSR form (zero-based). 0 on success;
+ * 1 or 2: MPI or hypre did not start; 3: not enough memory; 4: hypre failed otherwise.
+ * On a failure nothing of this matrix is kept. */
+int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, const double *value,
+                             double strength) {
+    int i, status;
+    int *sizes, *rows;
+    sigjmp_buf target;
+    if ((status = start()) != 0) return status;
+    lc_hypre_free();
+    if (!room_for((size_t)LC_HYPRE_BYTES_PER_UNKNOWN * (size_t)n)) return OUT_OF_MEMORY;
+    sizes = malloc(sizeof(int) * (size_t)n);
+    rows = malloc(sizeof(int) * (size_t)n);
+    if (!sizes || !rows) {
+        free(sizes);
+        free(rows);
+        return OUT_OF_MEMORY;
+    }
+    for (i = 0; i < n; i++) {
+        sizes[i] = row_start[i + 1] - row_start[i];
+        rows[i] = i;
+    }
+    HYPRE_ClearAllErrors();
+    memset(&amg, 0, sizeof amg);
+    amg.n = n;
+    amg.live = 1;
+    if (sigsetjmp(target, 0) != 0) {
+        free(sizes);
+        free(rows);
+        return aborted();
+    }
+    abort_return = &target;
+    status = build(n, sizes, rows, column, value, strength);
+    abort_return = NULL;
+    free(sizes);
+    free(rows);
     if (status != 0) {
         lc_hypre_free();
         return failure(status);
@@ -245,10 +276,14 @@ int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, con
 
 /* z = M^-1 r: one V-cycle from a zero guess (n values, as set up). */
 int lc_hypre_apply(const double *r, double *z) {
+    sigjmp_buf target;
     if (!amg.live) return 5;
     memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), r, sizeof(double) * (size_t)amg.n);
     HYPRE_ParVectorSetConstantValues(amg.par_x, 0.0);
+    if (sigsetjmp(target, 0) != 0) return aborted();
+    abort_return = &target;
     HYPRE_BoomerAMGSolve(amg.solver, amg.par_a, amg.par_b, amg.par_x);
+    abort_return = NULL;
     memcpy(z, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), sizeof(double) * (size_t)amg.n);
     HYPRE_ClearAllErrors(); /* "not converged" after one cycle is the intent */
     return 0;

@@ -437,7 +437,12 @@ contains
       subroutine precondition(r, z)
          real(wp), intent(in) :: r(:)
          real(wp), intent(out) :: z(:)
-         if (lc_hypre_apply(r, z) /= 0) then
+         integer(c_int) :: status
+         status = lc_hypre_apply(r, z)
+         if (status == hypre_out_of_memory) then
+            z = 0.0_wp
+            call out_of_memory(error, 'the work arrays of hypre''s V-cycle', hypre_bytes_per_unknown*size(r, kind=i8))
+         else if (status /= 0) then
             z = 0.0_wp
             call fatal_error(error, 'leakage: hypre''s BoomerAMG failed to apply its V-cycle', code_internal)
          end if
