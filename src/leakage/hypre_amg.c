@@ -13,7 +13,9 @@
  * leaves $TMPDIR as it found it and touches no other process's session.
  */
 #define _GNU_SOURCE
+#include <dlfcn.h>
 #include <ftw.h>
+#include <link.h>
 #include <setjmp.h>
 #include <malloc.h>
 #include <stdio.h>
@@ -153,12 +155,34 @@ static int failure(int flag) {
  * objects cannot be destroyed safely) until the process ends. */
 static sigjmp_buf *abort_return = NULL;
 
-__attribute__((visibility("default"))) int MPI_Abort(MPI_Comm comm, int errorcode) {
+/* Come back to this copy's waiting caller, if there is one (else return). Python loads two
+ * builds of this file (the portable core and the x86-64-v3 one): hypre's MPI_Abort binds to
+ * the first loaded, while the other may be the one that called hypre. */
+__attribute__((visibility("default"))) void lc_hypre_abort_return(void) {
     if (abort_return != NULL) {
         sigjmp_buf *target = abort_return;
         abort_return = NULL;
         siglongjmp(*target, 1);
     }
+}
+
+/* Ask every loaded object that defines lc_hypre_abort_return (each build of this file). */
+static int return_in_any_copy(struct dl_phdr_info *info, size_t size, void *data) {
+    void *handle;
+    void (*come_back)(void);
+    (void)size;
+    (void)data;
+    handle = dlopen(info->dlpi_name[0] ? info->dlpi_name : NULL, RTLD_LAZY | RTLD_NOLOAD);
+    if (handle == NULL) return 0;
+    *(void **)&come_back = dlsym(handle, "lc_hypre_abort_return");
+    if (come_back != NULL && come_back != lc_hypre_abort_return) come_back();
+    dlclose(handle);
+    return 0;
+}
+
+__attribute__((visibility("default"))) int MPI_Abort(MPI_Comm comm, int errorcode) {
+    lc_hypre_abort_return();
+    dl_iterate_phdr(return_in_any_copy, NULL);
     return PMPI_Abort(comm, errorcode);
 }
 
