@@ -11,6 +11,7 @@ scaleoffset, fletcher32), each file fsynced, and the time is given as a ratio to
 executable's solve time.
 
     .venv/bin/python bench/result_write.py [--n 2048] [--thickness 0.05] [--scenes coupled frictionless]
+        [--dir DIRECTORY] [--executable PROGRAM]
 """
 
 from __future__ import annotations
@@ -86,11 +87,11 @@ def executable() -> str:
     return found
 
 
-def run_scene(work: Path, n: int, thickness: float, friction: float, precision: str) -> dict:
+def run_scene(work: Path, n: int, thickness: float, friction: float, precision: str, program: str) -> dict:
     nml = work / "scene.nml"
     nml.write_text(SCENE.format(n=n, thickness=thickness, friction=friction, precision=precision))
     start = time.perf_counter()
-    proc = subprocess.run([executable(), str(nml)], cwd=work, capture_output=True, text=True)
+    proc = subprocess.run([program, str(nml)], cwd=work, capture_output=True, text=True)
     wall = time.perf_counter() - start
     if proc.returncode not in (0, 3):
         raise SystemExit(proc.stdout + proc.stderr)
@@ -131,14 +132,16 @@ def main() -> None:
     parser.add_argument("--thickness", type=float, default=0.05)
     parser.add_argument("--scenes", nargs="+", default=["coupled", "frictionless"])
     parser.add_argument("--dir", default=None, help="where to write (default: a temporary directory)")
+    parser.add_argument("--executable", default=None, help="the layercontact program (default: next to this Python)")
     args = parser.parse_args()
+    program = args.executable or executable()
     work = Path(tempfile.mkdtemp(dir=args.dir, prefix="result-write-"))
     try:
         for scene in args.scenes:
             friction = 0.5 if scene == "coupled" else 0.0
             print(f"== {scene}: {args.n}^2, h/lambda = {args.thickness}, nu = 0.5, mu_c = {friction}")
-            single = run_scene(work, args.n, args.thickness, friction, "single")
-            double = run_scene(work, args.n, args.thickness, friction, "double")
+            single = run_scene(work, args.n, args.thickness, friction, "single", program)
+            double = run_scene(work, args.n, args.thickness, friction, "double", program)
             solve = double["solve"]
             for label, r in (("double", double), ("single", single)):
                 print(f"  executable, precision = '{label}': solve {r['solve']:.2f} s, write {r['write']:.2f} s "
