@@ -55,7 +55,7 @@ def test_every_row_is_complete():
             assert v.alias_of in [w.name for w in schema.group_variables(v.group)]
     assert [v.sweep for v in schema.sweep_parameters()] == list(range(1, len(schema.sweep_parameters()) + 1))
     names = {(v.group, v.name) for v in schema.VARIABLES}
-    assert len(names) == len(schema.VARIABLES) == 59
+    assert len(names) == len(schema.VARIABLES) == 60
 
 
 def test_keyword_groups_put_each_keyword_in_its_group():
