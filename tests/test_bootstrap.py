@@ -34,6 +34,22 @@ def as_user() -> list[str]:
     return ["setpriv", f"--reuid={USER}", f"--regid={USER}", "--clear-groups"]
 
 
+def python_for_user() -> str | None:
+    """An interpreter of this Python's version that USER may run: the system's, or this one
+    (which may live where only root reads, as under /root/.pyenv); None if none."""
+    version = f"{sys.version_info.major}.{sys.version_info.minor}"
+    for candidate in (f"/usr/bin/python{version}", f"/usr/local/bin/python{version}", os.path.realpath(sys.executable)):
+        if not os.path.exists(candidate):
+            continue
+        check = subprocess.run([*as_user(), candidate, "-c", "import sys; print(sys.version_info[:2])"],
+                               capture_output=True, text=True, env={"PATH": "/usr/bin:/bin"})
+        # (and may test it: bash's `test -x` is what the bootstrap asks)
+        test = subprocess.run([*as_user(), "test", "-x", candidate])
+        if check.returncode == test.returncode == 0 and check.stdout.strip() == str(sys.version_info[:2]):
+            return candidate
+    return None
+
+
 @pytest.fixture
 def workspace():
     """A directory USER owns (under /tmp: pytest's own is private to root), with the copy of
@@ -72,14 +88,27 @@ def test_bootstrap_builds_as_a_normal_user_without_package_managers(workspace):
     builds as nobody and calls none of dpkg, apt-get, sudo; the executable it built then
     solves Westergaard's problem as the closed form says."""
     repo = workspace / "repo"
-    # The running environment as the copy's .venv, so the build downloads only what pip's
-    # build isolation asks for (the test tools are there already).
-    if sys.prefix != sys.base_prefix:
-        subprocess.run(["cp", "-a", sys.prefix, str(repo / ".venv")], check=True)
-        (repo / ".venv" / ".layercontact-installed").unlink(missing_ok=True)
+    env = environment(workspace)
+    python = python_for_user()
+    if sys.prefix != sys.base_prefix and python is not None:
+        # The running environment as the copy's .venv, on an interpreter of the same version
+        # that the user may run, so that the build downloads only what pip's build isolation
+        # asks for (the test tools are there already).
+        venv = repo / ".venv"
+        subprocess.run(["cp", "-a", sys.prefix, str(venv)], check=True)
+        (venv / ".layercontact-installed").unlink(missing_ok=True)
+        for link in ("python", "python3", f"python3.{sys.version_info.minor}"):
+            (venv / "bin" / link).unlink(missing_ok=True)
+            (venv / "bin" / link).symlink_to(python)
+        config = (venv / "pyvenv.cfg").read_text().splitlines()
+        config = [f"home = {Path(python).parent}" if line.startswith("home") else line for line in config
+                  if not line.startswith(("executable", "command"))]
+        (venv / "pyvenv.cfg").write_text("\n".join(config) + "\n")
         if os.geteuid() == 0:
-            subprocess.run(["chown", "-R", f"{USER}:{USER}", str(repo / ".venv")], check=True)
-    proc = subprocess.run([*as_user(), "bash", "tools/bootstrap.sh"], cwd=repo, env=environment(workspace),
+            subprocess.run(["chown", "-R", f"{USER}:{USER}", str(venv)], check=True)
+    elif python is not None:
+        env["PYTHON"] = python
+    proc = subprocess.run([*as_user(), "bash", "tools/bootstrap.sh"], cwd=repo, env=env,
                           capture_output=True, text=True, timeout=1800)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert (workspace / "calls.log").read_text() == "", "a package manager was called"
