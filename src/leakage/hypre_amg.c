@@ -192,9 +192,10 @@ static int aborted(void) {
     return failure(HYPRE_GetError());
 }
 
-/* Bytes of hypre's copy of the matrix, its vectors and the BoomerAMG hierarchy per unknown
- * (bench/leakage_memory.py). This much address space is made sure of before the setup
- * starts, so that a leakage too large for what is left is refused before hypre holds
+/* Bytes of hypre's copy of the matrix, its vectors and the BoomerAMG hierarchy per unknown:
+ * hypre's share of the 268 bytes per cell bench/leakage_memory.py measures (about 130 besides
+ * the Fortran arrays), with a margin. This much address space is made sure of before the
+ * setup starts, so that a leakage too large for what is left is refused before hypre holds
  * anything; an allocation that fails all the same comes back through MPI_Abort above. */
 #define LC_HYPRE_BYTES_PER_UNKNOWN 160
 

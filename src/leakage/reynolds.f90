@@ -54,7 +54,7 @@ module lc_leakage_reynolds
    !> lc_hypre_setup_boomeramg's status when memory ran out (hypre_amg.c)
    integer(c_int), parameter :: hypre_out_of_memory = 3_c_int
    !> bytes of hypre's matrix and hierarchy per unknown that hypre_amg.c makes sure of before
-   !> the setup (hypre_amg.c, LC_HYPRE_BYTES_PER_UNKNOWN)
+   !> the setup (LC_HYPRE_BYTES_PER_UNKNOWN there), for messages
    integer(i8), parameter :: hypre_bytes_per_unknown = 160_i8
 
    !> The flow along one direction.
