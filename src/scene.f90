@@ -139,6 +139,8 @@ module lc_scene
       !> write the maps (the profile and the solution fields) to the result file; without
       !> them a result holds the scalars, histograms, spots and patches (sweeps of large grids)
       logical :: fields = .true.
+      !> storage of the maps in the result file: 'double' (float64) or 'single' (float32)
+      character(len=max_string) :: precision = 'double'
       !> areal scenes: the Reynolds leakage of the gap (k_eff along x and y, lc_leakage_reynolds)
       logical :: leakage = .false.
       real(wp) :: leakage_tol = 1.0e-6_wp !< relative accuracy of k_eff

@@ -232,3 +232,101 @@ def test_python_raises_code_5_for_a_leakage_too_large_and_lives_on(tmp_path):
         assert first.startswith(f"5 not enough memory: {words} needs about"), proc.stdout
         assert float(last) == pytest.approx(1.0)   # a uniform gap of 1: k_eff = g^3
         assert not (tmp_path / "leak.h5").exists()
+
+
+#: A child Python: a striped gap of n x n cells (g along y only: the closed forms above),
+#: then, under a soft address-space limit of `extra` bytes above what the process maps by
+#: then, lc.core_leakage; after it the limit is lifted and a small leakage computed, to show
+#: the interpreter lives on. Prints "ok k_x k_y" or "error CODE MESSAGE", then "after K".
+OUT_OF_MEMORY_CHILD = """
+import resource, sys
+import numpy as np
+import layercontact as lc
+
+n, extra = int(sys.argv[1]), int(sys.argv[2])
+stripes = 1.0 + 0.5 * np.cos(2 * np.pi * np.arange(n) / n)
+gap = np.ascontiguousarray(np.tile(stripes[:, None], (1, n)))
+mapped = next(int(line.split()[1]) * 1024 for line in open('/proc/self/status') if line.startswith('VmSize:'))
+soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+resource.setrlimit(resource.RLIMIT_AS, (mapped + extra, hard))
+try:
+    res = lc.core_leakage(gap, tol=1e-8)
+    print('ok', repr(res.k_eff_x), repr(res.k_eff_y))
+except lc.LayercontactError as err:
+    print('error', err.code, err)
+resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+small = np.tile((1.0 + 0.5 * np.cos(2 * np.pi * np.arange(16) / 16))[:, None], (1, 16))
+print('after', repr(lc.core_leakage(small, tol=1e-12).k_eff_y))
+"""
+
+
+def test_a_leakage_that_runs_out_of_memory_raises_code_5_at_every_limit():
+    """lc.core_leakage of 1024^2 striped cells under address-space limits from 100 MiB to
+    1.2 GiB above what the process maps: each call raises LayercontactError code 5 (before
+    it allocates, or when an allocation of its own or of hypre's fails) or gives the closed
+    forms; the interpreter never crashes and computes on afterwards. Some limits fall
+    between the check before the leakage and what it allocates: there the allocations'
+    own checks end it."""
+    import subprocess
+    import sys
+
+    def harmonic(rows):
+        stripes = 1.0 + 0.5 * np.cos(2 * np.pi * np.arange(rows) / rows)
+        return 1 / np.mean(1 / stripes**3)
+
+    n = 1024
+    stripes = 1.0 + 0.5 * np.cos(2 * np.pi * np.arange(n) / n)
+    outcomes = {}
+    for mib in (100, 300, 450, 500, 550, 600, 650, 700, 800, 1200):
+        proc = subprocess.run([sys.executable, "-c", OUT_OF_MEMORY_CHILD, str(n), str(mib * 2**20)],
+                              capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, f"{mib} MiB: exit {proc.returncode}\n{proc.stdout}{proc.stderr}"
+        first, last = proc.stdout.splitlines()[0], proc.stdout.splitlines()[-1]
+        # the small gap's flow across its stripes, by hypre again: the harmonic mean
+        assert float(last.split()[1]) == pytest.approx(harmonic(16), rel=ITERATIVE), f"{mib} MiB"
+        if first.startswith("ok"):
+            k_x, k_y = map(float, first.split()[1:])
+            assert k_x == pytest.approx(np.mean(stripes**3), rel=EXACT)
+            # CG stopped at tol = 1e-8 on k_eff (an upper bound): 1e-8 above, with rounding
+            assert k_y == pytest.approx(harmonic(n), rel=1e-7)
+            outcomes[mib] = "ok"
+        else:
+            assert first.startswith("error 5 not enough memory: the leakage"), f"{mib} MiB: {first}"
+            outcomes[mib] = "allocation" if "could not allocate" in first else "check"
+    assert outcomes[100] == "check" and outcomes[1200] == "ok", outcomes
+    assert "allocation" in outcomes.values(), outcomes
+
+
+def test_a_leakage_leaves_tmpdir_as_it_found_it(tmp_path):
+    """A run with the leakage (the executable) and lc.core_leakage in a Python process, with
+    TMPDIR a fresh directory holding another process's Open MPI session: afterwards it holds
+    that session only, as it was; the leakage is the closed form's."""
+    import subprocess
+    import sys
+
+    from test_inputs import executable
+
+    tmpdir = tmp_path / "tmp"
+    other = tmpdir / "ompi.host.0" / "pid.1"
+    other.mkdir(parents=True)
+    (other / "contact.txt").write_text("another run's session\n")
+    before = sorted(str(p.relative_to(tmpdir)) for p in tmpdir.rglob("*"))
+    env = dict(__import__("os").environ, TMPDIR=str(tmpdir))
+
+    (tmp_path / "leak.nml").write_text(AREAL + "&output\n file = 'leak.h5'\n leakage = .true.\n/\n")
+    run = subprocess.run([executable(), "leak.nml"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert lc.read_result(tmp_path / "leak.h5").leakage.k_eff_x > 0
+    assert sorted(str(p.relative_to(tmpdir)) for p in tmpdir.rglob("*")) == before
+
+    # stripes along x: the flow across them needs hypre, and so starts MPI
+    stripes = np.random.default_rng(4).uniform(0.2, 2.0, 24)
+    script = ("import numpy as np, layercontact as lc\n"
+              f"gap = np.tile(np.array({stripes.tolist()!r})[:, None], (1, 16))\n"
+              "print(repr(lc.core_leakage(gap, tol=1e-12).k_eff_y))\n")
+    proc = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert float(proc.stdout) == pytest.approx(1 / np.mean(1 / stripes**3), rel=ITERATIVE)
+    assert sorted(str(p.relative_to(tmpdir)) for p in tmpdir.rglob("*")) == before
+    assert (other / "contact.txt").read_text() == "another run's session\n"

@@ -286,6 +286,10 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("output", "fields", "logical", ".true.", "", "both", ".true. or .false.",
              "write the maps (`/profile` and `/fields`); `.false.`: scalars, histograms, spots and patches only",
              "scene%fields"),
+    Variable("output", "precision", "string", "'double'", "", "both", "'double' or 'single'",
+             "the maps' storage: `'double'` (float64) or `'single'` (float32: half the size, 7 significant "
+             "digits); scalars, histograms, spots and patches stay double ([output.md](output.md#size-and-write-time))",
+             "scene%precision", choices=("double", "single")),
     Variable("output", "leakage", "logical", ".false.", "", "areal", ".false. with geometry = 'line'",
              "compute the Reynolds leakage of the solved gap, `k_eff` along `x` and `y` "
              "([leakage.md](leakage.md#leakage-in-the-result))", "scene%leakage"),

@@ -15,16 +15,17 @@
 !> `error_type` messages naming the file and the object instead.
 module lc_io_hdf5
    use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_char, c_null_char, c_ptr, c_loc, c_size_t
+   use, intrinsic :: iso_fortran_env, only: error_unit
    use hdf5, only: hid_t, hsize_t, size_t, h5kind_to_type, H5_INTEGER_KIND, h5open_f, h5close_f, h5eset_auto_f, &
       & h5fis_hdf5_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5fget_filesize_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
       & H5F_CLOSE_STRONG_F, &
       & h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, H5P_DATASET_CREATE_F, h5pset_chunk_f, &
-      & h5pset_deflate_f, &
+      & h5pset_deflate_f, h5pset_shuffle_f, &
       & h5gcreate_f, h5gclose_f, h5iget_name_f, &
       & h5screate_f, h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
       & h5sget_simple_extent_dims_f, H5S_SCALAR_F, &
       & h5tcopy_f, h5tset_size_f, h5tset_strpad_f, h5tclose_f, h5tget_class_f, &
-      & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
+      & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_IEEE_F32LE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
       & h5acreate_f, h5awrite_f, h5aclose_f, &
       & h5dcreate_f, h5dopen_f, h5dwrite_f, h5dread_f, h5dclose_f, h5dget_space_f, h5dget_type_f
    use lc_base_kinds, only: wp, i8
@@ -110,6 +111,8 @@ module lc_io_hdf5
       end function c_getpid
    end interface
 
+   !> maps from this size on (bytes) make the write announce itself on stderr
+   integer(i8), parameter :: large_file = 64_i8*2_i8**20
    !> access() modes: write and search permission on a directory
    integer(c_int), parameter :: w_ok = 2_c_int, x_ok = 1_c_int
    !> rwxrwxrwx, reduced by the process umask as `mkdir -p` does
@@ -192,6 +195,7 @@ contains
       integer(hid_t) :: fapl, file, group
       character(len=:), allocatable :: reason
       integer :: ignore, j, n
+      integer(i8) :: maps
       logical :: synced
 
       n = size(height)
@@ -205,6 +209,13 @@ contains
       tmp = filename // '.' // host_name() // '.' // to_string(int(c_getpid())) // '.tmp'
       call delete_file(tmp, error)
       if (allocated(error)) return
+      ! a large file takes seconds to reach the disk: say so meanwhile, as the solver's progress does
+      maps = map_bytes(scene, result, present(companion))
+      if (maps >= large_file) then
+         write (error_unit, '(a)') "layercontact: writing result file '" // filename // "' (" // &
+            & to_string(maps/10_i8**6) // ' MB of maps)'
+         flush (error_unit)
+      end if
 
       call h5open_f(st%hdferr)
       call h5eset_auto_f(0, ignore)
@@ -734,9 +745,13 @@ contains
       if (st%hdferr /= 0 .and. .not. allocated(st%object)) call failed(loc, name, st)
    end subroutine write_dataset_1d
 
-   !> A field on the scene's grid: a 1D dataset of a line, or a 2D dataset of a surface
-   !> (shape [ny, nx] as C and h5py see it, x fastest), chunked by whole rows and
-   !> compressed (deflate): a gap field of a partial contact holds many zeros.
+   !> A map on the scene's grid: a 1D dataset of a line, or a 2D dataset of a surface (shape
+   !> [ny, nx] as C and h5py see it, x fastest), float64 or float32 (&output precision; HDF5
+   !> converts while it writes). Stored contiguous and unfiltered: deflate runs slower than
+   !> the disk writes and saves little on dense maps. A map whose values are mostly exact
+   !> zeros (the pressure and the shear outside the contact) is stored in chunks of whole rows
+   !> with shuffle + deflate level 1, which there costs little and saves ~90 %
+   !> (docs/decisions/020-result-writing.md).
    subroutine write_field(loc, name, values, units, scene, st)
       integer(hid_t), intent(in) :: loc
       character(len=*), intent(in) :: name
@@ -744,35 +759,58 @@ contains
       character(len=*), intent(in) :: units
       type(scene_type), intent(in) :: scene
       type(h5_status), intent(inout) :: st
-      integer(hid_t) :: space, dset, dcpl
+      integer(hid_t) :: space, dset, dcpl, file_type
       integer(hsize_t) :: dims(2), chunk(2)
-      integer :: ignore
-      if (.not. is_areal(scene)) then
-         call write_dataset_1d(loc, name, values, units, st)
-         return
-      end if
+      integer :: rank, ignore
       if (st%hdferr /= 0) return
-      dims = [int(scene%n, hsize_t), int(scene%ny, hsize_t)]
-      ! rows of about 2**16 values a chunk (512 KiB)
-      chunk = [dims(1), max(1_hsize_t, min(dims(2), 65536_hsize_t/dims(1)))]
-      call h5screate_simple_f(2, dims, space, st%hdferr)
+      rank = merge(2, 1, is_areal(scene))
+      dims = [int(scene%n, hsize_t), int(max(scene%ny, 1), hsize_t)]
+      file_type = H5T_NATIVE_DOUBLE
+      if (trim(scene%precision) == 'single') file_type = H5T_IEEE_F32LE
+      call h5screate_simple_f(rank, dims(:rank), space, st%hdferr)
       if (st%hdferr == 0) then
          call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, st%hdferr)
-         if (st%hdferr == 0) call h5pset_chunk_f(dcpl, 2, chunk, st%hdferr)
-         if (st%hdferr == 0) call h5pset_deflate_f(dcpl, 4, st%hdferr)
+         if (st%hdferr == 0 .and. mostly_zeros(values)) then
+            ! chunks of about 2**16 values (512 KiB in double): whole rows of a surface
+            chunk = [min(dims(1), 65536_hsize_t), max(1_hsize_t, min(dims(2), 65536_hsize_t/dims(1)))]
+            call h5pset_chunk_f(dcpl, rank, chunk(:rank), st%hdferr)
+            if (st%hdferr == 0) call h5pset_shuffle_f(dcpl, st%hdferr)
+            if (st%hdferr == 0) call h5pset_deflate_f(dcpl, 1, st%hdferr)
+         end if
          if (st%hdferr == 0) then
-            call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, st%hdferr, dcpl_id=dcpl)
+            call h5dcreate_f(loc, name, file_type, space, dset, st%hdferr, dcpl_id=dcpl)
             if (st%hdferr == 0) then
-               call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, st%hdferr)
+               if (size(values) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims(:rank), st%hdferr)
                if (st%hdferr == 0) call write_attr_string(dset, 'units', units, st)
                call close_dataset(dset, st)
             end if
-            call h5pclose_f(dcpl, ignore)
          end if
+         call h5pclose_f(dcpl, ignore)
          call h5sclose_f(space, ignore)
       end if
       if (st%hdferr /= 0 .and. .not. allocated(st%object)) call failed(loc, name, st)
    end subroutine write_field
+
+   !> Whether more than half of the values are exact zeros (a map deflate shrinks cheaply).
+   pure logical function mostly_zeros(values)
+      real(wp), intent(in) :: values(:)
+      mostly_zeros = 2*count(values == 0.0_wp, kind=i8) > size(values, kind=i8)
+   end function mostly_zeros
+
+   !> The bytes of the maps a result holds (for the progress line of a large file).
+   pure function map_bytes(scene, res, companion_present) result(bytes)
+      type(scene_type), intent(in) :: scene
+      type(contact_result), intent(in) :: res
+      logical, intent(in) :: companion_present
+      integer(i8) :: bytes
+      integer :: maps
+      maps = 3
+      if (allocated(res%stress_xx)) maps = maps + 3
+      if (allocated(res%stress_yy)) maps = maps + 3
+      if (companion_present) maps = 2*maps
+      bytes = 0
+      if (scene%fields) bytes = int(maps + 1, i8)*scene%n*max(scene%ny, 1)*merge(4, 8, trim(scene%precision) == 'single')
+   end function map_bytes
 
    !> Where and when the result was made: @host, @created (UTC, ISO 8601), and under Slurm
    !> @slurm_job_id, @slurm_array_job_id, @slurm_array_task_id, @slurm_cluster_name,

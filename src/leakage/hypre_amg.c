@@ -5,8 +5,20 @@
  * Debian's hypre is built with MPI. MPI is started here only when a preconditioner is
  * first needed (a singleton start: no mpirun), and finished at exit if it was started here,
  * so that runs that compute no leakage never touch MPI. Everything runs on MPI_COMM_SELF.
+ *
+ * Open MPI keeps a session directory (ompi.HOST.UID/ with the singleton's files) under
+ * $TMPDIR and leaves it there after MPI_Finalize. MPI is therefore started with a directory
+ * of its own as that base, made for this process in $TMPDIR (or in the base the caller set
+ * with OMPI_MCA_orte_tmpdir_base), and that directory is removed, whole, at exit: the run
+ * leaves $TMPDIR as it found it and touches no other process's session.
  */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <ftw.h>
+#include <link.h>
+#include <setjmp.h>
 #include <malloc.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <mpi.h>
@@ -14,8 +26,13 @@
 #include <HYPRE_parcsr_ls.h>
 #include <_hypre_parcsr_mv.h>
 
+/* The status of lc_hypre_setup_boomeramg when memory ran out (lc_leakage_reynolds). */
+enum { OUT_OF_MEMORY = 3 };
+
 static int mpi_started_here = 0;
 static int hypre_started = 0;
+/* the session base made for this process's MPI ("" if none) */
+static char session_base[4096] = "";
 
 /* Loading Debian's hypre loads SuperLU_DIST, whose initialisation turns off glibc's mmap for
  * large blocks and the trimming of the heap (mallopt M_MMAP_MAX 0, M_TRIM_THRESHOLD -1): every
@@ -33,12 +50,36 @@ __attribute__((constructor)) static void malloc_defaults_at_load(void) { malloc_
 
 void lc_hypre_free(void);
 
+static int remove_entry(const char *path, const struct stat *info, int type, struct FTW *where) {
+    (void)info;
+    (void)type;
+    (void)where;
+    remove(path);
+    return 0; /* go on: remove what can be removed */
+}
+
 static void finish_at_exit(void) {
     int finalized = 0;
     lc_hypre_free();
     if (hypre_started) HYPRE_Finalize();
     MPI_Finalized(&finalized);
     if (mpi_started_here && !finalized) MPI_Finalize();
+    /* children first (FTW_DEPTH), symbolic links not followed (FTW_PHYS) */
+    if (session_base[0] != '\0') nftw(session_base, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+/* Make this process's session base (see the top) and point Open MPI at it; without a
+ * writable $TMPDIR Open MPI keeps its default. */
+static void make_session_base(void) {
+    const char *base = getenv("OMPI_MCA_orte_tmpdir_base");
+    if (base == NULL || base[0] == '\0') base = getenv("TMPDIR");
+    if (base == NULL || base[0] == '\0') base = "/tmp";
+    if (snprintf(session_base, sizeof session_base, "%s/layercontact-mpi.XXXXXX", base) >= (int)sizeof session_base ||
+        mkdtemp(session_base) == NULL) {
+        session_base[0] = '\0';
+        return;
+    }
+    setenv("OMPI_MCA_orte_tmpdir_base", session_base, 1);
 }
 
 /* 1 if MPI runs in this process (started by a first preconditioner, or by the caller). */
@@ -54,7 +95,23 @@ static int start(void) {
     if (hypre_started) return 0;
     MPI_Initialized(&initialized);
     if (!initialized) {
-        if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) return 1;
+        const char *given = getenv("OMPI_MCA_orte_tmpdir_base");
+        char *caller_base = given ? strdup(given) : NULL;
+        int status;
+        make_session_base();
+        status = MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided);
+        /* the environment as the caller left it (Open MPI has read it) */
+        if (caller_base) {
+            setenv("OMPI_MCA_orte_tmpdir_base", caller_base, 1);
+            free(caller_base);
+        } else {
+            unsetenv("OMPI_MCA_orte_tmpdir_base");
+        }
+        if (status != MPI_SUCCESS) {
+            if (session_base[0] != '\0') nftw(session_base, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+            session_base[0] = '\0';
+            return 1;
+        }
         mpi_started_here = 1;
         atexit(finish_at_exit);
     }
@@ -77,56 +134,106 @@ static struct {
 
 void lc_hypre_free(void) {
     if (!amg.live) return;
-    HYPRE_BoomerAMGDestroy(amg.solver);
-    HYPRE_IJMatrixDestroy(amg.ij_a);
-    HYPRE_IJVectorDestroy(amg.ij_b);
-    HYPRE_IJVectorDestroy(amg.ij_x);
+    if (amg.solver) HYPRE_BoomerAMGDestroy(amg.solver);
+    if (amg.ij_a) HYPRE_IJMatrixDestroy(amg.ij_a);
+    if (amg.ij_b) HYPRE_IJVectorDestroy(amg.ij_b);
+    if (amg.ij_x) HYPRE_IJVectorDestroy(amg.ij_x);
     amg.live = 0;
 }
 
-static HYPRE_IJVector ij_vector(int n, HYPRE_ParVector *par) {
-    HYPRE_IJVector v;
-    HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, n - 1, &v);
-    HYPRE_IJVectorSetObjectType(v, HYPRE_PARCSR);
-    HYPRE_IJVectorInitialize(v);
-    HYPRE_IJVectorAssemble(v);
-    HYPRE_IJVectorGetObject(v, (void **)par);
-    return v;
+/* The status of a setup that hypre failed with its error flag `flag`: memory or another. */
+static int failure(int flag) {
+    HYPRE_ClearAllErrors();
+    return (flag & HYPRE_ERROR_MEMORY) ? OUT_OF_MEMORY : 4;
 }
 
-/* BoomerAMG of the symmetric matrix of n > 0 rows in CSR form (zero-based). 0 on success. */
-int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, const double *value,
-                             double strength) {
-    int i, status;
-    int *sizes, *rows;
-    if ((status = start()) != 0) return status;
-    lc_hypre_free();
-    sizes = malloc(sizeof(int) * (size_t)n);
-    rows = malloc(sizeof(int) * (size_t)n);
-    if (!sizes || !rows) {
-        free(sizes);
-        free(rows);
-        return 3;
-    }
-    for (i = 0; i < n; i++) {
-        sizes[i] = row_start[i + 1] - row_start[i];
-        rows[i] = i;
-    }
-    amg.n = n;
-    HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, n - 1, 0, n - 1, &amg.ij_a);
-    HYPRE_IJMatrixSetObjectType(amg.ij_a, HYPRE_PARCSR);
-    HYPRE_IJMatrixSetRowSizes(amg.ij_a, sizes);
-    HYPRE_IJMatrixInitialize(amg.ij_a);
-    HYPRE_IJMatrixSetValues(amg.ij_a, n, sizes, rows, column, value);
-    HYPRE_IJMatrixAssemble(amg.ij_a);
-    HYPRE_IJMatrixGetObject(amg.ij_a, (void **)&amg.par_a);
-    free(sizes);
-    free(rows);
-    amg.ij_b = ij_vector(n, &amg.par_b);
-    amg.ij_x = ij_vector(n, &amg.par_x);
+/* hypre does not return from a failed allocation: it sets HYPRE_ERROR_MEMORY and calls
+ * MPI_Abort, which ends the process (and a Python interpreter with it). MPI's profiling
+ * interface lets a library define MPI_Abort itself and pass on to PMPI_Abort; while hypre
+ * works for this file (abort_return set) an abort comes back to the caller instead, which
+ * reports hypre's error. What hypre held at that moment stays allocated (its half-made
+ * objects cannot be destroyed safely) until the process ends. */
+static sigjmp_buf *abort_return = NULL;
 
-    HYPRE_BoomerAMGCreate(&amg.solver);
-    amg.live = 1;
+/* Come back to this copy's waiting caller, if there is one (else return). Python loads two
+ * builds of this file (the portable core and the x86-64-v3 one): hypre's MPI_Abort binds to
+ * the first loaded, while the other may be the one that called hypre. */
+__attribute__((visibility("default"))) void lc_hypre_abort_return(void) {
+    if (abort_return != NULL) {
+        sigjmp_buf *target = abort_return;
+        abort_return = NULL;
+        siglongjmp(*target, 1);
+    }
+}
+
+/* Ask every loaded object that defines lc_hypre_abort_return (each build of this file). */
+static int return_in_any_copy(struct dl_phdr_info *info, size_t size, void *data) {
+    void *handle;
+    void (*come_back)(void);
+    (void)size;
+    (void)data;
+    handle = dlopen(info->dlpi_name[0] ? info->dlpi_name : NULL, RTLD_LAZY | RTLD_NOLOAD);
+    if (handle == NULL) return 0;
+    *(void **)&come_back = dlsym(handle, "lc_hypre_abort_return");
+    if (come_back != NULL && come_back != lc_hypre_abort_return) come_back();
+    dlclose(handle);
+    return 0;
+}
+
+__attribute__((visibility("default"))) int MPI_Abort(MPI_Comm comm, int errorcode) {
+    lc_hypre_abort_return();
+    dl_iterate_phdr(return_in_any_copy, NULL);
+    return PMPI_Abort(comm, errorcode);
+}
+
+/* After an abort inside hypre: forget its objects, and say why it gave up. */
+static int aborted(void) {
+    memset(&amg, 0, sizeof amg);
+    return failure(HYPRE_GetError());
+}
+
+/* Bytes of hypre's copy of the matrix, its vectors and the BoomerAMG hierarchy per unknown:
+ * hypre's share of the 268 bytes per cell bench/leakage_memory.py measures (about 130 besides
+ * the Fortran arrays), with a margin. This much address space is made sure of before the
+ * setup starts, so that a leakage too large for what is left is refused before hypre holds
+ * anything; an allocation that fails all the same comes back through MPI_Abort above. */
+#define LC_HYPRE_BYTES_PER_UNKNOWN 160
+
+/* 1 if `bytes` more can be allocated now: a block that size is taken and given back
+ * without being touched (mapped, not resident). */
+static int room_for(size_t bytes) {
+    void *probe = malloc(bytes);
+    if (probe == NULL) return 0;
+    free(probe);
+    return 1;
+}
+
+/* An IJ vector of n rows and its ParCSR object; 0 on success, else hypre's error flag. */
+static int ij_vector(int n, HYPRE_IJVector *v, HYPRE_ParVector *par) {
+    int status = HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, n - 1, v);
+    if (status == 0) status = HYPRE_IJVectorSetObjectType(*v, HYPRE_PARCSR);
+    if (status == 0) status = HYPRE_IJVectorInitialize(*v);
+    if (status == 0) status = HYPRE_IJVectorAssemble(*v);
+    if (status == 0) status = HYPRE_IJVectorGetObject(*v, (void **)par);
+    return status;
+}
+
+/* hypre's matrix of n rows (`sizes` entries each, rows numbered in `rows`), its vectors and
+ * BoomerAMG set up on it, into `amg`; 0 or hypre's error flag (the objects made so far are
+ * then in `amg` for lc_hypre_free). */
+static int build(int n, const int *sizes, const int *rows, const int *column, const double *value,
+                 double strength) {
+    int status = HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, n - 1, 0, n - 1, &amg.ij_a);
+    if (status == 0) status = HYPRE_IJMatrixSetObjectType(amg.ij_a, HYPRE_PARCSR);
+    if (status == 0) status = HYPRE_IJMatrixSetRowSizes(amg.ij_a, sizes);
+    if (status == 0) status = HYPRE_IJMatrixInitialize(amg.ij_a);
+    if (status == 0) status = HYPRE_IJMatrixSetValues(amg.ij_a, n, (int *)sizes, rows, column, value);
+    if (status == 0) status = HYPRE_IJMatrixAssemble(amg.ij_a);
+    if (status == 0) status = HYPRE_IJMatrixGetObject(amg.ij_a, (void **)&amg.par_a);
+    if (status == 0) status = ij_vector(n, &amg.ij_b, &amg.par_b);
+    if (status == 0) status = ij_vector(n, &amg.ij_x, &amg.par_x);
+    if (status == 0) status = HYPRE_BoomerAMGCreate(&amg.solver);
+    if (status != 0) return status;
     HYPRE_BoomerAMGSetPrintLevel(amg.solver, 0);
     HYPRE_BoomerAMGSetMaxIter(amg.solver, 1); /* one V-cycle: a preconditioner */
     HYPRE_BoomerAMGSetTol(amg.solver, 0.0);
@@ -146,16 +253,62 @@ int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, con
     HYPRE_BoomerAMGSetCycleRelaxType(amg.solver, 3, 1);
     HYPRE_BoomerAMGSetCycleRelaxType(amg.solver, 4, 2);
     HYPRE_BoomerAMGSetCycleRelaxType(amg.solver, 9, 3);
-    status = HYPRE_BoomerAMGSetup(amg.solver, amg.par_a, amg.par_b, amg.par_x);
-    return status == 0 ? 0 : 4;
+    return HYPRE_BoomerAMGSetup(amg.solver, amg.par_a, amg.par_b, amg.par_x);
+}
+
+/* BoomerAMG of the symmetric matrix of n > 0 rows in CSR form (zero-based). 0 on success;
+ * 1 or 2: MPI or hypre did not start; 3: not enough memory; 4: hypre failed otherwise.
+ * On a failure nothing of this matrix is kept. */
+int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, const double *value,
+                             double strength) {
+    int i, status;
+    int *sizes, *rows;
+    sigjmp_buf target;
+    if ((status = start()) != 0) return status;
+    lc_hypre_free();
+    if (!room_for((size_t)LC_HYPRE_BYTES_PER_UNKNOWN * (size_t)n)) return OUT_OF_MEMORY;
+    sizes = malloc(sizeof(int) * (size_t)n);
+    rows = malloc(sizeof(int) * (size_t)n);
+    if (!sizes || !rows) {
+        free(sizes);
+        free(rows);
+        return OUT_OF_MEMORY;
+    }
+    for (i = 0; i < n; i++) {
+        sizes[i] = row_start[i + 1] - row_start[i];
+        rows[i] = i;
+    }
+    HYPRE_ClearAllErrors();
+    memset(&amg, 0, sizeof amg);
+    amg.n = n;
+    amg.live = 1;
+    if (sigsetjmp(target, 0) != 0) {
+        free(sizes);
+        free(rows);
+        return aborted();
+    }
+    abort_return = &target;
+    status = build(n, sizes, rows, column, value, strength);
+    abort_return = NULL;
+    free(sizes);
+    free(rows);
+    if (status != 0) {
+        lc_hypre_free();
+        return failure(status);
+    }
+    return 0;
 }
 
 /* z = M^-1 r: one V-cycle from a zero guess (n values, as set up). */
 int lc_hypre_apply(const double *r, double *z) {
+    sigjmp_buf target;
     if (!amg.live) return 5;
     memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), r, sizeof(double) * (size_t)amg.n);
     HYPRE_ParVectorSetConstantValues(amg.par_x, 0.0);
+    if (sigsetjmp(target, 0) != 0) return aborted();
+    abort_return = &target;
     HYPRE_BoomerAMGSolve(amg.solver, amg.par_a, amg.par_b, amg.par_x);
+    abort_return = NULL;
     memcpy(z, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), sizeof(double) * (size_t)amg.n);
     HYPRE_ClearAllErrors(); /* "not converged" after one cycle is the intent */
     return 0;

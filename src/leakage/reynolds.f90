@@ -51,6 +51,11 @@ module lc_leakage_reynolds
    !> BoomerAMG strength threshold: hypre's default for 2D Laplacians; 0.5 took more CG
    !> iterations and more time near percolation (docs/decisions/006-leakage-in-the-core.md).
    real(c_double), parameter :: amg_strength = 0.25_c_double
+   !> lc_hypre_setup_boomeramg's status when memory ran out (hypre_amg.c)
+   integer(c_int), parameter :: hypre_out_of_memory = 3_c_int
+   !> bytes of hypre's matrix and hierarchy per unknown that hypre_amg.c makes sure of before
+   !> the setup (LC_HYPRE_BYTES_PER_UNKNOWN there), for messages
+   integer(i8), parameter :: hypre_bytes_per_unknown = 160_i8
 
    !> The flow along one direction.
    type :: leakage_flow
@@ -110,6 +115,7 @@ contains
       real(wp) :: threshold, hx, hy
       integer(i8) :: start, finish, rate
       logical :: same, prepared
+      integer :: stat
 
       call system_clock(start, rate)
       if (.not. leakage_tol_allowed(tol)) then
@@ -129,10 +135,23 @@ contains
       hx = lx/nx
       hy = ly/ny
       threshold = max(contact_threshold_relative*max(maxval(g), 0.0_wp), smallest_gap)
+      allocate (fluid(size(g)), active_x(size(g)), active_y(size(g)), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory(error, 'its cell masks', 3*size(g, kind=i8))
+         return
+      end if
       fluid = .not. closed .and. g > threshold
       result%fluid_fraction = real(count(fluid), wp)/size(g)
-      call face_weights(g, fluid, nx, ny, hx, hy, east, north)
-      call flow_clusters(fluid, nx, ny, cluster, winds_x, winds_y)
+      call face_weights(g, fluid, nx, ny, hx, hy, east, north, stat)
+      if (stat /= 0) then
+         call out_of_memory(error, 'its face conductances', 24*size(g, kind=i8))
+         return
+      end if
+      call flow_clusters(fluid, nx, ny, cluster, winds_x, winds_y, stat)
+      if (stat /= 0) then
+         call out_of_memory(error, 'its fluid clusters', 17*size(g, kind=i8))
+         return
+      end if
       active_x = fluid
       active_y = fluid
       where (fluid) active_x = winds_x(max(cluster, 1))
@@ -175,6 +194,17 @@ contains
       call check_leakage_memory(points, resident, lc_hypre_mpi_started() /= 0, error)
    end subroutine leakage_memory_check
 
+   !> Error code 5 for an allocation of the leakage that failed: `what` it was for and about
+   !> how many bytes it asked.
+   pure subroutine out_of_memory(error, what, bytes)
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in) :: what
+      integer(i8), intent(in) :: bytes
+      call fatal_error(error, 'not enough memory: the leakage could not allocate ' // what // ' (' // &
+         & to_string(bytes) // ' bytes); allowed: a smaller grid, &output leakage = .false., or a machine ' // &
+         & 'or job with more memory (Slurm: --mem)', code_internal)
+   end subroutine out_of_memory
+
    !> True for a tolerance in leakage_tol_range (false for NaN).
    pure logical function leakage_tol_allowed(tol)
       real(wp), intent(in) :: tol
@@ -183,14 +213,17 @@ contains
 
    !> c/h^2 of the face from each cell to its east (+x) and north (+y) neighbour: the harmonic
    !> mean of the two g^3, zero when either cell is closed.
-   pure subroutine face_weights(g, fluid, nx, ny, hx, hy, east, north)
+   pure subroutine face_weights(g, fluid, nx, ny, hx, hy, east, north, stat)
       real(wp), intent(in) :: g(:), hx, hy
       logical, intent(in) :: fluid(:)
       integer, intent(in) :: nx, ny
       real(wp), allocatable, intent(out) :: east(:), north(:)
+      !> nonzero: an allocation failed (nothing computed)
+      integer, intent(out) :: stat
       real(wp), allocatable :: resistance(:)
       integer :: i, j, k, ke, kn
-      allocate (resistance(size(g)), east(size(g)), north(size(g)))
+      allocate (resistance(size(g)), east(size(g)), north(size(g)), stat=stat)
+      if (stat /= 0) return
       where (fluid)
          resistance = 1.0_wp/(g*g*g)
       elsewhere
@@ -215,17 +248,20 @@ contains
    !> coordinates closes a loop around the cell, along x when the x coordinates differ. Every
    !> loop is a sum of the loops the edges outside the search tree close, so the cluster winds
    !> along x exactly when one of its edges says so.
-   pure subroutine flow_clusters(fluid, nx, ny, cluster, winds_x, winds_y)
+   pure subroutine flow_clusters(fluid, nx, ny, cluster, winds_x, winds_y, stat)
       logical, intent(in) :: fluid(:)
       integer, intent(in) :: nx, ny
       integer, allocatable, intent(out) :: cluster(:)
       logical, allocatable, intent(out) :: winds_x(:), winds_y(:)
+      !> nonzero: an allocation failed
+      integer, intent(out) :: stat
       integer, allocatable :: queue(:), ux(:), uy(:)
       logical, allocatable :: winds(:, :)
       integer, parameter :: step_x(4) = [1, -1, 0, 0], step_y(4) = [0, 0, 1, -1]
       integer :: seed, head, tail, k, m, i, j, ni, nj, next, label, n_labels
-      allocate (cluster(size(fluid)), queue(size(fluid)), ux(size(fluid)), uy(size(fluid)))
-      allocate (winds(2, size(fluid)/2 + 1))
+      allocate (cluster(size(fluid)), queue(size(fluid)), ux(size(fluid)), uy(size(fluid)), &
+         & winds(2, size(fluid)/2 + 1), stat=stat)
+      if (stat /= 0) return
       cluster = 0
       winds = .false.
       n_labels = 0
@@ -262,6 +298,8 @@ contains
             end do
          end do
       end do
+      allocate (winds_x(max(n_labels, 1)), winds_y(max(n_labels, 1)), stat=stat)
+      if (stat /= 0) return
       winds_x = winds(1, :max(n_labels, 1))
       winds_y = winds(2, :max(n_labels, 1))
    end subroutine flow_clusters
@@ -284,18 +322,22 @@ contains
       integer(c_int), allocatable :: row_start(:), column(:)
       real(c_double), allocatable :: value(:)
       real(wp) :: jump_x, jump_y, rho, rho_next, alpha, bound, b_norm
-      integer :: k, n_cells, n_free, iteration, status
+      integer :: k, n_cells, n_free, iteration, status, stat
 
       n_cells = size(active)
       ! weights restricted to the flow-carrying clusters: an open face joins two cells of one
       ! cluster, so these are exactly its faces
-      allocate (we(n_cells), wn(n_cells))
+      allocate (we(n_cells), wn(n_cells), free(n_cells), pinned_cluster(maxval(cluster)), number(n_cells), &
+         & phi_grid(n_cells), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory(error, 'its weights and cell numbers', 33*int(n_cells, i8))
+         return
+      end if
       we = merge(east, 0.0_wp, active)
       wn = merge(north, 0.0_wp, active)
       jump_x = merge(hx, 0.0_wp, direction == 1)
       jump_y = merge(hy, 0.0_wp, direction == 2)
       ! pin the first cell of each flow-carrying cluster
-      allocate (free(n_cells), pinned_cluster(maxval(cluster)))
       pinned_cluster = .false.
       free = active
       do k = 1, n_cells
@@ -308,7 +350,11 @@ contains
       end do
       n_free = count(free)
       flow%unknowns = n_free
-      allocate (number(n_cells), free_cells(n_free), phi_grid(n_cells))
+      allocate (free_cells(n_free), b(n_free), phi(n_free), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory(error, 'its unknowns', 20*int(n_free, i8))
+         return
+      end if
       number = 0
       n_free = 0
       do k = 1, n_cells
@@ -319,18 +365,26 @@ contains
          end if
       end do
       ! b = -D^T W j: the jump on the faces along the flow
-      b = rhs_on_free_cells()
-      allocate (phi(n_free))
+      call rhs_on_free_cells(b)
       phi = 0.0_wp
       b_norm = sqrt(sum(b*b))
       if (n_free == 0 .or. b_norm == 0.0_wp) then
          flow%k_eff = dissipation(phi)/n_cells
          return
       end if
+      allocate (row_start(n_free + 1), column(5*n_free), value(5*n_free), r(n_free), z(n_free), p(n_free), &
+         & q(n_free), decreases(max_iter), stat=stat)
+      if (stat /= 0) then
+         call out_of_memory(error, 'its matrix and iteration vectors', 96*int(n_free, i8))
+         return
+      end if
       call assemble()
       if (.not. prepared) then
          status = lc_hypre_setup_boomeramg(int(n_free, c_int), row_start, column, value, amg_strength)
-         if (status /= 0) then
+         if (status == hypre_out_of_memory) then
+            call out_of_memory(error, 'hypre''s BoomerAMG hierarchy', hypre_bytes_per_unknown*n_free)
+            return
+         else if (status /= 0) then
             call fatal_error(error, 'leakage: hypre''s BoomerAMG failed to set up (status ' // &
                & char(48 + min(status, 9)) // ')', code_internal)
             return
@@ -338,7 +392,6 @@ contains
          prepared = .true.
       end if
 
-      allocate (r(n_free), z(n_free), q(n_free), decreases(max_iter))
       r = b
       call precondition(r, z)
       if (allocated(error)) return
@@ -384,7 +437,12 @@ contains
       subroutine precondition(r, z)
          real(wp), intent(in) :: r(:)
          real(wp), intent(out) :: z(:)
-         if (lc_hypre_apply(r, z) /= 0) then
+         integer(c_int) :: status
+         status = lc_hypre_apply(r, z)
+         if (status == hypre_out_of_memory) then
+            z = 0.0_wp
+            call out_of_memory(error, 'the work arrays of hypre''s V-cycle', hypre_bytes_per_unknown*size(r, kind=i8))
+         else if (status /= 0) then
             z = 0.0_wp
             call fatal_error(error, 'leakage: hypre''s BoomerAMG failed to apply its V-cycle', code_internal)
          end if
@@ -392,8 +450,8 @@ contains
 
       !> The right-hand side on the free cells: the divergence of the face fluxes of the
       !> imposed jump.
-      function rhs_on_free_cells() result(b)
-         real(wp) :: b(n_free)
+      subroutine rhs_on_free_cells(b)
+         real(wp), intent(out) :: b(:)
          integer :: i, j, k, m
          do m = 1, n_free
             k = free_cells(m)
@@ -402,7 +460,7 @@ contains
             b(m) = jump_x*(we(modulo(i - 2, nx) + 1 + (j - 1)*nx) - we(k)) &
                & + jump_y*(wn(i + modulo(j - 2, ny)*nx) - wn(k))
          end do
-      end function rhs_on_free_cells
+      end subroutine rhs_on_free_cells
 
       !> The matrix on the free cells in CSR form (zero-based, as hypre takes it): rows of the
       !> diagonal and the open faces to free neighbours; a face to a pinned cell only adds
@@ -410,7 +468,6 @@ contains
       subroutine assemble()
          integer :: i, j, k, m, f, nnz, neighbours(4)
          real(wp) :: weights(4)
-         allocate (row_start(n_free + 1), column(5*n_free), value(5*n_free))
          nnz = 0
          do m = 1, n_free
             k = free_cells(m)
