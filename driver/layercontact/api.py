@@ -12,7 +12,8 @@ import numpy as np
 
 from . import scene_schema
 from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError, _check,  # noqa: F401
-                       _lines, _namelist, real_array, regular_file)
+                       _input_error, _lines, _namelist, contact_map, grid_points, periods, positive_real,
+                       real_array, regular_file)
 from .leakage import CoreLeakage
 from .native import core as _core
 
@@ -131,6 +132,14 @@ class LineResult:
     summit_shift: float = 0.0
     normalised_pressure: float = float("nan")
     normalised_thickness: float = float("nan")
+    #: with ``&output conductance``: the conductance per unit nominal area (``conductivity``
+    #: per L, S/m^2 with S/m and m) and the normal interfacial stiffness ``dp_m/dDelta`` (S/L)
+    #: at the solved contact set (docs/theory.md), NaN otherwise
+    conductance: float = float("nan")
+    contact_stiffness: float = float("nan")
+    conductance_converged: bool = True
+    conductance_iterations: int = 0
+    stiffness_iterations: int = 0
     a_over_a0: float | None = None
     companion: "LineResult | None" = field(default=None, repr=False)
 
@@ -391,6 +400,14 @@ class ArealResult:
     max_principal_stress: float = float("nan")
     max_principal_x: float = float("nan")
     max_principal_y: float = float("nan")
+    #: with ``&output conductance``: the conductance per unit nominal area (``conductivity``
+    #: per L, S/m^2 with S/m and m) and the normal interfacial stiffness ``dp_m/dDelta`` (S/L)
+    #: at the solved contact set (docs/theory.md), NaN otherwise
+    conductance: float = float("nan")
+    contact_stiffness: float = float("nan")
+    conductance_converged: bool = True
+    conductance_iterations: int = 0
+    stiffness_iterations: int = 0
     a_over_a0: float | None = None
     companion: "ArealResult | None" = field(default=None, repr=False)
     #: the Reynolds leakage of the gap computed by the run (``&output leakage = .true.``):
@@ -479,6 +496,44 @@ def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson
     p = np.ascontiguousarray(real_array(pressure, "pressure", ndim=(1,)))
     fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction)
     return fields[:, 0].copy(), fields[:, 2].copy()
+
+
+def contact_conductance(contact_mask, period, conductivity, *, thickness=np.inf, tol: float = 1e-10,
+                        max_iter: int = 100000) -> float:
+    """The electrical (or thermal) conductance per unit nominal area of a prescribed contact
+    map: the rigid counter-surface a perfect conductor touching the body where
+    ``contact_mask`` is true (1D: a line of ``period``; 2D ``(ny, nx)``, x = axis 1, with
+    ``period`` one length or a pair ``(period_x, period_y)``), the rest of the surface
+    insulated, and the far field of a half-space (``thickness=np.inf``) or the perfectly
+    conducting base under a layer of ``thickness`` at the other potential. Returns
+    ``conductivity * mean(J)/DeltaV`` (``conductivity`` per length: S/m^2 with S/m and m; a
+    half-space's is the constriction conductance, docs/theory.md). Solved by preconditioned
+    conjugate gradients to ``|r| <= tol |b|``; a solve that does not reach it within
+    ``max_iter`` iterations raises :class:`LayercontactError` with code 3."""
+    mask = contact_map(contact_mask, "contact_mask")
+    if mask.ndim == 1:
+        if np.ndim(period) != 0:
+            raise _input_error("period", period, "one positive length for a line")
+        lx = ly = periods(period)[0]
+        ny, nx = 1, mask.size
+    else:
+        lx, ly = periods(period)
+        ny, nx = mask.shape
+    sigma = positive_real(conductivity, "conductivity")
+    h = positive_real(thickness, "thickness", infinite=True)
+    tol = positive_real(tol, "tol")
+    if not 1e-14 <= tol <= 1e-2:
+        raise _input_error("tol", tol, "1e-14 <= tol <= 1e-2")
+    budget = grid_points(max_iter, "max_iter")
+    if not 1 <= budget <= 10_000_000:
+        raise _input_error("max_iter", max_iter, "1 <= max_iter <= 10000000")
+    value, iterations, converged, stat, errmsg = _core.py_contact_conductance(
+        nx, ny, lx, ly, np.ascontiguousarray(mask).ravel(), h, tol, budget)
+    _check(stat, errmsg)
+    if not converged:
+        raise LayercontactError(f"contact_conductance: not converged to tol = {tol!r} in {iterations} iterations "
+                                "(max_iter)", 3)
+    return sigma * float(value)
 
 
 def _surface_stress(p, scene: dict, thickness, young, poisson, friction) -> np.ndarray:
