@@ -177,6 +177,9 @@ def solve_line(
     max_iter: int | None = None,
     memory: int | None = None,
     threads: int | None = None,
+    conductance: bool | None = None,
+    conductivity: float | None = None,
+    conductance_base: str | None = None,
 ) -> LineResult:
     """Solve the sliding line contact of the rigid profile ``heights`` (L, on a uniform
     periodic grid of one ``period``) on a layer of ``thickness`` (``inf``: half-space)
@@ -197,7 +200,11 @@ def solve_line(
     hence a unique solution) are reported. ``companion=True`` also solves the frictionless
     problem at the load of this one (its computed mean pressure, whatever the control) and
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
-    and the surface stress ``stress_xx`` (one more FFT pair).
+    and the surface stress ``stress_xx`` (one more FFT pair). ``conductance=True`` computes
+    the contact's conductance per unit nominal area (``conductivity``, default 1, per L) and
+    its normal interfacial stiffness ``dp_m/dDelta`` (S/L) at the solved contact set
+    (``conductance``, ``contact_stiffness``; docs/theory.md); ``conductance_base``:
+    ``'conducting'``, the base under a layer at the far potential.
     ``method``: ``'auto'`` (the multigrid method for the frictionless elastic lines it
     applies to from 4096 points on (a thin incompressible one from 262144 points when its
     coarse solve needed more than 20 CG iterations), and surfaces from 1024², constrained CG for other
@@ -237,7 +244,8 @@ def solve_line(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress)
+        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
+        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base)
     runs = _solve_scene(h, {"scene": {"n": h.size, "period": period}, **groups}, areal=False,
                         companion=bool(companion), stress=stress)
     results = [_line_result(**run, height=h.copy()) for run in runs]
@@ -458,6 +466,9 @@ def solve_areal(
     memory: int | None = None,
     threads: int | None = None,
     stress: bool | None = None,
+    conductance: bool | None = None,
+    conductivity: float | None = None,
+    conductance_base: str | None = None,
 ) -> ArealResult:
     """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
     a uniform periodic grid, axis 1 = x = the sliding direction) on a layer of
@@ -477,7 +488,8 @@ def solve_areal(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress)
+        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
+        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base)
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
     runs = _solve_scene(np.ascontiguousarray(h).ravel(), {"scene": scene, **groups}, areal=True,
                         companion=bool(companion), stress=stress)
