@@ -43,7 +43,8 @@ def test_every_row_is_complete():
     """Every variable has a known group, type, use and unit, a meaning and an allowed range;
     the names of /input (and of the keywords) are unique; aliases name a variable of their
     group; the sweep's positions are 1, 2, ..."""
-    units = {"", "1", "L", "S", "T", "L/T", "S or 1/S"}
+    # (siemens/L: the conductivity, S/m with lengths in m; S is the stress unit)
+    units = {"", "1", "L", "S", "T", "L/T", "S or 1/S", "siemens/L"}
     for v in schema.VARIABLES:
         assert v.group in schema.GROUPS and v.type in schema.TYPES, v
         assert v.uses in ("both", "line", "areal") and v.unit in units, v
@@ -55,7 +56,7 @@ def test_every_row_is_complete():
             assert v.alias_of in [w.name for w in schema.group_variables(v.group)]
     assert [v.sweep for v in schema.sweep_parameters()] == list(range(1, len(schema.sweep_parameters()) + 1))
     names = {(v.group, v.name) for v in schema.VARIABLES}
-    assert len(names) == len(schema.VARIABLES) == 59
+    assert len(names) == len(schema.VARIABLES) == 62
 
 
 def test_keyword_groups_put_each_keyword_in_its_group():
