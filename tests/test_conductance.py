@@ -258,3 +258,23 @@ def test_bad_conductance_input_in_a_scene_is_refused(text, message, tmp_path):
     proc = subprocess.run([executable(), str(nml)], cwd=tmp_path, capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2 and message in proc.stderr, proc.stderr
     assert not list(tmp_path.rglob("*.h5"))
+
+
+def test_a_sweep_summary_has_both_columns(tmp_path, monkeypatch):
+    """A sweep of scenes with &output conductance: its summary (CSV and HDF5) carries
+    conductance and contact_stiffness for each scene and its companion, equal to the
+    result files'."""
+    monkeypatch.chdir(tmp_path)
+    sweep_file = tmp_path / "c.nml"
+    sweep_file.write_text("&scene\n n = 256\n/\n&layer\n thickness = 0.16\n poisson = 0.3\n/\n"
+                          "&friction\n companion = .true.\n/\n&profile\n short_wavelength = 0.03125\n/\n"
+                          "&loading\n normalised_pressure = 1.0\n/\n&output\n conductance = .true.\n conductivity = 2.0\n/\n"
+                          "&sweep\n directory = 'out/c'\n processes = 1\n friction = 0.0, 0.5\n/\n")
+    rows = lc.sweep(sweep_file, progress=False)
+    summary = lc.read_summary("out/c/c_summary.csv")
+    for k, row in enumerate(rows):
+        res = lc.read_result(row["result_file"])
+        assert row["conductance"] == res.conductance > 0 and row["contact_stiffness"] == res.contact_stiffness > 0
+        assert row["companion_conductance"] == res.companion.conductance
+        assert summary["conductance"][k] == pytest.approx(res.conductance, rel=1e-12)
+        assert summary["contact_stiffness"][k] == pytest.approx(res.contact_stiffness, rel=1e-12)
