@@ -39,10 +39,12 @@ module lc_observables_conductance
       logical :: converged = .false.
    end type masked_outcome
 
-   !> A linear system restricted to the contact set: y = P_A A x and its preconditioner
-   !> z = P_A B r, for fields that vanish off A (P_A: zero off A).
+   !> A linear system restricted to the contact set A: y = P_A A x and its preconditioner
+   !> z = P_A B r, on the values at the points of A only (a field vanishing off A; the vector
+   !> operations then cost a pass over A, not over the grid).
    type, abstract :: masked_system
-      logical, allocatable :: contact(:)
+      integer, allocatable :: contact(:)   !< the points of A (flat indices of the grid)
+      integer :: n = 0                     !< grid points
       integer :: fft_pairs = 0
    contains
       procedure(masked_map), deferred :: apply
@@ -130,7 +132,7 @@ contains
       if (trivial(contact, ieee_is_finite(thickness), thickness, conductance, outcome)) return
       call system%fft%init(grid%nx, grid%ny, threads, error)
       if (allocated(error)) return
-      system%contact = contact
+      call restrict(system, contact)
       system%multiplier = conduction_multiplier(grid, thickness)/grid%points()
       allocate (system%inverse(size(system%multiplier)))
       where (system%multiplier > 0.0_wp)
@@ -139,7 +141,7 @@ contains
          system%inverse = 0.0_wp
       end where
       call masked_cg(system, tol, max_iter, solution, outcome)
-      conductance = sum(solution)/size(solution)
+      conductance = sum(solution)/system%n
       call system%fft%destroy()
    end subroutine contact_conductance
 
@@ -162,13 +164,13 @@ contains
       bounded = op%metric(1) + op%dropped_uniform > 0.0_wp
       if (trivial(contact, bounded, op%metric(1) + op%dropped_uniform, stiffness, outcome)) return
       system%op => op
-      system%contact = contact
+      call restrict(system, contact)
       if (op%coupled) then
          call masked_bicgstab(system, tol, max_iter, solution, outcome)
       else
          call masked_cg(system, tol, max_iter, solution, outcome)
       end if
-      stiffness = sum(solution)/size(solution)
+      stiffness = sum(solution)/system%n
    end subroutine contact_stiffness
 
    !> The answers without an iteration: no contact gives 0, full contact 1/uniform (or +Inf
@@ -207,9 +209,9 @@ contains
       integer :: n
 
       n = size(system%contact)
-      allocate (x(n), z(n), ad(n))
+      allocate (x(n), z(n), ad(n), r(n))
       x = 0.0_wp
-      r = merge(1.0_wp, 0.0_wp, system%contact)
+      r = 1.0_wp
       b_norm = norm2(r)
       r_norm = b_norm
       call system%precondition(r, z)
@@ -247,9 +249,9 @@ contains
       integer :: n
 
       n = size(system%contact)
-      allocate (x(n), p_hat(n), s_hat(n), t(n))
+      allocate (x(n), p_hat(n), s_hat(n), t(n), r(n))
       x = 0.0_wp
-      r = merge(1.0_wp, 0.0_wp, system%contact)
+      r = 1.0_wp
       shadow = r
       b_norm = norm2(r)
       r_norm = b_norm
@@ -264,7 +266,7 @@ contains
          ! a breakdown (rho or omega at rounding): restart from the current iterate
          if (abs(rho_next) <= epsilon(1.0_wp)*b_norm*r_norm .or. omega == 0.0_wp) then
             call system%apply(x, v)
-            r = merge(1.0_wp, 0.0_wp, system%contact) - v
+            r = 1.0_wp - v
             shadow = r
             p = 0.0_wp
             v = 0.0_wp
@@ -321,11 +323,12 @@ contains
       class(conduction_system), intent(inout) :: self
       real(wp), intent(in) :: multiplier(:), x(:)
       real(wp), intent(out) :: y(:)
-      self%fft%real_buffer = x
+      self%fft%real_buffer = 0.0_wp
+      self%fft%real_buffer(self%contact) = x
       call self%fft%forward_unscaled()
       self%fft%spectrum = self%fft%spectrum*multiplier
       call self%fft%backward()
-      y = merge(self%fft%real_buffer, 0.0_wp, self%contact)
+      y = self%fft%real_buffer(self%contact)
       self%fft_pairs = self%fft_pairs + 1
    end subroutine multiply
 
@@ -335,8 +338,12 @@ contains
       class(stiffness_system), intent(inout) :: self
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: y(:)
-      call self%op%apply_full(x, y)
-      y = merge(y + self%op%dropped_uniform*sum(x)/size(x), 0.0_wp, self%contact)
+      real(wp), pointer, contiguous :: field(:)
+      field => self%op%buffer()
+      field = 0.0_wp
+      field(self%contact) = x
+      call self%op%full_in_buffer()
+      y = field(self%contact) + self%op%dropped_uniform*sum(x)/self%n
       self%fft_pairs = self%fft_pairs + 1
    end subroutine stiffness_apply
 
@@ -348,10 +355,20 @@ contains
       real(wp), intent(out) :: y(:)
       real(wp), pointer, contiguous :: field(:)
       field => self%op%buffer()
-      field = x
+      field = 0.0_wp
+      field(self%contact) = x
       call self%op%inverse_metric_in_buffer()
-      y = merge(field, 0.0_wp, self%contact)
+      y = field(self%contact)
       self%fft_pairs = self%fft_pairs + 1
    end subroutine stiffness_precondition
+
+   !> The points of the contact set `contact` (flat, x fastest) as the system's unknowns.
+   subroutine restrict(system, contact)
+      class(masked_system), intent(inout) :: system
+      logical, intent(in) :: contact(:)
+      integer :: i
+      system%n = size(contact)
+      system%contact = pack([(i, i = 1, size(contact))], contact)
+   end subroutine restrict
 
 end module lc_observables_conductance
