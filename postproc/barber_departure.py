@@ -37,8 +37,8 @@ def main() -> None:
     args = parser.parse_args()
     heights = lc.self_affine_surface(n=args.n, hurst=0.8, seed=1, short_wavelength=8 / args.n, rms_gradient=0.1)
     curves = {}
-    print("| h/lambda | nu | mu_c | p_m/(E* h/lambda) | contact fraction | C E*/(2 sigma K) |")
-    print("|---|---|---|---|---|---|")
+    print("| h/lambda | nu | mu_c | p_m/(E* h/lambda) | contact fraction | C/sigma (1/L) | K (E/L) | C E*/(2 sigma K) |")
+    print("|---|---|---|---|---|---|---|---|")
     for thickness, poisson in LAYERS:
         for friction in FRICTIONS:
             points = []
@@ -51,7 +51,7 @@ def main() -> None:
                 points.append((res.contact_fraction, ratio(res, poisson)))
                 if load in (LOADS[0], LOADS[3], LOADS[-1]):
                     print(f"| {thickness:g} | {poisson:g} | {friction:g} | {load:.3g} | {res.contact_fraction:.4f} | "
-                          f"{points[-1][1]:.4f} |")
+                          f"{res.conductance:.4g} | {res.contact_stiffness:.4g} | {points[-1][1]:.4f} |")
             curves[thickness, poisson, friction] = np.array(points)
     half = lc.solve_areal(heights, period=1.0, poisson=0.3, normalised_pressure=0.05, stress=False, tol=1e-10,
                           conductance=True)
@@ -62,7 +62,7 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(9.0, 4.6))
     colours = {LAYERS[0]: "C0", LAYERS[1]: "C1", LAYERS[2]: "C2", LAYERS[3]: "C3"}
     for (thickness, poisson, friction), points in curves.items():
         style = "-o" if friction == 0 else "--s"
@@ -74,7 +74,7 @@ def main() -> None:
     ax.set_xlabel("contact fraction A/A0")
     ax.set_ylabel("C E* / (2 sigma K)")
     ax.set_title(f"Barber's analogy on thin layers ({args.n}$^2$, self-affine H = 0.8)")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     fig.tight_layout()
     fig.savefig(args.out, dpi=120)
     print(f"figure: {args.out}")

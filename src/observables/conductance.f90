@@ -10,7 +10,8 @@
 !>   constriction convention, the potential measured from the mean surface potential). With
 !>   phi = 1 on A and J = 0 elsewhere, C = mean(J) (sigma/L). G_c is real, even and positive,
 !>   so the masked system is symmetric positive definite: the conjugate gradients,
-!>   preconditioned by the Fourier inverse 1/G_c masked to A.
+!>   preconditioned by the Fourier inverse 1/G_c masked to A, stopped when the mean is
+!>   within a relative tol (its error is the energy norm of the iterate's, masked_cg).
 !> - stiffness: with the scene's own compliance operator G (lc_contact_operator, its Coulomb
 !>   coupling included), an extra approach delta = 1 held on A gives the pressure increment
 !>   G Delta p = 1 on A, Delta p = 0 elsewhere, and K = mean(Delta p) (S/L). Symmetric
@@ -30,6 +31,10 @@ module lc_observables_conductance
    implicit none (type, external)
    private
    public :: conduction_multiplier, contact_conductance, contact_stiffness, masked_outcome
+
+   !> Iterations over which the conjugate gradients sum alpha_j (r_j.z_j) to estimate the
+   !> error of the mean of an iterate that many steps back (docs/decisions/021).
+   integer, parameter :: error_delay = 3
 
    !> How an iteration on the contact set ended.
    type :: masked_outcome
@@ -106,7 +111,8 @@ contains
    !> The conductance per unit nominal area and per unit conductivity (1/L) of the contact
    !> set `contact` (flat, x fastest) on `grid`, for a layer of `thickness` on a perfectly
    !> conducting base (+Inf: a half-space, constriction convention): C/sigma = mean(J) with
-   !> sigma G_c J = 1 on the contact set. Stops at |r| <= tol |b|, or after max_iter iterations.
+   !> sigma G_c J = 1 on the contact set, to a relative tol (masked_cg), within max_iter
+   !> iterations.
    subroutine contact_conductance(grid, contact, thickness, tol, max_iter, threads, conductance, outcome, error)
       type(grid_type), intent(in) :: grid
       logical, intent(in) :: contact(:)
@@ -148,7 +154,8 @@ contains
    !> The normal interfacial stiffness dp_m/d(delta) (S/L) at the contact set `contact` of a
    !> solved contact with the operator `op` it was solved with: mean(Delta p) with
    !> G Delta p = 1 on the contact set (the uniform mode a load-controlled solve dropped
-   !> added back). The conjugate gradients for a symmetric operator, BiCGSTAB for a coupled one.
+   !> added back). The conjugate gradients for a symmetric operator (the mean to a relative
+   !> tol), BiCGSTAB for a coupled one (stopped at |r| <= tol |b|).
    subroutine contact_stiffness(op, contact, tol, max_iter, stiffness, outcome)
       type(compliance_operator), target, intent(inout) :: op
       logical, intent(in) :: contact(:)
@@ -197,7 +204,11 @@ contains
    end function trivial
 
    !> Preconditioned conjugate gradients for the symmetric positive definite P_A A P_A x =
-   !> 1 on A, from x = 0.
+   !> 1 on A, from x = 0. What is wanted is the mean, b.x/n with b = 1 on A, and from x_0 = 0
+   !> b.x - b.x_k = |x - x_k|_A^2 = sum_{j >= k} alpha_j (r_j.z_j) (Hestenes and Stiefel):
+   !> the iteration stops when the last error_delay terms, an estimate of the error of the
+   !> iterate error_delay steps back, are at most tol times b.x_k (the mean to a relative
+   !> tol), or when |r| <= tol |b|.
    subroutine masked_cg(system, tol, max_iter, x, outcome)
       class(masked_system), intent(inout) :: system
       real(wp), intent(in) :: tol
@@ -205,7 +216,7 @@ contains
       real(wp), allocatable, intent(out) :: x(:)
       type(masked_outcome), intent(inout) :: outcome
       real(wp), allocatable :: r(:), z(:), d(:), ad(:)
-      real(wp) :: rz, rz_next, alpha, b_norm, r_norm
+      real(wp) :: rz, rz_next, alpha, b_norm, r_norm, energy, recent(0:error_delay - 1)
       integer :: n
 
       n = size(system%contact)
@@ -217,21 +228,25 @@ contains
       call system%precondition(r, z)
       d = z
       rz = dot_product(r, z)
+      energy = 0.0_wp
+      recent = huge(1.0_wp)/error_delay   ! (no estimate before error_delay steps)
       do while (outcome%iterations < max_iter)
          call system%apply(d, ad)
          alpha = rz/dot_product(d, ad)
          x = x + alpha*d
          r = r - alpha*ad
          outcome%iterations = outcome%iterations + 1
+         energy = energy + alpha*rz
+         recent(mod(outcome%iterations, error_delay)) = alpha*rz
          r_norm = norm2(r)
-         if (r_norm <= tol*b_norm) exit
+         outcome%converged = r_norm <= tol*b_norm .or. sum(recent) <= tol*energy
+         if (outcome%converged) exit
          call system%precondition(r, z)
          rz_next = dot_product(r, z)
          d = z + (rz_next/rz)*d
          rz = rz_next
       end do
       outcome%residual = r_norm/b_norm
-      outcome%converged = r_norm <= tol*b_norm
       outcome%fft_pairs = system%fft_pairs
    end subroutine masked_cg
 
