@@ -267,7 +267,7 @@ VARIABLES: tuple[Variable, ...] = (
              "the layer's conductivity `sigma` (S/m with L in m; thermal: W/(m K))", "scene%conductivity",
              interval="(0, inf)"),
     Variable("output", "conductance_base", "string", "'conducting'", "", "both",
-             "'conducting' ('insulating' is refused: no finite answer)",
+             "'conducting' ('insulating' is refused: no current reaches the base)",
              "what lies under a layer: `'conducting'`, a perfect conductor held at the far potential (a half-space "
              "has none)", "scene%conductance_base", choices=("conducting", "insulating")),
 )
