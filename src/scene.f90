@@ -13,13 +13,15 @@ module lc_scene
    use lc_base_strings, only: to_string
    use lc_greens_viscoelastic, only: material_law, check_material, static_modulus, is_viscoelastic
    use lc_base_grid, only: grid_type, line_grid, surface_grid
-   use lc_greens_kernel, only: layer_kernel, make_kernel
+   use lc_greens_kernel, only: layer_kernel, make_kernel, place_on
+   use lc_greens_stack, only: stack_layer, stack_base, base_rigid, base_halfspace
    use lc_leakage_reynolds, only: leakage_tol_allowed, leakage_tol_range
    use lc_profiles_measured, only: check_treatments
+   use lc_io_files, only: same_file
    implicit none (type, external)
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
-      & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale, companion_of
+      & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale, companion_of, foundation
    public :: max_string, default_rms_gradient
 
    !> Sentinel for "not given" in optional positive quantities: a value nobody types, so
@@ -104,6 +106,19 @@ module lc_scene
       real(wp) :: thickness = half_space   !< h (L); +Inf = half-space (the default: no length scale)
       real(wp) :: young = 1.0_wp           !< E (S)
       real(wp) :: poisson = 0.5_wp         !< nu
+      !> What the layer rests on (a finite layer only; docs/theory.md, "Layered stacks"): the
+      !> interface below it ('bonded' or 'slip'), elastic lower layers from the top down (each
+      !> with the interface below it, one word per layer in lower_interfaces, '' all bonded),
+      !> and an elastic half-space substrate, or a rigid base where substrate_young is not set
+      !> (substrate_poisson not set: the layer's poisson).
+      character(len=max_string) :: interface = 'bonded'
+      real(wp), allocatable :: lower_thickness(:), lower_young(:), lower_poisson(:)
+      !> viscoelastic lower layers: a standard linear solid where lower_tau > 0 (lower_young
+      !> its low-frequency modulus, lower_e_inf its high-frequency one)
+      real(wp), allocatable :: lower_tau(:), lower_e_inf(:)
+      character(len=max_string) :: lower_interfaces = ''
+      real(wp) :: substrate_young = not_set
+      real(wp) :: substrate_poisson = not_set
       !> material law (elastic: young; sls, prony: see lc_greens_viscoelastic) and the
       !> sliding speed V (L/T) that sets the frequency k V of each mode
       type(material_law) :: material
@@ -160,12 +175,94 @@ contains
       end if
    end function grid_of
 
-   !> The scene's layer kernel (lc_greens_kernel).
+   !> The scene's layer kernel (lc_greens_kernel), resting on its lower layers and substrate.
    function kernel_of(scene) result(kernel)
       type(scene_type), intent(in) :: scene
       type(layer_kernel) :: kernel
+      type(stack_layer), allocatable :: lower(:)
+      type(stack_base) :: base
+      real(wp), allocatable :: tau(:), e_inf(:)
       kernel = make_kernel(scene%thickness, material_of(scene), scene%poisson, scene%speed)
+      if (is_halfspace(scene)) return
+      call lower_layers(scene, lower, tau, e_inf)
+      if (scene%substrate_young /= not_set) then
+         base = stack_base(kind=base_halfspace, young=cmplx(scene%substrate_young, 0.0_wp, wp), &
+            & poisson=merge(scene%substrate_poisson, scene%poisson, scene%substrate_poisson /= not_set))
+      else
+         base = stack_base(kind=base_rigid)
+      end if
+      call place_on(kernel, trim(scene%interface) == 'slip', lower, base, tau, e_inf)
    end function kernel_of
+
+   !> What a finite layer rests on, in words for the summary ('' for the usual rigid base
+   !> bonded to it): the interface below it, the lower layers and the substrate.
+   function foundation(scene) result(text)
+      type(scene_type), intent(in) :: scene
+      character(len=:), allocatable :: text
+      integer :: n
+      text = ''
+      n = 0
+      if (allocated(scene%lower_thickness)) n = size(scene%lower_thickness)
+      if (is_halfspace(scene) .or. (trim(scene%interface) == 'bonded' .and. n == 0 .and. &
+         & scene%substrate_young == not_set)) return
+      text = trim(scene%interface)
+      if (n > 0) text = text // ' on ' // to_string(n) // ' lower layer' // trim(merge('s', ' ', n > 1))
+      if (scene%substrate_young /= not_set) then
+         text = text // ' on a half-space, E_s = ' // to_string(scene%substrate_young) // ' (S)'
+      else
+         text = text // ' on a rigid base'
+      end if
+   end function foundation
+
+   !> The scene's lower layers (none if it gives none); lower_poisson defaults to 0.5 each.
+   pure subroutine lower_layers(scene, lower, tau, e_inf)
+      type(scene_type), intent(in) :: scene
+      type(stack_layer), allocatable, intent(out) :: lower(:)
+      !> per lower layer: retardation time (0: elastic) and high-frequency modulus
+      real(wp), allocatable, intent(out) :: tau(:), e_inf(:)
+      character(len=8), allocatable :: words(:)
+      integer :: i, n
+      n = 0
+      if (allocated(scene%lower_thickness)) n = size(scene%lower_thickness)
+      allocate (lower(n), tau(n), e_inf(n))
+      if (n == 0) return
+      tau = 0.0_wp
+      e_inf = scene%lower_young
+      if (count_of(scene%lower_tau) == n) then
+         tau = scene%lower_tau
+         where (tau > 0.0_wp) e_inf = scene%lower_e_inf
+      end if
+      words = interface_words(scene%lower_interfaces)
+      do i = 1, n
+         lower(i)%thickness = scene%lower_thickness(i)
+         lower(i)%young = cmplx(scene%lower_young(i), 0.0_wp, wp)
+         lower(i)%poisson = 0.5_wp
+         if (allocated(scene%lower_poisson)) then
+            if (size(scene%lower_poisson) > 0) lower(i)%poisson = scene%lower_poisson(i)
+         end if
+         if (size(words) == n) lower(i)%slip_below = words(i) == 'slip'
+      end do
+   end subroutine lower_layers
+
+   !> The words of a list separated by blanks or commas (each cut to 8 characters: a longer
+   !> one is no interface word anyway).
+   pure function interface_words(text) result(words)
+      character(len=*), intent(in) :: text
+      character(len=8), allocatable :: words(:)
+      integer :: i, start
+      allocate (words(0))
+      start = 0
+      do i = 1, len_trim(text) + 1
+         if (i > len_trim(text)) then
+            if (start > 0) words = [character(len=8) :: words, text(start:i - 1)]
+         else if (text(i:i) == ' ' .or. text(i:i) == ',') then
+            if (start > 0) words = [character(len=8) :: words, text(start:i - 1)]
+            start = 0
+         else if (start == 0) then
+            start = i
+         end if
+      end do
+   end function interface_words
 
    !> The scene's material law (an elastic law takes &layer young).
    pure function material_of(scene) result(law)
@@ -253,11 +350,14 @@ contains
          if (allocated(error)) return
          call check_material(scene%material, error)
          if (allocated(error)) return
-         if (.not. is_viscoelastic(scene%material) .and. scene%speed /= 0.0_wp) then
+         if (.not. (is_viscoelastic(scene%material) .or. any_positive(scene%lower_tau)) .and. &
+            & scene%speed /= 0.0_wp) then
             call input_error(error, 'material', 'speed', to_string(scene%speed), &
-               & "0 with model = 'elastic' (an elastic layer does not depend on the speed)")
+               & "0 with model = 'elastic' and elastic lower layers (an elastic layer does not depend on the speed)")
             return
          end if
+         call check_stack_below(scene, error)
+         if (allocated(error)) return
 
          select case (trim(p%kind))
          case ('self_affine')
@@ -312,6 +412,11 @@ contains
             if (len_trim(p%file) == 0) then
                call input_error(error, 'profile', 'file', "''", &
                   & 'the name of a file holding the heights (.h5/.hdf5, .npy or text)')
+            else if (same_file(trim(p%file), trim(scene%output_file))) then
+               ! (through a symbolic link or `..` too: the result would replace the heights it
+               ! is computed from)
+               call input_error(error, 'output', 'file', "'" // trim(scene%output_file) // "'", &
+                  & "another file than &profile file = '" // trim(p%file) // "' (they name one file)")
             else
                call check_treatments(p%detrend, p%boundary, p%resample, error)
             end if
@@ -365,6 +470,108 @@ contains
       end associate
    end subroutine check_scene
 
+
+   !> What the layer rests on: only a finite layer rests on anything; one Young's modulus (and
+   !> none or one Poisson's ratio, and none or one interface word) per lower layer, each in
+   !> range; substrate_poisson with substrate_young.
+   subroutine check_stack_below(scene, error)
+      type(scene_type), intent(in) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      character(len=8), allocatable :: words(:)
+      integer :: n, i
+      n = 0
+      if (allocated(scene%lower_thickness)) n = size(scene%lower_thickness)
+      if (is_halfspace(scene)) then
+         if (trim(scene%interface) /= 'bonded') then
+            call input_error(error, 'layer', 'interface', trim(scene%interface), &
+               & "'bonded' with thickness = Inf (a half-space has nothing below it)")
+         else if (n > 0) then
+            call input_error(error, 'layer', 'lower_thickness', to_string(n) // ' layers', &
+               & 'none with thickness = Inf (a half-space has nothing below it)')
+         else if (scene%substrate_young /= not_set) then
+            call input_error(error, 'layer', 'substrate_young', to_string(scene%substrate_young), &
+               & 'not set with thickness = Inf (a half-space has nothing below it)')
+         end if
+         if (allocated(error)) return
+      end if
+      if (scene%substrate_poisson /= not_set .and. scene%substrate_young == not_set) then
+         call input_error(error, 'layer', 'substrate_poisson', to_string(scene%substrate_poisson), &
+            & 'not set without substrate_young (a rigid base has no Poisson ratio)')
+         return
+      end if
+      if (count_of(scene%lower_young) /= n) then
+         call input_error(error, 'layer', 'lower_young', to_string(count_of(scene%lower_young)) // ' values', &
+            & 'one per lower layer: ' // to_string(n) // ' (as many as lower_thickness)')
+         return
+      end if
+      if (count_of(scene%lower_poisson) /= 0 .and. count_of(scene%lower_poisson) /= n) then
+         call input_error(error, 'layer', 'lower_poisson', to_string(count_of(scene%lower_poisson)) // ' values', &
+            & 'none (0.5 each) or one per lower layer: ' // to_string(n))
+         return
+      end if
+      do i = 1, n
+         if (.not. positive_finite(scene%lower_thickness(i))) then
+            call input_error(error, 'layer', 'lower_thickness(' // to_string(i) // ')', &
+               & to_string(scene%lower_thickness(i)), '> 0 and finite')
+         else if (.not. positive_finite(scene%lower_young(i))) then
+            call input_error(error, 'layer', 'lower_young(' // to_string(i) // ')', to_string(scene%lower_young(i)), &
+               & '> 0 and finite')
+         else if (count_of(scene%lower_poisson) > 0) then
+            if (.not. (scene%lower_poisson(i) > -1.0_wp .and. scene%lower_poisson(i) <= 0.5_wp)) &
+               & call input_error(error, 'layer', 'lower_poisson(' // to_string(i) // ')', &
+               & to_string(scene%lower_poisson(i)), '-1 < lower_poisson <= 0.5')
+         end if
+         if (allocated(error)) return
+      end do
+      if (count_of(scene%lower_tau) /= 0 .and. count_of(scene%lower_tau) /= n) then
+         call input_error(error, 'layer', 'lower_tau', to_string(count_of(scene%lower_tau)) // ' values', &
+            & 'none (elastic lower layers) or one per lower layer: ' // to_string(n))
+         return
+      end if
+      if (count_of(scene%lower_e_inf) /= count_of(scene%lower_tau)) then
+         call input_error(error, 'layer', 'lower_e_inf', to_string(count_of(scene%lower_e_inf)) // ' values', &
+            & 'one per lower_tau value: ' // to_string(count_of(scene%lower_tau)))
+         return
+      end if
+      do i = 1, count_of(scene%lower_tau)
+         if (.not. (scene%lower_tau(i) >= 0.0_wp .and. ieee_is_finite(scene%lower_tau(i)))) then
+            call input_error(error, 'layer', 'lower_tau(' // to_string(i) // ')', to_string(scene%lower_tau(i)), &
+               & '>= 0 and finite (0: an elastic lower layer)')
+         else if (scene%lower_tau(i) > 0.0_wp .and. .not. (scene%lower_e_inf(i) >= scene%lower_young(i) .and. &
+            & ieee_is_finite(scene%lower_e_inf(i)))) then
+            call input_error(error, 'layer', 'lower_e_inf(' // to_string(i) // ')', to_string(scene%lower_e_inf(i)), &
+               & '>= lower_young(' // to_string(i) // ') = ' // to_string(scene%lower_young(i)) // &
+               & ' and finite (the glassy modulus is the larger one)')
+         end if
+         if (allocated(error)) return
+      end do
+      words = interface_words(scene%lower_interfaces)
+      if (size(words) /= 0 .and. size(words) /= n) then
+         call input_error(error, 'layer', 'lower_interfaces', trim(scene%lower_interfaces), &
+            & "'' (all bonded) or one word per lower layer: " // to_string(n))
+         return
+      end if
+      do i = 1, size(words)
+         if (words(i) /= 'bonded' .and. words(i) /= 'slip') then
+            call input_error(error, 'layer', 'lower_interfaces', trim(scene%lower_interfaces), &
+               & "words 'bonded' or 'slip', one per lower layer")
+            return
+         end if
+      end do
+   end subroutine check_stack_below
+
+   !> Whether a list holds a positive value (a viscoelastic lower layer).
+   pure logical function any_positive(values)
+      real(wp), allocatable, intent(in) :: values(:)
+      any_positive = .false.
+      if (allocated(values)) any_positive = any(values > 0.0_wp)
+   end function any_positive
+
+   pure integer function count_of(values)
+      real(wp), allocatable, intent(in) :: values(:)
+      count_of = 0
+      if (allocated(values)) count_of = size(values)
+   end function count_of
 
    !> The values every scene variable with a range or a list of words in the scene schema
    !> may take, whatever the other variables (the first one outside is reported).

@@ -3,10 +3,12 @@ result; bad input gives a clear error naming group and variable, exit code 2, an
 writes nothing; an existing result is not overwritten unless the input says so."""
 
 import os
+import re
 import shutil
 import subprocess
 import sys
 import sysconfig
+import warnings
 from pathlib import Path
 
 import h5py
@@ -129,7 +131,8 @@ BAD = [
     ("&scene\n geometry = 'volume'\n/\n", "&scene: geometry = volume is not allowed; allowed: 'line' or 'areal'"),
     ("&scene\n period = 0.0\n/\n", "&scene: period = 0"),
     ("&scene\n n = 4\n/\n", "allowed: 8 <= n <= 2**26"),
-    ("&scene\n n = 128\n ny = 16\n/\n", "allowed: 1 with geometry = 'line'"),
+    ("&scene\n n = 128\n ny = 16\n/\n", "line 3, group &scene: ny = 16 is not allowed; allowed: not given with "
+     "geometry = 'line' (ny applies to surfaces only, geometry = 'areal')"),
     ("&scene\n geometry = 'areal'\n n = 2\n/\n", "allowed: 4 <= nx <= 65536 with geometry = 'areal'"),
     ("&scene\n geometry = 'areal'\n nx = 64\n ny = 100000\n/\n", "allowed: 4 <= ny <= 65536"),
     ("&scene\n geometry = 'areal'\n nx = 65536\n ny = 65536\n/\n", "&scene: nx*ny"),
@@ -177,10 +180,30 @@ BAD = [
     (f"&solver\n method = '{'m' * 700}'\n/\n", "method = 'mmm"),
     # the leakage needs an areal gap (cases that bring their own &output, writing bad.h5)
     ("&output\n file = 'bad.h5'\n leakage = .true.\n/\n",
-     "&output: leakage = .true. is not allowed; allowed: .false. with geometry = 'line'"),
+     "group &output: leakage = .true. is not allowed; allowed: not given with geometry = 'line' (leakage applies "
+     "to surfaces only"),
     ("&scene\n geometry = 'areal'\n n = 32\n/\n&output\n file = 'bad.h5'\n leakage = .true.\n leakage_tol = 0.5\n/\n",
      "&output: leakage_tol = 5.00000E-01 is not allowed; allowed: 1e-14 <= leakage_tol <= 1e-2"),
     ("&output\n file = 'bad.h5'\n leakage = 1\n/\n", "'leakage = 1': leakage takes .true. or .false."),
+    # a variable given twice, or under both of its names, is refused (the read would keep the
+    # last one silently), naming the group, the lines and which one to keep
+    ("&scene\n n = 64\n period = 2.0\n n = 128\n/\n", "line 4, group &scene: n is given twice (lines 2 and 4); "
+     "allowed: one assignment of each variable: keep the one you mean and remove the other"),
+    ("&scene\n period = 2.0, period_x = 3.0\n/\n", "line 2, group &scene: period and period_x are both given "
+     "(lines 2 and 2) and are two names of one variable; allowed: one of them: keep period"),
+    ("&scene\n geometry = 'areal'\n n = 64\n nx = 32\n/\n", "group &scene: n and nx are both given"),
+    ("&layer\n thickness = 0.1\n/\n&friction\n coefficient = 0.1\n coefficient = 0.2\n/\n",
+     "line 6, group &friction: coefficient is given twice (lines 5 and 6)"),
+    ("&solver\n tol = 1e-8\n TOL = 1e-9\n/\n", "group &solver: tol is given twice"),
+    # the variables of surfaces only are refused in a line scene (it would ignore them)
+    ("&scene\n period_y = 2.0\n/\n", "line 2, group &scene: period_y = 2.0 is not allowed; allowed: not given "
+     "with geometry = 'line' (period_y applies to surfaces only, geometry = 'areal')"),
+    ("&scene\n nx = 64\n/\n", "group &scene: nx = 64 is not allowed; allowed: not given with geometry = 'line'"),
+    ("&profile\n kind = 'sinusoid'\n amplitude = 0.1\n mode_y = 1\n/\n",
+     "line 4, group &profile: mode_y = 1 is not allowed; allowed: not given with geometry = 'line' (mode_y "
+     "applies to surfaces only"),
+    ("&profile\n kind = 'sinusoid'\n amplitude = 0.1\n radius = 2.0\n/\n", "radius applies to surfaces only"),
+    ("&output\n file = 'bad.h5'\n leakage_tol = 1e-8\n/\n", "leakage_tol applies to surfaces only"),
 ]
 
 
@@ -533,3 +556,189 @@ def test_picture_title_carries_the_scene_and_its_outcome(default_result):
     assert scene == "h/lambda = 0.16, nu = 0.5, mu_c = 0.5, p_m = 0.0235 (3 in the seed's scale)"
     assert outcome == (f"contact fraction {attrs['contact_fraction']:.3f}, Delta mu = {attrs['delta_mu']:.3g}, "
                        "converged")
+
+
+def test_the_shipped_scene_files_give_no_variable_twice_and_no_surface_variable_to_a_line():
+    """Every file of inputs/ passes the checks of a variable given twice and of the
+    variables of surfaces in a line scene (they run: test_every_input_runs...; this names
+    the file that would not)."""
+    for nml in INPUTS:
+        lc.check_scene_file(nml)
+
+
+def test_the_scene_written_back_reads_again_for_lines_and_surfaces():
+    """A scene written back as a namelist leaves the variables of surfaces as comments in a
+    line scene (a line scene refuses them) and gives them in an areal one."""
+    line = lc.default_scene("line")
+    assert "! ny: surfaces only" in line and "! period_y: surfaces only" in line
+    surfaces_only = [v.name for v in lc.scene_schema.VARIABLES if v.uses == "areal" and v.alias_of is None]
+    again = lc.scene_namelist(line.replace("&loading", "&loading\n   normalised_pressure = 1.0", 1))
+    assert [name for name in surfaces_only if f"! {name}: surfaces only" in again] == surfaces_only
+    areal = lc.default_scene("areal")
+    assert "surfaces only" not in areal and "   ny = 256" in areal
+
+
+@pytest.mark.parametrize("how", ["same path", "symbolic link", "dot-dot"])
+def test_a_result_file_that_is_the_height_file_is_refused_and_nothing_is_clobbered(how, tmp_path, monkeypatch):
+    """&output file naming the HDF5 height file itself (its path, a symbolic link to it, a
+    path through `..`), with overwrite, is refused before anything is solved: exit 2, the
+    heights untouched."""
+    heights = np.cos(2 * np.pi * np.arange(256) / 256) * 0.01
+    (tmp_path / "sub").mkdir()
+    with h5py.File(tmp_path / "heights.h5", "w") as f:
+        f["profile/height"] = heights
+    before = (tmp_path / "heights.h5").read_bytes()
+    output = {"same path": "heights.h5", "symbolic link": "link.h5", "dot-dot": "sub/../heights.h5"}[how]
+    if how == "symbolic link":
+        (tmp_path / "link.h5").symlink_to("heights.h5")
+    nml = tmp_path / "scene.nml"
+    nml.write_text(f"&profile\n kind = 'file'\n file = 'heights.h5'\n/\n&loading\n normalised_pressure = 1.0\n/\n"
+                   f"&output\n file = '{output}'\n overwrite = .true.\n/\n")
+    message = (f"&output: file = '{output}' is not allowed; allowed: another file than &profile file = "
+               "'heights.h5' (they name one file)")
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2 and message in proc.stderr, proc.stderr
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(lc.InputError, match=re.escape(message)):
+        lc.run(nml)
+    cli = subprocess.run([sys.executable, "-m", "layercontact", "run", str(nml), "--no-png"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=300)
+    assert cli.returncode == 2 and message in cli.stderr
+    assert (tmp_path / "heights.h5").read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["heights.h5", "scene.nml", "sub"]
+                                                               + (["link.h5"] if how == "symbolic link" else []))
+
+
+def scene_reading(tmp_path: Path, name: str) -> Path:
+    nml = tmp_path / "scene.nml"
+    nml.write_text(f"&profile\n kind = 'file'\n file = '{name}'\n/\n&loading\n normalised_pressure = 1.0\n/\n"
+                   "&output\n file = 'r.h5'\n/\n")
+    return nml
+
+
+@pytest.mark.parametrize("name, found", [
+    # what is there but holds no heights is bad input (2), as a word in a text file is
+    ("garbage.h5", "is not an HDF5 file (no HDF5 signature)"),
+    ("x.npy", "is a directory"),
+    ("loop.txt", "is a loop of symbolic links"),
+])
+def test_a_height_file_that_holds_no_heights_is_bad_input(name, found, tmp_path, monkeypatch):
+    """docs/topographies.md: whatever the reader refuses is bad input, exit 2 (4 only for a
+    file there that cannot be opened or read); a loop of symbolic links is named as one."""
+    path = tmp_path / name
+    if name == "garbage.h5":
+        path.write_bytes(np.random.default_rng(1).bytes(4096))
+    elif name == "x.npy":
+        path.mkdir()
+    else:
+        (tmp_path / "other.txt").symlink_to("loop.txt")
+        path.symlink_to("other.txt")
+    nml = scene_reading(tmp_path, name)
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert f"&profile: file = '{name}' {found}" in proc.stderr
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(lc.InputError, match=re.escape(found)):
+        lc.run(nml)
+    with pytest.raises((ValueError, OSError), match=re.escape(found)):
+        lc.load_profile(path)
+    assert not (tmp_path / "r.h5").exists()
+
+
+def test_an_unreadable_height_file_is_an_io_failure(tmp_path):
+    """A file that is there but cannot be opened: exit 4 (not as root: root reads it)."""
+    if os.geteuid() == 0:
+        pytest.skip("root opens a file without read permission")
+    path = tmp_path / "heights.h5"
+    path.write_bytes(b"")
+    path.chmod(0)
+    proc = run_exe(scene_reading(tmp_path, "heights.h5"), tmp_path)
+    assert proc.returncode == 4, proc.stderr
+
+
+@pytest.mark.parametrize("what", ["namelist file", "prony file", "sweep file"])
+def test_a_loop_of_symbolic_links_is_named_as_one(what, tmp_path):
+    """ELOOP is reported as a loop of symbolic links, not as a missing file, exit 2."""
+    (tmp_path / "a").symlink_to("b")
+    (tmp_path / "b").symlink_to("a")
+    if what == "namelist file":
+        command = [executable(), "a"]
+        named = "namelist file 'a' is a loop of symbolic links"
+    elif what == "prony file":
+        (tmp_path / "scene.nml").write_text("&material\n model = 'prony'\n prony_equilibrium = 1.0\n"
+                                            " prony_file = 'a'\n/\n&loading\n normalised_pressure = 1.0\n/\n")
+        command = [executable(), "scene.nml"]
+        named = "&material: prony_file = 'a' is a loop of symbolic links"
+    else:
+        command = [sys.executable, "-m", "layercontact", "sweep", "a"]
+        named = "sweep file 'a' is a loop of symbolic links"
+    proc = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and named in proc.stderr, proc.stderr
+    status = subprocess.run([sys.executable, "-m", "layercontact", "status", "a"], cwd=tmp_path,
+                            capture_output=True, text=True, timeout=120)
+    assert status.returncode == 2 and "a: a loop of symbolic links" in status.stderr
+
+
+def tilted(n: int) -> np.ndarray:
+    """A plane rising by 0.01 over the cell and a small periodic roughness: not periodic."""
+    x = np.arange(n) / n
+    return 0.01 * x + 1e-4 * np.cos(2 * np.pi * 3 * x)
+
+
+@pytest.mark.parametrize("surface", ["tilted", "periodic"])
+def test_a_height_file_taken_as_periodic_that_is_not_gets_a_warning(surface, tmp_path, monkeypatch):
+    """A tilted plane taken as one period warns (stderr; PeriodicityWarning in Python) and
+    names what to set; a periodic self-affine surface (the generator's) does not. The jump
+    the warning reports is the one numpy computes (lc.periodicity_mismatch) to the two
+    printed decimals."""
+    heights = tilted(512) if surface == "tilted" else lc.self_affine_profile(512, 0.8, seed=3)
+    np.savetxt(tmp_path / "heights.txt", heights)
+    nml = scene_reading(tmp_path, "heights.txt")
+    proc = run_exe(nml, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    jump, kink = lc.periodicity_mismatch(heights)
+    if surface == "tilted":
+        # a plane's jump is sqrt(12) (n-1)/n rms heights (the roughness is 1 % of it)
+        assert jump == pytest.approx(np.sqrt(12) * 511 / 512, rel=0.01)
+        assert f"its heights jump by {jump:.2f} rms heights" in proc.stderr
+        assert "set &profile boundary = 'mirror'" in proc.stderr and "detrend = 'plane'" in proc.stderr
+    else:
+        assert jump < lc.profiles.EDGE_JUMP_LIMIT and kink < lc.profiles.EDGE_KINK_LIMIT
+        assert "warning" not in proc.stderr
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "r.h5").unlink()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lc.run(nml)
+        lc.read_profile(tmp_path / "heights.txt", 512)
+        lc.read_profile(tmp_path / "heights.txt", 1024, boundary="mirror")   # mirrored: periodic, no warning
+    warned = [w for w in caught if issubclass(w.category, lc.PeriodicityWarning)]
+    assert len(warned) == (2 if surface == "tilted" else 0), [str(w.message) for w in caught]
+    # the setting the warning names removes it: the plane detrended, the heights are periodic
+    if surface == "tilted":
+        (tmp_path / "r.h5").unlink()
+        nml.write_text(nml.read_text().replace("file = 'heights.txt'", "file = 'heights.txt'\n detrend = 'plane'"))
+        assert "warning" not in run_exe(nml, tmp_path).stderr
+
+
+@pytest.mark.parametrize("text, message", [
+    ("&scene\n n = 64\n n = 128\n/\n", "group &scene: n is given twice (lines 2 and 3)"),
+    ("&scene\n period_y = 2.0\n/\n", "period_y applies to surfaces only"),
+])
+def test_the_module_refuses_what_the_executable_refuses(text, message, tmp_path):
+    """`python -m layercontact run` reads the scene with the same routine: exit 2, the same
+    message, nothing written."""
+    nml = tmp_path / "bad.nml"
+    nml.write_text(text + "&loading\n normalised_pressure = 1.0\n/\n&output\n file = 'bad.h5'\n/\n")
+    proc = subprocess.run([sys.executable, "-m", "layercontact", "run", str(nml)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2 and message in proc.stderr, proc.stderr
+    assert not (tmp_path / "bad.h5").exists()
+
+
+def test_the_module_warns_of_a_tilted_height_file(tmp_path):
+    np.savetxt(tmp_path / "heights.txt", tilted(256))
+    proc = subprocess.run([sys.executable, "-m", "layercontact", "run", str(scene_reading(tmp_path, "heights.txt")),
+                           "--no-png"], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "layercontact: warning: &profile: file = 'heights.txt' is taken as one period" in proc.stderr

@@ -108,19 +108,27 @@ def test_surface_stress_refuses_a_pressure_that_is_not_a_real_map(pressure, word
 
 
 def test_reading_a_file_that_is_not_a_result_names_it(tmp_path):
+    """What is there but is not a result is bad input (code 2), as for the height files;
+    so are a missing file and a loop of symbolic links, named as what they are."""
     text = tmp_path / "notes.h5"
     text.write_text("not HDF5\n")
-    with pytest.raises(lc.LayercontactError, match="cannot read result file '.*notes.h5'") as err:
+    with refused("cannot read result file '.*notes.h5': not an HDF5 file") as err:
         lc.read_result(text)
-    assert err.value.code == 4
+    assert err.value.code == 2
     import h5py
 
     other = tmp_path / "other.h5"
     with h5py.File(other, "w") as f:
         f["x"] = np.ones(3)
-    with pytest.raises(lc.LayercontactError, match="not a layercontact result") as err:
+    with refused("not a layercontact result") as err:
         lc.read_result(other)
-    assert err.value.code == 4
+    assert err.value.code == 2
+    with refused("result file '.*missing.h5' is not found"):
+        lc.read_result(tmp_path / "missing.h5")
+    (tmp_path / "a.h5").symlink_to("b.h5")
+    (tmp_path / "b.h5").symlink_to("a.h5")
+    with refused("result file '.*a.h5' is a loop of symbolic links"):
+        lc.read_result(tmp_path / "a.h5")
 
 
 def test_the_module_says_its_version_and_core():
@@ -148,3 +156,24 @@ def test_a_name_across_two_lines_of_a_namelist_is_refused(tmp_path):
 def test_a_keyword_with_a_control_character_is_refused(method, rough_profile):
     with refused("control characters"):
         lc.solve_line(rough_profile, mean_pressure=0.1, method=method)
+
+
+@pytest.mark.parametrize("solve, heights", [
+    (lc.solve_line, np.cos(2 * np.pi * np.arange(64) / 64)),
+    (lc.solve_areal, np.cos(2 * np.pi * np.arange(16) / 16)[None, :] * np.ones((16, 1))),
+])
+def test_young_and_a_material_both_given_are_refused(solve, heights):
+    """``young`` and ``material`` both give the layer's modulus (the material's wins inside
+    the library): both given are refused, as a namelist variable given twice is."""
+    material = lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0)
+    with refused("young = 2.0 and material = .* both give the layer's modulus; allowed: one of them") as err:
+        solve(heights, young=2.0, material=material, speed=1.0, normalised_pressure=1.0, thickness=0.5)
+    assert err.value.code == 2
+
+
+def test_a_scene_text_with_a_variable_twice_is_refused_from_python():
+    """The text path of the keyword API refuses what a namelist file would."""
+    with refused("group &scene: period and period_x are both given"):
+        lc.scene_namelist("&scene\n period = 1.0\n period_x = 2.0\n/\n&loading\n normalised_pressure = 1.0\n/\n")
+    with refused("period_y applies to surfaces only"):
+        lc.scene_namelist(period_y=2.0, normalised_pressure=1.0)

@@ -7,6 +7,7 @@ full)."""
 from __future__ import annotations
 
 import itertools
+import json
 import os
 import shutil
 import sys
@@ -454,3 +455,95 @@ def test_a_sweep_variable_given_twice_is_refused(tmp_path, lists):
 def test_a_sweep_variable_in_a_comment_or_a_string_is_not_counted(tmp_path):
     path = write_sweep(tmp_path, "friction = 0.0, 0.5 ! friction = 1.0\n seed = 1, 2\n")
     assert sweep_module.read_sweep(path).values["friction"] == [0.0, 0.5]
+
+
+def test_a_scene_variable_given_twice_in_a_sweep_file_is_refused(tmp_path):
+    """The scene groups of a sweep file are checked as a scene file is: a variable given
+    twice, or under both of its names, is refused before anything is planned."""
+    path = write_sweep(tmp_path, "seed = 1, 2\n", base=BASE.replace("n = 256", "n = 256\n   period = 1.0\n"
+                                                                    "   period_x = 2.0"))
+    with pytest.raises(ValueError, match="&scene: period and period_x are both given .*keep the one you mean"):
+        sweep_module.read_sweep(path)
+    path = write_sweep(tmp_path, "seed = 1, 2\n", base=BASE.replace("poisson = 0.5", "poisson = 0.5\n   poisson = 0.3"))
+    with pytest.raises(ValueError, match="&layer: poisson is given more than once"):
+        sweep_module.read_sweep(path)
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_swept_grid_replaces_the_second_name_of_the_base(tmp_path, monkeypatch):
+    """A sweep of n over an areal base that gives nx: each scene's grid is the swept n (the
+    base's nx, the same variable, is replaced rather than given twice)."""
+    monkeypatch.chdir(tmp_path)
+    base = ("&scene\n   geometry = 'areal'\n   nx = 16\n   ny = 16\n/\n&profile\n   kind = 'sinusoid'\n"
+            "   amplitude = 0.01\n/\n&loading\n   normalised_pressure = 1.0\n/\n")
+    path = write_sweep(tmp_path, "n = 16, 32\n", base=base)
+    rows = sweep_module.sweep(path, processes=1, progress=False)
+    assert [lc.read_result(row["result_file"]).pressure.shape for row in rows] == [(16, 16), (16, 32)]
+
+
+def processes_marked(marker: str) -> list[int]:
+    """The processes whose environment holds ``marker`` (a sweep's and all it started)."""
+    found = []
+    for environ in Path("/proc").glob("[0-9]*/environ"):
+        try:
+            if marker.encode() in environ.read_bytes():
+                found.append(int(environ.parent.name))
+        except OSError:
+            continue
+    return found
+
+
+#: Scenes that each take seconds (a line of 2^18 points with friction on a thin layer: 11 s
+#: on a loaded 2-core machine): a Ctrl-C reaches them inside the library.
+SLOW_BASE = BASE.replace("n = 256", "n = 262144").replace("coefficient = 0.0", "coefficient = 0.3") \
+    .replace("short_wavelength = 0.03125", "short_wavelength = 0.0001")
+
+
+def test_ctrl_c_ends_the_scenes_in_flight_at_once_and_a_rerun_completes(tmp_path):
+    """Ctrl-C while every worker is inside a scene's solve: the sweep says at once that it
+    stops, ends its workers (no process it started is left, no temporary file), marks the
+    scenes in flight as interrupted and exits with 130 within seconds, not after the
+    scenes; the same command then runs them and completes the sweep."""
+    import os
+    import signal
+    import subprocess
+    import time
+    import uuid
+
+    path = write_sweep(tmp_path, lists="seed = 1, 2\n", base=SLOW_BASE)
+    marker = f"LAYERCONTACT_TEST_SWEEP={uuid.uuid4().hex}"
+    env = {**os.environ, "LAYERCONTACT_TEST_SWEEP": marker.split("=")[1]}
+    command = [sys.executable, "-m", "layercontact", "sweep", str(path), "--no-progress"]
+    proc = subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True, env=env)
+    runs = tmp_path / "out/s/runs"
+    deadline = time.monotonic() + 300
+
+    def running() -> int:
+        records = [json.loads(p.read_text()) for p in runs.glob("*.json")] if runs.is_dir() else []
+        return sum(r.get("state") == "running" for r in records)
+
+    while running() < 2 and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    assert running() == 2, "both scenes should be running"
+    time.sleep(1.0)   # inside the library's solve by now
+    start = time.monotonic()
+    os.killpg(proc.pid, signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    elapsed = time.monotonic() - start
+    assert proc.returncode == 130, (out, err)
+    # one scene alone takes several seconds here; ending the workers takes well under one
+    # (SIGTERM, then SIGKILL after 0.5 s): 3 s leaves room for a loaded machine
+    assert elapsed < 3.0, elapsed
+    assert "Ctrl-C: stopping the sweep 's': ending the scenes in flight" in err and "Traceback" not in err
+    deadline = time.monotonic() + 2.0
+    while processes_marked(marker) and time.monotonic() < deadline:   # the forkserver ends with its pipe
+        time.sleep(0.05)
+    assert not processes_marked(marker)
+    assert not list((tmp_path / "out").rglob("*.tmp")) and not list((tmp_path / "out/s/results").glob("*.h5"))
+    records = [json.loads(p.read_text()) for p in sorted(runs.glob("*.json"))]
+    assert [(r["state"], r["exit_code"]) for r in records] == [("finished", 130)] * 2
+    assert all("interrupted (Ctrl-C)" in r["error"] for r in records)
+    rerun = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=900)
+    assert rerun.returncode == 0, rerun.stderr
+    assert len(list((tmp_path / "out/s/results").glob("*.h5"))) == 2

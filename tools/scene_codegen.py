@@ -106,6 +106,12 @@ def group_lists(schema) -> str:
     for kind, text in kinds.items():
         out.append(f"   !> The {kind} variables (of every group), between blanks.")
         out.append(f"   character(len=*), parameter :: {kind}_variables = &\n      & " + _literal(text))
+    aliases = " " + " ".join(f"{v.group}:{v.name}={v.alias_of}" for v in schema.VARIABLES if v.alias_of) + " "
+    out.append("   !> The second names of variables, as ' group:alias=name ', between blanks.")
+    out.append("   character(len=*), parameter :: alias_names = &\n      & " + _literal(aliases))
+    areal = " " + " ".join(f"{v.group}:{v.name}" for v in schema.VARIABLES if v.uses == "areal") + " "
+    out.append("   !> The variables that only surfaces use, as ' group:name ', between blanks.")
+    out.append("   character(len=*), parameter :: areal_only_variables = &\n      & " + _literal(areal))
     return "\n".join(out) + "\n"
 
 
@@ -124,6 +130,7 @@ def namelist_writer(schema) -> str:
         for v in schema.group_variables(group):
             if v.alias_of is not None:
                 continue
+            start = len(out)
             if not v.echo:
                 out += [f"      if (len_trim({v.fortran}) == 0) then",
                         f"         text = text // entry('{v.name}', {_value(v)})",
@@ -140,6 +147,13 @@ def namelist_writer(schema) -> str:
                 out.append("      end if")
             else:
                 out.append(f"      text = text // entry('{v.name}', {_value(v)})")
+            if v.uses == "areal":
+                # (a line scene refuses the variables of surfaces: they stay comments there)
+                out[start:] = ["      if (trim(scene%geometry) == 'areal') then",
+                               *("   " + line for line in out[start:]),
+                               "      else",
+                               f"         text = text // '   ! {v.name}: surfaces only' // newline",
+                               "      end if"]
         out.append("      text = text // '/' // newline")
     return "\n".join(out) + "\n"
 

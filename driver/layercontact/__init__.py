@@ -11,6 +11,7 @@ from .api import (
     InputError,
     LayercontactError,
     LineResult,
+    PeriodicityWarning,
     check_scene_file,
     choose_resolution,
     contact_conductance,
@@ -29,10 +30,12 @@ from .api import (
 from .leakage import CoreLeakage, LeakageResult, core_leakage, reynolds_leakage
 from .materials import Prony, StandardLinearSolid, creep_compliance
 from .native import BUILD
+from .plot import plot_result, plot_sweep
 from . import scene_schema
 from .profiles import (
     load_profile,
     load_surface,
+    periodicity_mismatch,
     prepare_heights,
     read_profile,
     read_surface,
@@ -56,6 +59,7 @@ __all__ = [
     "LayercontactError",
     "LeakageResult",
     "LineResult",
+    "PeriodicityWarning",
     "check_scene_file",
     "choose_resolution",
     "contact_conductance",
@@ -65,6 +69,9 @@ __all__ = [
     "layer_multipliers_lapack",
     "load_profile",
     "load_surface",
+    "periodicity_mismatch",
+    "plot_result",
+    "plot_sweep",
     "prepare_heights",
     "read_profile",
     "read_surface",

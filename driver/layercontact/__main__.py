@@ -6,6 +6,7 @@
     python -m layercontact status DIR [--all]
     python -m layercontact collect DIR
     python -m layercontact convert INPUT OUTPUT.h5 [--unit UNIT] [--channel N]
+    python -m layercontact plot RESULT.h5|SWEEP_DIR [-o PICTURE]
     python -m layercontact defaults [line|areal]
 
 ``run`` runs a scene like the ``layercontact`` executable (same library routine, same
@@ -15,7 +16,9 @@ submits it as a Slurm job array (layercontact.sweeps.submit). ``status`` and ``c
 sweep directory (or a sweep file): where each scene stands, and the summary. ``convert``
 reads an instrument topography file (with the optional SurfaceTopography package) and
 writes the HDF5 height file that ``&profile kind = 'file'`` reads, printing the &scene and
-&profile lines that run it. ``defaults`` prints the default scene as a complete namelist,
+&profile lines that run it. ``plot`` draws a result file (maps and profiles) or a sweep's
+summary (observables against the swept variables, mean and standard error over the
+realisations) without solving anything. ``defaults`` prints the default scene as a complete namelist,
 as ``layercontact --defaults`` does.
 
 Exit codes:
@@ -30,6 +33,9 @@ Exit codes:
               written all the same), 2 not a sweep (directory)
     convert   0 written, 2 the input cannot be read as a topography, 4 SurfaceTopography
               missing or the output not writable
+    plot      0 written, 2 not a result file or a sweep with a summary, 4 the picture not
+              writable
+    Ctrl-C    130 (a local sweep ends the scenes in flight; the same command resumes it)
 """
 
 from __future__ import annotations
@@ -118,6 +124,11 @@ def _parser() -> argparse.ArgumentParser:
     convert_p.add_argument("output", help="HDF5 file to write (/profile/height)")
     convert_p.add_argument("--unit", help="length unit of heights and sizes, e.g. um (default: the file's)")
     convert_p.add_argument("--channel", type=int, help="data channel (default: the file's default)")
+    plot_p = sub.add_parser(
+        "plot", help="draw a result file or a sweep's summary (nothing is solved again)"
+    )
+    plot_p.add_argument("target", help="a result file (.h5), or a sweep directory (or its sweep file)")
+    plot_p.add_argument("-o", "--output", help="picture to write (default: RESULT.png, or DIR/NAME_summary.png)")
     defaults_p = sub.add_parser("defaults", help="print the default scene as a complete namelist")
     defaults_p.add_argument("geometry", nargs="?", default="line", choices=("line", "areal"))
     return parser
@@ -142,6 +153,8 @@ def main(argv: list[str] | None = None) -> int:
         return collect_command(args.directory)
     if args.command == "convert":
         return convert_command(args.input, args.output, args.unit, args.channel)
+    if args.command == "plot":
+        return plot_command(args.target, args.output)
     if args.command == "defaults":
         from .api import default_scene
 
@@ -162,13 +175,15 @@ def run_command(args: argparse.Namespace) -> int:
     if not args.no_png:
         import h5py
 
+        import matplotlib.pyplot as plt
+
         from .plot import plot_result
 
         with h5py.File(h5, "r") as f:
             has_maps = "fields" in f
         if has_maps:
             png = Path(args.png) if args.png else h5.with_suffix(".png")
-            plot_result(h5, png)
+            plt.close(plot_result(h5, png))
             print(f"  {'picture':<32}{png}")
         else:
             print(f"  {'picture':<32}none (&output fields = .false.: the result has no maps)")
@@ -320,6 +335,55 @@ def collect_command(directory: str) -> int:
         if scene.state != DONE:
             print(f"layercontact: scene {scene.stem}: {scene.state}: {scene.reason}", file=sys.stderr)
     return 1 if bad else 0
+
+
+def plot_command(target: str, output: str | None) -> int:
+    """``python -m layercontact plot TARGET [-o PICTURE]``: 0 written, 2 not a result file or
+    a sweep with a summary, 4 the picture not writable."""
+    import matplotlib.pyplot as plt
+
+    from .plot import plot_result, plot_sweep
+
+    path = Path(target)
+    try:
+        if path.is_file() and path.suffix.lower() in (".h5", ".hdf5"):
+            import h5py
+
+            from ._library import regular_file
+
+            regular_file(path, "result file")
+            try:
+                with h5py.File(path, "r") as f:
+                    is_result = "results" in f and "input" in f
+                    is_summary = "summary" in f
+            except OSError as err:
+                raise ValueError(f"{path}: not an HDF5 file ({err})") from None
+            if is_result:
+                picture = Path(output) if output else path.with_suffix(".png")
+                figure = plot_result(path)
+            elif is_summary:
+                picture = Path(output) if output else path.with_suffix(".png")
+                figure = plot_sweep(path)
+            else:
+                raise ValueError(f"{path}: neither a result file (/input, /results) nor a sweep summary")
+        else:
+            figure = plot_sweep(path)
+            from .plot import _summary_of
+
+            summary, _, _ = _summary_of(path)
+            picture = Path(output) if output else summary.with_suffix(".png")
+    except (ValueError, OSError, LayercontactError) as err:
+        print(f"layercontact: error: {err}", file=sys.stderr)
+        return 2
+    try:
+        figure.savefig(picture, dpi=120)
+    except OSError as err:
+        print(f"layercontact: error: {picture}: {err}", file=sys.stderr)
+        return 4
+    finally:
+        plt.close(figure)
+    print(f"  {'picture':<32}{picture}")
+    return 0
 
 
 def convert_command(source: str, output: str, unit: str | None, channel: int | None) -> int:

@@ -4,6 +4,7 @@ public names are re-exported by the package."""
 
 from __future__ import annotations
 
+import errno
 import os
 import stat as _stat
 
@@ -40,6 +41,14 @@ class InputError(LayercontactError, ValueError):
     """Bad input (code 2): a value the library does not allow. The message is the one a
     namelist file with that value gets: it names the group, the variable, the value and
     the allowed range."""
+
+
+class PeriodicityWarning(UserWarning):
+    """Heights taken as one period (``&profile boundary = 'periodic'``) that jump or kink
+    across the cell's edges: most likely a tilted or non-periodic measurement, which the
+    solve takes as a periodic surface with a step at each edge. Set ``boundary = 'mirror'``
+    (a non-periodic patch) or ``detrend = 'plane'`` (a tilt); the measure and its limits are
+    :func:`layercontact.periodicity_mismatch` (docs/decisions/019)."""
 
 
 def _check(stat: int, errmsg: bytes | str) -> None:
@@ -83,6 +92,35 @@ def _namelist(groups: dict[str, dict]) -> str:
 # heights), far above what one node solves, and below what would overflow the library's
 # default integers.
 MAX_POINTS = 2**30
+
+
+#: The &layer keywords that say what a layer rests on (docs/theory.md, "Layered stacks"),
+#: taken by every function that takes a layer.
+STACK_KEYWORDS = ("interface", "lower_thickness", "lower_young", "lower_poisson", "lower_tau", "lower_e_inf",
+                  "lower_interfaces", "substrate_young", "substrate_poisson")
+
+
+def stack_keywords(function: str, given: dict) -> dict:
+    """The stack keywords ``given`` to ``function`` as &layer variables: lists of reals for
+    the lower layers' values, one blank-separated word list for ``lower_interfaces``; None
+    and empty lists are not given. Another name raises TypeError, as Python does."""
+    unknown = sorted(set(given) - set(STACK_KEYWORDS))
+    if unknown:
+        raise TypeError(f"{function}() got unexpected keyword argument(s) {', '.join(map(repr, unknown))}; "
+                        f"the stack keywords are {', '.join(STACK_KEYWORDS)}")
+    out = {}
+    for name, value in given.items():
+        if value is None:
+            continue
+        if name == "lower_interfaces":
+            if not isinstance(value, str):
+                value = " ".join(str(word) for word in value)
+        elif name.startswith("lower_"):
+            if np.size(value) == 0:
+                continue
+            value = [float(x) for x in real_array(value, name, ndim=(0, 1)).ravel()]
+        out[name] = value
+    return out
 
 
 def _input_error(name: str, value, allowed: str) -> InputError:
@@ -143,11 +181,14 @@ def real_array(value, name: str, *, ndim: tuple[int, ...], finite: bool = True) 
 def regular_file(filename: str | os.PathLike, what: str) -> str:
     """``filename`` as a string, refused (:class:`InputError`, code 2) when it names
     something other than a regular file: a FIFO would block the read until a writer comes,
-    a directory or a device holds no input. A missing file passes (its reader says so)."""
+    a directory or a device holds no input, a loop of symbolic links names nothing. A missing
+    file passes (its reader says so)."""
     path = os.fspath(filename)
     try:
         mode = os.stat(path).st_mode
-    except OSError:
+    except OSError as err:
+        if err.errno == errno.ELOOP:
+            raise InputError(f"{what} '{path}' is a loop of symbolic links; allowed: a regular file", 2) from None
         return path
     if not _stat.S_ISREG(mode):
         kind = ("a directory" if _stat.S_ISDIR(mode) else "a FIFO (named pipe)" if _stat.S_ISFIFO(mode)

@@ -11,9 +11,9 @@ from dataclasses import fields as dataclass_fields
 import numpy as np
 
 from . import scene_schema
-from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError, _check,  # noqa: F401
-                       _input_error, _lines, _namelist, contact_map, grid_points, periods, positive_real,
-                       real_array, regular_file)
+from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError,  # noqa: F401
+                       PeriodicityWarning, _check, _input_error, _lines, _namelist, contact_map, grid_points,
+                       periods, positive_real, real_array, regular_file, stack_keywords)
 from .leakage import CoreLeakage
 from .native import core as _core
 
@@ -33,16 +33,20 @@ def layer_multipliers(kh, nu: float):
     return _core.py_layer_coefficients(kh, float(nu))
 
 
-def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None):
+def surface_tensor(qx, qy, *, thickness=None, young=None, poisson=None, **stack):
     """The layer's 3x3 surface compliance for in-plane wavevectors ``(qx, qy)`` (1/L,
     broadcast together): ``(u_x^, u_y^, w^) = T (tau_x^, tau_y^, p^)`` in convention P,
     shape ``broadcast.shape + (3, 3)``, complex. In the frame ``(l, t, z)`` with
     ``l = q/|q|`` it is the plane-strain multiplier with ``|k| -> |q|`` in ``(l, z)`` and the
-    antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t``; ``q = 0`` gives the uniform mode
-    ``(h/G, h/G, h/M)`` of a layer (zero for a half-space). The layer's keywords and their
-    defaults are those of :func:`solve_line` (``&layer``)."""
+    antiplane compliance ``tanh(|q|h)/(G|q|)`` along ``t`` (for one layer bonded to a rigid
+    base); ``q = 0`` gives the uniform mode ``(h/G, h/G, h/M)`` of a layer (summed over a
+    stack's layers; zero where a half-space lies below, and in-plane where an interface
+    slips). The layer's keywords and their defaults are those of :func:`solve_line`
+    (``&layer``), the stack keywords of :func:`solve_line` included (elastic: the tensor is
+    at rest)."""
     qx, qy = np.broadcast_arrays(np.asarray(qx, dtype=np.float64), np.asarray(qy, dtype=np.float64))
-    text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson}})
+    text = _namelist({"layer": {"thickness": thickness, "young": young, "poisson": poisson,
+                                **stack_keywords("surface_tensor", stack)}})
     t, stat, errmsg = _core.py_surface_tensor(text, np.ascontiguousarray(qx.ravel()),
                                               np.ascontiguousarray(qy.ravel()))
     _check(stat, errmsg)
@@ -180,10 +184,11 @@ def solve_line(
     conductance: bool | None = None,
     conductivity: float | None = None,
     conductance_base: str | None = None,
+    **stack,
 ) -> LineResult:
     """Solve the sliding line contact of the rigid profile ``heights`` (L, on a uniform
     periodic grid of one ``period``) on a layer of ``thickness`` (``inf``: half-space)
-    bonded to a rigid base, with Coulomb friction ``tau = friction * p``.
+    bonded to a rigid base (or resting on a stack: below), with Coulomb friction ``tau = friction * p``.
 
     Every keyword sets the namelist variable of the same meaning (docs/namelist.md); one
     that is not given (None) takes that variable's default: ``period`` 1, ``thickness``
@@ -195,9 +200,16 @@ def solve_line(
     Give ``mean_pressure`` (load control), ``normalised_pressure`` (the load in the seed's
     scale ``E* Lambda0/period``) or ``penetration`` (displacement control, finite
     compressible layers only). ``material`` (a :class:`StandardLinearSolid` or
-    :class:`Prony`; ``young`` is then ignored) makes the layer viscoelastic, sliding at
+    :class:`Prony`; not with ``young``) makes the layer viscoelastic, sliding at
     ``speed`` (L/T); ``dissipated_power`` and ``monotone`` (``Re G_eff >= 0`` on every mode,
-    hence a unique solution) are reported. ``companion=True`` also solves the frictionless
+    hence a unique solution) are reported. The layer may rest on more than a rigid base bonded to it:
+    the stack keywords ``interface`` (``'bonded'`` or ``'slip'``, below the layer),
+    ``lower_thickness``, ``lower_young``, ``lower_poisson`` (lower layers, from the top down;
+    ``lower_tau`` and ``lower_e_inf`` make them standard linear solids), ``lower_interfaces``
+    (a word or a list of words, one per lower layer),
+    ``substrate_young`` and ``substrate_poisson`` (an elastic half-space below them; not
+    given: rigid) are the ``&layer`` variables of those names (docs/theory.md, "Layered
+    stacks"). ``companion=True`` also solves the frictionless
     problem at the load of this one (its computed mean pressure, whatever the control) and
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
     and the surface stress ``stress_xx`` (one more FFT pair). ``conductance=True`` computes
@@ -245,7 +257,8 @@ def solve_line(
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
         progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
-        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base)
+        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
+        **stack_keywords("solve_line", stack))
     runs = _solve_scene(h, {"scene": {"n": h.size, "period": period}, **groups}, areal=False,
                         companion=bool(companion), stress=stress)
     results = [_line_result(**run, height=h.copy()) for run in runs]
@@ -258,7 +271,13 @@ def _keyword_groups(*, material, method, progress, penetration, **keywords) -> d
     """The namelist groups and variables that the keywords of solve_line and solve_areal set
     (None: not given): the scene schema's variables of the same names, ``method`` and
     ``progress`` for ``solver_method`` and ``verbose``, a penetration with displacement
-    control, and the variables of ``material``."""
+    control, and the variables of ``material``. ``young`` and ``material`` both give the
+    layer's modulus: given together they are refused (:class:`InputError`), as a namelist
+    variable given twice is."""
+    if material is not None and keywords.get("young") is not None:
+        raise InputError(f"young = {keywords['young']!r} and material = {material!r} both give the layer's "
+                         "modulus; allowed: one of them: keep material (a viscoelastic layer) or young (an "
+                         "elastic one)", 2)
     groups = scene_schema.keyword_groups(
         **keywords, solver_method=method, verbose=progress, penetration=penetration,
         control=None if penetration is None else "displacement")
@@ -469,15 +488,17 @@ def solve_areal(
     conductance: bool | None = None,
     conductivity: float | None = None,
     conductance_base: str | None = None,
+    **stack,
 ) -> ArealResult:
     """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
     a uniform periodic grid, axis 1 = x = the sliding direction) on a layer of
-    ``thickness`` (``inf``: half-space) bonded to a rigid base, with Coulomb friction
+    ``thickness`` (``inf``: half-space) bonded to a rigid base or resting on a stack, with Coulomb friction
     ``tau_x = friction * p``. ``period`` is one length or a pair ``(period_x, period_y)``.
     ``stress`` (default True) also computes the in-plane displacements and the surface
     stress tensor (five more transforms). ``normalised_pressure`` is the load in the scale
-    ``E* h/period_x`` on a layer, ``E* Lambda0/period_x`` on a half-space. Every other
-    keyword means what it means for :func:`solve_line`, with the same defaults.
+    ``E* h/period_x`` on a layer (the top layer's on a stack), ``E* Lambda0/period_x`` on a
+    half-space. Every other keyword, the stack keywords included, means what it means for
+    :func:`solve_line`, with the same defaults.
     """
     h = np.asarray(heights, dtype=np.float64)
     if h.ndim != 2:
@@ -489,7 +510,8 @@ def solve_areal(
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
         progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
-        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base)
+        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
+        **stack_keywords("solve_areal", stack))
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
     runs = _solve_scene(np.ascontiguousarray(h).ravel(), {"scene": scene, **groups}, areal=True,
                         companion=bool(companion), stress=stress)
@@ -500,13 +522,14 @@ def solve_areal(
     return results[0]
 
 
-def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None):
+def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson=None, friction=None, **stack):
     """Surface displacement ``u_x`` (L) and in-plane stress ``sigma_xx`` (S, tension
     positive) of the layer under a prescribed pressure (S) and shear ``friction * p``,
-    without solving a contact problem. The keywords and their defaults are those of
-    :func:`solve_line`."""
+    without solving a contact problem. The keywords (the stack keywords included) and their
+    defaults are those of :func:`solve_line`."""
     p = np.ascontiguousarray(real_array(pressure, "pressure", ndim=(1,)))
-    fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction)
+    fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction,
+                             stack_keywords("surface_fields", stack))
     return fields[:, 0].copy(), fields[:, 2].copy()
 
 
@@ -520,8 +543,9 @@ def contact_conductance(contact_mask, period, conductivity, *, thickness=np.inf,
     conducting base under a layer of ``thickness`` at the other potential. Returns
     ``conductivity * mean(J)/DeltaV`` (``conductivity`` per length: S/m^2 with S/m and m; a
     half-space's is the constriction conductance, docs/theory.md). Solved by preconditioned
-    conjugate gradients to ``|r| <= tol |b|``; a solve that does not reach it within
-    ``max_iter`` iterations raises :class:`LayercontactError` with code 3."""
+    conjugate gradients to a relative ``tol`` on the mean (docs/numerics.md); a solve that
+    does not reach it within ``max_iter`` iterations raises :class:`LayercontactError` with
+    code 3."""
     mask = contact_map(contact_mask, "contact_mask")
     if mask.ndim == 1:
         if np.ndim(period) != 0:
@@ -548,10 +572,10 @@ def contact_conductance(contact_mask, period, conductivity, *, thickness=np.inf,
     return sigma * float(value)
 
 
-def _surface_stress(p, scene: dict, thickness, young, poisson, friction) -> np.ndarray:
+def _surface_stress(p, scene: dict, thickness, young, poisson, friction, stack: dict) -> np.ndarray:
     """fields(n, 5) = u_x, u_y, sigma_xx, sigma_yy, sigma_xy of the layer under the flat
     pressure ``p`` (x fastest) on the grid of the &scene variables ``scene``."""
-    text = _namelist({"scene": scene, "layer": {"thickness": thickness, "young": young, "poisson": poisson},
+    text = _namelist({"scene": scene, "layer": {"thickness": thickness, "young": young, "poisson": poisson, **stack},
                       "friction": {"coefficient": friction}})
     fields, stat, errmsg = _core.py_surface_stress(text, p)
     _check(stat, errmsg)
@@ -572,7 +596,7 @@ class SurfaceStress:
 
 
 def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson=None,
-                   friction=None) -> SurfaceStress:
+                   friction=None, **stack) -> SurfaceStress:
     """Surface displacements and stresses of an elastic layer (``thickness=np.inf``:
     half-space, the default) under the prescribed pressure (S; 1D for a line, ``(ny, nx)``
     for a surface, x = axis 1) and the shear ``friction * p`` along x, without solving a
@@ -582,12 +606,13 @@ def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson
     if p.ndim == 1:
         lx = period if np.ndim(period) == 0 else float(period[0])
         ux, sxx = surface_fields(p, period=lx, thickness=thickness, young=young, poisson=poisson,
-                                 friction=friction)
+                                 friction=friction, **stack)
         return SurfaceStress(displacement_x=ux, stress_xx=sxx)
     lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
     ny, nx = p.shape
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
-    fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction)
+    fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction,
+                             stack_keywords("surface_stress", stack))
     ux, uy, sxx, syy, sxy = (fields[:, k].reshape(ny, nx).copy() for k in range(5))
     return SurfaceStress(displacement_x=ux, stress_xx=sxx, displacement_y=uy, stress_yy=syy, stress_xy=sxy)
 
@@ -626,16 +651,23 @@ def read_result(filename: str | os.PathLike, companion: bool = True) -> LineResu
             result.leakage = CoreLeakage.from_attributes(base["leakage"].attrs)
         return result
 
+    # as for the readers of input files: a file that is not there, or whose content is not
+    # a result, is bad input (code 2); one that is there but cannot be read an I/O failure (4)
     path = regular_file(filename, "result file")
+    if not os.path.exists(path):
+        raise InputError(f"result file '{path}' is not found; allowed: an existing result file", 2)
     try:
         f = h5py.File(path, "r")
     except OSError as err:
-        # (h5py's message does not name the file; a missing file or one that is not HDF5)
+        # (h5py's message does not name the file)
+        if os.access(path, os.R_OK) and not h5py.is_hdf5(path):
+            raise InputError(f"cannot read result file '{path}': not an HDF5 file (no HDF5 signature); allowed: "
+                             "a result file written by layercontact", 2) from err
         raise LayercontactError(f"cannot read result file '{path}': {err}", 4) from err
     with f:
         if "results" not in f or "input" not in f:
-            raise LayercontactError(f"cannot read result file '{path}': it is an HDF5 file but not a layercontact "
-                                    "result (no /results or /input)", 4)
+            raise InputError(f"cannot read result file '{path}': it is an HDF5 file but not a layercontact "
+                             "result (no /results or /input)", 2)
         geometry = f.attrs.get("geometry", b"line")
         geometry = geometry.decode() if isinstance(geometry, bytes) else str(geometry)
         builder = _areal_result if geometry == "areal" else _line_result
@@ -696,8 +728,31 @@ def choose_resolution(filename: str | os.PathLike) -> tuple[int | tuple[int, int
 def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult | ArealResult:
     """Run a namelist file exactly as the ``layercontact`` executable does (same library
     routine): the HDF5 result is written where ``&output file`` says, and read back.
-    Raises :class:`LayercontactError` on bad input (nothing is written)."""
-    return read_result(run_to_file(filename, verbose))
+    Raises :class:`LayercontactError` on bad input (nothing is written). Heights from a
+    file taken as one period that jump or kink across the cell's edges give a
+    :class:`PeriodicityWarning` (the executable's warning on standard error)."""
+    result_file = run_to_file(filename, verbose)
+    result = read_result(result_file)
+    _warn_if_not_periodic(result, result_file)
+    return result
+
+
+def _warn_if_not_periodic(result, result_file: str) -> None:
+    """The executable's warning of a height file that is not periodic, as a warning."""
+    import h5py
+
+    from .profiles import warn_if_not_periodic
+
+    def text(value) -> str:
+        return value.decode() if isinstance(value, bytes) else str(value)
+
+    with h5py.File(result_file, "r") as f:
+        attrs = f["input"].attrs
+        if text(attrs.get("profile_kind", "")) != "file" or text(attrs.get("profile_boundary", "")) != "periodic":
+            return
+        file = text(attrs.get("profile_file", ""))
+    if result.height is not None and np.size(result.height) > 0:
+        warn_if_not_periodic(np.reshape(result.height, (-1, np.shape(result.height)[-1])), file)
 
 
 def run_to_file(filename: str | os.PathLike, verbose: bool = False) -> str:

@@ -9,12 +9,13 @@ the C order of the Fortran library's flat fields with x fastest."""
 from __future__ import annotations
 
 import os
+import warnings
 
 import numpy as np
 
 from .native import core as _core
-from ._library import _CONSTANTS, NOT_SET, LayercontactError, _check, _namelist, grid_points, grid_size, periods, \
-    real_array
+from ._library import _CONSTANTS, NOT_SET, LayercontactError, PeriodicityWarning, _check, _namelist, grid_points, \
+    grid_size, periods, real_array
 
 # Length of the Fortran scene's file-name fields (lc_scene max_string).
 _MAX_STRING = 512
@@ -265,6 +266,57 @@ def read_profile(
     return _measured(path, dataset, False, detrend, boundary, resample, n, 1)
 
 
+#: Limits of :func:`periodicity_mismatch` above which heights taken as one period are
+#: suspect (the library's edge_jump_limit and edge_kink_limit, lc_profiles_measured;
+#: measured in docs/decisions/019).
+EDGE_JUMP_LIMIT = 2.0
+EDGE_KINK_LIMIT = 4.0
+
+
+def periodicity_mismatch(height) -> tuple[float, float]:
+    """How far heights taken as one period are from periodic: ``(jump, kink)``, the larger
+    value along x and along y (an axis of fewer than 16 points is not measured).
+
+    ``jump`` is the rms over the rows of the step across the cell's edge,
+    ``h[0] - h[n-1]``, in rms heights (about the mean): a tilted plane gives
+    ``sqrt(12) (n-1)/n``. ``kink`` is the rms over the rows of the mismatch of the slopes
+    across the edge, the second difference ``h[m] - 2 h[0] + h[n-m]`` over
+    ``m = max(2, n//16)`` points of the periodic continuation, in units of the rms of the
+    same second difference at the points at least ``2m`` from the edges: about 1 for a
+    periodic surface, large for a kink that the cell does not have elsewhere (``inf`` on a
+    smooth cell). The library warns of a height file taken as periodic above
+    :data:`EDGE_JUMP_LIMIT` or :data:`EDGE_KINK_LIMIT` (the same measure, in Fortran).
+    """
+    h = np.atleast_2d(np.asarray(height, dtype=np.float64))
+    rms = float(np.sqrt(np.mean((h - h.mean()) ** 2)))
+    jump = kink = 0.0
+    if not rms > 0:
+        return jump, kink
+    for rows in (h, h.T):   # each row along the axis measured: x, then y
+        n = rows.shape[1]
+        if n < 16:
+            continue
+        m = max(2, n // 16)
+        jump = max(jump, float(np.sqrt(np.mean((rows[:, 0] - rows[:, -1]) ** 2))) / rms)
+        edge = float(np.mean((rows[:, m] - 2 * rows[:, 0] + rows[:, n - m]) ** 2))
+        j = np.arange(2 * m, n - 2 * m)
+        inside = float(np.mean((rows[:, j + m] - 2 * rows[:, j] + rows[:, j - m]) ** 2)) if j.size else 0.0
+        kink = max(kink, np.sqrt(edge / inside) if inside > 0 else (np.inf if edge > 0 else 0.0))
+    return jump, kink
+
+
+def warn_if_not_periodic(height, file: str) -> None:
+    """A :class:`PeriodicityWarning` when heights from ``file`` taken as one period exceed the
+    limits of :func:`periodicity_mismatch`."""
+    jump, kink = periodicity_mismatch(height)
+    if jump > EDGE_JUMP_LIMIT or kink > EDGE_KINK_LIMIT:
+        warnings.warn(f"&profile: file = '{file}' is taken as one period (boundary = 'periodic'), but its heights "
+                      f"jump by {jump:.2f} rms heights across the edges of the cell and their slopes differ there "
+                      f"by {kink:.2e} times their differences inside it: a tilted or non-periodic surface; set "
+                      "&profile boundary = 'mirror' (a non-periodic patch, detrended by a plane) or detrend = "
+                      "'plane' (a tilt)", PeriodicityWarning, stacklevel=4)
+
+
 def _measured(path, dataset, areal, detrend, boundary, resample, nx, ny) -> np.ndarray:
     path = os.fspath(path)
     dataset = _DEFAULT_DATASET if dataset is None else dataset
@@ -274,6 +326,8 @@ def _measured(path, dataset, areal, detrend, boundary, resample, nx, ny) -> np.n
         path, dataset, int(areal), str(detrend), str(boundary), str(resample), int(nx), int(ny)
     )
     _check(stat, errmsg)
+    if boundary == "periodic":
+        warn_if_not_periodic(height.reshape(ny, nx), path)
     return height
 
 

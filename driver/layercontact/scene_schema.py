@@ -1,7 +1,8 @@
 """The scene schema: one table of every namelist variable.
 
 Each row names a variable's group and name, its type, default, unit, allowed values, which
-contacts use it (lines, surfaces or both) and its meaning, and where it lives:
+contacts use it (lines, surfaces or both: a line scene refuses the variables of surfaces) and
+its meaning, and where it lives:
 
 - ``fortran``: the component of ``scene_type`` (``lc_scene``) that holds it;
 - ``key``: its name as an attribute of the result file's ``/input`` and as a keyword of
@@ -10,7 +11,8 @@ contacts use it (lines, surfaces or both) and its meaning, and where it lives:
 - ``sweep``: its position in the product of a ``&sweep`` (None: not a sweep parameter);
 - ``unset``: the Fortran value that marks "not given" (None: the variable always has a
   value); a variable that is not given is absent from ``/input``;
-- ``alias_of``: another name of that variable (``period_x`` for ``period``);
+- ``alias_of``: another name of that variable (``period_x`` for ``period``; a scene that
+  gives both is refused);
 - ``read``: ``'copy'`` (the reader copies it between the scene and the namelist) or
   ``'hook'`` (the group's hand-written hooks in ``lc_io_namelist`` set it up and take it
   over: the grid's variables); lists always go through the hooks;
@@ -103,6 +105,37 @@ VARIABLES: tuple[Variable, ...] = (
              "scene%young", interval="(0, inf)"),
     Variable("layer", "poisson", "real", "0.5", "1", "both", "-1 < poisson <= 0.5", "Poisson's ratio `nu`",
              "scene%poisson", sweep=5, interval="(-1, 0.5]"),
+    Variable("layer", "interface", "string", "'bonded'", "", "both", "'bonded' or 'slip'",
+             "the interface below the layer (with the next layer, the substrate or the rigid base): bonded, or "
+             "slipping without friction (continuous normal displacement and traction, no shear traction); "
+             "a finite `thickness` only ([theory.md](theory.md#layered-stacks))", "scene%interface",
+             choices=("bonded", "slip")),
+    Variable("layer", "lower_thickness", "reals", "none", "L", "both",
+             "up to 64 layers, each > 0 and finite; a finite `thickness` only",
+             "elastic layers below the layer, from the top down: their thicknesses", "scene%lower_thickness"),
+    Variable("layer", "lower_young", "reals", "none", "S", "both", "one per lower layer, each > 0 and finite",
+             "Young's moduli of the lower layers", "scene%lower_young"),
+    Variable("layer", "lower_poisson", "reals", "0.5 each", "1", "both",
+             "none or one per lower layer, each in (-1, 0.5]", "Poisson's ratios of the lower layers",
+             "scene%lower_poisson"),
+    Variable("layer", "lower_tau", "reals", "none (elastic)", "T", "both",
+             "none or one per lower layer, each >= 0 and finite",
+             "a lower layer with `lower_tau > 0` is a standard linear solid (seed Eq. 15) of retardation time "
+             "`lower_tau`, low-frequency modulus `lower_young` and high-frequency modulus `lower_e_inf`, sliding "
+             "at `&material speed`; 0: elastic", "scene%lower_tau"),
+    Variable("layer", "lower_e_inf", "reals", "none", "S", "both",
+             "one per lower layer with lower_tau; each >= lower_young and finite",
+             "high-frequency (glassy) moduli of the viscoelastic lower layers", "scene%lower_e_inf"),
+    Variable("layer", "lower_interfaces", "string", "''", "", "both",
+             "'' or one word 'bonded' or 'slip' per lower layer, separated by blanks or commas",
+             "the interface below each lower layer, from the top down (`''`: all bonded)", "scene%lower_interfaces"),
+    Variable("layer", "substrate_young", "real", "not set (a rigid base)", "S", "both",
+             "> 0 and finite; a finite `thickness` only",
+             "Young's modulus of an elastic half-space substrate below the layers; not set: a rigid base",
+             "scene%substrate_young", sweep=10, unset=_NOT_SET, interval="(0, inf)"),
+    Variable("layer", "substrate_poisson", "real", "`poisson`", "1", "both",
+             "-1 < substrate_poisson <= 0.5; with substrate_young only", "Poisson's ratio of the substrate",
+             "scene%substrate_poisson", unset=_NOT_SET, interval="(-1, 0.5]"),
     # &material
     Variable("material", "model", "string", "'elastic'", "", "both", "'elastic', 'sls' or 'prony'",
              "the material law: `'elastic'` (uses `young`), `'sls'` or `'prony'`", "scene%material%model",
@@ -204,7 +237,8 @@ VARIABLES: tuple[Variable, ...] = (
              "> 0 and finite; exactly one of mean_pressure and normalised_pressure with control = 'load'",
              "`p_m/p_s`, the load in the seed's pressure scale `p_s`; one rule for lines and surfaces: "
              "`p_s = E* Lambda0/lambda` (`Lambda0 = max r - mean r`, the highest summit above the mean plane), "
-             "except on an areal scene on a layer: `p_s = E* h/lambda`; `E*` with the static modulus; "
+             "except on an areal scene on a layer: `p_s = E* h/lambda` (of the top layer on a stack); `E*` with the "
+             "static modulus; "
              "`/input@normalised_pressure_scale` names the one a result used",
              "scene%normalised_pressure", sweep=2, unset=_NOT_SET),
     Variable("loading", "penetration", "real", "not set", "L", "both",
@@ -213,11 +247,8 @@ VARIABLES: tuple[Variable, ...] = (
     # &solver
     Variable("solver", "method", "string", "'auto'", "", "both",
              "'auto', 'cg', 'gcr', 'anderson', 'gfmd', 'newton' or 'multigrid'",
-             "the solver; `'auto'` chooses (see [numerics.md](numerics.md)); `'cg'` (symmetric scenes only), "
-             "`'gcr'`, `'anderson'`, `'gfmd'` (damped dynamics; refused before any step where |Im G_eff|/Re G_eff "
-             "exceeds 0.5, docs/decisions/001), `'newton'` (dense semismooth Newton, grids of at "
-             "most 2048 points) or `'multigrid'` (nonsmooth Newton multigrid; where it applies, "
-             "docs/decisions/009 to 015)", "scene%solver%method", key="solver_method", choices=("auto", "cg",
+             "the solver: `'auto'` chooses the methods from the scene, or one method; each is described "
+             "[below the table](#solver-method)", "scene%solver%method", key="solver_method", choices=("auto", "cg",
              "gcr", "anderson", "gfmd", "newton", "multigrid")),
     Variable("solver", "tol", "real", "1e-10", "1", "both", "1e-14 <= tol <= 1e-2",
              "tolerance on the complementarity residual", "scene%solver%tol", interval="[1e-14, 1e-2]"),
@@ -306,12 +337,15 @@ def input_keywords(attrs, datasets=None) -> dict[str, object]:
     """The keywords of :func:`keyword_groups` that give the scene of a result file back:
     from the attributes of its ``/input`` (and the list datasets there, e.g. the Prony terms;
     ``datasets`` maps names to arrays). Flags (1/0) become bools, byte strings text; a
-    variable that is not echoed (a Prony file whose terms are given) is left out."""
+    variable that is not echoed (a Prony file whose terms are given) is left out, and so are
+    the variables of surfaces in a line scene's (its ``ny = 1``: a line scene refuses them)."""
     table = by_key()
     out: dict[str, object] = {}
+    geometry = attrs.get("geometry", "line")
+    line = (geometry.decode() if isinstance(geometry, bytes) else str(geometry)) == "line"
     for key, variable in table.items():
         source = attrs if variable.type != "reals" else (datasets or {})
-        if key not in source or not variable.echo:
+        if key not in source or not variable.echo or (line and variable.uses == "areal"):
             continue
         value = source[key]
         if variable.type == "logical":

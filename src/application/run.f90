@@ -6,16 +6,17 @@
 !> anything is computed; the result file appears only when it is complete.
 module lc_application_run
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use, intrinsic :: iso_fortran_env, only: error_unit
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
-   use lc_scene, only: scene_type, not_set, is_areal, check_scene
+   use lc_scene, only: scene_type, not_set, is_areal, check_scene, foundation
    use lc_leakage_reynolds, only: leakage_memory_check
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
    use lc_profiles_profile, only: make_profile
-   use lc_profiles_measured, only: measured_grid
+   use lc_profiles_measured, only: measured_grid, periodicity_mismatch, edge_jump_limit, edge_kink_limit
    use lc_application_scene_solve, only: solve_runs
    use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_application_accuracy, only: choose_resolution
@@ -72,6 +73,7 @@ contains
       allocate (height(scene%n*scene%ny))
       call make_profile(scene, height, error)
       if (allocated(error)) return
+      if (unit >= 0) call warn_if_not_periodic(scene, height)
       ! bad input in the profile (a file's content) is found before anything is created
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
@@ -103,6 +105,24 @@ contains
          end if
       end if
    end subroutine run_scene_file
+
+   !> A height file taken as one period (&profile boundary = 'periodic') whose heights jump
+   !> or kink across the cell's edges is most likely a tilted or non-periodic measurement,
+   !> which the solve would take as a periodic surface with a step (or kink) at each edge:
+   !> a warning on standard error says so and what to set (limits: docs/decisions/019).
+   subroutine warn_if_not_periodic(scene, height)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:)
+      real(wp) :: jump, kink
+      if (trim(scene%profile%kind) /= 'file' .or. trim(scene%profile%boundary) /= 'periodic') return
+      call periodicity_mismatch(reshape(height, [scene%n, max(scene%ny, 1)]), jump, kink)
+      if (jump <= edge_jump_limit .and. kink <= edge_kink_limit) return
+      write (error_unit, '(a, f0.2, a, es9.2, a)') "layercontact: warning: &profile: file = '" // &
+         & trim(scene%profile%file) // "' is taken as one period (boundary = 'periodic'), but its heights jump by ", &
+         & jump, ' rms heights across the edges of the cell and their slopes differ there by ', kink, &
+         & " times their differences inside it: a tilted or non-periodic surface; set &profile boundary = " // &
+         & "'mirror' (a non-periodic patch, detrended by a plane) or detrend = 'plane' (a tilt)"
+   end subroutine warn_if_not_periodic
 
    !> A namelist file that is there must be a regular file: a FIFO would block the read
    !> until a writer comes (bad input, code 2; a missing file is the reader's to report).
@@ -145,6 +165,7 @@ contains
       if (len_trim(scene%title) > 0) write (unit, '(2x, a)') trim(scene%title)
       if (scene%ny > 1) write (unit, '(2x, a, t34, i6, a, i6, a)') 'areal grid nx x ny', scene%n, ' x', scene%ny
       write (unit, real_fmt) 'thickness h/lambda', scene%thickness/scene%period
+      if (len(foundation(scene)) > 0) write (unit, '(2x, a, t34, a)') 'interface below the layer', foundation(scene)
       if (scene%solver%target_error /= not_set) then
          write (unit, real_fmt) 'target error', scene%solver%target_error
          write (unit, int_fmt) 'grid points n (chosen)', scene%n
@@ -163,8 +184,10 @@ contains
       end if
       write (unit, real_fmt) 'penetration Delta', result%penetration, '(L)'
       if (present(companion)) write (unit, real_fmt) 'penetration Delta, mu_c = 0', companion%penetration, '(L)'
-      if (is_viscoelastic(scene%material)) then
-         write (unit, '(2x, a, t34, a)') 'material', trim(scene%material%model) // ' (viscoelastic)'
+      if (is_viscoelastic(scene%material)) &
+         & write (unit, '(2x, a, t34, a)') 'material', trim(scene%material%model) // ' (viscoelastic)'
+      ! (a speed is allowed only where a layer is viscoelastic: the top one or a lower one)
+      if (is_viscoelastic(scene%material) .or. scene%speed > 0.0_wp) then
          write (unit, real_fmt) 'sliding speed V', scene%speed, '(L/T)'
          write (unit, real_fmt) 'dissipated power', result%dissipated_power, '(S L/T)'
       end if

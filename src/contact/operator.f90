@@ -107,8 +107,8 @@ contains
       real(wp), intent(in) :: friction
       integer, intent(in) :: threads
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: qx, qy, q, one_minus_a, one_minus_b, c, q_min, q_max
-      complex(wp) :: g
+      real(wp) :: qx, qy, q, q_min, q_max
+      complex(wp) :: g, one_minus_a, one_minus_b, c, t
       real(wp), allocatable :: factor(:)
       integer :: i, mx, nkx
 
@@ -151,8 +151,8 @@ contains
          q_min = min(q_min, q)
          q_max = max(q_max, q)
          mx = mod(i - 1, nkx)
-         call kernel%factors(q, one_minus_a, one_minus_b, c)
-         g = 2.0_wp/q*op%compliance(mx + 1)*cmplx(one_minus_a, -friction*c*(qx/q), kind=wp)
+         call kernel%factors(q, qx, one_minus_a, one_minus_b, c, t)
+         g = 2.0_wp/q*op%compliance(mx + 1)*(one_minus_a - (0.0_wp, 1.0_wp)*friction*c*(qx/q))
          ! A Nyquist column mode is its own mirror image (q_x = +-pi/dx), so its multiplier is
          ! the mirror average (G(q_x, q_y) + G(-q_x, q_y))/2 = Re G
          if (2*mx == grid%nx) g = real(g, wp)

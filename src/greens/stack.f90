@@ -24,12 +24,14 @@
 !> `stack_compliance_lapack` solves the same boundary-value problem as one dense linear system
 !> (4 Papkovich-Neuber coefficients per layer), as a test oracle.
 module lc_greens_stack
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_input, code_internal
    use lc_greens_layer, only: mode_field_rows
    implicit none (type, external)
    private
    public :: stack_layer, stack_base, stack_compliance, stack_coefficients, stack_compliance_lapack
+   public :: condense_stack, check_stack
    public :: base_rigid, base_halfspace, lapack_layer_x_min, lapack_layer_x_max
 
    !> Kinds of base below the last layer.
@@ -92,18 +94,37 @@ contains
       complex(wp), intent(out) :: antiplane
       !> Allocated on invalid input or a singular condensation.
       type(error_type), allocatable, intent(out) :: error
+      integer :: singular
+      character(len=80) :: message
+
+      plane = (0.0_wp, 0.0_wp)
+      antiplane = (0.0_wp, 0.0_wp)
+      call check_stack(layers, base, q, error)
+      if (allocated(error)) return
+      call condense_stack(layers, base, q, plane, antiplane, singular)
+      if (singular > 0) then
+         write (message, '(a, i0)') 'stack_compliance: singular condensation at layer ', singular
+         call fatal_error(error, trim(message), code_internal)
+      end if
+   end subroutine stack_compliance
+
+   !> stack_compliance for valid input (checked by the caller, once for all modes): the
+   !> index of the layer where the condensation met a singular matrix in `singular` (0: none;
+   !> the results are then NaN), so that it can run per mode in pure code.
+   pure subroutine condense_stack(layers, base, q, plane, antiplane, singular)
+      type(stack_layer), intent(in) :: layers(:)
+      type(stack_base), intent(in) :: base
+      real(wp), intent(in) :: q
+      complex(wp), intent(out) :: plane(2, 2)
+      complex(wp), intent(out) :: antiplane
+      integer, intent(out) :: singular
       ! b: the stack below as a 2-parameter family of (u_x/i, u_z, sigma_xz/i, sigma_zz) at the
       ! interface, [U; T] = b v, with T the traction on the plane of normal +z (units |q| = 1).
       complex(wp) :: b(4, 2), bn(4, 2), comp(2, 2), stiff(2, 2), m(2, 2), kl(4, 4), pl(4, 4)
       complex(wp) :: anti(2), anti_new(2), two_g, g, anti_comp, det
       real(wp) :: x, th
       integer :: i, n
-      character(len=80) :: message
 
-      plane = (0.0_wp, 0.0_wp)
-      antiplane = (0.0_wp, 0.0_wp)
-      call check_input(layers, base, q, error)
-      if (allocated(error)) return
       n = size(layers)
       call base_family(base, layers(n)%slip_below, b, anti)
       do i = n, 1, -1
@@ -134,9 +155,10 @@ contains
          if (anti_new(2) == 0.0_wp) exit
          anti_comp = -anti_new(1)/anti_new(2)
       end do
-      if (i >= 1) then
-         write (message, '(a, i0)') 'stack_compliance: singular condensation at layer ', i
-         call fatal_error(error, trim(message), code_internal)
+      singular = max(i, 0)
+      if (singular > 0) then
+         plane = cmplx(ieee_value(1.0_wp, ieee_quiet_nan), 0.0_wp, wp)
+         antiplane = plane(1, 1)
          return
       end if
       g = layers(1)%young/(2.0_wp*(1.0_wp + layers(1)%poisson))
@@ -146,7 +168,7 @@ contains
       plane(2, 1) = -i_unit*comp(2, 1)
       plane(2, 2) = comp(2, 2)
       antiplane = anti_comp*g
-   end subroutine stack_compliance
+   end subroutine condense_stack
 
    !> The factors 1-A, 1-B, c (from d u_l/d p) and t of a stack (see stack_compliance).
    subroutine stack_coefficients(layers, base, q, one_minus_a, one_minus_b, c, t, error)
@@ -164,7 +186,8 @@ contains
       c = -i_unit*plane(1, 2)
    end subroutine stack_coefficients
 
-   subroutine check_input(layers, base, q, error)
+   !> The checks of stack_compliance's input (the layers, the base and |q|).
+   subroutine check_stack(layers, base, q, error)
       type(stack_layer), intent(in) :: layers(:)
       type(stack_base), intent(in) :: base
       real(wp), intent(in) :: q
@@ -202,7 +225,7 @@ contains
          call fatal_error(error, 'layered stack: base kind must be base_rigid or base_halfspace', code_input)
          return
       end if
-   end subroutine check_input
+   end subroutine check_stack
 
    !> The base as a family [U; T] = b v (plane strain, units |q| = 1) and (u, T) = anti (antiplane).
    pure subroutine base_family(base, slip, b, anti)
@@ -382,7 +405,7 @@ contains
 
       plane = (0.0_wp, 0.0_wp)
       antiplane = (0.0_wp, 0.0_wp)
-      call check_input(layers, base, q, error)
+      call check_stack(layers, base, q, error)
       if (allocated(error)) return
       n = size(layers)
       do i = 1, n

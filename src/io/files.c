@@ -2,7 +2,7 @@
  * path names without opening it (a FIFO blocks an open for reading until a writer comes),
  * fsync of a file and of a directory (a result is on disk before it replaces an older one,
  * and its new name after the rename), disk space reserved for a file before it is written,
- * and the space left on a file system (for messages).
+ * and the space left on a file system (for messages), whether two paths name one file.
  * Each returns 0 or the C errno of the failure; none keeps state. */
 #include <errno.h>
 #include <fcntl.h>
@@ -25,6 +25,18 @@ int lc_file_kind(const char *path, int *kind) {
     else if (S_ISCHR(info.st_mode) || S_ISBLK(info.st_mode)) *kind = KIND_DEVICE;
     else if (S_ISSOCK(info.st_mode)) *kind = KIND_SOCKET;
     else *kind = KIND_OTHER;
+    return 0;
+}
+
+/* Whether the paths `a` and `b` name one file (the same device and inode, symbolic links
+ * followed, `..` resolved by the system): *same 1 or 0; returns 0, or the errno of stat() of
+ * either (ENOENT: one is not there, so they are not one file). */
+int lc_same_file(const char *a, const char *b, int *same) {
+    struct stat first, second;
+    *same = 0;
+    if (stat(a, &first) != 0) return errno;
+    if (stat(b, &second) != 0) return errno;
+    *same = first.st_dev == second.st_dev && first.st_ino == second.st_ino;
     return 0;
 }
 

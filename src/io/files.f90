@@ -1,14 +1,14 @@
 !> File-system questions the Fortran runtime cannot answer (C helpers in files.c): the kind
 !> of file a path names (inquire cannot tell a FIFO, which blocks a read until a writer
 !> comes, from a regular file), fsync of a file or a directory, disk space reserved for a
-!> file, the space left on a file system. Used for "a result file is complete or absent" (docs/output.md) and for refusing
+!> file, the space left on a file system, whether two paths name one file. Used for "a result file is complete or absent" (docs/output.md) and for refusing
 !> input files that are not regular files.
 module lc_io_files
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_long_long, c_null_char
    use lc_base_kinds, only: i8
    implicit none (type, external)
    private
-   public :: path_kind, kind_name, sync_path, reserve_space, free_bytes, system_error_text
+   public :: path_kind, kind_name, sync_path, reserve_space, free_bytes, system_error_text, same_file
    public :: kind_regular, kind_directory, kind_fifo, kind_device, kind_socket, kind_other, kind_missing, &
       & kind_loop, kind_unknown
 
@@ -24,6 +24,11 @@ module lc_io_files
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int), intent(out) :: kind
       end function lc_file_kind
+      integer(c_int) function lc_same_file(a, b, same) bind(C, name='lc_same_file')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: a(*), b(*)
+         integer(c_int), intent(out) :: same
+      end function lc_same_file
       integer(c_int) function lc_sync_path(path, directory) bind(C, name='lc_sync_path')
          import :: c_int, c_char
          character(kind=c_char), intent(in) :: path(*)
@@ -75,6 +80,16 @@ contains
          detail = system_error_text(code)
       end select
    end subroutine path_kind
+
+   !> Whether two paths name one existing file (through symbolic links, `..` or hard links);
+   !> false when either is not there.
+   logical function same_file(a, b)
+      !> the paths, as given
+      character(len=*), intent(in) :: a, b
+      integer(c_int) :: same
+      same_file = .false.
+      if (lc_same_file(a // c_null_char, b // c_null_char, same) == 0) same_file = same /= 0
+   end function same_file
 
    !> A kind in words, for messages ('a FIFO (named pipe)', 'a directory', ...).
    pure function kind_name(kind) result(name)

@@ -7,7 +7,10 @@
 !> (driver/layercontact/scene_schema.py, tools/scene_codegen.py) as include files; the
 !> hooks of the grid's variables and of the Prony terms are here. A Fortran namelist read
 !> silently skips groups it does not know, so the text is pre-scanned for `&name` tokens
-!> first; unknown or repeated groups are errors that name the line.
+!> first; unknown or repeated groups are errors that name the line. The assignments of each
+!> group are listed from the text too (the namelist read keeps the last of two silently): a
+!> variable given twice, or under both of its names (`period` and `period_x`), is refused,
+!> and so is a variable of surfaces only (`period_y`, `ny`, ...) in a line scene.
 module lc_io_namelist
    use, intrinsic :: iso_fortran_env, only: iostat_end
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
@@ -16,6 +19,7 @@ module lc_io_namelist
    use lc_base_strings, only: to_string, lower_case
    use lc_scene, only: scene_type, check_scene, not_set, max_string
    use lc_greens_viscoelastic, only: max_prony_terms
+   use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
    implicit none (type, external)
    private
    public :: read_scene, read_scene_text, write_scene_namelist, read_prony_file, default_scene
@@ -33,6 +37,8 @@ module lc_io_namelist
    real(wp), parameter :: unset_entry = -huge(1.0_wp)
    !> The same for grid sizes.
    integer, parameter :: unset_count = -huge(1)
+   !> Characters kept of a variable's name (with its index) and of its value, for messages.
+   integer, parameter :: name_width = 64
    !> Grid points per side of an areal scene that gives no n, nx or ny.
    integer, parameter :: default_areal_n = 256
 
@@ -43,6 +49,15 @@ module lc_io_namelist
       integer :: first = 0
       integer :: last = 0
    end type group_span
+
+   !> One `name = value` of the text: the variable (lower case, an index kept: `prony_times(2)`),
+   !> the first value written after it, its group (position in `group_names`) and its line.
+   type :: assignment
+      character(len=name_width) :: name = ''
+      character(len=name_width) :: value = ''
+      integer :: group = 0
+      integer :: line = 0
+   end type assignment
 
 contains
 
@@ -84,11 +99,18 @@ contains
       type(scene_type), intent(out) :: scene
       type(error_type), allocatable, intent(out) :: error
       type(group_span) :: groups(n_groups)
+      type(assignment), allocatable :: given(:)
       character(len=512) :: msg
       character(len=:), allocatable :: name
       integer :: n_found, i, stat, line
 
       call find_groups(text, source, groups, n_found, error)
+      if (allocated(error)) return
+      allocate (given(0))
+      do i = 1, n_found
+         call list_assignments(text(groups(i)%first:groups(i)%last), groups(i)%index, groups(i)%line, given)
+      end do
+      call check_repeated(given, source, error)
       if (allocated(error)) return
 
       do i = 1, n_found
@@ -103,6 +125,10 @@ contains
             return
          end if
       end do
+      if (trim(scene%geometry) == 'line') then
+         call check_line_scene(given, source, error)
+         if (allocated(error)) return
+      end if
 
       if (len_trim(scene%prony_file) > 0) then
          if (scene%material%terms() > 0 .or. allocated(scene%material%values)) then
@@ -181,6 +207,11 @@ contains
       if (index(msg, 'out of range for namelist variable prony_') > 0) then
          msg = trim(msg) // ' (prony_times and prony_values hold at most ' // to_string(max_prony_terms) // &
             & ' terms, indexed from 1)'
+         return
+      end if
+      if (index(msg, 'out of range for namelist variable lower_') > 0) then
+         msg = trim(msg) // ' (lower_thickness, lower_young and lower_poisson hold at most ' // &
+            & to_string(max_prony_terms) // ' layers, indexed from 1)'
          return
       end if
       k = index(msg, marker)
@@ -279,6 +310,51 @@ contains
       config%ny = merge(ny, merge(points, 1, trim(config%geometry) == 'areal'), ny /= unset_count)
    end subroutine after_scene
 
+   !> &layer before the read: the lower layers the scene holds, the other entries unset.
+   pure subroutine before_layer(config, lower_thickness, lower_young, lower_poisson, lower_tau, lower_e_inf)
+      type(scene_type), intent(in) :: config
+      real(wp), intent(out) :: lower_thickness(:), lower_young(:), lower_poisson(:), lower_tau(:), lower_e_inf(:)
+      call start_list(config%lower_thickness, lower_thickness)
+      call start_list(config%lower_young, lower_young)
+      call start_list(config%lower_poisson, lower_poisson)
+      call start_list(config%lower_tau, lower_tau)
+      call start_list(config%lower_e_inf, lower_e_inf)
+   end subroutine before_layer
+
+   !> &layer after the read: each list is its leading entries that were set; a gap is refused.
+   pure subroutine after_layer(config, lower_thickness, lower_young, lower_poisson, lower_tau, lower_e_inf, stat, msg)
+      type(scene_type), intent(inout) :: config
+      real(wp), intent(in) :: lower_thickness(:), lower_young(:), lower_poisson(:), lower_tau(:), lower_e_inf(:)
+      integer, intent(inout) :: stat
+      character(len=*), intent(inout) :: msg
+      if (gapped(lower_thickness) .or. gapped(lower_young) .or. gapped(lower_poisson) .or. gapped(lower_tau) .or. &
+         & gapped(lower_e_inf)) then
+         stat = -1
+         msg = 'lower_thickness/lower_young/lower_poisson/lower_tau/lower_e_inf: give the entries in order from the ' &
+            & // 'first, without gaps'
+         return
+      end if
+      config%lower_thickness = lower_thickness(:count_set(lower_thickness))
+      config%lower_young = lower_young(:count_set(lower_young))
+      config%lower_poisson = lower_poisson(:count_set(lower_poisson))
+      config%lower_tau = lower_tau(:count_set(lower_tau))
+      config%lower_e_inf = lower_e_inf(:count_set(lower_e_inf))
+   end subroutine after_layer
+
+   !> Whether a list has an unset entry before a set one.
+   pure logical function gapped(values)
+      real(wp), intent(in) :: values(:)
+      gapped = count_set(values) /= count(values /= unset_entry)
+   end function gapped
+
+   !> A list's local copy before a read: the scene's entries, the others unset.
+   pure subroutine start_list(held, local)
+      real(wp), allocatable, intent(in) :: held(:)
+      real(wp), intent(out) :: local(:)
+      local = unset_entry
+      if (allocated(held)) local(:size(held)) = held
+   end subroutine start_list
+
    !> &material before the read: the terms the scene holds, the other entries marked unset.
    pure subroutine before_material(config, prony_times, prony_values)
       type(scene_type), intent(in) :: config
@@ -342,16 +418,21 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=1024) :: line, msg
       real(wp) :: pair(2), extra
-      integer :: unit, stat, lineno, cut
-      logical :: found
+      integer :: unit, stat, lineno, cut, kind
+      character(len=:), allocatable :: detail
 
       allocate (times(0), values(0))
-      ! a file that is not there is bad input (as for &profile file); one that is there but
-      ! cannot be opened an I/O failure
-      inquire (file=filename, exist=found)
-      if (.not. found) then
+      ! a file that is not there, or not a regular file (a loop of symbolic links, a
+      ! directory, a FIFO), is bad input (as for &profile file); one that is there but cannot
+      ! be opened an I/O failure
+      call path_kind(filename, kind, detail)
+      if (kind == kind_missing) then
          call input_error(error, 'material', 'prony_file', "'" // filename // "'", &
             & 'an existing text file of tau_i value_i lines, relative to the working directory')
+         return
+      else if (kind /= kind_regular .and. kind /= kind_unknown) then
+         call fatal_error(error, "&material: prony_file = '" // filename // "' is " // kind_name(kind) // &
+            & '; allowed: a regular text file of tau_i value_i lines', code_input)
          return
       end if
       open (newunit=unit, file=filename, status='old', action='read', iostat=stat, iomsg=msg)
@@ -396,6 +477,168 @@ contains
             & "'tau_i value_i', 1 to " // to_string(max_prony_terms), code_input)
       end if
    end subroutine read_prony_file
+
+   ! ---------------------------------------------------------------------------------------
+   ! The assignments of the text: variables given twice, variables of surfaces in a line scene.
+
+   !> Append the assignments of one group's text (`segment`, starting on line `first_line`
+   !> of the file) to `given`.
+   subroutine list_assignments(segment, group, first_line, given)
+      character(len=*), intent(in) :: segment
+      integer, intent(in) :: group, first_line
+      type(assignment), allocatable, intent(inout) :: given(:)
+      character(len=line_width(segment)) :: lines(count_char(segment, newline) + 1)
+      character(len=:), allocatable :: code
+      type(assignment) :: item
+      integer :: k, i, start, finish
+
+      call split_lines(segment, lines)
+      do k = 1, size(lines)
+         code = blank_strings(code_of(lines(k), k == 1))
+         do i = 1, len(code)
+            if (code(i:i) /= '=') cycle
+            ! the name before the '=', with its index: `name =`, `name(2) =`
+            finish = len_trim(code(:i - 1))
+            if (finish == 0) cycle
+            start = finish
+            if (code(finish:finish) == ')') start = index(code(:finish), '(', back=.true.) - 1
+            if (start < 1) cycle
+            start = len_trim(code(:start))
+            do while (start > 1)
+               if (.not. is_name_char(code(start - 1:start - 1))) exit
+               start = start - 1
+            end do
+            if (start < 1) cycle
+            if (.not. is_name_char(code(start:start))) cycle
+            item%name = remove_blanks(code(start:finish))
+            item%value = first_value(code_of(lines(k), k == 1), i)
+            item%group = group
+            item%line = first_line + k - 1
+            given = [given, item]
+         end do
+      end do
+   end subroutine list_assignments
+
+   !> A variable assigned twice in a group, or under both of its names, is an error naming
+   !> the group, the variable(s), their lines and which one to keep.
+   subroutine check_repeated(given, source, error)
+      type(assignment), intent(in) :: given(:)
+      character(len=*), intent(in) :: source
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i, j
+      character(len=:), allocatable :: place
+
+      do j = 2, size(given)
+         do i = 1, j - 1
+            if (given(i)%group /= given(j)%group) cycle
+            if (quantity(given(i)) /= quantity(given(j))) cycle
+            place = source // ', line ' // to_string(given(j)%line) // ', group &' // trim(group_names(given(j)%group))
+            if (given(i)%name == given(j)%name) then
+               call fatal_error(error, place // ': ' // trim(given(j)%name) // ' is given twice (lines ' // &
+                  & to_string(given(i)%line) // ' and ' // to_string(given(j)%line) // '); allowed: one ' // &
+                  & 'assignment of each variable: keep the one you mean and remove the other', code_input)
+            else
+               call fatal_error(error, place // ': ' // trim(given(i)%name) // ' and ' // trim(given(j)%name) // &
+                  & ' are both given (lines ' // to_string(given(i)%line) // ' and ' // to_string(given(j)%line) // &
+                  & ') and are two names of one variable; allowed: one of them: keep ' // quantity(given(j)) // &
+                  & ' and remove the other', code_input)
+            end if
+            return
+         end do
+      end do
+   end subroutine check_repeated
+
+   !> The variables that only surfaces use (`period_y`, `ny`, `mode_y`, ...: the scene schema's
+   !> uses 'areal') are refused in a line scene, which would ignore them.
+   subroutine check_line_scene(given, source, error)
+      type(assignment), intent(in) :: given(:)
+      character(len=*), intent(in) :: source
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: group
+      integer :: i
+
+      do i = 1, size(given)
+         group = trim(group_names(given(i)%group))
+         if (index(areal_only_variables, ' ' // group // ':' // bare_name(given(i)%name) // ' ') == 0) cycle
+         call fatal_error(error, source // ', line ' // to_string(given(i)%line) // ', group &' // group // ': ' // &
+            & trim(given(i)%name) // ' = ' // trim(given(i)%value) // " is not allowed; allowed: not given with " // &
+            & "geometry = 'line' (" // bare_name(given(i)%name) // " applies to surfaces only, geometry = 'areal')", &
+            & code_input)
+         return
+      end do
+   end subroutine check_line_scene
+
+   !> The variable an assignment sets: its name with the index kept, a second name
+   !> (`period_x`, `nx`) replaced by the first (`period`, `n`).
+   pure function quantity(given) result(name)
+      type(assignment), intent(in) :: given
+      character(len=:), allocatable :: name
+      character(len=:), allocatable :: key
+      integer :: k, finish
+      name = trim(given%name)
+      key = ' ' // trim(group_names(given%group)) // ':' // bare_name(given%name) // '='
+      k = index(alias_names, key)
+      if (k == 0) return
+      finish = k + len(key) - 1 + index(alias_names(k + len(key):), ' ') - 1
+      name = alias_names(k + len(key):finish) // name(len(bare_name(given%name)) + 1:)
+   end function quantity
+
+   !> A name without its index (`prony_times(2)` -> `prony_times`).
+   pure function bare_name(name) result(bare)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: bare
+      bare = trim(name)
+      if (index(name, '(') > 0) bare = name(:index(name, '(') - 1)
+   end function bare_name
+
+   !> The first value after the '=' at `at` of a line (up to the next comma outside quotes).
+   pure function first_value(code, at) result(value)
+      character(len=*), intent(in) :: code
+      integer, intent(in) :: at
+      character(len=:), allocatable :: value
+      character :: quote
+      integer :: i
+      quote = ' '
+      do i = at + 1, len(code)
+         if (quote /= ' ') then
+            if (code(i:i) == quote) quote = ' '
+         else if (code(i:i) == '"' .or. code(i:i) == "'") then
+            quote = code(i:i)
+         else if (code(i:i) == ',' .or. code(i:i) == '/') then
+            exit
+         end if
+      end do
+      value = trim(adjustl(code(at + 1:i - 1)))
+   end function first_value
+
+   !> The line with the characters of quoted strings blanked (a '=' there is no assignment).
+   pure function blank_strings(code) result(out)
+      character(len=*), intent(in) :: code
+      character(len=len(code)) :: out
+      character :: quote
+      integer :: i
+      out = code
+      quote = ' '
+      do i = 1, len(code)
+         if (quote /= ' ') then
+            if (code(i:i) == quote) quote = ' '
+            out(i:i) = ' '
+         else if (code(i:i) == '"' .or. code(i:i) == "'") then
+            quote = code(i:i)
+            out(i:i) = ' '
+         end if
+      end do
+   end function blank_strings
+
+   pure function remove_blanks(text) result(out)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: out
+      integer :: i
+      out = ''
+      do i = 1, len(text)
+         if (text(i:i) /= ' ') out = out // text(i:i)
+      end do
+   end function remove_blanks
 
    ! ---------------------------------------------------------------------------------------
    ! Scanning the text.

@@ -25,7 +25,7 @@ contains
    !> in a viscoelastic layer per unit nominal area (S L/T) at sliding speed V:
    !>    D = V sum_q q_x Im[s^* T s],  s = (mu_c p^, 0, p^),
    !> over the whole spectrum, T the surface compliance (lc_greens_kernel); on a line
-   !>    D = V sum_{k>0} 4 Im[(1-nu^2) J*(kV)] |p^(k)|^2 [(1-A) + mu_c^2 (1-B)]
+   !>    D = V sum_{k>0} 4 Im[(1-nu^2) J*(kV) ((1-A) + mu_c^2 (1-B))] |p^(k)|^2
    !> (the normal-tangential coupling drops out of the quadratic form). The steady power
    !> balance (work of the tractions = dissipation) reads D = V p_m (Delta mu - by_energy), so
    !> for an elastic layer Delta mu = by_energy, and for a viscoelastic one the difference is
@@ -35,8 +35,8 @@ contains
       real(wp), intent(in) :: p(:), w(:), r(:)
       real(wp), intent(out) :: by_displacement, by_spectrum, by_energy, by_profile, dissipation
       complex(wp), allocatable :: ph(:), rh(:), wh(:)
-      real(wp) :: pm, qx, qy, q, cx, cy, one_minus_a, one_minus_b, c, im_g, power, mu
-      complex(wp) :: uxh, compliance, anti
+      real(wp) :: pm, qx, qy, q, cx, cy, im_g, power, mu
+      complex(wp) :: uxh, compliance, anti, one_minus_a, one_minus_b, c, t
       integer :: i, mx
 
       pm = sum(p)/op%n
@@ -59,9 +59,9 @@ contains
          q = hypot(qx, qy)
          cx = qx/q
          cy = qy/q
-         call op%kernel%factors(q, one_minus_a, one_minus_b, c)
+         call op%kernel%factors(q, qx, one_minus_a, one_minus_b, c, t)
          compliance = op%compliance(mx + 1)
-         anti = op%kernel%antiplane(q, compliance)
+         anti = op%kernel%antiplane(q, compliance, t)
          by_displacement = by_displacement - 2*real(conjg(ph(i))*cmplx(0.0_wp, qx, wp)*wh(i), wp)
          by_profile = by_profile - 2*real(conjg(ph(i))*cmplx(0.0_wp, qx, wp)*rh(i), wp)
          im_g = 0.0_wp
@@ -69,9 +69,10 @@ contains
          power = abs(ph(i))**2
          by_spectrum = by_spectrum + 2*qx*im_g*power
          ! u_x^ = {2C/q [i c cx + mu_c (1-B) cx^2] + mu_c cy^2 tanh(qh)/(G q)} p^
-         uxh = (2.0_wp/q*compliance*cmplx(mu*one_minus_b*cx**2, c*cx, wp) + mu*cy**2*anti)*ph(i)
+         uxh = (2.0_wp/q*compliance*(mu*one_minus_b*cx**2 + (0.0_wp, 1.0_wp)*c*cx) + mu*cy**2*anti)*ph(i)
          by_energy = by_energy + mu*2*real(conjg(ph(i))*cmplx(0.0_wp, qx, wp)*uxh, wp)
-         dissipation = dissipation + 2*qx*power*(2*aimag(compliance)/q*(one_minus_a + mu**2*one_minus_b*cx**2) &
+         ! (the coupling c drops out of the quadratic form: Maxwell-Betti, complex c too)
+         dissipation = dissipation + 2*qx*power*(2*aimag(compliance*(one_minus_a + mu**2*one_minus_b*cx**2))/q &
             & + mu**2*cy**2*aimag(anti))
       end do
       by_displacement = by_displacement/pm

@@ -51,6 +51,11 @@ contains
       c0 = real(op%compliance(1), wp)
       if (op%kernel%halfspace) then
          fh(1, :) = [complex(wp) :: 0.0_wp, 0.0_wp, -pm, -2.0_wp*poisson*pm, 0.0_wp]
+      else if (op%kernel%unbounded()) then
+         ! a stack on a half-space: the limit of its modes along x (as the half-space's row
+         ! above), u undefined (zero)
+         fh(1, :) = real(mode_multipliers(op, 1.0e-9_wp/sum(op%kernel%stack%thickness), 0.0_wp, 0), wp)*pm
+         fh(1, 1:2) = 0.0_wp
       else
          fh(1, :) = [complex(wp) :: op%friction*pm*op%kernel%shear_uniform(c0), 0.0_wp, -contraction*pm, &
             & -contraction*pm, 0.0_wp]

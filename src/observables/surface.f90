@@ -7,9 +7,11 @@
 !> and at z = 0, from Hooke's law in plane strain with sigma_zz = -p (exact at the surface):
 !>    sigma_xx = -(nu/(1-nu)) p + E* du_x/dx.
 !> The uniform modes are set explicitly: a bonded layer sheared by the mean traction moves by
-!> u_x = mu_c p_m h/G and has sigma_xx = -(nu/(1-nu)) p_m (uniaxial strain); a half-space has
-!> no defined uniform u_x (set to zero) and sigma_xx = -p_m, the k -> 0 limit of its modes
-!> (on a frictionless half-space every mode gives sigma_xx = -p at the surface).
+!> u_x = mu_c p_m h/G (summed over a stack's layers; zero where an interface slips) and has
+!> sigma_xx = -(nu/(1-nu)) p_m (uniaxial strain); a half-space has no defined uniform u_x
+!> (set to zero) and sigma_xx = -p_m, the k -> 0 limit of its modes (on a frictionless
+!> half-space every mode gives sigma_xx = -p at the surface); a stack on a half-space takes
+!> the k -> 0 limit of its own modes.
 !> Grid values next to a trailing edge converge slowly (like dx^(1/2)): sigma_xx has a
 !> square-root cusp there. `edge_stress_field` gives the smooth field that equals sigma_xx at
 !> every contact edge, from which the cusp's peak is interpolated sub-grid
@@ -29,14 +31,13 @@ contains
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: displacement_x(:), stress_xx(:)
       complex(wp), allocatable :: ph(:), uh(:), sh(:)
-      real(wp) :: k, unused, one_minus_a, one_minus_b, c, pm, contraction, friction
+      real(wp) :: k, unused, pm, contraction, friction
+      complex(wp) :: one_minus_a, one_minus_b, c, t, multiplier
       integer :: m, n
-      logical :: halfspace
 
-      associate (fft => op%fft, thickness => op%kernel%thickness, poisson => op%kernel%poisson)
+      associate (fft => op%fft, poisson => op%kernel%poisson)
       n = fft%n
       friction = op%friction
-      halfspace = op%kernel%halfspace
       contraction = poisson/(1.0_wp - poisson)
       fft%real_buffer = p
       call fft%forward()
@@ -46,25 +47,27 @@ contains
 
       ! Per mode: u_x^ = 2/(E*k) [i c + mu (1-B)] p^ and, since i k/|k| = i sgn(k),
       ! E* i k u_x^ = [-2 c + 2 i mu (1-B)] p^.
-      if (halfspace) then
+      if (op%kernel%unbounded()) then
+         ! the k -> 0 limit of sigma_xx's multiplier below (-p_m on a half-space)
          uh(1) = 0.0_wp
-         sh(1) = -pm
+         sh(1) = real(-contraction - 2.0_wp*op%kernel%long_wave_coupling(), wp)*pm
       else
-         ! simple shear of the bonded layer: u_x = tau_m h/G, h/G = 2 h (1+nu)/E_static
-         uh(1) = friction*pm*2.0_wp*thickness*real(op%compliance(1), wp)/(1.0_wp - poisson)
+         ! simple shear of the bonded layer (or stack): u_x = tau_m h/G summed over the layers
+         uh(1) = friction*pm*op%kernel%shear_uniform(real(op%compliance(1), wp))
          sh(1) = -contraction*pm
       end if
       do m = 1, fft%nk - 1
          call op%grid%wavevector(m + 1, k, unused)
-         call op%kernel%factors(k, one_minus_a, one_minus_b, c)
+         call op%kernel%factors(k, k, one_minus_a, one_minus_b, c, t)
          ! (1 - nu^2) J*(kV) = 1/E* for an elastic layer; sigma_xx does not depend on it
-         uh(m + 1) = 2.0_wp/k*op%compliance(m + 1)*cmplx(friction*one_minus_b, c, wp)*ph(m + 1)
-         sh(m + 1) = cmplx(-contraction - 2.0_wp*c, 2.0_wp*friction*one_minus_b, wp)*ph(m + 1)
+         multiplier = 2.0_wp/k*op%compliance(m + 1)*(friction*one_minus_b + (0.0_wp, 1.0_wp)*c)
+         uh(m + 1) = multiplier*ph(m + 1)
+         sh(m + 1) = (-contraction - 2.0_wp*c + (0.0_wp, 2.0_wp)*friction*one_minus_b)*ph(m + 1)
          if (2*m == n) then
             ! the Nyquist mode is its own mirror image: mirror averages (real parts) of the
             ! multipliers
-            uh(m + 1) = real(2.0_wp/k*op%compliance(m + 1)*cmplx(friction*one_minus_b, c, wp), wp)*ph(m + 1)
-            sh(m + 1) = (-contraction - 2.0_wp*c)*ph(m + 1)
+            uh(m + 1) = real(multiplier, wp)*ph(m + 1)
+            sh(m + 1) = real(-contraction - 2.0_wp*c + (0.0_wp, 2.0_wp)*friction*one_minus_b, wp)*ph(m + 1)
          end if
       end do
 

@@ -17,11 +17,11 @@
 !> numpy.savetxt writes for a 1D array). The file must be a regular file (not a FIFO, a
 !> directory or a device). Every height must be finite. Errors name
 !> &profile file and the value found, with code code_io when the file cannot be opened or
-!> read and code_input when its content is not heights.
+!> read and code_input when its content is not heights (an '.h5' file that is not HDF5 too).
 module lc_profiles_height_file
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use, intrinsic :: iso_fortran_env, only: int8, int16, int32, iostat_end
-   use hdf5, only: hid_t, hsize_t, h5open_f, h5close_f, h5eset_auto_f, h5fopen_f, h5fclose_f, H5F_ACC_RDONLY_F, &
+   use hdf5, only: hid_t, hsize_t, h5open_f, h5close_f, h5eset_auto_f, h5fis_hdf5_f, h5fopen_f, h5fclose_f, H5F_ACC_RDONLY_F, &
       & H5F_CLOSE_STRONG_F, h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, h5dopen_f, h5dclose_f, &
       & h5dread_f, h5dget_space_f, h5dget_type_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
       & h5sget_simple_extent_dims_f, h5tget_class_f, h5tclose_f, H5T_NATIVE_DOUBLE, H5T_FLOAT_F
@@ -128,6 +128,7 @@ contains
       integer(hsize_t) :: dims(max_rank), maxdims(max_rank)
       integer :: hdferr, ignore, rank, class, i
       character(len=:), allocatable :: found
+      logical :: is_hdf5
 
       call h5open_f(hdferr)
       call h5eset_auto_f(0, ignore)
@@ -136,6 +137,14 @@ contains
       reading: block
          if (hdferr /= 0) then
             call fatal_error(error, named(filename) // ': cannot initialise HDF5 to read it', code_internal)
+            exit reading
+         end if
+         ! a file without the HDF5 signature holds no heights (bad input, as a text file with
+         ! a word for a number); one that HDF5 cannot even look into is an I/O failure
+         call h5fis_hdf5_f(filename, is_hdf5, hdferr)
+         if (hdferr == 0 .and. .not. is_hdf5) then
+            call fatal_error(error, named(filename) // ' is not an HDF5 file (no HDF5 signature); allowed: an ' // &
+               & 'HDF5 file (.h5, .hdf5), a .npy file or a text file of heights', code_input)
             exit reading
          end if
          call h5fopen_f(filename, H5F_ACC_RDONLY_F, file, hdferr, access_prp=fapl)

@@ -33,11 +33,17 @@ module lc_profiles_measured
    private
    public :: measured_heights, measured_grid, prepare_heights, detrend_heights, mirror_heights, resample_heights
    public :: detrend_modes, boundary_modes, resample_modes, check_treatments
+   public :: periodicity_mismatch, edge_jump_limit, edge_kink_limit
 
    !> Allowed values of &profile detrend, boundary and resample, for checks and messages.
    character(len=*), parameter :: detrend_modes = "'auto', 'none', 'mean', 'plane' or 'curvature'"
    character(len=*), parameter :: boundary_modes = "'periodic' or 'mirror'"
    character(len=*), parameter :: resample_modes = "'none' or 'fourier'"
+   !> Heights taken as one period are suspect of not being periodic above these
+   !> (periodicity_mismatch): a jump across the cell's edges of 2 rms heights (a tilted plane
+   !> gives sqrt(12) = 3.46, the periodic self-affine surfaces measured at most 1.61), a kink
+   !> of 4 times the cell's own (those surfaces measured at most 3.14; docs/decisions/019).
+   real(wp), parameter :: edge_jump_limit = 2.0_wp, edge_kink_limit = 4.0_wp
 
 contains
 
@@ -336,4 +342,60 @@ contains
       call to%backward()
       height = reshape(to%real_buffer, [nx, ny])
    end subroutine resample_heights
+   !> How far heights taken as one period are from periodic, the larger value along x and
+   !> along y (an axis of fewer than 16 points is not measured):
+   !> `jump`, the rms over the rows of the step across the cell's edge, h(1) - h(n), in rms
+   !> heights (about the mean); `kink`, the rms over the rows of the mismatch of the slopes
+   !> across the edge, the second difference h(1+m) - 2 h(1) + h(n+1-m) over m = max(2, n/16)
+   !> points of the periodic continuation, in units of the rms of the same second difference
+   !> at the points at least 2m from the edges (a periodic surface's edge is one of its
+   !> points: about 1; a kink the cell does not have elsewhere: large, Inf on a smooth one).
+   pure subroutine periodicity_mismatch(height, jump, kink)
+      !> Heights on the grid (L), (nx, ny), x fastest
+      real(wp), intent(in) :: height(:, :)
+      !> The step across the edges in rms heights, the slope mismatch in the cell's own units
+      real(wp), intent(out) :: jump, kink
+      real(wp) :: rms, axis_jump, axis_kink
+      rms = sqrt(sum((height - sum(height)/size(height))**2)/size(height))
+      jump = 0.0_wp
+      kink = 0.0_wp
+      if (.not. rms > 0.0_wp) return
+      if (size(height, 1) >= 16) then
+         call edge_mismatch(height, rms, axis_jump, axis_kink)
+         jump = max(jump, axis_jump)
+         kink = max(kink, axis_kink)
+      end if
+      if (size(height, 2) >= 16) then
+         call edge_mismatch(transpose(height), rms, axis_jump, axis_kink)
+         jump = max(jump, axis_jump)
+         kink = max(kink, axis_kink)
+      end if
+   end subroutine periodicity_mismatch
+
+   !> periodicity_mismatch along the first axis of `rows` (n, rows).
+   pure subroutine edge_mismatch(rows, rms, jump, kink)
+      real(wp), intent(in) :: rows(:, :), rms
+      real(wp), intent(out) :: jump, kink
+      real(wp) :: edge, inside
+      integer :: n, m, j, count_inside
+      n = size(rows, 1)
+      m = max(2, n/16)
+      jump = sqrt(sum((rows(1, :) - rows(n, :))**2)/size(rows, 2))/rms
+      edge = sum((rows(1 + m, :) - 2*rows(1, :) + rows(n + 1 - m, :))**2)/size(rows, 2)
+      inside = 0.0_wp
+      count_inside = 0
+      do j = 2*m + 1, n - 2*m
+         inside = inside + sum((rows(j + m, :) - 2*rows(j, :) + rows(j - m, :))**2)
+         count_inside = count_inside + size(rows, 2)
+      end do
+      if (count_inside > 0) inside = inside/count_inside
+      if (inside > 0.0_wp) then
+         kink = sqrt(edge/inside)
+      else if (edge > 0.0_wp) then
+         kink = huge(1.0_wp)
+      else
+         kink = 0.0_wp
+      end if
+   end subroutine edge_mismatch
+
 end module lc_profiles_measured

@@ -26,6 +26,7 @@ record that says "running" cannot be checked and is reported as running, unconfi
 
 from __future__ import annotations
 
+import errno
 import os
 import socket
 from collections.abc import Callable
@@ -146,6 +147,12 @@ def find_sweep(path: str | os.PathLike) -> SweepDirectory:
             raise ValueError(f"{path}: holds several sweeps ({names}); give the one you mean")
         return _record_of(records[0])
     if not path.exists():
+        # (a loop of symbolic links does not exist either: say which it is)
+        try:
+            os.stat(path)
+        except OSError as err:
+            if err.errno == errno.ELOOP:
+                raise ValueError(f"{path}: a loop of symbolic links; allowed: a sweep directory or file") from None
         raise FileNotFoundError(f"{path}: no such file or directory")
     if path.suffix == ".json":
         return _record_of(path)

@@ -109,7 +109,9 @@ def _parameter(variable: scene_schema.Variable) -> _Parameter:
     control."""
     kind = float if variable.type == "real" else int
     if variable.group != "loading":
-        return _Parameter(variable.group, variable.name, kind)
+        # (the variable's second name in the base scene would be a second value of it: `nx` for `n`)
+        aliases = tuple(v.name for v in scene_schema.group_variables(variable.group) if v.alias_of == variable.name)
+        return _Parameter(variable.group, variable.name, kind, aliases)
     loads = tuple(v.name for v in scene_schema.group_variables("loading") if v.type == "real")
     return _Parameter(variable.group, variable.name, kind, loads, (("control", "load"),))
 
@@ -268,32 +270,47 @@ def _read_namelist(source: Path) -> f90nml.Namelist:
     repeated = [name for name in dict.fromkeys(names) if names.count(name) > 1]
     if repeated:
         raise ValueError(f"{source}: &{repeated[0]} is given more than once; allowed: one &{repeated[0]} group")
-    # f90nml merges a variable given twice element by element: refused, as the lists of a
-    # sweep are read whole
-    twice = _repeated_sweep_variable(source.read_text()) if source.is_file() else None
+    # f90nml merges a variable given twice element by element, and keeps both names of one
+    # variable (period, period_x): refused, as the library refuses them in a scene file and
+    # as the lists of a sweep are read whole
+    twice = _repeated_variable(source.read_text()) if source.is_file() else None
     if twice is not None:
-        raise _sweep_error(source, twice, "given more than once; allowed: one assignment with its whole list")
+        group, first, second = twice
+        if group == SWEEP_GROUP:
+            raise _sweep_error(source, second, "given more than once; allowed: one assignment with its whole list")
+        both = f"{second} is given more than once" if first == second else \
+            f"{first} and {second} are both given (two names of one variable)"
+        raise ValueError(f"{source}: &{group}: {both}; allowed: one of them: keep the one you mean and remove "
+                         "the other")
     return nml
 
 
-def _repeated_sweep_variable(text: str) -> str | None:
-    """The first variable assigned more than once in the &sweep group of a namelist text."""
-    seen = set()
-    inside = False
+#: The second names of scene variables, as (group, name) -> the first name (period_x -> period).
+_ALIASES = {(v.group, v.name): v.alias_of for v in scene_schema.VARIABLES if v.alias_of}
+
+
+def _repeated_variable(text: str) -> tuple[str, str, str] | None:
+    """The first variable of a namelist text assigned twice in its group, directly or under
+    its second name: ``(group, first name, second name)``, or None."""
+    seen: dict[tuple[str, str], str] = {}
+    group = None
     for line in text.splitlines():
         code = re.sub(r"'[^']*'|\"[^\"]*\"", "''", line).split("!")[0]
-        if not inside:
-            match = re.match(r"\s*&sweep\b(.*)", code, flags=re.I)
+        if group is None:
+            match = re.match(r"\s*&(\w+)\b(.*)", code)
             if not match:
                 continue
-            inside, code = True, match.group(1)
-        for name in re.findall(r"(?:^|[\s,])([A-Za-z_]\w*)\s*(?:\([^)]*\))?\s*=", code):
+            group, code = match.group(1).lower(), match.group(2)
+        for name, index in re.findall(r"(?:^|[\s,])([A-Za-z_]\w*)\s*(\([^)]*\))?\s*=", code):
             name = name.lower()
-            if name in seen:
-                return name
-            seen.add(name)
+            # (elements of a scene's list may be given one by one; a &sweep list is read whole)
+            element = "" if group == SWEEP_GROUP else index.replace(" ", "")
+            key = (group, _ALIASES.get((group, name), name) + element)
+            if key in seen:
+                return group, seen[key], name
+            seen[key] = name
         if "/" in code:
-            inside = False
+            group = None
     return None
 
 
@@ -726,10 +743,13 @@ def _pool_context() -> multiprocessing.context.BaseContext:
 
 def _start_worker(directory: str, sweep_pid: int) -> None:
     """A worker runs in the caller's working directory (a forkserver keeps its own),
-    leaves Ctrl-C to the sweep's process (which lets the running scenes finish and stops),
-    and ends when that process is gone (killed with SIGKILL, it cannot stop its workers)."""
+    leaves Ctrl-C to the sweep's process (which ends the scenes in flight and stops),
+    and ends when that process is gone (killed with SIGKILL, it cannot stop its workers).
+    On Ctrl-C the sweep's process ends its workers with SIGTERM, whose default action ends
+    one at once, inside the library too."""
     os.chdir(directory)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
     def watch() -> None:
         while True:
@@ -755,6 +775,7 @@ def _run_pending(
                disable=not progress)
     pool = ProcessPoolExecutor(max_workers=min(processes, len(pending)), mp_context=_pool_context(),
                                initializer=_start_worker, initargs=(os.getcwd(), os.getpid()))
+    futures = {}
     try:
         futures = {
             pool.submit(_solve, str(s.scene_file), str(s.result_file), str(_record_file(s))): s
@@ -766,10 +787,49 @@ def _run_pending(
             except Exception as err:  # a worker died (e.g. killed): report, go on
                 outcomes[futures[future].index] = _failure(f"{type(err).__name__}: {err}")
             bar.update()
+    except KeyboardInterrupt:
+        bar.close()
+        # (a scene queued for a worker counts as running too: it has not started, which its
+        # run record says)
+        running = [s for f, s in futures.items() if f.running()]
+        print(f"\nlayercontact: Ctrl-C: stopping the sweep '{name}': ending the scenes in flight (they run "
+              "again on resume)", file=sys.stderr, flush=True)
+        _stop_workers(pool, running)
+        raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
         bar.close()
     return outcomes
+
+
+#: Seconds a worker is given to end on SIGTERM before SIGKILL.
+_STOP_GRACE = 0.5
+
+
+def _stop_workers(pool: ProcessPoolExecutor, running: list[Scene]) -> None:
+    """End the pool's workers now (a scene in flight may take hours: Ctrl-C does not wait
+    for it), then remove what their scenes left: the temporary result files, and a run record
+    that says "running" becomes "interrupted" (the scene has no result: a resume runs it)."""
+    # (the executor keeps its worker processes by pid, until it shuts down; it offers no call
+    # that ends them)
+    workers = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for worker in workers:
+        if worker.is_alive():
+            worker.terminate()
+    deadline = time.monotonic() + _STOP_GRACE
+    for worker in workers:
+        worker.join(max(0.0, deadline - time.monotonic()))
+        if worker.is_alive():
+            worker.kill()
+            worker.join(1.0)
+    for scene in running:
+        for left in stale_temporary_results(scene.result_file.parent, scene.stem):
+            left.unlink(missing_ok=True)
+        record = provenance.read_record(_record_file(scene))
+        if record and record.get("state") == "running" and record.get("host") == socket.gethostname():
+            provenance.write_record(_record_file(scene), provenance.finish_record(
+                record, 130, 0.0, "interrupted (Ctrl-C); the next run of the sweep runs it again"))
 
 
 def _resolve_processes(plan: SweepPlan, processes: int | None) -> int:
