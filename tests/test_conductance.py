@@ -278,3 +278,23 @@ def test_a_sweep_summary_has_both_columns(tmp_path, monkeypatch):
         assert row["companion_conductance"] == res.companion.conductance
         assert summary["conductance"][k] == pytest.approx(res.conductance, rel=1e-12)
         assert summary["contact_stiffness"][k] == pytest.approx(res.contact_stiffness, rel=1e-12)
+
+
+@pytest.mark.parametrize("friction", [0.0, 0.5])
+@pytest.mark.parametrize("stack", [dict(substrate_young=0.3, substrate_poisson=0.3),
+                                   dict(lower_thickness=[0.1], lower_young=[3.0], lower_poisson=[0.45])],
+                         ids=["soft substrate", "stiff lower layer"])
+def test_stiffness_on_a_stack_is_the_slope_of_its_load_approach_curve(stack, friction):
+    """The stiffness uses only the scene's operator, so it holds on a layer resting on a stack:
+    K against (p_m2 - p_m1)/(Delta2 - Delta1) of two load-controlled solves 1e-6 apart in
+    load (the contact set checked unchanged). Delta carries the rounding of a solve at
+    tol = 1e-13 (~1e-13 of the profile's scale) over a step of ~1e-6 of it: 1e-5 relative."""
+    heights = rough_surface(64)
+    keywords = dict(period=1.0, thickness=0.05, poisson=0.3, friction=friction, stress=False, tol=1e-13, **stack)
+    load = 0.002
+    res = lc.solve_areal(heights, mean_pressure=load, conductance=True, **keywords)
+    above = lc.solve_areal(heights, mean_pressure=load * (1 + 1e-6), **keywords)
+    np.testing.assert_array_equal(above.pressure > 0, res.pressure > 0)
+    slope = (above.mean_pressure - res.mean_pressure) / (above.penetration - res.penetration)
+    assert res.conductance_converged and 0 < res.contact_fraction < 0.5
+    assert res.contact_stiffness == pytest.approx(slope, rel=1e-5)
