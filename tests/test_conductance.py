@@ -298,3 +298,15 @@ def test_stiffness_on_a_stack_is_the_slope_of_its_load_approach_curve(stack, fri
     slope = (above.mean_pressure - res.mean_pressure) / (above.penetration - res.penetration)
     assert res.conductance_converged and 0 < res.contact_fraction < 0.5
     assert res.contact_stiffness == pytest.approx(slope, rel=1e-5)
+
+
+@pytest.mark.parametrize("thickness", [np.inf, 0.02])
+def test_the_mean_is_within_the_tolerance(thickness):
+    """The conjugate gradients stop on the estimated error of the mean (the energy of the
+    last steps): the conductance at tol is within tol of the one at 1e-14 (measured: 3e-7 at
+    tol = 1e-3, 2e-11 at 1e-6; the estimate's delay makes it conservative)."""
+    heights = rough_surface(256)
+    mask = heights > np.quantile(heights, 0.93)
+    reference = lc.contact_conductance(mask, 1.0, 1.0, thickness=thickness, tol=1e-14)
+    for tol in (1e-3, 1e-4, 1e-6, 1e-8):
+        assert abs(lc.contact_conductance(mask, 1.0, 1.0, thickness=thickness, tol=tol) / reference - 1) <= tol
