@@ -426,3 +426,34 @@ subroutine py_reynolds_leakage(n, gap, closed, nx, lx, ly, tol, max_iter, values
    counts = [merge(1, 0, res%x%percolating), merge(1, 0, res%y%percolating), res%x%iterations, &
       & res%y%iterations, res%x%unknowns, res%y%unknowns, merge(1, 0, res%x%converged), merge(1, 0, res%y%converged)]
 end subroutine py_reynolds_leakage
+
+!> The conductance per unit nominal area and per unit conductivity (1/L) of the prescribed
+!> contact map `contact` (1 in contact, 0 elsewhere; nx*ny values, x fastest; ny = 1: a
+!> line of period lx) on a layer of `thickness` on a perfectly conducting base (Inf: a
+!> half-space) (lc_observables_conductance).
+subroutine py_contact_conductance(n, nx, ny, lx, ly, contact, thickness, tol, max_iter, conductance, iterations, &
+   & converged, stat, errmsg)
+   use lc_base_errors, only: error_type, status_of
+   use lc_base_grid, only: grid_type, line_grid, surface_grid
+   use lc_observables_conductance, only: contact_conductance, masked_outcome
+   implicit none (type, external)
+   integer, intent(in) :: n, nx, ny, max_iter
+   real(8), intent(in) :: lx, ly, thickness, tol
+   integer(1), intent(in) :: contact(n)
+   real(8), intent(out) :: conductance
+   integer, intent(out) :: iterations, converged, stat
+   character(len=1024), intent(out) :: errmsg
+   !f2py intent(hide) :: n
+   type(error_type), allocatable :: error
+   type(grid_type) :: grid
+   type(masked_outcome) :: outcome
+   if (ny == 1) then
+      grid = line_grid(nx, lx)
+   else
+      grid = surface_grid(nx, ny, lx, ly)
+   end if
+   call contact_conductance(grid, contact /= 0, thickness, tol, max_iter, 1, conductance, outcome, error)
+   iterations = outcome%iterations
+   converged = merge(1, 0, outcome%converged)
+   call status_of(error, stat, errmsg)
+end subroutine py_contact_conductance

@@ -66,6 +66,15 @@ module lc_result
       real(wp) :: max_tension_grid = 0.0_wp   !< the largest grid value of sigma_xx (S)
       real(wp) :: max_tension_x = 0.0_wp      !< where it sits (L)
       real(wp) :: max_tension_offset = 0.0_wp !< its offset from the nearest spot's trailing edge (L)
+      !> with &output conductance (lc_observables_conductance): the conductance per unit nominal
+      !> area (sigma/L: S/m^2 with sigma in S/m and L in m), the normal interfacial stiffness
+      !> dp_m/d(Delta) (S/L), whether both iterations converged and their iteration counts
+      logical :: has_conductance = .false.
+      real(wp) :: conductance = 0.0_wp
+      real(wp) :: contact_stiffness = 0.0_wp
+      logical :: conductance_converged = .false.
+      integer :: conductance_iterations = 0
+      integer :: stiffness_iterations = 0
       logical :: converged = .false.
       !> CG or GCR iterations (all inner CG solves for anderson; fine-grid ones for multigrid)
       integer :: iterations = 0
@@ -151,6 +160,11 @@ contains
             & real_scalar('max_principal_x', res%max_principal_x, 'L'), &
             & real_scalar('max_principal_y', res%max_principal_y, 'L')]
       end if
+      if (res%has_conductance) table = [table, real_scalar('conductance', res%conductance, 'sigma/L'), &
+         & real_scalar('contact_stiffness', res%contact_stiffness, 'S/L'), &
+         & integer_scalar('conductance_converged', merge(1, 0, res%conductance_converged)), &
+         & integer_scalar('conductance_iterations', res%conductance_iterations), &
+         & integer_scalar('stiffness_iterations', res%stiffness_iterations)]
       table = [table, real_scalar('normalised_pressure', res%normalised_pressure), &
          & real_scalar('normalised_thickness', res%normalised_thickness)]
       if (present(a_over_a0)) table = [table, real_scalar('a_over_a0', a_over_a0)]

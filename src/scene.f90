@@ -144,6 +144,11 @@ module lc_scene
       !> areal scenes: the Reynolds leakage of the gap (k_eff along x and y, lc_leakage_reynolds)
       logical :: leakage = .false.
       real(wp) :: leakage_tol = 1.0e-6_wp !< relative accuracy of k_eff
+      !> the contact's conductance and normal interfacial stiffness (lc_observables_conductance)
+      logical :: conductance = .false.
+      real(wp) :: conductivity = 1.0_wp   !< sigma of the layer (siemens/L)
+      !> what lies under a layer: 'conducting' (a perfect conductor at the far potential)
+      character(len=max_string) :: conductance_base = 'conducting'
    end type scene_type
 
 contains
@@ -459,6 +464,10 @@ contains
                & ".false. with geometry = 'line' (the Reynolds leakage needs the gap of an areal contact)")
          else if (.not. leakage_tol_allowed(scene%leakage_tol)) then
             call input_error(error, 'output', 'leakage_tol', to_string(scene%leakage_tol), leakage_tol_range)
+         else if (scene%conductance .and. trim(scene%conductance_base) == 'insulating') then
+            call input_error(error, 'output', 'conductance_base', "'insulating'", &
+               & "'conducting' (a layer on an insulating base carries no current from the contact to the far " // &
+               & "potential: its conductance is zero; a half-space has no base)")
          end if
       end associate
    end subroutine check_scene

@@ -96,7 +96,8 @@ BAD = [
      "short_wavelength, rms_gradient, rms_height, amplitude, mode, mode_y, radius, file, dataset, detrend, boundary, "
      "resample"),
     ("&output\n file = 'bad.h5'\n leakag = .true.\n/\n",
-     "allowed variables in &output: file, overwrite, stress, gap_bins, fields, precision, leakage, leakage_tol"),
+     "allowed variables in &output: file, overwrite, stress, gap_bins, fields, precision, leakage, leakage_tol, "
+     "conductance, conductivity, conductance_base"),
     ("&layer\n thickness = -1.0\n/\n", "&layer: thickness"),
     ("&layer\n poisson = 0.7\n/\n", "-1 < poisson <= 0.5"),
     ("&layr\n thickness = 1.0\n/\n", "line 1: unknown namelist group '&layr'"),

@@ -43,7 +43,8 @@ def test_every_row_is_complete():
     """Every variable has a known group, type, use and unit, a meaning and an allowed range;
     the names of /input (and of the keywords) are unique; aliases name a variable of their
     group; the sweep's positions are 1, 2, ..."""
-    units = {"", "1", "L", "S", "T", "L/T", "S or 1/S"}
+    # (siemens/L: the conductivity, S/m with lengths in m; S is the stress unit)
+    units = {"", "1", "L", "S", "T", "L/T", "S or 1/S", "siemens/L"}
     for v in schema.VARIABLES:
         assert v.group in schema.GROUPS and v.type in schema.TYPES, v
         assert v.uses in ("both", "line", "areal") and v.unit in units, v
@@ -259,7 +260,8 @@ def test_the_python_keywords_are_scene_variables():
         names = [p.name for p in inspect.signature(function).parameters.values() if p.kind == p.KEYWORD_ONLY]
         assert set(names) - {"material", "method", "progress"} <= set(schema.by_key()), function
     assert list(lc.sweep.__globals__["PARAMETERS"]) == [
-        "friction", "normalised_pressure", "mean_pressure", "thickness", "poisson", "speed", "hurst", "n", "seed"]
+        "friction", "normalised_pressure", "mean_pressure", "thickness", "poisson", "speed", "hurst", "n", "seed",
+        "substrate_young"]
 
 
 def _outside(variable) -> list[str]:

@@ -196,3 +196,33 @@ def regular_file(filename: str | os.PathLike, what: str) -> str:
                 else "a socket" if _stat.S_ISSOCK(mode) else "not a regular file")
         raise InputError(f"{what} '{path}' is {kind}; allowed: a regular file", 2)
     return path
+
+
+def contact_map(value, name: str) -> np.ndarray:
+    """A contact map given in Python: a non-empty 1D or 2D array of booleans, or of the
+    numbers 0 and 1 (a NaN, a 0.5 or a -1 is not a contact map), as int8 (1 in contact);
+    :class:`InputError` names it."""
+    raw = np.asarray(value)
+    if raw.ndim not in (1, 2) or raw.size == 0 or min(raw.shape) < 2:
+        raise InputError(f"{name}: an array of shape {raw.shape} is not allowed; allowed: a 1D or 2D array of at "
+                         "least 2 points along each axis", 2)
+    if raw.dtype.kind == "b":
+        return raw.astype(np.int8)
+    if raw.dtype.kind not in "iuf":
+        raise InputError(f"{name}: an array of dtype {raw.dtype} is not allowed; allowed: booleans, or 0 and 1", 2)
+    bad = ~((raw == 0) | (raw == 1))
+    if np.any(bad):
+        raise InputError(f"{name}: {int(np.count_nonzero(bad))} values other than 0 and 1 (e.g. "
+                         f"{raw[bad].flat[0]!r}) are not allowed; allowed: booleans, or 0 and 1", 2)
+    return (raw == 1).astype(np.int8)
+
+
+def positive_real(value, name: str, *, infinite: bool = False) -> float:
+    """A real number > 0 (finite unless ``infinite``); :class:`InputError` names it."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = float("nan")
+    if isinstance(value, (bool, np.bool_)) or not (x > 0 and (infinite or np.isfinite(x))):
+        raise _input_error(name, value, "> 0, or Inf" if infinite else "> 0 and finite")
+    return x

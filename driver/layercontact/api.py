@@ -12,7 +12,8 @@ import numpy as np
 
 from . import scene_schema
 from ._library import (_CONSTANTS, HISTORY_CAPACITY, NOT_SET, InputError, LayercontactError,  # noqa: F401
-                       PeriodicityWarning, _check, _lines, _namelist, real_array, regular_file, stack_keywords)
+                       PeriodicityWarning, _check, _input_error, _lines, _namelist, contact_map, grid_points,
+                       periods, positive_real, real_array, regular_file, stack_keywords)
 from .leakage import CoreLeakage
 from .native import core as _core
 
@@ -135,6 +136,14 @@ class LineResult:
     summit_shift: float = 0.0
     normalised_pressure: float = float("nan")
     normalised_thickness: float = float("nan")
+    #: with ``&output conductance``: the conductance per unit nominal area (``conductivity``
+    #: per L, S/m^2 with S/m and m) and the normal interfacial stiffness ``dp_m/dDelta`` (S/L)
+    #: at the solved contact set (docs/theory.md), NaN otherwise
+    conductance: float = float("nan")
+    contact_stiffness: float = float("nan")
+    conductance_converged: bool = True
+    conductance_iterations: int = 0
+    stiffness_iterations: int = 0
     a_over_a0: float | None = None
     companion: "LineResult | None" = field(default=None, repr=False)
 
@@ -172,6 +181,9 @@ def solve_line(
     max_iter: int | None = None,
     memory: int | None = None,
     threads: int | None = None,
+    conductance: bool | None = None,
+    conductivity: float | None = None,
+    conductance_base: str | None = None,
     **stack,
 ) -> LineResult:
     """Solve the sliding line contact of the rigid profile ``heights`` (L, on a uniform
@@ -200,7 +212,11 @@ def solve_line(
     stacks"). ``companion=True`` also solves the frictionless
     problem at the load of this one (its computed mean pressure, whatever the control) and
     sets ``a_over_a0`` and ``companion``. ``stress`` computes ``displacement_x``, ``shear``
-    and the surface stress ``stress_xx`` (one more FFT pair).
+    and the surface stress ``stress_xx`` (one more FFT pair). ``conductance=True`` computes
+    the contact's conductance per unit nominal area (``conductivity``, default 1, per L) and
+    its normal interfacial stiffness ``dp_m/dDelta`` (S/L) at the solved contact set
+    (``conductance``, ``contact_stiffness``; docs/theory.md); ``conductance_base``:
+    ``'conducting'``, the base under a layer at the far potential.
     ``method``: ``'auto'`` (the multigrid method for the frictionless elastic lines it
     applies to from 4096 points on (a thin incompressible one from 262144 points when its
     coarse solve needed more than 20 CG iterations), and surfaces from 1024², constrained CG for other
@@ -241,6 +257,7 @@ def solve_line(
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
         progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
+        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
         **stack_keywords("solve_line", stack))
     runs = _solve_scene(h, {"scene": {"n": h.size, "period": period}, **groups}, areal=False,
                         companion=bool(companion), stress=stress)
@@ -410,6 +427,14 @@ class ArealResult:
     max_principal_stress: float = float("nan")
     max_principal_x: float = float("nan")
     max_principal_y: float = float("nan")
+    #: with ``&output conductance``: the conductance per unit nominal area (``conductivity``
+    #: per L, S/m^2 with S/m and m) and the normal interfacial stiffness ``dp_m/dDelta`` (S/L)
+    #: at the solved contact set (docs/theory.md), NaN otherwise
+    conductance: float = float("nan")
+    contact_stiffness: float = float("nan")
+    conductance_converged: bool = True
+    conductance_iterations: int = 0
+    stiffness_iterations: int = 0
     a_over_a0: float | None = None
     companion: "ArealResult | None" = field(default=None, repr=False)
     #: the Reynolds leakage of the gap computed by the run (``&output leakage = .true.``):
@@ -460,6 +485,9 @@ def solve_areal(
     memory: int | None = None,
     threads: int | None = None,
     stress: bool | None = None,
+    conductance: bool | None = None,
+    conductivity: float | None = None,
+    conductance_base: str | None = None,
     **stack,
 ) -> ArealResult:
     """Solve the sliding contact of the rigid surface ``heights`` (L; a ``(ny, nx)`` array on
@@ -482,6 +510,7 @@ def solve_areal(
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
         progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
+        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
         **stack_keywords("solve_areal", stack))
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
     runs = _solve_scene(np.ascontiguousarray(h).ravel(), {"scene": scene, **groups}, areal=True,
@@ -502,6 +531,45 @@ def surface_fields(pressure, *, period=None, thickness=None, young=None, poisson
     fields = _surface_stress(p, {"n": p.size, "period": period}, thickness, young, poisson, friction,
                              stack_keywords("surface_fields", stack))
     return fields[:, 0].copy(), fields[:, 2].copy()
+
+
+def contact_conductance(contact_mask, period, conductivity, *, thickness=np.inf, tol: float = 1e-10,
+                        max_iter: int = 100000) -> float:
+    """The electrical (or thermal) conductance per unit nominal area of a prescribed contact
+    map: the rigid counter-surface a perfect conductor touching the body where
+    ``contact_mask`` is true (1D: a line of ``period``; 2D ``(ny, nx)``, x = axis 1, with
+    ``period`` one length or a pair ``(period_x, period_y)``), the rest of the surface
+    insulated, and the far field of a half-space (``thickness=np.inf``) or the perfectly
+    conducting base under a layer of ``thickness`` at the other potential. Returns
+    ``conductivity * mean(J)/DeltaV`` (``conductivity`` per length: S/m^2 with S/m and m; a
+    half-space's is the constriction conductance, docs/theory.md). Solved by preconditioned
+    conjugate gradients to a relative ``tol`` on the mean (docs/numerics.md); a solve that
+    does not reach it within ``max_iter`` iterations raises :class:`LayercontactError` with
+    code 3."""
+    mask = contact_map(contact_mask, "contact_mask")
+    if mask.ndim == 1:
+        if np.ndim(period) != 0:
+            raise _input_error("period", period, "one positive length for a line")
+        lx = ly = periods(period)[0]
+        ny, nx = 1, mask.size
+    else:
+        lx, ly = periods(period)
+        ny, nx = mask.shape
+    sigma = positive_real(conductivity, "conductivity")
+    h = positive_real(thickness, "thickness", infinite=True)
+    tol = positive_real(tol, "tol")
+    if not 1e-14 <= tol <= 1e-2:
+        raise _input_error("tol", tol, "1e-14 <= tol <= 1e-2")
+    budget = grid_points(max_iter, "max_iter")
+    if not 1 <= budget <= 10_000_000:
+        raise _input_error("max_iter", max_iter, "1 <= max_iter <= 10000000")
+    value, iterations, converged, stat, errmsg = _core.py_contact_conductance(
+        nx, ny, lx, ly, np.ascontiguousarray(mask).ravel(), h, tol, budget)
+    _check(stat, errmsg)
+    if not converged:
+        raise LayercontactError(f"contact_conductance: not converged to tol = {tol!r} in {iterations} iterations "
+                                "(max_iter)", 3)
+    return sigma * float(value)
 
 
 def _surface_stress(p, scene: dict, thickness, young, poisson, friction, stack: dict) -> np.ndarray:

@@ -295,6 +295,16 @@ VARIABLES: tuple[Variable, ...] = (
              "([leakage.md](leakage.md#leakage-in-the-result))", "scene%leakage"),
     Variable("output", "leakage_tol", "real", "1e-6", "1", "areal", "1e-14 <= leakage_tol <= 1e-2",
              "relative accuracy of `k_eff` (the CG's energy-error stop)", "scene%leakage_tol"),
+    Variable("output", "conductance", "logical", ".false.", "", "both", ".true. or .false.",
+             "compute the contact's electrical (or thermal) conductance and its normal interfacial stiffness "
+             "([theory.md](theory.md#contact-conductance-and-interfacial-stiffness))", "scene%conductance"),
+    Variable("output", "conductivity", "real", "1.0", "siemens/L", "both", "> 0 and finite",
+             "the layer's conductivity `sigma` (S/m with L in m; thermal: W/(m K))", "scene%conductivity",
+             interval="(0, inf)"),
+    Variable("output", "conductance_base", "string", "'conducting'", "", "both",
+             "'conducting' ('insulating' is refused: no current reaches the base)",
+             "what lies under a layer: `'conducting'`, a perfect conductor held at the far potential (a half-space "
+             "has none)", "scene%conductance_base", choices=("conducting", "insulating")),
 )
 
 

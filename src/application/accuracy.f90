@@ -87,6 +87,7 @@ contains
       call set_grid(pilot, first_ppw, wavelengths)
       pilot%solver%tol = 1.0e-4_wp
       pilot%stress = .false.
+      pilot%conductance = .false.
       pilot%gap_bins = 0
       allocate (height(int(pilot%n, kind=8)*pilot%ny))
       call make_profile(pilot, height, error)

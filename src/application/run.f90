@@ -209,6 +209,16 @@ contains
             & ' (|Delta mu| <', resolution, ', the rounding of w'')'
          write (unit, real_fmt) 'total friction mu_c + Delta mu', result%friction
       end if
+      if (result%has_conductance) then
+         write (unit, real_fmt) 'conductance C', result%conductance, '(sigma/L)'
+         write (unit, real_fmt) 'contact stiffness K', result%contact_stiffness, '(S/L)'
+         if (present(companion)) then
+            write (unit, real_fmt) 'conductance C, mu_c = 0', companion%conductance, '(sigma/L)'
+            write (unit, real_fmt) 'contact stiffness K, mu_c = 0', companion%contact_stiffness, '(S/L)'
+         end if
+         if (.not. result%conductance_converged) write (unit, '(2x, a)') &
+            & 'WARNING: the conductance or stiffness iteration did not reach tol'
+      end if
       if (allocated(result%leakage)) then
          write (unit, real_fmt) 'leakage k_eff along x', result%leakage%x%k_eff, '(L^3)'
          write (unit, real_fmt) 'leakage k_eff along y', result%leakage%y%k_eff, '(L^3)'

@@ -1,6 +1,7 @@
 !> The solves of a scene and what is computed from them: the contact solve
 !> (lc_contact_solve), the observables the scene asks for (lc_observables), the Reynolds
-!> leakage of the gap (lc_leakage_reynolds), and the frictionless companion. The
+!> leakage of the gap (lc_leakage_reynolds), the conductance and interfacial stiffness
+!> (lc_observables_conductance), and the frictionless companion. The
 !> executable's run, the Python driver and the resolution pilot all solve through it.
 module lc_application_scene_solve
    use lc_base_kinds, only: wp
@@ -12,6 +13,7 @@ module lc_application_scene_solve
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solve, only: solve_contact
    use lc_observables, only: observe
+   use lc_observables_conductance, only: contact_conductance, contact_stiffness, masked_outcome
    implicit none (type, external)
    private
    public :: solve_scene, solve_runs
@@ -20,7 +22,7 @@ contains
 
    !> Solve `scene` on the profile `height` (flat, x fastest) with Coulomb coefficient
    !> `friction` (the scene's, or 0 for the frictionless companion) and compute its
-   !> observables.
+   !> observables (with &output conductance, the conductance and stiffness too).
    subroutine solve_scene(scene, height, friction, result, error)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in), target :: height(:)
@@ -31,7 +33,30 @@ contains
       call solve_contact(scene, height, friction, result, op, error)
       if (allocated(error)) return
       call observe(scene, op, height, result)
+      if (scene%conductance) call conductance_of(scene, op, result, error)
    end subroutine solve_scene
+
+   !> The conductance and the normal interfacial stiffness at the solved contact set (p > 0),
+   !> each to the scene's tolerance and within its budget of iterations.
+   subroutine conductance_of(scene, op, result, error)
+      type(scene_type), intent(in) :: scene
+      type(compliance_operator), target, intent(inout) :: op
+      type(contact_result), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(masked_outcome) :: conduction, stiffness
+      logical, allocatable :: contact(:)
+      real(wp) :: per_conductivity
+      contact = result%pressure > 0.0_wp
+      call contact_conductance(op%grid, contact, scene%thickness, scene%solver%tol, scene%solver%max_iter, &
+         & scene%solver%threads, per_conductivity, conduction, error)
+      if (allocated(error)) return
+      result%conductance = scene%conductivity*per_conductivity
+      call contact_stiffness(op, contact, scene%solver%tol, scene%solver%max_iter, result%contact_stiffness, stiffness)
+      result%has_conductance = .true.
+      result%conductance_converged = conduction%converged .and. stiffness%converged
+      result%conductance_iterations = conduction%iterations
+      result%stiffness_iterations = stiffness%iterations
+   end subroutine conductance_of
 
    !> The runs the scene asks for: the scene with its Coulomb coefficient and, with
    !> &friction companion, its frictionless companion at the mean pressure the first found

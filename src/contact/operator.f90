@@ -55,6 +55,9 @@ module lc_contact_operator
       !> largest |multiplier| of M and G_eff (L/S): sets the rounding noise of w = G p
       real(wp) :: largest = 0.0_wp
       real(wp) :: inv_n = 1.0_wp            !< 1/n, folded into the multipliers when applied
+      !> the uniform multiplier drop_uniform_mode took out (L/S; 0 while it is in): what a
+      !> response to a change of the load (the contact stiffness) adds back
+      real(wp) :: dropped_uniform = 0.0_wp
       !> C = (1 - nu^2) J*(q_x V) per column mx = 0..nx/2 of the half spectrum (1/S)
       complex(wp), allocatable :: compliance(:)
       !> Fourier preconditioner of the constrained CG: 1/M(k) with half the material's
@@ -221,6 +224,7 @@ contains
       real(wp), intent(out) :: uniform
       uniform = self%metric(1)
       if (uniform == 0.0_wp) return   ! half-space, incompressible layer
+      self%dropped_uniform = self%dropped_uniform + uniform
       self%metric(1) = 0.0_wp
       self%preconditioner(1) = 0.0_wp
       if (self%coupled) self%full(1) = 0.0_wp
