@@ -177,3 +177,48 @@ def test_a_scene_text_with_a_variable_twice_is_refused_from_python():
         lc.scene_namelist("&scene\n period = 1.0\n period_x = 2.0\n/\n&loading\n normalised_pressure = 1.0\n/\n")
     with refused("period_y applies to surfaces only"):
         lc.scene_namelist(period_y=2.0, normalised_pressure=1.0)
+
+
+@pytest.mark.parametrize("heights, word", [
+    (np.ones(64, dtype=complex), "complex"),
+    (np.ones(64, dtype=bool), "boolean"),
+    (np.full(64, np.inf), "NaN or infinite"),
+    (np.ones((8, 8)), "solve_areal"),
+])
+def test_solve_line_refuses_what_is_not_a_real_profile(heights, word):
+    with refused(word) as err:
+        lc.solve_line(heights, mean_pressure=0.01)
+    assert err.value.code == 2
+
+
+@pytest.mark.parametrize("heights, period, word", [
+    (np.ones((8, 8), dtype=complex), 1.0, "complex"),
+    (np.ones((8, 8), dtype=bool), 1.0, "boolean"),
+    (np.ones(64), 1.0, "shape"),
+    (np.zeros((8, 8)), (1.0,), "period"),
+    (np.zeros((8, 8)), (1.0, 0.0), "period"),
+])
+def test_solve_areal_refuses_what_is_not_a_real_surface_or_its_periods(heights, period, word):
+    with refused(word) as err:
+        lc.solve_areal(heights, period=period, mean_pressure=0.01)
+    assert err.value.code == 2
+
+
+def test_a_surface_larger_than_the_memory_allowed_is_an_error_not_a_crash():
+    """Under an address-space limit of 1 GiB a 16384² surface (2 GiB of heights) cannot be
+    made: the interpreter gets code 5 and goes on."""
+    import subprocess
+    import sys
+    script = """
+import resource
+resource.setrlimit(resource.RLIMIT_AS, (2**30, 2**30))
+import layercontact as lc
+try:
+    lc.self_affine_surface(16384)
+except lc.LayercontactError as error:
+    print("code", error.code)
+print("alive", lc.self_affine_surface(16).shape)
+"""
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "code 5" in proc.stdout and "alive (16, 16)" in proc.stdout

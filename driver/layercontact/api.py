@@ -249,9 +249,10 @@ def solve_line(
     terminal, not in a notebook cell.
     A run that did not reach ``tol`` returns with ``converged = False``.
     """
-    h = np.ascontiguousarray(np.asarray(heights, dtype=np.float64))
-    if h.ndim != 1:
-        raise ValueError("heights must be one-dimensional (line contact); use solve_areal for a surface")
+    if np.ndim(heights) == 2:
+        raise InputError("heights: a 2D array is not allowed; allowed: a 1D profile (use solve_areal for a "
+                         "surface)", 2)
+    h = np.ascontiguousarray(real_array(heights, "heights", ndim=(1,)))
     groups = _keyword_groups(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
@@ -500,11 +501,9 @@ def solve_areal(
     half-space. Every other keyword, the stack keywords included, means what it means for
     :func:`solve_line`, with the same defaults.
     """
-    h = np.asarray(heights, dtype=np.float64)
-    if h.ndim != 2:
-        raise ValueError(f"heights must be a (ny, nx) array for an areal contact; got shape {h.shape}")
+    h = real_array(heights, "heights", ndim=(2,))
     ny, nx = h.shape
-    lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    lx, ly = (period, None) if period is None or np.ndim(period) == 0 else periods(period)
     groups = _keyword_groups(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
@@ -604,11 +603,11 @@ def surface_stress(pressure, *, period=None, thickness=None, young=None, poisson
     period_y)``; the keywords and their defaults are those of :func:`solve_areal`."""
     p = real_array(pressure, "pressure", ndim=(1, 2))
     if p.ndim == 1:
-        lx = period if np.ndim(period) == 0 else float(period[0])
+        lx = period if period is None or np.ndim(period) == 0 else periods(period)[0]
         ux, sxx = surface_fields(p, period=lx, thickness=thickness, young=young, poisson=poisson,
                                  friction=friction, **stack)
         return SurfaceStress(displacement_x=ux, stress_xx=sxx)
-    lx, ly = (period, None) if np.ndim(period) == 0 else (float(period[0]), float(period[1]))
+    lx, ly = (period, None) if period is None or np.ndim(period) == 0 else periods(period)
     ny, nx = p.shape
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
     fields = _surface_stress(np.ascontiguousarray(p).ravel(), scene, thickness, young, poisson, friction,

@@ -164,18 +164,23 @@ def self_affine_surface(
     seed = int(_CONSTANTS["profile/seed"]) if seed is None else seed
     if rms_gradient is None and rms_height is None:
         rms_gradient = float(_CONSTANTS["profile/rms_gradient"])
-    height, stat, errmsg = _core.py_self_affine_surface(
-        nx,
-        ny,
-        lx,
-        ly,
-        float(hurst),
-        int(seed),
-        NOT_SET if rolloff_wavelength is None else float(rolloff_wavelength),
-        NOT_SET if short_wavelength is None else float(short_wavelength),
-        NOT_SET if rms_gradient is None else float(rms_gradient),
-        NOT_SET if rms_height is None else float(rms_height),
-    )
+    try:
+        height, stat, errmsg = _core.py_self_affine_surface(
+            nx,
+            ny,
+            lx,
+            ly,
+            float(hurst),
+            int(seed),
+            NOT_SET if rolloff_wavelength is None else float(rolloff_wavelength),
+            NOT_SET if short_wavelength is None else float(short_wavelength),
+            NOT_SET if rms_gradient is None else float(rms_gradient),
+            NOT_SET if rms_height is None else float(rms_height),
+        )
+    except MemoryError:
+        # (the heights and their half spectrum: 16 bytes a point)
+        raise LayercontactError(f"self_affine_surface: {nx} x {ny} points need about {16*nx*ny/2**30:.1f} GiB, "
+                                "more than this process may allocate; allowed: a smaller grid", 5) from None
     _check(stat, errmsg)
     return height.reshape(ny, nx)
 
