@@ -23,9 +23,10 @@ module lc_contact_operator
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_base_strings, only: to_string
-   use lc_fft_plans, only: fft_plan, fft_threads_available
+   use lc_fft_plans, only: fft_plan
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
+   use lc_base_threads, only: parallel_points, reduction_block, reduction_blocks
    implicit none (type, external)
    private
    public :: compliance_operator, build_operator
@@ -109,12 +110,6 @@ contains
       real(wp), allocatable :: factor(:)
       integer :: i, mx, nkx
 
-      if (threads > 1 .and. .not. fft_threads_available()) then
-         call fatal_error(error, '&solver: threads > 1 needs a build with FFTW threads ' // &
-            & '(meson option -Dopenmp=true, e.g. pip install . -Csetup-args=-Dopenmp=true); allowed here: threads = 1', &
-            & code_input)
-         return
-      end if
       call op%fft%init(grid%nx, grid%ny, threads, error)
       if (allocated(error)) return
       op%grid = grid
@@ -373,28 +368,35 @@ contains
    !> spectrum <- spectrum * multiplier/n, and energy = (1/n) sum over the whole spectrum of
    !> multiplier |spectrum|^2 (the modes of the half spectrum stand for two, q and -q, but
    !> those of each row's columns mx = 0 and, for even nx, mx = nx/2 for one).
-   pure subroutine multiply_with_energy(spectrum, multiplier, inv_n, nkx, even, energy)
+   subroutine multiply_with_energy(spectrum, multiplier, inv_n, nkx, even, energy)
       complex(wp), intent(inout) :: spectrum(:)
       real(wp), intent(in) :: multiplier(:), inv_n
       integer, intent(in) :: nkx
       logical, intent(in) :: even
       real(wp), intent(out) :: energy
       real(wp) :: f, twice, once
-      integer :: m, first, last
+      real(wp) :: block_sums(reduction_blocks(size(spectrum)))
+      integer :: m, first, last, block
       once = 0.0_wp
       do first = 1, size(spectrum), nkx
          once = once + multiplier(first)*inv_n*abs(spectrum(first))**2
          last = first + nkx - 1
          if (even .and. nkx > 1) once = once + multiplier(last)*inv_n*abs(spectrum(last))**2
       end do
-      twice = 0.0_wp
-      !$omp simd reduction(+:twice) private(f)
-      do m = 1, size(spectrum)
-         f = multiplier(m)*inv_n
-         twice = twice + f*(real(spectrum(m), wp)**2 + aimag(spectrum(m))**2)
-         spectrum(m) = spectrum(m)*f
+      !$omp parallel do schedule(static) private(first, last, twice, f) if(size(spectrum) >= parallel_points)
+      do block = 1, size(block_sums)
+         first = (block - 1)*reduction_block + 1
+         last = min(block*reduction_block, size(spectrum))
+         twice = 0.0_wp
+         !$omp simd reduction(+:twice) private(f)
+         do m = first, last
+            f = multiplier(m)*inv_n
+            twice = twice + f*(real(spectrum(m), wp)**2 + aimag(spectrum(m))**2)
+            spectrum(m) = spectrum(m)*f
+         end do
+         block_sums(block) = twice
       end do
-      energy = 2.0_wp*twice - once
+      energy = 2.0_wp*sum(block_sums) - once
    end subroutine multiply_with_energy
 
    !> fft%real_buffer <- P fft%real_buffer with the preconditioner P (see metric_in_buffer).
@@ -456,8 +458,14 @@ contains
    subroutine multiply_complex_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
       complex(wp), intent(in) :: multiplier(:)
+      integer :: m
       call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
+      associate (spectrum => self%fft%spectrum, inv_n => self%inv_n)
+         !$omp parallel do simd schedule(static) if(size(spectrum) >= parallel_points)
+         do m = 1, size(spectrum)
+            spectrum(m) = spectrum(m)*(multiplier(m)*inv_n)
+         end do
+      end associate
       call self%fft%backward()
    end subroutine multiply_complex_in_buffer
 
@@ -475,8 +483,14 @@ contains
    subroutine multiply_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(in) :: multiplier(:)
+      integer :: m
       call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
+      associate (spectrum => self%fft%spectrum, inv_n => self%inv_n)
+         !$omp parallel do simd schedule(static) if(size(spectrum) >= parallel_points)
+         do m = 1, size(spectrum)
+            spectrum(m) = spectrum(m)*(multiplier(m)*inv_n)
+         end do
+      end associate
       call self%fft%backward()
    end subroutine multiply_in_buffer
 

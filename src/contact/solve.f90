@@ -29,6 +29,7 @@ module lc_contact_solve
    use lc_contact_solver_multigrid, only: allowed_rise
    use lc_contact_progress, only: progress_log
    use lc_base_memory, only: check_memory
+   use lc_base_threads, only: solve_threads, use_threads, active_threads
    implicit none (type, external)
    private
    public :: solve_contact, scene_mean_pressure
@@ -82,6 +83,9 @@ contains
       integer :: n
 
       call system_clock(start, rate)
+      call solve_threads(scene%solver%threads, result%omp_threads, error)
+      if (allocated(error)) return
+      call use_threads(result%omp_threads)
       call progress%begin(scene%solver%verbose)
       grid = grid_of(scene)
       kernel = kernel_of(scene)
@@ -181,7 +185,7 @@ contains
 
       ! (the operator first: which methods run depends on it, and refusals come before any
       ! coarse solve)
-      call build_operator(op, grid, kernel, friction, scene%solver%threads, error)
+      call build_operator(op, grid, kernel, friction, active_threads(), error)
       if (allocated(error)) return
       indicators = measure_problem(op, scene%solver%method, load_control)
       call plan_solve(indicators, scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid), plan, error)

@@ -30,6 +30,7 @@ module lc_contact_solver_gcr
    use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    implicit none (type, external)
    private
    public :: constrained_gcr, gcr_outcome, gcr_solver
@@ -342,43 +343,62 @@ contains
       real(wp), intent(out) :: residual
       real(wp), intent(out) :: norm2   !< sum of gap^2 over the contact set
       real(wp) :: contact, gap_sum, p_sum, w_max, p_max, p_scale, g_scale, g_floor, g, c, inside, check
-      integer :: j
-      contact = 0.0_wp
-      gap_sum = 0.0_wp
-      p_sum = 0.0_wp
+      real(wp) :: sums(3, reduction_blocks(size(p)))
+      integer :: j, block, first, last
       w_max = 0.0_wp
       p_max = 0.0_wp
-      ! (the stores are unconditional: a store under a condition is not vectorised)
-      !$omp simd reduction(+:contact, gap_sum, p_sum) reduction(max:w_max, p_max) private(inside)
-      do j = 1, size(p)
-         p(j) = p(j)*load_scale
-         w(j) = w(j)*load_scale
-         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         contact = contact + inside
-         gap_sum = gap_sum + (w(j) - b(j))*inside
-         p_sum = p_sum + p(j)
-         w_max = max(w_max, abs(w(j)))
-         p_max = max(p_max, p(j))
+      ! (the stores are unconditional: a store under a condition is not vectorised; sums by
+      ! blocks, added in order: the same bits on any number of threads)
+      !$omp parallel do schedule(static) private(first, last, contact, gap_sum, p_sum, inside) &
+      !$omp & reduction(max:w_max, p_max) if(size(p) >= parallel_points)
+      do block = 1, size(sums, 2)
+         call block_range(block, size(p), first, last)
+         contact = 0.0_wp
+         gap_sum = 0.0_wp
+         p_sum = 0.0_wp
+         !$omp simd reduction(+:contact, gap_sum, p_sum) reduction(max:w_max, p_max) private(inside)
+         do j = first, last
+            p(j) = p(j)*load_scale
+            w(j) = w(j)*load_scale
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            contact = contact + inside
+            gap_sum = gap_sum + (w(j) - b(j))*inside
+            p_sum = p_sum + p(j)
+            w_max = max(w_max, abs(w(j)))
+            p_max = max(p_max, p(j))
+         end do
+         sums(:, block) = [contact, gap_sum, p_sum]
       end do
+      contact = sum(sums(1, :))
+      gap_sum = sum(sums(2, :))
+      p_sum = sum(sums(3, :))
       n_contact = nint(contact)
       if (load_control) s = gap_sum/max(contact, 1.0_wp)
       p_scale = 1.0_wp/max(merge(mean_pressure, p_sum/size(p), load_control), tiny(1.0_wp))
       g_scale = 1.0_wp/g_ref
       g_floor = rounding_floor(w_max, b_max, p_max, m_max)
       residual = 0.0_wp
-      check = 0.0_wp
-      norm2 = 0.0_wp
-      !$omp simd reduction(max:residual) reduction(+:check, norm2) private(g, c, inside)
-      do j = 1, size(p)
-         g = w(j) - b(j) - s
-         gap(j) = g
-         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         masked(j) = -g*inside
-         norm2 = norm2 + g*g*inside
-         c = abs(min(p(j)*p_scale, g*g_scale))
-         residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
-         check = check + g + p(j)
+      !$omp parallel do schedule(static) private(first, last, check, norm2, g, c, inside) &
+      !$omp & reduction(max:residual) if(size(p) >= parallel_points)
+      do block = 1, size(sums, 2)
+         call block_range(block, size(p), first, last)
+         check = 0.0_wp
+         norm2 = 0.0_wp
+         !$omp simd reduction(max:residual) reduction(+:check, norm2) private(g, c, inside)
+         do j = first, last
+            g = w(j) - b(j) - s
+            gap(j) = g
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            masked(j) = -g*inside
+            norm2 = norm2 + g*g*inside
+            c = abs(min(p(j)*p_scale, g*g_scale))
+            residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
+            check = check + g + p(j)
+         end do
+         sums(1:2, block) = [check, norm2]
       end do
+      check = sum(sums(1, :))
+      norm2 = sum(sums(2, :))
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
    end subroutine evaluate
 
@@ -387,18 +407,24 @@ contains
       real(wp), contiguous, intent(in) :: p(:), v(:)
       logical, intent(in) :: load_control
       real(wp) :: v_sum, contact, inside
-      integer :: j
+      real(wp) :: sums(2, reduction_blocks(size(p)))
+      integer :: j, block, first, last
       mean = 0.0_wp
       if (.not. load_control) return
-      v_sum = 0.0_wp
-      contact = 0.0_wp
-      !$omp simd reduction(+:v_sum, contact) private(inside)
-      do j = 1, size(p)
-         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         v_sum = v_sum + v(j)*inside
-         contact = contact + inside
+      !$omp parallel do schedule(static) private(first, last, v_sum, contact, inside) if(size(p) >= parallel_points)
+      do block = 1, size(sums, 2)
+         call block_range(block, size(p), first, last)
+         v_sum = 0.0_wp
+         contact = 0.0_wp
+         !$omp simd reduction(+:v_sum, contact) private(inside)
+         do j = first, last
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            v_sum = v_sum + v(j)*inside
+            contact = contact + inside
+         end do
+         sums(:, block) = [v_sum, contact]
       end do
-      mean = v_sum/max(contact, 1.0_wp)
+      mean = sum(sums(1, :))/max(sum(sums(2, :)), 1.0_wp)
    end function set_mean
 
    !> d = z on the contact set, minus its mean there under load control, 0 elsewhere; z
@@ -411,7 +437,7 @@ contains
       real(wp) :: mean, inside
       integer :: j
       mean = set_mean(p, load_control, z)
-      !$omp simd private(inside)
+      !$omp parallel do simd schedule(static) private(inside) if(size(p) >= parallel_points)
       do j = 1, size(p)
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
          d(j) = (z(j) - mean)*inside
@@ -426,27 +452,38 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(out) :: centre, norm
       real(wp) :: v2_sum, inside, x
-      integer :: j
+      real(wp) :: sums(reduction_blocks(size(p)))
+      integer :: j, block, first, last
       centre = set_mean(p, load_control, v)
-      v2_sum = 0.0_wp
-      !$omp simd reduction(+:v2_sum) private(inside, x)
-      do j = 1, size(p)
-         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         x = (v(j) - centre)*inside
-         v2_sum = v2_sum + x*x
+      !$omp parallel do schedule(static) private(first, last, v2_sum, inside, x) if(size(p) >= parallel_points)
+      do block = 1, size(sums)
+         call block_range(block, size(p), first, last)
+         v2_sum = 0.0_wp
+         !$omp simd reduction(+:v2_sum) private(inside, x)
+         do j = first, last
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            x = (v(j) - centre)*inside
+            v2_sum = v2_sum + x*x
+         end do
+         sums(block) = v2_sum
       end do
-      norm = sqrt(v2_sum)
+      norm = sqrt(sum(sums))
    end subroutine set_norm
 
    !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
    !> (The stored images are centred on the set, so the mean of a need not be removed.)
-   pure subroutine history_products(images, p, a, coeff)
+   subroutine history_products(images, p, a, coeff)
       real(wp), intent(in) :: images(:, :), p(:), a(:)
       real(wp), intent(out) :: coeff(:)
       real(wp) :: c
-      integer :: i, i0, i1, k
-      coeff = 0.0_wp
-      do i0 = 1, size(a), block_rows
+      real(wp), allocatable :: partial(:, :)
+      integer :: i, i0, i1, k, block
+      ! (each block's products apart, then added block by block in order: the same bits on
+      ! any number of threads)
+      allocate (partial(size(coeff), (size(a) + block_rows - 1)/block_rows))
+      !$omp parallel do schedule(static) private(i0, i1, k, c) if(size(a) >= parallel_points)
+      do block = 1, size(partial, 2)
+         i0 = (block - 1)*block_rows + 1
          i1 = min(size(a), i0 + block_rows - 1)
          do k = 1, size(coeff)
             c = 0.0_wp
@@ -454,16 +491,21 @@ contains
             do i = i0, i1
                c = c + a(i)*images(i, k)*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
             end do
-            coeff(k) = coeff(k) + c
+            partial(k, block) = c
          end do
+      end do
+      coeff = 0.0_wp
+      do block = 1, size(partial, 2)
+         coeff = coeff + partial(:, block)
       end do
    end subroutine history_products
 
    !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks.
-   pure subroutine subtract_history(dirs, images, coeff, d, a)
+   subroutine subtract_history(dirs, images, coeff, d, a)
       real(wp), intent(in) :: dirs(:, :), images(:, :), coeff(:)
       real(wp), intent(inout) :: d(:), a(:)
       integer :: i, i0, i1, k
+      !$omp parallel do schedule(static) private(i1, k) if(size(a) >= parallel_points)
       do i0 = 1, size(a), block_rows
          i1 = min(size(a), i0 + block_rows - 1)
          do k = 1, size(coeff)
@@ -484,17 +526,24 @@ contains
       real(wp), intent(in) :: centre, norm
       real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
       real(wp), intent(out) :: alpha
-      real(wp) :: scale, inside
-      integer :: j
+      real(wp) :: scale, inside, partial
+      real(wp) :: sums(reduction_blocks(size(p)))
+      integer :: j, block, first, last
       scale = 1.0_wp/norm
-      alpha = 0.0_wp
-      !$omp simd reduction(+:alpha) private(inside)
-      do j = 1, size(p)
-         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         d_unit(j) = d(j)*scale
-         a_unit(j) = (a(j) - centre)*scale
-         alpha = alpha - gap(j)*a_unit(j)*inside
+      !$omp parallel do schedule(static) private(first, last, partial, inside) if(size(p) >= parallel_points)
+      do block = 1, size(sums)
+         call block_range(block, size(p), first, last)
+         partial = 0.0_wp
+         !$omp simd reduction(+:partial) private(inside)
+         do j = first, last
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            d_unit(j) = d(j)*scale
+            a_unit(j) = (a(j) - centre)*scale
+            partial = partial - gap(j)*a_unit(j)*inside
+         end do
+         sums(block) = partial
       end do
+      alpha = sum(sums)
    end subroutine normalised_step
 
    !> One pass: p <- p + alpha d and w <- w + alpha a; points out of contact with a negative
@@ -510,27 +559,36 @@ contains
       integer, intent(out) :: n_clipped
       logical, intent(out) :: entered
       real(wp), intent(out) :: p_sum
-      real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count
-      integer :: j
+      real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count, partial
+      real(wp) :: sums(reduction_blocks(size(p)))
+      integer :: j, block, first, last
+      ! (the counts are exact in any order; the sum of p by blocks, added in order)
       clip_count = 0.0_wp
       enter_count = 0.0_wp
       changed_count = 0.0_wp
-      p_sum = 0.0_wp
-      !$omp simd reduction(+:clip_count, enter_count, changed_count, p_sum) private(trial, p_new, c)
-      do j = 1, size(p)
-         trial = p(j) + alpha*d(j)   ! (d = 0 off the contact set)
-         ! let in: out of contact (p = 0) and overlapping
-         c = merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp)*merge(1.0_wp, 0.0_wp, gap(j) < 0.0_wp)
-         p_new = c*max(-let_in_scale*gap(j), 0.0_wp) + (1.0_wp - c)*trial
-         enter_count = enter_count + c*merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
-         clip_count = clip_count + merge(1.0_wp, 0.0_wp, p_new < 0.0_wp)
-         p_new = merge(p_new, 0.0_wp, p_new >= 0.0_wp)   ! clip (a NaN too)
-         w(j) = w(j) + alpha*a(j)
-         delta(j) = p_new - trial
-         changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
-         p(j) = p_new
-         p_sum = p_sum + p_new
+      !$omp parallel do schedule(static) private(first, last, partial, trial, p_new, c) &
+      !$omp & reduction(+:clip_count, enter_count, changed_count) if(size(p) >= parallel_points)
+      do block = 1, size(sums)
+         call block_range(block, size(p), first, last)
+         partial = 0.0_wp
+         !$omp simd reduction(+:clip_count, enter_count, changed_count, partial) private(trial, p_new, c)
+         do j = first, last
+            trial = p(j) + alpha*d(j)   ! (d = 0 off the contact set)
+            ! let in: out of contact (p = 0) and overlapping
+            c = merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp)*merge(1.0_wp, 0.0_wp, gap(j) < 0.0_wp)
+            p_new = c*max(-let_in_scale*gap(j), 0.0_wp) + (1.0_wp - c)*trial
+            enter_count = enter_count + c*merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
+            clip_count = clip_count + merge(1.0_wp, 0.0_wp, p_new < 0.0_wp)
+            p_new = merge(p_new, 0.0_wp, p_new >= 0.0_wp)   ! clip (a NaN too)
+            w(j) = w(j) + alpha*a(j)
+            delta(j) = p_new - trial
+            changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
+            p(j) = p_new
+            partial = partial + p_new
+         end do
+         sums(block) = partial
       end do
+      p_sum = sum(sums)
       n_changed = nint(changed_count)
       n_clipped = nint(clip_count)
       entered = enter_count > 0.0_wp
@@ -561,7 +619,7 @@ contains
       real(wp) :: count_negative
       integer :: j
       count_negative = 0.0_wp
-      !$omp simd reduction(+:count_negative)
+      !$omp parallel do simd schedule(static) reduction(+:count_negative) if(size(p) >= parallel_points)
       do j = 1, size(p)
          delta(j) = merge(-p(j), 0.0_wp, p(j) < 0.0_wp)
          count_negative = count_negative + merge(1.0_wp, 0.0_wp, p(j) < 0.0_wp)
@@ -580,10 +638,10 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: dirs(:, :), images(:, :)
       integer, intent(inout) :: columns, newest
-      real(wp), allocatable :: gram(:, :), sums(:), centre(:), length(:)
+      real(wp), allocatable :: gram(:, :), sums(:), centre(:), length(:), block_gram(:, :, :), block_sums(:, :)
       integer, allocatable :: order(:)
       real(wp) :: contact, x
-      integer :: i, i0, i1, k, l, m, info
+      integer :: i, i0, i1, k, l, m, info, block
 
       m = columns
       ! oldest first
@@ -592,14 +650,18 @@ contains
          order(k) = modulo(newest - m + k - 1, size(dirs, 2)) + 1
       end do
       allocate (gram(m, m), sums(m), centre(m), length(m))
-      gram = 0.0_wp
-      sums = 0.0_wp
       contact = count(p > 0.0_wp)
-      do i0 = 1, size(p), block_rows
+      ! (each block of rows apart, then added block by block in order: the same bits on any
+      ! number of threads)
+      allocate (block_gram(m, m, (size(p) + block_rows - 1)/block_rows), block_sums(m, (size(p) + block_rows - 1)/block_rows))
+      !$omp parallel do schedule(static) private(i0, i1, k, l, x) if(size(p) >= parallel_points)
+      do block = 1, size(block_gram, 3)
+         i0 = (block - 1)*block_rows + 1
          i1 = min(size(p), i0 + block_rows - 1)
          do k = 1, m
+            block_sums(k, block) = 0.0_wp
             do i = i0, i1
-               if (p(i) > 0.0_wp) sums(k) = sums(k) + images(i, order(k))
+               if (p(i) > 0.0_wp) block_sums(k, block) = block_sums(k, block) + images(i, order(k))
             end do
             do l = 1, k
                x = 0.0_wp
@@ -607,8 +669,16 @@ contains
                do i = i0, i1
                   x = x + images(i, order(k))*images(i, order(l))*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
                end do
-               gram(k, l) = gram(k, l) + x
+               block_gram(k, l, block) = x
             end do
+         end do
+      end do
+      gram = 0.0_wp
+      sums = 0.0_wp
+      do block = 1, size(block_gram, 3)
+         do k = 1, m
+            sums(k) = sums(k) + block_sums(k, block)
+            gram(k, 1:k) = gram(k, 1:k) + block_gram(k, 1:k, block)
          end do
       end do
       centre = 0.0_wp
@@ -639,6 +709,7 @@ contains
          return
       end if
       ! forward substitution, row block by row block: new_k = (old_k - sum_{l<k} L(k,l) new_l)/L(k,k)
+      !$omp parallel do schedule(static) private(i1, k, l) if(size(p) >= parallel_points)
       do i0 = 1, size(p), block_rows
          i1 = min(size(p), i0 + block_rows - 1)
          do k = 1, m
