@@ -17,6 +17,7 @@ module lc_contact_solver_cg
    use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
    implicit none (type, external)
    private
@@ -262,27 +263,42 @@ contains
       real(wp), contiguous, intent(out) :: d(:)
       type(grid_sums), intent(out) :: sums
       real(wp) :: contact, d_contact, b_contact, w_max, p_max, p_sum, inside, pj, wj
-      integer :: j
+      real(wp) :: block_sums(4, reduction_blocks(size(p)))
+      integer :: j, block, first, last
       contact = 0.0_wp
       d_contact = 0.0_wp
       b_contact = 0.0_wp
       w_max = 0.0_wp
       p_max = 0.0_wp
       p_sum = 0.0_wp
-      !$omp simd reduction(+:contact, d_contact, b_contact, p_sum) reduction(max:w_max, p_max) private(inside, pj, wj)
-      do j = 1, size(p)
-         pj = p(j)*load_scale
-         wj = w(j)*load_scale
-         p(j) = pj
-         d(j) = wj - b(j)
-         inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
-         contact = contact + inside
-         d_contact = d_contact + d(j)*inside
-         b_contact = b_contact + b(j)*inside
-         w_max = max(w_max, abs(wj))
-         p_max = max(p_max, pj)
-         p_sum = p_sum + pj
+      !$omp parallel do schedule(static) private(first, last, contact, d_contact, b_contact, p_sum, inside, pj, wj) &
+      !$omp & reduction(max:w_max, p_max) if(size(p) >= parallel_points)
+      do block = 1, size(block_sums, 2)
+         call block_range(block, size(p), first, last)
+         contact = 0.0_wp
+         d_contact = 0.0_wp
+         b_contact = 0.0_wp
+         p_sum = 0.0_wp
+         !$omp simd reduction(+:contact, d_contact, b_contact, p_sum) reduction(max:w_max, p_max) private(inside, pj, wj)
+         do j = first, last
+            pj = p(j)*load_scale
+            wj = w(j)*load_scale
+            p(j) = pj
+            d(j) = wj - b(j)
+            inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
+            contact = contact + inside
+            d_contact = d_contact + d(j)*inside
+            b_contact = b_contact + b(j)*inside
+            w_max = max(w_max, abs(wj))
+            p_max = max(p_max, pj)
+            p_sum = p_sum + pj
+         end do
+         block_sums(:, block) = [contact, d_contact, b_contact, p_sum]
       end do
+      contact = sum(block_sums(1, :))
+      d_contact = sum(block_sums(2, :))
+      b_contact = sum(block_sums(3, :))
+      p_sum = sum(block_sums(4, :))
       sums = grid_sums(contact, d_contact, b_contact, w_max, p_max, p_sum)
    end subroutine fresh_state
 
@@ -309,25 +325,36 @@ contains
       real(wp), intent(out) :: gnorm, residual
       real(wp), contiguous, intent(inout) :: masked_gap(:)
       real(wp) :: check, g, c, inside, pj, dj, shift
-      integer :: j
+      real(wp) :: block_sums(2, reduction_blocks(size(p)))
+      integer :: j, block, first, last
       shift = load_scale - 1.0_wp
       residual = 0.0_wp
       gnorm = 0.0_wp
       check = 0.0_wp
-      !$omp simd reduction(max:residual) reduction(+:gnorm, check) private(g, c, inside, pj, dj)
-      do j = 1, size(p)
-         pj = p(j)*load_scale
-         dj = d(j)*load_scale + shift*b(j)
-         p(j) = pj
-         d(j) = dj
-         g = dj - s
-         inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
-         c = abs(min(pj*p_scale, g*g_scale))
-         residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
-         gnorm = gnorm + g*g*inside
-         masked_gap(j) = g*inside
-         check = check + g + pj
+      !$omp parallel do schedule(static) private(first, last, gnorm, check, g, c, inside, pj, dj) &
+      !$omp & reduction(max:residual) if(size(p) >= parallel_points)
+      do block = 1, size(block_sums, 2)
+         call block_range(block, size(p), first, last)
+         gnorm = 0.0_wp
+         check = 0.0_wp
+         !$omp simd reduction(+:gnorm, check) reduction(max:residual) private(g, c, inside, pj, dj)
+         do j = first, last
+            pj = p(j)*load_scale
+            dj = d(j)*load_scale + shift*b(j)
+            p(j) = pj
+            d(j) = dj
+            g = dj - s
+            inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
+            c = abs(min(pj*p_scale, g*g_scale))
+            residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
+            gnorm = gnorm + g*g*inside
+            masked_gap(j) = g*inside
+            check = check + g + pj
+         end do
+         block_sums(:, block) = [gnorm, check]
       end do
+      gnorm = sum(block_sums(1, :))
+      check = sum(block_sums(2, :))
       ! a NaN or Inf gap or pressure (which max() may skip) makes the sum non-finite:
       ! count it as infinitely wrong
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
@@ -340,17 +367,29 @@ contains
       real(wp), intent(in) :: s
       real(wp), intent(out) :: gz_sum, z_mean
       real(wp) :: z_sum, contact, inside
-      integer :: j
+      real(wp) :: block_sums(3, reduction_blocks(size(p)))
+      integer :: j, block, first, last
       gz_sum = 0.0_wp
       z_sum = 0.0_wp
       contact = 0.0_wp
-      !$omp simd reduction(+:gz_sum, z_sum, contact) private(inside)
-      do j = 1, size(p)
-         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         gz_sum = gz_sum + (d(j) - s)*z(j)*inside
-         z_sum = z_sum + z(j)*inside
-         contact = contact + inside
+      !$omp parallel do schedule(static) private(first, last, gz_sum, z_sum, contact, inside) if(size(p) >= parallel_points)
+      do block = 1, size(block_sums, 2)
+         call block_range(block, size(p), first, last)
+         gz_sum = 0.0_wp
+         z_sum = 0.0_wp
+         contact = 0.0_wp
+         !$omp simd reduction(+:gz_sum, z_sum, contact) private(inside)
+         do j = first, last
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            gz_sum = gz_sum + (d(j) - s)*z(j)*inside
+            z_sum = z_sum + z(j)*inside
+            contact = contact + inside
+         end do
+         block_sums(:, block) = [gz_sum, z_sum, contact]
       end do
+      gz_sum = sum(block_sums(1, :))
+      z_sum = sum(block_sums(2, :))
+      contact = sum(block_sums(3, :))
       z_mean = z_sum/max(contact, 1.0_wp)
    end subroutine preconditioned_products
 
@@ -364,23 +403,33 @@ contains
       real(wp), contiguous, intent(inout) :: t(:), buffer(:)
       real(wp), intent(out) :: gt_sum, t_sum
       real(wp) :: g, e, tj, inside, from_z
-      integer :: j
+      real(wp) :: block_sums(2, reduction_blocks(size(p)))
+      integer :: j, block, first, last
       gt_sum = 0.0_wp
       t_sum = 0.0_wp
       ! a 0/1 weight rather than a branch, which would keep the loop from being vectorised
       ! (without the preconditioner the buffer holds the masked gap: finite)
       from_z = merge(1.0_wp, 0.0_wp, preconditioned)
-      !$omp simd reduction(+:gt_sum, t_sum) private(g, e, tj, inside)
-      do j = 1, size(p)
-         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         g = d(j) - s
-         e = from_z*(buffer(j) - z_mean) + (1.0_wp - from_z)*g
-         tj = (e + beta*(t(j) - t_shift))*inside
-         t(j) = tj
-         buffer(j) = tj
-         gt_sum = gt_sum + g*tj
-         t_sum = t_sum + tj
+      !$omp parallel do schedule(static) private(first, last, gt_sum, t_sum, g, e, tj, inside) if(size(p) >= parallel_points)
+      do block = 1, size(block_sums, 2)
+         call block_range(block, size(p), first, last)
+         gt_sum = 0.0_wp
+         t_sum = 0.0_wp
+         !$omp simd reduction(+:gt_sum, t_sum) private(g, e, tj, inside)
+         do j = first, last
+            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+            g = d(j) - s
+            e = from_z*(buffer(j) - z_mean) + (1.0_wp - from_z)*g
+            tj = (e + beta*(t(j) - t_shift))*inside
+            t(j) = tj
+            buffer(j) = tj
+            gt_sum = gt_sum + g*tj
+            t_sum = t_sum + tj
+         end do
+         block_sums(:, block) = [gt_sum, t_sum]
       end do
+      gt_sum = sum(block_sums(1, :))
+      t_sum = sum(block_sums(2, :))
    end subroutine new_direction
 
    !> One pass: p <- p - tau t clipped at zero, overlapping points (p = 0, g < 0) let in,
@@ -403,7 +452,8 @@ contains
       logical, intent(out) :: entered
       real(wp) :: contact, d_contact, b_contact, p_sum, changed_count, entered_count
       real(wp) :: trial, p_new, d_new, g, c, inside, left, reenter_weight
-      integer :: j
+      real(wp) :: block_sums(7, reduction_blocks(size(p)))
+      integer :: j, block, first, last
       contact = 0.0_wp
       d_contact = 0.0_wp
       b_contact = 0.0_wp
@@ -412,34 +462,54 @@ contains
       entered_count = 0.0_wp
       t_left = 0.0_wp
       reenter_weight = merge(1.0_wp, 0.0_wp, reenter)
-      !$omp simd reduction(+:contact, d_contact, b_contact, p_sum, changed_count, entered_count, t_left) &
-      !$omp& private(trial, p_new, d_new, g, c, inside, left)
-      do j = 1, size(p)
-         ! t = 0 off the contact set, so p - tau t is p there
-         trial = p(j) - tau*t(j)
-         p_new = merge(trial, 0.0_wp, trial >= 0.0_wp)   ! clip (a NaN too)
-         ! let in where p = 0 and g < 0 (g before the step; p after it with `reenter`, before
-         ! it otherwise); max(): once the contact set is
-         ! solved tau is a ratio of rounding noise and may be negative, and a negative
-         ! pressure would never be clipped again
-         g = d(j) - s
-         c = merge(1.0_wp, 0.0_wp, g < 0.0_wp)*(reenter_weight*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp) &
-            & + (1.0_wp - reenter_weight)*merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp))
-         p_new = c*max(-tau*g, 0.0_wp) + (1.0_wp - c)*p_new
-         entered_count = entered_count + c
-         left = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)
-         t_left = t_left + t(j)*left
-         d_new = d(j) - tau*r(j)
-         d(j) = d_new
-         r(j) = p_new - trial
-         changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
-         p(j) = p_new
-         inside = merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
-         contact = contact + inside
-         d_contact = d_contact + d_new*inside
-         b_contact = b_contact + b(j)*inside
-         p_sum = p_sum + p_new
+      !$omp parallel do schedule(static) private(first, last, contact, d_contact, b_contact, p_sum, changed_count) &
+      !$omp & private(entered_count, t_left, trial, p_new, d_new, g, c, inside, left) if(size(p) >= parallel_points)
+      do block = 1, size(block_sums, 2)
+         call block_range(block, size(p), first, last)
+         contact = 0.0_wp
+         d_contact = 0.0_wp
+         b_contact = 0.0_wp
+         p_sum = 0.0_wp
+         changed_count = 0.0_wp
+         entered_count = 0.0_wp
+         t_left = 0.0_wp
+         !$omp simd reduction(+:contact, d_contact, b_contact, p_sum, changed_count, entered_count, t_left) &
+         !$omp & private(trial, p_new, d_new, g, c, inside, left)
+         do j = first, last
+            ! t = 0 off the contact set, so p - tau t is p there
+            trial = p(j) - tau*t(j)
+            p_new = merge(trial, 0.0_wp, trial >= 0.0_wp)   ! clip (a NaN too)
+            ! let in where p = 0 and g < 0 (g before the step; p after it with `reenter`, before
+            ! it otherwise); max(): once the contact set is
+            ! solved tau is a ratio of rounding noise and may be negative, and a negative
+            ! pressure would never be clipped again
+            g = d(j) - s
+            c = merge(1.0_wp, 0.0_wp, g < 0.0_wp)*(reenter_weight*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp) &
+               & + (1.0_wp - reenter_weight)*merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp))
+            p_new = c*max(-tau*g, 0.0_wp) + (1.0_wp - c)*p_new
+            entered_count = entered_count + c
+            left = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)
+            t_left = t_left + t(j)*left
+            d_new = d(j) - tau*r(j)
+            d(j) = d_new
+            r(j) = p_new - trial
+            changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
+            p(j) = p_new
+            inside = merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
+            contact = contact + inside
+            d_contact = d_contact + d_new*inside
+            b_contact = b_contact + b(j)*inside
+            p_sum = p_sum + p_new
+         end do
+         block_sums(:, block) = [contact, d_contact, b_contact, p_sum, changed_count, entered_count, t_left]
       end do
+      contact = sum(block_sums(1, :))
+      d_contact = sum(block_sums(2, :))
+      b_contact = sum(block_sums(3, :))
+      p_sum = sum(block_sums(4, :))
+      changed_count = sum(block_sums(5, :))
+      entered_count = sum(block_sums(6, :))
+      t_left = sum(block_sums(7, :))
       sums%contact = contact
       sums%d_contact = d_contact
       sums%b_contact = b_contact
