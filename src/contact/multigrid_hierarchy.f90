@@ -27,6 +27,7 @@ module lc_contact_multigrid_hierarchy
    use lc_base_errors, only: error_type
    use lc_fft_plans, only: fft_plan
    use lc_contact_operator, only: compliance_operator
+   use lc_base_threads, only: active_threads, parallel_points, reduction_blocks, block_range
    implicit none (type, external)
    private
    interface
@@ -611,18 +612,27 @@ contains
    end subroutine apply_stiffness
 
    !> y = buffer + f and x.buffer in one pass (see copy)
-   pure subroutine read_out(buffer, x, f, y, dot)
+   subroutine read_out(buffer, x, f, y, dot)
       real(wp), contiguous, intent(in) :: buffer(:), x(:)
       real(wp), intent(in) :: f
       real(wp), contiguous, intent(out) :: y(:)
       real(wp), intent(out) :: dot
-      integer :: j
-      dot = 0.0_wp
-      !$omp simd reduction(+:dot)
-      do j = 1, size(x)
-         dot = dot + x(j)*buffer(j)
-         y(j) = buffer(j) + f
+      real(wp) :: partial
+      real(wp) :: block_sums(reduction_blocks(size(x)))
+      integer :: j, block, first, last
+      ! (by blocks, added in order: the same bits on any number of threads)
+      !$omp parallel do schedule(static) private(first, last, partial) if(size(x) >= parallel_points)
+      do block = 1, size(block_sums)
+         call block_range(block, size(x), first, last)
+         partial = 0.0_wp
+         !$omp simd reduction(+:partial)
+         do j = first, last
+            partial = partial + x(j)*buffer(j)
+            y(j) = buffer(j) + f
+         end do
+         block_sums(block) = partial
       end do
+      dot = sum(block_sums)
    end subroutine read_out
 
    !> The buffer of level t times its circulant, counted in pairs of the finest grid.
@@ -633,10 +643,12 @@ contains
       associate (lv => h%level(t))
       call lv%fft%forward_unscaled()
       if (h%complex) then
+         !$omp parallel do simd schedule(static) if(lv%n >= parallel_points)
          do k = 1, size(lv%symbol)
             lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%cmultiplier(k)
          end do
       else
+         !$omp parallel do simd schedule(static) if(lv%n >= parallel_points)
          do k = 1, size(lv%symbol)
             lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%multiplier(k)
          end do
@@ -705,12 +717,13 @@ contains
    end subroutine add_masked
 
    !> Along x, row by row: coarse(i) = fine(2i - 1) + (fine(2i) + fine(2i - 2))/2.
-   pure subroutine restrict_x(fine, coarse, nx, ny)
+   subroutine restrict_x(fine, coarse, nx, ny)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: fine(nx, ny)
       real(wp), intent(out) :: coarse(nx/2, ny)
       integer :: i, j, m
       m = nx/2
+      !$omp parallel do schedule(static) private(i) if(nx*ny >= parallel_points)
       do j = 1, ny
          coarse(1, j) = fine(1, j) + 0.5_wp*(fine(2, j) + fine(2*m, j))
          do i = 2, m
@@ -720,13 +733,14 @@ contains
    end subroutine restrict_x
 
    !> Along y: the same for the rows.
-   pure subroutine restrict_y(fine, coarse, nx, ny)
+   subroutine restrict_y(fine, coarse, nx, ny)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: fine(nx, ny)
       real(wp), intent(out) :: coarse(nx, ny/2)
       integer :: j, m
       m = ny/2
       coarse(:, 1) = fine(:, 1) + 0.5_wp*(fine(:, 2) + fine(:, 2*m))
+      !$omp parallel do schedule(static) if(nx*ny >= parallel_points)
       do j = 2, m
          coarse(:, j) = fine(:, 2*j - 1) + 0.5_wp*(fine(:, 2*j) + fine(:, 2*j - 2))
       end do
@@ -734,7 +748,7 @@ contains
 
    !> Along x, row by row: fine <- fine + P coarse, masked by `free` if given; with `base`
    !> (and free), fine <- scale base + free P coarse.
-   pure subroutine prolong_x_add(coarse, fine, nx, ny, free, base, scale)
+   subroutine prolong_x_add(coarse, fine, nx, ny, free, base, scale)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: coarse(nx/2, ny)
       real(wp), intent(inout) :: fine(nx, ny)
@@ -744,6 +758,7 @@ contains
       ! (the last point of a row, between the last coarse point and the first, apart: the
       ! passes over the others then vectorise)
       m = nx/2
+      !$omp parallel do schedule(static) if(nx*ny >= parallel_points)
       do j = 1, ny
          if (present(base)) then
             fine(1:nx:2, j) = scale*base(1:nx:2, j) + free(1:nx:2, j)*coarse(:, j)
@@ -763,12 +778,13 @@ contains
    end subroutine prolong_x_add
 
    !> Along y: fine = P coarse (assigned).
-   pure subroutine prolong_y(coarse, fine, nx, ny)
+   subroutine prolong_y(coarse, fine, nx, ny)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: coarse(nx, ny/2)
       real(wp), intent(out) :: fine(nx, ny)
       integer :: j, m
       m = ny/2
+      !$omp parallel do schedule(static) if(nx*ny >= parallel_points)
       do j = 1, m
          fine(:, 2*j - 1) = coarse(:, j)
          fine(:, 2*j) = 0.5_wp*(coarse(:, j) + coarse(:, mod(j, m) + 1))
@@ -816,7 +832,8 @@ contains
             lv%fft => op%fft
          else
             allocate (lv%plan)
-            call lv%plan%init(lv%nx, lv%ny, 1, error)
+            ! (FFTW's threads on the grids large enough for them to pay)
+            call lv%plan%init(lv%nx, lv%ny, merge(active_threads(), 1, m >= parallel_points), error)
             if (allocated(error)) return
             lv%fft => lv%plan
          end if

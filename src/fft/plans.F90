@@ -169,6 +169,9 @@ contains
       nx = int(self%nx, c_int)
       ny = int(self%ny, c_int)
       nkx = nx/2 + 1
+#ifdef LC_OPENMP
+      call fftw_plan_with_nthreads(int(self%threads, c_int))
+#endif
       self%rows_r2c = fftw_plan_many_dft_r2c(1_c_int, [nx], ny, self%real_buffer, [nx], 1_c_int, nx, &
          & self%spectrum, [nkx], 1_c_int, nkx, FFTW_ESTIMATE)
       self%rows_c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], ny, self%spectrum, [nkx], 1_c_int, nkx, &
