@@ -35,7 +35,9 @@ def openmp_build() -> bool:
     return True
 
 
-needs_openmp = pytest.mark.skipif(not openmp_build(), reason="a build without OpenMP runs one thread")
+#: CI (.ci/run) requires the threads: there these tests fail in a build without OpenMP
+needs_openmp = pytest.mark.skipif(not openmp_build() and not os.environ.get("LAYERCONTACT_REQUIRE_OPENMP"),
+                                  reason="a build without OpenMP runs one thread")
 
 
 def test_a_build_without_openmp_refuses_more_threads():
@@ -99,10 +101,10 @@ def assert_same(one, two, names):
 
 
 FIELDS = ["pressure", "gap", "displacement_z"]
-STRESS = ["displacement_x", "displacement_y", "shear", "stress_xx", "stress_yy", "stress_xy"]
+STRESS = ["displacement_x", "displacement_y", "stress_xx", "stress_yy", "stress_xy"]
 SCALARS = ["mean_pressure", "penetration", "contact_fraction", "delta_mu", "delta_mu_spectral", "dissipated_power",
            "max_tension", "max_principal_stress", "converged", "iterations", "fft_pairs", "residual", "solver",
-           "n_spots", "mean_gap", "leak_rate"]
+           "mean_gap"]
 
 AREAL = """&scene geometry = 'areal', n = {n} /
 &layer thickness = {thickness}, poisson = 0.5 /

@@ -6,7 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# libhypre-dev: the leakage's algebraic multigrid (it brings Open MPI)
+# libhypre-dev: the leakage's algebraic multigrid (it brings Open MPI); the threads of a solve
+# need nothing more: gfortran brings OpenMP (libgomp), libfftw3-dev FFTW's fftw3_omp
 packages=(gfortran libfftw3-dev liblapack-dev libopenblas-dev libhdf5-dev libhypre-dev pkg-config)
 missing=()
 for p in "${packages[@]}"; do
