@@ -40,16 +40,21 @@ needs_openmp = pytest.mark.skipif(not openmp_build() and not os.environ.get("LAY
                                   reason="a build without OpenMP runs one thread")
 
 
+def solve_small_surface(**keywords):
+    """A frictionless 64 x 64 surface (the thread count is decided before the solve)."""
+    h = lc.self_affine_surface(64, 0.8, seed=1, short_wavelength=8 / 64)
+    return lc.solve_areal(h, thickness=0.1, normalised_pressure=0.15, tol=1e-6, stress=False, **keywords)
+
+
 def test_a_build_without_openmp_refuses_more_threads():
     """Without OpenMP, threads = 2 is refused naming the variable; threads = 0 runs one."""
-    h = lc.self_affine_profile(256, 0.8, seed=1, short_wavelength=1 / 32)
     if openmp_build():
-        assert lc.solve_line(h, mean_pressure=0.01, threads=2).omp_threads == 2
+        assert solve_small_surface(threads=2).omp_threads == 2
         return
     with pytest.raises(lc.LayercontactError, match="&solver: threads = 2 needs a build with OpenMP") as err:
-        lc.solve_line(h, mean_pressure=0.01, threads=2)
+        solve_small_surface(threads=2)
     assert err.value.code == 2
-    assert lc.solve_line(h, mean_pressure=0.01, threads=0).omp_threads == 1
+    assert solve_small_surface(threads=0).omp_threads == 1
 
 
 @pytest.mark.parametrize("threads", [-1, 1025])
@@ -63,10 +68,8 @@ def test_thread_counts_out_of_range_are_refused(threads):
 def test_threads_not_given_are_what_the_job_was_given(monkeypatch):
     """threads = 0 (the default): OMP_NUM_THREADS, else SLURM_CPUS_PER_TASK, else the CPUs
     of the affinity mask (not os.cpu_count(): a job confined to some CPUs sees those)."""
-    h = lc.self_affine_profile(256, 0.8, seed=1, short_wavelength=1 / 32)
-
     def threads_used(**keywords):
-        return lc.solve_line(h, mean_pressure=0.01, stress=False, **keywords).omp_threads
+        return solve_small_surface(**keywords).omp_threads
 
     monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
     monkeypatch.delenv("SLURM_CPUS_PER_TASK", raising=False)
@@ -156,9 +159,17 @@ def test_a_large_surface_is_the_same_on_two_threads():
 
 
 @needs_openmp
+def test_a_short_line_runs_on_one_thread():
+    """Below 2^18 points a line's passes and transforms are too short to share (lc_contact_solve's
+    smallest_threaded_line): it runs on one thread whatever is asked."""
+    h = lc.self_affine_profile(2**18 - 2, 0.8, seed=4, short_wavelength=16 / 2**18)
+    assert lc.solve_line(h, mean_pressure=0.01, threads=2, stress=False, tol=1e-6).omp_threads == 1
+
+
+@needs_openmp
 def test_a_line_is_the_same_on_two_threads():
-    """A coupled line (friction on a thin layer) with its stress, 2^16 points."""
-    h = lc.self_affine_profile(2**16, 0.8, seed=4, short_wavelength=16 / 2**16)
+    """A coupled line (friction on a thin layer) with its stress, 2^18 points."""
+    h = lc.self_affine_profile(2**18, 0.8, seed=4, short_wavelength=16 / 2**18)
     one, two = (lc.solve_line(h, thickness=0.05, friction=0.5, normalised_pressure=0.5, tol=1e-8, threads=threads)
                 for threads in (1, 2))
     assert one.converged and two.omp_threads == 2

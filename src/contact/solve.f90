@@ -47,6 +47,9 @@ module lc_contact_solve
    !> are solved to this tolerance instead: the fine grid's iterations do not need a closer
    !> start (docs/numerics.md, "The coarse start").
    real(wp), parameter :: multigrid_coarse_tol = 1.0e-3_wp
+   !> A line of fewer points runs on one thread whatever &solver threads says: its transforms
+   !> and passes are too short for a second thread to pay (docs/decisions/022-threads.md).
+   integer, parameter :: smallest_threaded_line = 262144
 
 contains
 
@@ -85,9 +88,10 @@ contains
       call system_clock(start, rate)
       call solve_threads(scene%solver%threads, result%omp_threads, error)
       if (allocated(error)) return
-      call use_threads(result%omp_threads)
       call progress%begin(scene%solver%verbose)
       grid = grid_of(scene)
+      if (grid%is_line() .and. grid%points() < smallest_threaded_line) result%omp_threads = 1
+      call use_threads(result%omp_threads)
       kernel = kernel_of(scene)
       n = grid%points()
       if (size(height) /= n) then

@@ -9,6 +9,9 @@
 !>    res = max_j | min(p_j/p_ref, gap_j/g_ref) |
 !> (zero exactly at the solution) falls to tol; p_ref = p_m (load control) or the
 !> current mean pressure, g_ref is given by the caller (the profile's peak-to-valley).
+!>
+!> The passes over the grid run on the solve's threads (lc_base_threads); their sums add
+!> blocks of a fixed size in order, so that the iterates do not depend on the thread count.
 module lc_contact_solver_cg
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp
@@ -265,12 +268,8 @@ contains
       real(wp) :: contact, d_contact, b_contact, w_max, p_max, p_sum, inside, pj, wj
       real(wp) :: block_sums(4, reduction_blocks(size(p)))
       integer :: j, block, first, last
-      contact = 0.0_wp
-      d_contact = 0.0_wp
-      b_contact = 0.0_wp
       w_max = 0.0_wp
       p_max = 0.0_wp
-      p_sum = 0.0_wp
       !$omp parallel do schedule(static) private(first, last, contact, d_contact, b_contact, p_sum, inside, pj, wj) &
       !$omp & reduction(max:w_max, p_max) if(size(p) >= parallel_points)
       do block = 1, size(block_sums, 2)
@@ -329,8 +328,6 @@ contains
       integer :: j, block, first, last
       shift = load_scale - 1.0_wp
       residual = 0.0_wp
-      gnorm = 0.0_wp
-      check = 0.0_wp
       !$omp parallel do schedule(static) private(first, last, gnorm, check, g, c, inside, pj, dj) &
       !$omp & reduction(max:residual) if(size(p) >= parallel_points)
       do block = 1, size(block_sums, 2)
@@ -369,9 +366,6 @@ contains
       real(wp) :: z_sum, contact, inside
       real(wp) :: block_sums(3, reduction_blocks(size(p)))
       integer :: j, block, first, last
-      gz_sum = 0.0_wp
-      z_sum = 0.0_wp
-      contact = 0.0_wp
       !$omp parallel do schedule(static) private(first, last, gz_sum, z_sum, contact, inside) if(size(p) >= parallel_points)
       do block = 1, size(block_sums, 2)
          call block_range(block, size(p), first, last)
@@ -405,8 +399,6 @@ contains
       real(wp) :: g, e, tj, inside, from_z
       real(wp) :: block_sums(2, reduction_blocks(size(p)))
       integer :: j, block, first, last
-      gt_sum = 0.0_wp
-      t_sum = 0.0_wp
       ! a 0/1 weight rather than a branch, which would keep the loop from being vectorised
       ! (without the preconditioner the buffer holds the masked gap: finite)
       from_z = merge(1.0_wp, 0.0_wp, preconditioned)
@@ -454,13 +446,6 @@ contains
       real(wp) :: trial, p_new, d_new, g, c, inside, left, reenter_weight
       real(wp) :: block_sums(7, reduction_blocks(size(p)))
       integer :: j, block, first, last
-      contact = 0.0_wp
-      d_contact = 0.0_wp
-      b_contact = 0.0_wp
-      p_sum = 0.0_wp
-      changed_count = 0.0_wp
-      entered_count = 0.0_wp
-      t_left = 0.0_wp
       reenter_weight = merge(1.0_wp, 0.0_wp, reenter)
       !$omp parallel do schedule(static) private(first, last, contact, d_contact, b_contact, p_sum, changed_count) &
       !$omp & private(entered_count, t_left, trial, p_new, d_new, g, c, inside, left) if(size(p) >= parallel_points)

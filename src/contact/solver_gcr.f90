@@ -20,7 +20,8 @@
 !>
 !> The images are stored centred on the contact set under load control: a constant added
 !> to w everywhere only moves s. w is recomputed as G_eff p to confirm convergence, so the
-!> fields returned belong together. Stopping rule and residual as in lc_contact_solver_cg.
+!> fields returned belong together. Stopping rule and residual as in lc_contact_solver_cg,
+!> and the passes over the grid threaded as there.
 module lc_contact_solver_gcr
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp
