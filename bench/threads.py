@@ -2,6 +2,7 @@
 coupled surface and a 2048² frictionless one, each thread count alternately, in one run.
 
     .venv/bin/python bench/threads.py [--n 2048] [--threads 1 2] [--repeats 2]
+    .venv/bin/python bench/threads.py --pairs    # FFT pairs of lines and surfaces only
 
 Scenes: the isotropic self-affine surface of lc.self_affine_surface (H = 0.8, shortest
 wavelength 8 points, rms gradient 0.1, seed 1) on an incompressible layer of
@@ -14,6 +15,10 @@ start's pairs are on grids of a quarter, a sixteenth... of the points; "rest" is
 FFT, the passes over the grid. Ratios are 1 thread over n threads, measured within this
 run. The load average is printed before and after: on a shared machine a second thread
 competes with whatever else runs.
+
+``--pairs`` times one FFT pair of lines of 2^14 .. 2^21 points and surfaces of 256² ..
+2048² on 1 and 2 threads instead (the best of 3 rounds, both thread counts twice,
+alternately): what lc_contact_solve's smallest_threaded_line rests on.
 """
 
 from __future__ import annotations
@@ -28,9 +33,11 @@ from layercontact.native import core as _core
 SCENES = {"coupled": 0.5, "frictionless": 0.0}
 
 
-def pair_seconds(n: int, threads: int) -> float:
-    """One unscaled r2c + c2r pair of an n x n grid on `threads` threads (best of 3 rounds)."""
-    seconds, stat, errmsg = _core.py_grid_fft_pair_seconds(n, n, threads, max(3, 2**24 // (n * n)), 3)
+def pair_seconds(nx: int, threads: int, ny: int | None = None) -> float:
+    """One unscaled r2c + c2r pair of an nx x ny grid (ny = nx by default) on `threads` threads
+    (best of 3 rounds)."""
+    ny = nx if ny is None else ny
+    seconds, stat, errmsg = _core.py_grid_fft_pair_seconds(nx, ny, threads, max(3, 2**22 // (nx * ny)), 3)
     if stat:
         raise SystemExit(errmsg.decode().strip() if isinstance(errmsg, bytes) else str(errmsg).strip())
     return seconds
@@ -40,14 +47,31 @@ def load() -> str:
     return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
+def pairs_table(threads: list[int]) -> None:
+    """One FFT pair per grid on each thread count (alternately, twice; the best kept)."""
+    print("| grid | points | " + " | ".join(f"{t} threads (ms)" for t in threads) + " | ratio |")
+    print("|---|---:|" + "---:|" * len(threads) + "---:|")
+    grids = [(2**k, 1) for k in range(14, 22)] + [(n, n) for n in (256, 512, 1024, 2048)]
+    for nx, ny in grids:
+        best = {t: min(pair_seconds(nx, t, ny) for _ in range(2)) for t in threads}
+        label = f"line {nx}" if ny == 1 else f"{nx}²"
+        print(f"| {label} | {nx * ny} | " + " | ".join(f"{best[t] * 1e3:.2f}" for t in threads)
+              + f" | {best[threads[0]] / best[threads[-1]]:.2f} |", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=2048)
     parser.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--repeats", type=int, default=2, help="solves per scene and thread count (best kept)")
+    parser.add_argument("--pairs", action="store_true", help="time FFT pairs of lines and surfaces only")
     args = parser.parse_args()
     n = args.n
     print(f"load average (1, 5, 15 min) before: {load()}; CPUs of this process: {len(os.sched_getaffinity(0))}")
+    if args.pairs:
+        pairs_table(args.threads)
+        print(f"load average after: {load()}")
+        return
     heights = lc.self_affine_surface(n, 0.8, seed=1, short_wavelength=8 / n)
     pairs_time = {t: pair_seconds(n, t) for t in args.threads}
     best: dict[tuple[str, int], object] = {}
