@@ -258,48 +258,71 @@ contains
    end subroutine constrained_cg
 
    !> One pass after w = M p was computed: p <- load_scale p, d = load_scale w - b, and the
-   !> sums of the state.
+   !> sums of the state (fresh_state_range on the blocks of the grid, on the solve's threads;
+   !> the blocks' sums added in order: the same bits on any number of threads).
    subroutine fresh_state(p, w, b, load_scale, d, sums)
       real(wp), contiguous, intent(inout) :: p(:)
       real(wp), contiguous, intent(in) :: w(:), b(:)
       real(wp), intent(in) :: load_scale
       real(wp), contiguous, intent(out) :: d(:)
       type(grid_sums), intent(out) :: sums
+      type(grid_sums) :: parts(reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(parts)
+         call block_range(block, size(p), first, last)
+         call fresh_state_range(p(first:last), w(first:last), b(first:last), load_scale, d(first:last), parts(block))
+      end do
+      sums = added(parts)
+   end subroutine fresh_state
+
+   !> The sums of the blocks' sums, in order, and the largest of their maxima.
+   pure type(grid_sums) function added(parts) result(sums)
+      type(grid_sums), intent(in) :: parts(:)
+      integer :: block
+      sums = grid_sums()
+      do block = 1, size(parts)
+         sums%contact = sums%contact + parts(block)%contact
+         sums%d_contact = sums%d_contact + parts(block)%d_contact
+         sums%b_contact = sums%b_contact + parts(block)%b_contact
+         sums%p_sum = sums%p_sum + parts(block)%p_sum
+         sums%w_max = max(sums%w_max, parts(block)%w_max)
+         sums%p_max = max(sums%p_max, parts(block)%p_max)
+      end do
+   end function added
+
+   !> One pass after w = M p was computed: p <- load_scale p, d = load_scale w - b, and the
+   !> sums of the state.
+   subroutine fresh_state_range(p, w, b, load_scale, d, sums)
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(in) :: w(:), b(:)
+      real(wp), intent(in) :: load_scale
+      real(wp), contiguous, intent(out) :: d(:)
+      type(grid_sums), intent(out) :: sums
       real(wp) :: contact, d_contact, b_contact, w_max, p_max, p_sum, inside, pj, wj
-      real(wp) :: block_sums(4, reduction_blocks(size(p)))
-      integer :: j, block, first, last
+      integer :: j
+      contact = 0.0_wp
+      d_contact = 0.0_wp
+      b_contact = 0.0_wp
       w_max = 0.0_wp
       p_max = 0.0_wp
-      !$omp parallel do schedule(static) private(first, last, contact, d_contact, b_contact, p_sum, inside, pj, wj) &
-      !$omp & reduction(max:w_max, p_max) if(size(p) >= parallel_points)
-      do block = 1, size(block_sums, 2)
-         call block_range(block, size(p), first, last)
-         contact = 0.0_wp
-         d_contact = 0.0_wp
-         b_contact = 0.0_wp
-         p_sum = 0.0_wp
-         !$omp simd reduction(+:contact, d_contact, b_contact, p_sum) reduction(max:w_max, p_max) private(inside, pj, wj)
-         do j = first, last
-            pj = p(j)*load_scale
-            wj = w(j)*load_scale
-            p(j) = pj
-            d(j) = wj - b(j)
-            inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
-            contact = contact + inside
-            d_contact = d_contact + d(j)*inside
-            b_contact = b_contact + b(j)*inside
-            w_max = max(w_max, abs(wj))
-            p_max = max(p_max, pj)
-            p_sum = p_sum + pj
-         end do
-         block_sums(:, block) = [contact, d_contact, b_contact, p_sum]
+      p_sum = 0.0_wp
+      !$omp simd reduction(+:contact, d_contact, b_contact, p_sum) reduction(max:w_max, p_max) private(inside, pj, wj)
+      do j = 1, size(p)
+         pj = p(j)*load_scale
+         wj = w(j)*load_scale
+         p(j) = pj
+         d(j) = wj - b(j)
+         inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
+         contact = contact + inside
+         d_contact = d_contact + d(j)*inside
+         b_contact = b_contact + b(j)*inside
+         w_max = max(w_max, abs(wj))
+         p_max = max(p_max, pj)
+         p_sum = p_sum + pj
       end do
-      contact = sum(block_sums(1, :))
-      d_contact = sum(block_sums(2, :))
-      b_contact = sum(block_sums(3, :))
-      p_sum = sum(block_sums(4, :))
       sums = grid_sums(contact, d_contact, b_contact, w_max, p_max, p_sum)
-   end subroutine fresh_state
+   end subroutine fresh_state_range
 
    !> The sums of the state after p <- load_scale p, d <- load_scale d + (load_scale - 1) b.
    pure subroutine scale_sums(sums, load_scale)
@@ -312,117 +335,174 @@ contains
       sums%p_sum = load_scale*sums%p_sum
    end subroutine scale_sums
 
-   !> One pass: scale p by load_scale and d so that d + b scales alike, then the
-   !> complementarity residual and the squared norm of the gap g = d - s on the contact set;
-   !> g on the contact set (0 elsewhere) goes into `masked_gap`, the preconditioner's input.
-   !> (The stores are unconditional: a store under a condition keeps the loop from being
-   !> vectorised, which costs more than the stores.)
+   !> evaluate_state_range on the blocks of the grid (see fresh_state).
    subroutine evaluate_state(p, d, b, load_scale, s, p_scale, g_scale, g_floor, gnorm, residual, masked_gap)
       real(wp), contiguous, intent(inout) :: p(:), d(:)
       real(wp), contiguous, intent(in) :: b(:)
       real(wp), intent(in) :: load_scale, s, p_scale, g_scale, g_floor
       real(wp), intent(out) :: gnorm, residual
       real(wp), contiguous, intent(inout) :: masked_gap(:)
+      real(wp) :: gnorms(reduction_blocks(size(p))), residuals(reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(gnorms)
+         call block_range(block, size(p), first, last)
+         call evaluate_state_range(p(first:last), d(first:last), b(first:last), load_scale, s, p_scale, g_scale, &
+            & g_floor, gnorms(block), residuals(block), masked_gap(first:last))
+      end do
+      gnorm = sum(gnorms)
+      residual = maxval(residuals)
+   end subroutine evaluate_state
+
+   !> One pass: scale p by load_scale and d so that d + b scales alike, then the
+   !> complementarity residual and the squared norm of the gap g = d - s on the contact set;
+   !> g on the contact set (0 elsewhere) goes into `masked_gap`, the preconditioner's input.
+   !> (The stores are unconditional: a store under a condition keeps the loop from being
+   !> vectorised, which costs more than the stores.)
+   subroutine evaluate_state_range(p, d, b, load_scale, s, p_scale, g_scale, g_floor, gnorm, residual, masked_gap)
+      real(wp), contiguous, intent(inout) :: p(:), d(:)
+      real(wp), contiguous, intent(in) :: b(:)
+      real(wp), intent(in) :: load_scale, s, p_scale, g_scale, g_floor
+      real(wp), intent(out) :: gnorm, residual
+      real(wp), contiguous, intent(inout) :: masked_gap(:)
       real(wp) :: check, g, c, inside, pj, dj, shift
-      real(wp) :: block_sums(2, reduction_blocks(size(p)))
-      integer :: j, block, first, last
+      integer :: j
       shift = load_scale - 1.0_wp
       residual = 0.0_wp
-      !$omp parallel do schedule(static) private(first, last, gnorm, check, g, c, inside, pj, dj) &
-      !$omp & reduction(max:residual) if(size(p) >= parallel_points)
-      do block = 1, size(block_sums, 2)
-         call block_range(block, size(p), first, last)
-         gnorm = 0.0_wp
-         check = 0.0_wp
-         !$omp simd reduction(+:gnorm, check) reduction(max:residual) private(g, c, inside, pj, dj)
-         do j = first, last
-            pj = p(j)*load_scale
-            dj = d(j)*load_scale + shift*b(j)
-            p(j) = pj
-            d(j) = dj
-            g = dj - s
-            inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
-            c = abs(min(pj*p_scale, g*g_scale))
-            residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
-            gnorm = gnorm + g*g*inside
-            masked_gap(j) = g*inside
-            check = check + g + pj
-         end do
-         block_sums(:, block) = [gnorm, check]
+      gnorm = 0.0_wp
+      check = 0.0_wp
+      !$omp simd reduction(max:residual) reduction(+:gnorm, check) private(g, c, inside, pj, dj)
+      do j = 1, size(p)
+         pj = p(j)*load_scale
+         dj = d(j)*load_scale + shift*b(j)
+         p(j) = pj
+         d(j) = dj
+         g = dj - s
+         inside = merge(1.0_wp, 0.0_wp, pj > 0.0_wp)
+         c = abs(min(pj*p_scale, g*g_scale))
+         residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
+         gnorm = gnorm + g*g*inside
+         masked_gap(j) = g*inside
+         check = check + g + pj
       end do
-      gnorm = sum(block_sums(1, :))
-      check = sum(block_sums(2, :))
       ! a NaN or Inf gap or pressure (which max() may skip) makes the sum non-finite:
       ! count it as infinitely wrong
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
-   end subroutine evaluate_state
+   end subroutine evaluate_state_range
 
    !> One pass over the preconditioned residual z (the buffer after the inverse metric):
-   !> gz_sum = sum g z and z_mean = <z> over the contact set.
+   !> gz_sum = sum g z and z_mean = <z> over the contact set (by blocks: see fresh_state).
    subroutine preconditioned_products(p, d, s, z, gz_sum, z_mean)
       real(wp), contiguous, intent(in) :: p(:), d(:), z(:)
       real(wp), intent(in) :: s
       real(wp), intent(out) :: gz_sum, z_mean
-      real(wp) :: z_sum, contact, inside
-      real(wp) :: block_sums(3, reduction_blocks(size(p)))
-      integer :: j, block, first, last
-      !$omp parallel do schedule(static) private(first, last, gz_sum, z_sum, contact, inside) if(size(p) >= parallel_points)
-      do block = 1, size(block_sums, 2)
+      real(wp) :: parts(3, reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(parts, 2)
          call block_range(block, size(p), first, last)
-         gz_sum = 0.0_wp
-         z_sum = 0.0_wp
-         contact = 0.0_wp
-         !$omp simd reduction(+:gz_sum, z_sum, contact) private(inside)
-         do j = first, last
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            gz_sum = gz_sum + (d(j) - s)*z(j)*inside
-            z_sum = z_sum + z(j)*inside
-            contact = contact + inside
-         end do
-         block_sums(:, block) = [gz_sum, z_sum, contact]
+         call preconditioned_products_range(p(first:last), d(first:last), s, z(first:last), parts(1, block), &
+            & parts(2, block), parts(3, block))
       end do
-      gz_sum = sum(block_sums(1, :))
-      z_sum = sum(block_sums(2, :))
-      contact = sum(block_sums(3, :))
-      z_mean = z_sum/max(contact, 1.0_wp)
+      gz_sum = sum(parts(1, :))
+      z_mean = sum(parts(2, :))/max(sum(parts(3, :)), 1.0_wp)
    end subroutine preconditioned_products
 
-   !> One pass: the new direction t = (e + beta (t - t_shift)) on the contact set (0
-   !> elsewhere), with e = z - z_mean (preconditioned; z in the buffer) or the gap g; t is
-   !> also written into the buffer (the transform's input). gt_sum = sum g t, t_sum = sum t.
+   !> One pass over a block of the preconditioned residual z: gz_sum = sum g z, z_sum = sum z
+   !> over the contact set and contact its points.
+   subroutine preconditioned_products_range(p, d, s, z, gz_sum, z_sum, contact)
+      real(wp), contiguous, intent(in) :: p(:), d(:), z(:)
+      real(wp), intent(in) :: s
+      real(wp), intent(out) :: gz_sum, z_sum, contact
+      real(wp) :: inside
+      integer :: j
+      gz_sum = 0.0_wp
+      z_sum = 0.0_wp
+      contact = 0.0_wp
+      !$omp simd reduction(+:gz_sum, z_sum, contact) private(inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         gz_sum = gz_sum + (d(j) - s)*z(j)*inside
+         z_sum = z_sum + z(j)*inside
+         contact = contact + inside
+      end do
+   end subroutine preconditioned_products_range
+
+   !> new_direction_range on the blocks of the grid (see fresh_state).
    subroutine new_direction(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
       real(wp), contiguous, intent(in) :: p(:), d(:)
       real(wp), intent(in) :: s, z_mean, beta, t_shift
       logical, intent(in) :: preconditioned
       real(wp), contiguous, intent(inout) :: t(:), buffer(:)
       real(wp), intent(out) :: gt_sum, t_sum
+      real(wp) :: parts(2, reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(parts, 2)
+         call block_range(block, size(p), first, last)
+         call new_direction_range(p(first:last), d(first:last), s, preconditioned, z_mean, beta, t_shift, &
+            & t(first:last), buffer(first:last), parts(1, block), parts(2, block))
+      end do
+      gt_sum = sum(parts(1, :))
+      t_sum = sum(parts(2, :))
+   end subroutine new_direction
+
+   !> One pass: the new direction t = (e + beta (t - t_shift)) on the contact set (0
+   !> elsewhere), with e = z - z_mean (preconditioned; z in the buffer) or the gap g; t is
+   !> also written into the buffer (the transform's input). gt_sum = sum g t, t_sum = sum t.
+   subroutine new_direction_range(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
+      real(wp), contiguous, intent(in) :: p(:), d(:)
+      real(wp), intent(in) :: s, z_mean, beta, t_shift
+      logical, intent(in) :: preconditioned
+      real(wp), contiguous, intent(inout) :: t(:), buffer(:)
+      real(wp), intent(out) :: gt_sum, t_sum
       real(wp) :: g, e, tj, inside, from_z
-      real(wp) :: block_sums(2, reduction_blocks(size(p)))
-      integer :: j, block, first, last
+      integer :: j
+      gt_sum = 0.0_wp
+      t_sum = 0.0_wp
       ! a 0/1 weight rather than a branch, which would keep the loop from being vectorised
       ! (without the preconditioner the buffer holds the masked gap: finite)
       from_z = merge(1.0_wp, 0.0_wp, preconditioned)
-      !$omp parallel do schedule(static) private(first, last, gt_sum, t_sum, g, e, tj, inside) if(size(p) >= parallel_points)
-      do block = 1, size(block_sums, 2)
-         call block_range(block, size(p), first, last)
-         gt_sum = 0.0_wp
-         t_sum = 0.0_wp
-         !$omp simd reduction(+:gt_sum, t_sum) private(g, e, tj, inside)
-         do j = first, last
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            g = d(j) - s
-            e = from_z*(buffer(j) - z_mean) + (1.0_wp - from_z)*g
-            tj = (e + beta*(t(j) - t_shift))*inside
-            t(j) = tj
-            buffer(j) = tj
-            gt_sum = gt_sum + g*tj
-            t_sum = t_sum + tj
-         end do
-         block_sums(:, block) = [gt_sum, t_sum]
+      !$omp simd reduction(+:gt_sum, t_sum) private(g, e, tj, inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         g = d(j) - s
+         e = from_z*(buffer(j) - z_mean) + (1.0_wp - from_z)*g
+         tj = (e + beta*(t(j) - t_shift))*inside
+         t(j) = tj
+         buffer(j) = tj
+         gt_sum = gt_sum + g*tj
+         t_sum = t_sum + tj
       end do
-      gt_sum = sum(block_sums(1, :))
-      t_sum = sum(block_sums(2, :))
-   end subroutine new_direction
+   end subroutine new_direction_range
+
+   !> update_range on the blocks of the grid (see fresh_state).
+   subroutine update(p, d, b, s, tau, t, r, reenter, sums, t_left, n_changed, entered)
+      real(wp), contiguous, intent(inout) :: p(:), d(:), r(:)
+      real(wp), contiguous, intent(in) :: b(:), t(:)
+      real(wp), intent(in) :: s, tau
+      logical, intent(in) :: reenter
+      type(grid_sums), intent(inout) :: sums
+      real(wp), intent(out) :: t_left
+      integer, intent(out) :: n_changed
+      logical, intent(out) :: entered
+      type(grid_sums) :: parts(reduction_blocks(size(p)))
+      real(wp) :: lefts(size(parts))
+      integer :: changed(size(parts))
+      logical :: entries(size(parts))
+      integer :: block, first, last
+      parts = sums
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(parts)
+         call block_range(block, size(p), first, last)
+         call update_range(p(first:last), d(first:last), b(first:last), s, tau, t(first:last), r(first:last), &
+            & reenter, parts(block), lefts(block), changed(block), entries(block))
+      end do
+      sums = added(parts)
+      t_left = sum(lefts)
+      n_changed = sum(changed)
+      entered = any(entries)
+   end subroutine update
 
    !> One pass: p <- p - tau t clipped at zero, overlapping points (p = 0, g < 0) let in,
    !> d <- d - tau r (r = M t, in the buffer); r then keeps the change of p that was not
@@ -433,7 +513,7 @@ contains
    !> (a safeguarded iteration restarts its conjugacy then). `reenter`: a point clipped by
    !> this step is let in again at once if its gap is negative (the safeguarded iteration);
    !> otherwise it stays out until the next evaluation.
-   subroutine update(p, d, b, s, tau, t, r, reenter, sums, t_left, n_changed, entered)
+   subroutine update_range(p, d, b, s, tau, t, r, reenter, sums, t_left, n_changed, entered)
       real(wp), contiguous, intent(inout) :: p(:), d(:), r(:)
       real(wp), contiguous, intent(in) :: b(:), t(:)
       real(wp), intent(in) :: s, tau
@@ -444,64 +524,50 @@ contains
       logical, intent(out) :: entered
       real(wp) :: contact, d_contact, b_contact, p_sum, changed_count, entered_count
       real(wp) :: trial, p_new, d_new, g, c, inside, left, reenter_weight
-      real(wp) :: block_sums(7, reduction_blocks(size(p)))
-      integer :: j, block, first, last
+      integer :: j
+      contact = 0.0_wp
+      d_contact = 0.0_wp
+      b_contact = 0.0_wp
+      p_sum = 0.0_wp
+      changed_count = 0.0_wp
+      entered_count = 0.0_wp
+      t_left = 0.0_wp
       reenter_weight = merge(1.0_wp, 0.0_wp, reenter)
-      !$omp parallel do schedule(static) private(first, last, contact, d_contact, b_contact, p_sum, changed_count) &
-      !$omp & private(entered_count, t_left, trial, p_new, d_new, g, c, inside, left) if(size(p) >= parallel_points)
-      do block = 1, size(block_sums, 2)
-         call block_range(block, size(p), first, last)
-         contact = 0.0_wp
-         d_contact = 0.0_wp
-         b_contact = 0.0_wp
-         p_sum = 0.0_wp
-         changed_count = 0.0_wp
-         entered_count = 0.0_wp
-         t_left = 0.0_wp
-         !$omp simd reduction(+:contact, d_contact, b_contact, p_sum, changed_count, entered_count, t_left) &
-         !$omp & private(trial, p_new, d_new, g, c, inside, left)
-         do j = first, last
-            ! t = 0 off the contact set, so p - tau t is p there
-            trial = p(j) - tau*t(j)
-            p_new = merge(trial, 0.0_wp, trial >= 0.0_wp)   ! clip (a NaN too)
-            ! let in where p = 0 and g < 0 (g before the step; p after it with `reenter`, before
-            ! it otherwise); max(): once the contact set is
-            ! solved tau is a ratio of rounding noise and may be negative, and a negative
-            ! pressure would never be clipped again
-            g = d(j) - s
-            c = merge(1.0_wp, 0.0_wp, g < 0.0_wp)*(reenter_weight*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp) &
-               & + (1.0_wp - reenter_weight)*merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp))
-            p_new = c*max(-tau*g, 0.0_wp) + (1.0_wp - c)*p_new
-            entered_count = entered_count + c
-            left = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)
-            t_left = t_left + t(j)*left
-            d_new = d(j) - tau*r(j)
-            d(j) = d_new
-            r(j) = p_new - trial
-            changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
-            p(j) = p_new
-            inside = merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
-            contact = contact + inside
-            d_contact = d_contact + d_new*inside
-            b_contact = b_contact + b(j)*inside
-            p_sum = p_sum + p_new
-         end do
-         block_sums(:, block) = [contact, d_contact, b_contact, p_sum, changed_count, entered_count, t_left]
+      !$omp simd reduction(+:contact, d_contact, b_contact, p_sum, changed_count, entered_count, t_left) &
+      !$omp& private(trial, p_new, d_new, g, c, inside, left)
+      do j = 1, size(p)
+         ! t = 0 off the contact set, so p - tau t is p there
+         trial = p(j) - tau*t(j)
+         p_new = merge(trial, 0.0_wp, trial >= 0.0_wp)   ! clip (a NaN too)
+         ! let in where p = 0 and g < 0 (g before the step; p after it with `reenter`, before
+         ! it otherwise); max(): once the contact set is
+         ! solved tau is a ratio of rounding noise and may be negative, and a negative
+         ! pressure would never be clipped again
+         g = d(j) - s
+         c = merge(1.0_wp, 0.0_wp, g < 0.0_wp)*(reenter_weight*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp) &
+            & + (1.0_wp - reenter_weight)*merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp))
+         p_new = c*max(-tau*g, 0.0_wp) + (1.0_wp - c)*p_new
+         entered_count = entered_count + c
+         left = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)*merge(1.0_wp, 0.0_wp, p_new <= 0.0_wp)
+         t_left = t_left + t(j)*left
+         d_new = d(j) - tau*r(j)
+         d(j) = d_new
+         r(j) = p_new - trial
+         changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
+         p(j) = p_new
+         inside = merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
+         contact = contact + inside
+         d_contact = d_contact + d_new*inside
+         b_contact = b_contact + b(j)*inside
+         p_sum = p_sum + p_new
       end do
-      contact = sum(block_sums(1, :))
-      d_contact = sum(block_sums(2, :))
-      b_contact = sum(block_sums(3, :))
-      p_sum = sum(block_sums(4, :))
-      changed_count = sum(block_sums(5, :))
-      entered_count = sum(block_sums(6, :))
-      t_left = sum(block_sums(7, :))
       sums%contact = contact
       sums%d_contact = d_contact
       sums%b_contact = b_contact
       sums%p_sum = p_sum
       n_changed = nint(changed_count)
       entered = entered_count > 0.0_wp
-   end subroutine update
+   end subroutine update_range
 
    !> Load the overlapping points out of contact (p = 0, g = d - s < 0) with the pressure
    !> -g/M_jj of a first step; n_changed: how many.

@@ -343,33 +343,18 @@ contains
       integer, intent(out) :: n_contact
       real(wp), intent(out) :: residual
       real(wp), intent(out) :: norm2   !< sum of gap^2 over the contact set
-      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, p_scale, g_scale, g_floor, g, c, inside, check
-      real(wp) :: sums(3, reduction_blocks(size(p)))
-      integer :: j, block, first, last
-      w_max = 0.0_wp
-      p_max = 0.0_wp
-      ! (the stores are unconditional: a store under a condition is not vectorised; sums by
-      ! blocks, added in order: the same bits on any number of threads)
-      !$omp parallel do schedule(static) private(first, last, contact, gap_sum, p_sum, inside) &
-      !$omp & reduction(max:w_max, p_max) if(size(p) >= parallel_points)
+      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, p_scale, g_scale, g_floor, check
+      real(wp) :: sums(5, reduction_blocks(size(p)))
+      integer :: block, first, last
+      ! (the passes on blocks of the grid, by procedures of their own, which vectorise: sums by
+      ! blocks, added in order, the same bits on any number of threads)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         contact = 0.0_wp
-         gap_sum = 0.0_wp
-         p_sum = 0.0_wp
-         !$omp simd reduction(+:contact, gap_sum, p_sum) reduction(max:w_max, p_max) private(inside)
-         do j = first, last
-            p(j) = p(j)*load_scale
-            w(j) = w(j)*load_scale
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            contact = contact + inside
-            gap_sum = gap_sum + (w(j) - b(j))*inside
-            p_sum = p_sum + p(j)
-            w_max = max(w_max, abs(w(j)))
-            p_max = max(p_max, p(j))
-         end do
-         sums(:, block) = [contact, gap_sum, p_sum]
+         call scale_and_sum(p(first:last), w(first:last), b(first:last), load_scale, sums(:, block))
       end do
+      w_max = maxval(sums(4, :))
+      p_max = maxval(sums(5, :))
       contact = sum(sums(1, :))
       gap_sum = sum(sums(2, :))
       p_sum = sum(sums(3, :))
@@ -378,55 +363,106 @@ contains
       p_scale = 1.0_wp/max(merge(mean_pressure, p_sum/size(p), load_control), tiny(1.0_wp))
       g_scale = 1.0_wp/g_ref
       g_floor = rounding_floor(w_max, b_max, p_max, m_max)
-      residual = 0.0_wp
-      !$omp parallel do schedule(static) private(first, last, check, norm2, g, c, inside) &
-      !$omp & reduction(max:residual) if(size(p) >= parallel_points)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         check = 0.0_wp
-         norm2 = 0.0_wp
-         !$omp simd reduction(max:residual) reduction(+:check, norm2) private(g, c, inside)
-         do j = first, last
-            g = w(j) - b(j) - s
-            gap(j) = g
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            masked(j) = -g*inside
-            norm2 = norm2 + g*g*inside
-            c = abs(min(p(j)*p_scale, g*g_scale))
-            residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
-            check = check + g + p(j)
-         end do
-         sums(1:2, block) = [check, norm2]
+         call gaps_and_residual(p(first:last), w(first:last), b(first:last), s, p_scale, g_scale, g_floor, &
+            & gap(first:last), masked(first:last), sums(1:3, block))
       end do
       check = sum(sums(1, :))
       norm2 = sum(sums(2, :))
+      residual = maxval(sums(3, :))
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
    end subroutine evaluate
+
+   !> evaluate's first pass on a block: p and w scaled by load_scale; sums = (points in
+   !> contact, sum of w - b over them, sum p, max |w|, max p).
+   subroutine scale_and_sum(p, w, b, load_scale, sums)
+      real(wp), contiguous, intent(inout) :: p(:), w(:)
+      real(wp), contiguous, intent(in) :: b(:)
+      real(wp), intent(in) :: load_scale
+      real(wp), intent(out) :: sums(5)
+      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, inside
+      integer :: j
+      contact = 0.0_wp
+      gap_sum = 0.0_wp
+      p_sum = 0.0_wp
+      w_max = 0.0_wp
+      p_max = 0.0_wp
+      ! (the stores are unconditional: a store under a condition is not vectorised)
+      !$omp simd reduction(+:contact, gap_sum, p_sum) reduction(max:w_max, p_max) private(inside)
+      do j = 1, size(p)
+         p(j) = p(j)*load_scale
+         w(j) = w(j)*load_scale
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         contact = contact + inside
+         gap_sum = gap_sum + (w(j) - b(j))*inside
+         p_sum = p_sum + p(j)
+         w_max = max(w_max, abs(w(j)))
+         p_max = max(p_max, p(j))
+      end do
+      sums = [contact, gap_sum, p_sum, w_max, p_max]
+   end subroutine scale_and_sum
+
+   !> evaluate's second pass on a block: the gap, -gap on the contact set in `masked`;
+   !> sums = (sum of gap + p (finite unless a value is not), sum of gap^2 over the contact
+   !> set, the largest complementarity term).
+   subroutine gaps_and_residual(p, w, b, s, p_scale, g_scale, g_floor, gap, masked, sums)
+      real(wp), contiguous, intent(in) :: p(:), w(:), b(:)
+      real(wp), intent(in) :: s, p_scale, g_scale, g_floor
+      real(wp), contiguous, intent(out) :: gap(:), masked(:)
+      real(wp), intent(out) :: sums(3)
+      real(wp) :: residual, check, norm2, g, c, inside
+      integer :: j
+      residual = 0.0_wp
+      check = 0.0_wp
+      norm2 = 0.0_wp
+      !$omp simd reduction(max:residual) reduction(+:check, norm2) private(g, c, inside)
+      do j = 1, size(p)
+         g = w(j) - b(j) - s
+         gap(j) = g
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         masked(j) = -g*inside
+         norm2 = norm2 + g*g*inside
+         c = abs(min(p(j)*p_scale, g*g_scale))
+         residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
+         check = check + g + p(j)
+      end do
+      sums = [check, norm2, residual]
+   end subroutine gaps_and_residual
 
    !> The mean of v over the contact set (p > 0) under load control, 0 otherwise (one pass).
    real(wp) function set_mean(p, load_control, v) result(mean)
       real(wp), contiguous, intent(in) :: p(:), v(:)
       logical, intent(in) :: load_control
-      real(wp) :: v_sum, contact, inside
       real(wp) :: sums(2, reduction_blocks(size(p)))
-      integer :: j, block, first, last
+      integer :: block, first, last
       mean = 0.0_wp
       if (.not. load_control) return
-      !$omp parallel do schedule(static) private(first, last, v_sum, contact, inside) if(size(p) >= parallel_points)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         v_sum = 0.0_wp
-         contact = 0.0_wp
-         !$omp simd reduction(+:v_sum, contact) private(inside)
-         do j = first, last
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            v_sum = v_sum + v(j)*inside
-            contact = contact + inside
-         end do
-         sums(:, block) = [v_sum, contact]
+         call set_sums(p(first:last), v(first:last), sums(:, block))
       end do
       mean = sum(sums(1, :))/max(sum(sums(2, :)), 1.0_wp)
    end function set_mean
+
+   !> On a block: sums = (sum of v over the contact set, its points).
+   subroutine set_sums(p, v, sums)
+      real(wp), contiguous, intent(in) :: p(:), v(:)
+      real(wp), intent(out) :: sums(2)
+      real(wp) :: v_sum, contact, inside
+      integer :: j
+      v_sum = 0.0_wp
+      contact = 0.0_wp
+      !$omp simd reduction(+:v_sum, contact) private(inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         v_sum = v_sum + v(j)*inside
+         contact = contact + inside
+      end do
+      sums = [v_sum, contact]
+   end subroutine set_sums
 
    !> d = z on the contact set, minus its mean there under load control, 0 elsewhere; z
    !> (the buffer) is overwritten by d, the next transform's input.
@@ -452,24 +488,31 @@ contains
       real(wp), contiguous, intent(in) :: p(:), v(:)
       logical, intent(in) :: load_control
       real(wp), intent(out) :: centre, norm
-      real(wp) :: v2_sum, inside, x
       real(wp) :: sums(reduction_blocks(size(p)))
-      integer :: j, block, first, last
+      integer :: block, first, last
       centre = set_mean(p, load_control, v)
-      !$omp parallel do schedule(static) private(first, last, v2_sum, inside, x) if(size(p) >= parallel_points)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums)
          call block_range(block, size(p), first, last)
-         v2_sum = 0.0_wp
-         !$omp simd reduction(+:v2_sum) private(inside, x)
-         do j = first, last
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            x = (v(j) - centre)*inside
-            v2_sum = v2_sum + x*x
-         end do
-         sums(block) = v2_sum
+         sums(block) = centred_squares(p(first:last), v(first:last), centre)
       end do
       norm = sqrt(sum(sums))
    end subroutine set_norm
+
+   !> On a block: the sum of (v - centre)^2 over the contact set.
+   real(wp) function centred_squares(p, v, centre) result(v2_sum)
+      real(wp), contiguous, intent(in) :: p(:), v(:)
+      real(wp), intent(in) :: centre
+      real(wp) :: inside, x
+      integer :: j
+      v2_sum = 0.0_wp
+      !$omp simd reduction(+:v2_sum) private(inside, x)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         x = (v(j) - centre)*inside
+         v2_sum = v2_sum + x*x
+      end do
+   end function centred_squares
 
    !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
    !> (The stored images are centred on the set, so the mean of a need not be removed.)
@@ -527,25 +570,33 @@ contains
       real(wp), intent(in) :: centre, norm
       real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
       real(wp), intent(out) :: alpha
-      real(wp) :: scale, inside, partial
       real(wp) :: sums(reduction_blocks(size(p)))
-      integer :: j, block, first, last
-      scale = 1.0_wp/norm
-      !$omp parallel do schedule(static) private(first, last, partial, inside) if(size(p) >= parallel_points)
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums)
          call block_range(block, size(p), first, last)
-         partial = 0.0_wp
-         !$omp simd reduction(+:partial) private(inside)
-         do j = first, last
-            inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-            d_unit(j) = d(j)*scale
-            a_unit(j) = (a(j) - centre)*scale
-            partial = partial - gap(j)*a_unit(j)*inside
-         end do
-         sums(block) = partial
+         sums(block) = scaled_step(p(first:last), gap(first:last), centre, 1.0_wp/norm, d(first:last), &
+            & a(first:last), d_unit(first:last), a_unit(first:last))
       end do
       alpha = sum(sums)
    end subroutine normalised_step
+
+   !> normalised_step on a block: d_unit, a_unit and the block's part of alpha.
+   real(wp) function scaled_step(p, gap, centre, scale, d, a, d_unit, a_unit) result(alpha)
+      real(wp), contiguous, intent(in) :: p(:), gap(:), d(:), a(:)
+      real(wp), intent(in) :: centre, scale
+      real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
+      real(wp) :: inside
+      integer :: j
+      alpha = 0.0_wp
+      !$omp simd reduction(+:alpha) private(inside)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         d_unit(j) = d(j)*scale
+         a_unit(j) = (a(j) - centre)*scale
+         alpha = alpha - gap(j)*a_unit(j)*inside
+      end do
+   end function scaled_step
 
    !> One pass: p <- p + alpha d and w <- w + alpha a; points out of contact with a negative
    !> gap are let in with -let_in_scale gap (Polonsky & Keer's rule: the preconditioned step
@@ -560,40 +611,55 @@ contains
       integer, intent(out) :: n_clipped
       logical, intent(out) :: entered
       real(wp), intent(out) :: p_sum
-      real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count, partial
-      real(wp) :: sums(reduction_blocks(size(p)))
-      integer :: j, block, first, last
-      ! (the counts are exact in any order; the sum of p by blocks, added in order)
-      clip_count = 0.0_wp
-      enter_count = 0.0_wp
-      changed_count = 0.0_wp
-      !$omp parallel do schedule(static) private(first, last, partial, trial, p_new, c) &
-      !$omp & reduction(+:clip_count, enter_count, changed_count) if(size(p) >= parallel_points)
-      do block = 1, size(sums)
+      real(wp) :: clip_count, enter_count, changed_count
+      real(wp) :: sums(4, reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         partial = 0.0_wp
-         !$omp simd reduction(+:clip_count, enter_count, changed_count, partial) private(trial, p_new, c)
-         do j = first, last
-            trial = p(j) + alpha*d(j)   ! (d = 0 off the contact set)
-            ! let in: out of contact (p = 0) and overlapping
-            c = merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp)*merge(1.0_wp, 0.0_wp, gap(j) < 0.0_wp)
-            p_new = c*max(-let_in_scale*gap(j), 0.0_wp) + (1.0_wp - c)*trial
-            enter_count = enter_count + c*merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
-            clip_count = clip_count + merge(1.0_wp, 0.0_wp, p_new < 0.0_wp)
-            p_new = merge(p_new, 0.0_wp, p_new >= 0.0_wp)   ! clip (a NaN too)
-            w(j) = w(j) + alpha*a(j)
-            delta(j) = p_new - trial
-            changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
-            p(j) = p_new
-            partial = partial + p_new
-         end do
-         sums(block) = partial
+         call update_block(p(first:last), w(first:last), gap(first:last), d(first:last), a(first:last), alpha, &
+            & let_in_scale, delta(first:last), sums(:, block))
       end do
-      p_sum = sum(sums)
+      ! (the counts are exact in any order; the sum of p added block by block in order)
+      clip_count = sum(sums(1, :))
+      enter_count = sum(sums(2, :))
+      changed_count = sum(sums(3, :))
+      p_sum = sum(sums(4, :))
       n_changed = nint(changed_count)
       n_clipped = nint(clip_count)
       entered = enter_count > 0.0_wp
    end subroutine update
+
+   !> update on a block; sums = (points clipped, let in, changed, sum of the new p).
+   subroutine update_block(p, w, gap, d, a, alpha, let_in_scale, delta, sums)
+      real(wp), contiguous, intent(inout) :: p(:), w(:)
+      real(wp), contiguous, intent(in) :: gap(:), d(:), a(:)
+      real(wp), intent(in) :: alpha, let_in_scale
+      real(wp), contiguous, intent(out) :: delta(:)
+      real(wp), intent(out) :: sums(4)
+      real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count, p_sum
+      integer :: j
+      clip_count = 0.0_wp
+      enter_count = 0.0_wp
+      changed_count = 0.0_wp
+      p_sum = 0.0_wp
+      !$omp simd reduction(+:clip_count, enter_count, changed_count, p_sum) private(trial, p_new, c)
+      do j = 1, size(p)
+         trial = p(j) + alpha*d(j)   ! (d = 0 off the contact set)
+         ! let in: out of contact (p = 0) and overlapping
+         c = merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp)*merge(1.0_wp, 0.0_wp, gap(j) < 0.0_wp)
+         p_new = c*max(-let_in_scale*gap(j), 0.0_wp) + (1.0_wp - c)*trial
+         enter_count = enter_count + c*merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
+         clip_count = clip_count + merge(1.0_wp, 0.0_wp, p_new < 0.0_wp)
+         p_new = merge(p_new, 0.0_wp, p_new >= 0.0_wp)   ! clip (a NaN too)
+         w(j) = w(j) + alpha*a(j)
+         delta(j) = p_new - trial
+         changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
+         p(j) = p_new
+         p_sum = p_sum + p_new
+      end do
+      sums = [clip_count, enter_count, changed_count, p_sum]
+   end subroutine update_block
 
    !> The factor that scales p (and w = G p, linear in p) to the load, from sum p; a vanished
    !> p is reset to uniform (w stale then, factor 1).
