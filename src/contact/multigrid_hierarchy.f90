@@ -26,7 +26,7 @@ module lc_contact_multigrid_hierarchy
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
    use lc_fft_plans, only: fft_plan
-   use lc_contact_operator, only: compliance_operator
+   use lc_contact_operator, only: compliance_operator, multiply_spectrum, multiply_complex
    use lc_base_threads, only: active_threads, parallel_points, reduction_blocks, block_range
    implicit none (type, external)
    private
@@ -639,19 +639,12 @@ contains
    subroutine transform(h, t)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
-      integer :: k
       associate (lv => h%level(t))
       call lv%fft%forward_unscaled()
       if (h%complex) then
-         !$omp parallel do simd schedule(static) if(lv%n >= parallel_points)
-         do k = 1, size(lv%symbol)
-            lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%cmultiplier(k)
-         end do
+         call multiply_complex(lv%fft%spectrum, lv%cmultiplier)
       else
-         !$omp parallel do simd schedule(static) if(lv%n >= parallel_points)
-         do k = 1, size(lv%symbol)
-            lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%multiplier(k)
-         end do
+         call multiply_spectrum(lv%fft%spectrum, lv%multiplier)
       end if
       call lv%fft%backward()
       h%pairs = h%pairs + real(lv%n, wp)/h%n_fine
@@ -717,13 +710,12 @@ contains
    end subroutine add_masked
 
    !> Along x, row by row: coarse(i) = fine(2i - 1) + (fine(2i) + fine(2i - 2))/2.
-   subroutine restrict_x(fine, coarse, nx, ny)
+   pure subroutine restrict_x(fine, coarse, nx, ny)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: fine(nx, ny)
       real(wp), intent(out) :: coarse(nx/2, ny)
       integer :: i, j, m
       m = nx/2
-      !$omp parallel do schedule(static) private(i) if(nx*ny >= parallel_points)
       do j = 1, ny
          coarse(1, j) = fine(1, j) + 0.5_wp*(fine(2, j) + fine(2*m, j))
          do i = 2, m
@@ -733,14 +725,13 @@ contains
    end subroutine restrict_x
 
    !> Along y: the same for the rows.
-   subroutine restrict_y(fine, coarse, nx, ny)
+   pure subroutine restrict_y(fine, coarse, nx, ny)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: fine(nx, ny)
       real(wp), intent(out) :: coarse(nx, ny/2)
       integer :: j, m
       m = ny/2
       coarse(:, 1) = fine(:, 1) + 0.5_wp*(fine(:, 2) + fine(:, 2*m))
-      !$omp parallel do schedule(static) if(nx*ny >= parallel_points)
       do j = 2, m
          coarse(:, j) = fine(:, 2*j - 1) + 0.5_wp*(fine(:, 2*j) + fine(:, 2*j - 2))
       end do
@@ -748,7 +739,7 @@ contains
 
    !> Along x, row by row: fine <- fine + P coarse, masked by `free` if given; with `base`
    !> (and free), fine <- scale base + free P coarse.
-   subroutine prolong_x_add(coarse, fine, nx, ny, free, base, scale)
+   pure subroutine prolong_x_add(coarse, fine, nx, ny, free, base, scale)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: coarse(nx/2, ny)
       real(wp), intent(inout) :: fine(nx, ny)
@@ -758,7 +749,6 @@ contains
       ! (the last point of a row, between the last coarse point and the first, apart: the
       ! passes over the others then vectorise)
       m = nx/2
-      !$omp parallel do schedule(static) if(nx*ny >= parallel_points)
       do j = 1, ny
          if (present(base)) then
             fine(1:nx:2, j) = scale*base(1:nx:2, j) + free(1:nx:2, j)*coarse(:, j)
@@ -778,13 +768,12 @@ contains
    end subroutine prolong_x_add
 
    !> Along y: fine = P coarse (assigned).
-   subroutine prolong_y(coarse, fine, nx, ny)
+   pure subroutine prolong_y(coarse, fine, nx, ny)
       integer, intent(in) :: nx, ny
       real(wp), intent(in) :: coarse(nx, ny/2)
       real(wp), intent(out) :: fine(nx, ny)
       integer :: j, m
       m = ny/2
-      !$omp parallel do schedule(static) if(nx*ny >= parallel_points)
       do j = 1, m
          fine(:, 2*j - 1) = coarse(:, j)
          fine(:, 2*j) = 0.5_wp*(coarse(:, j) + coarse(:, mod(j, m) + 1))

@@ -26,10 +26,10 @@ module lc_contact_operator
    use lc_fft_plans, only: fft_plan
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
-   use lc_base_threads, only: parallel_points, reduction_block, reduction_blocks
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    implicit none (type, external)
    private
-   public :: compliance_operator, build_operator
+   public :: compliance_operator, build_operator, multiply_spectrum, multiply_complex
 
    real(wp), parameter :: pi = acos(-1.0_wp)
    !> The Fourier preconditioner of the inner CG is (|J*(kV)|/|J*(k1 V)|)^preconditioner_exponent/M:
@@ -369,35 +369,92 @@ contains
    !> multiplier |spectrum|^2 (the modes of the half spectrum stand for two, q and -q, but
    !> those of each row's columns mx = 0 and, for even nx, mx = nx/2 for one).
    subroutine multiply_with_energy(spectrum, multiplier, inv_n, nkx, even, energy)
-      complex(wp), intent(inout) :: spectrum(:)
-      real(wp), intent(in) :: multiplier(:), inv_n
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: inv_n
       integer, intent(in) :: nkx
       logical, intent(in) :: even
       real(wp), intent(out) :: energy
-      real(wp) :: f, twice, once
+      real(wp) :: once
       real(wp) :: block_sums(reduction_blocks(size(spectrum)))
-      integer :: m, first, last, block
+      integer :: first, last, block
       once = 0.0_wp
       do first = 1, size(spectrum), nkx
          once = once + multiplier(first)*inv_n*abs(spectrum(first))**2
          last = first + nkx - 1
          if (even .and. nkx > 1) once = once + multiplier(last)*inv_n*abs(spectrum(last))**2
       end do
-      !$omp parallel do schedule(static) private(first, last, twice, f) if(size(spectrum) >= parallel_points)
+      ! (by blocks on the solve's threads, their sums added in order: lc_base_threads)
+      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
       do block = 1, size(block_sums)
-         first = (block - 1)*reduction_block + 1
-         last = min(block*reduction_block, size(spectrum))
-         twice = 0.0_wp
-         !$omp simd reduction(+:twice) private(f)
-         do m = first, last
-            f = multiplier(m)*inv_n
-            twice = twice + f*(real(spectrum(m), wp)**2 + aimag(spectrum(m))**2)
-            spectrum(m) = spectrum(m)*f
-         end do
-         block_sums(block) = twice
+         call block_range(block, size(spectrum), first, last)
+         block_sums(block) = multiplied_energy(spectrum(first:last), multiplier(first:last), inv_n)
       end do
       energy = 2.0_wp*sum(block_sums) - once
    end subroutine multiply_with_energy
+
+   !> multiply_with_energy on a block: spectrum <- spectrum * multiplier/n and the sum of
+   !> multiplier/n |spectrum|^2 before.
+   real(wp) function multiplied_energy(spectrum, multiplier, inv_n) result(twice)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: inv_n
+      real(wp) :: f
+      integer :: m
+      twice = 0.0_wp
+      !$omp simd reduction(+:twice) private(f)
+      do m = 1, size(spectrum)
+         f = multiplier(m)*inv_n
+         twice = twice + f*(real(spectrum(m), wp)**2 + aimag(spectrum(m))**2)
+         spectrum(m) = spectrum(m)*f
+      end do
+   end function multiplied_energy
+
+   !> spectrum <- spectrum * multiplier (times scale), by blocks on the solve's threads.
+   subroutine multiply_spectrum(spectrum, multiplier, scale)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in), optional :: scale
+      real(wp) :: f
+      integer :: block, first, last
+      f = 1.0_wp
+      if (present(scale)) f = scale
+      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
+      do block = 1, reduction_blocks(size(spectrum))
+         call block_range(block, size(spectrum), first, last)
+         call multiply_real_block(spectrum(first:last), multiplier(first:last), f)
+      end do
+   end subroutine multiply_spectrum
+
+   !> The same with a complex multiplier.
+   subroutine multiply_complex(spectrum, multiplier, scale)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      complex(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in), optional :: scale
+      real(wp) :: f
+      integer :: block, first, last
+      f = 1.0_wp
+      if (present(scale)) f = scale
+      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
+      do block = 1, reduction_blocks(size(spectrum))
+         call block_range(block, size(spectrum), first, last)
+         call multiply_complex_block(spectrum(first:last), multiplier(first:last), f)
+      end do
+   end subroutine multiply_complex
+
+   pure subroutine multiply_real_block(spectrum, multiplier, f)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: f
+      spectrum = spectrum*(multiplier*f)
+   end subroutine multiply_real_block
+
+   pure subroutine multiply_complex_block(spectrum, multiplier, f)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      complex(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: f
+      spectrum = spectrum*(multiplier*f)
+   end subroutine multiply_complex_block
 
    !> fft%real_buffer <- P fft%real_buffer with the preconditioner P (see metric_in_buffer).
    subroutine inverse_metric_in_buffer(self)
@@ -458,14 +515,8 @@ contains
    subroutine multiply_complex_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
       complex(wp), intent(in) :: multiplier(:)
-      integer :: m
       call self%fft%forward_unscaled()
-      associate (spectrum => self%fft%spectrum, inv_n => self%inv_n)
-         !$omp parallel do simd schedule(static) if(size(spectrum) >= parallel_points)
-         do m = 1, size(spectrum)
-            spectrum(m) = spectrum(m)*(multiplier(m)*inv_n)
-         end do
-      end associate
+      call multiply_complex(self%fft%spectrum, multiplier, self%inv_n)
       call self%fft%backward()
    end subroutine multiply_complex_in_buffer
 
@@ -483,14 +534,8 @@ contains
    subroutine multiply_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(in) :: multiplier(:)
-      integer :: m
       call self%fft%forward_unscaled()
-      associate (spectrum => self%fft%spectrum, inv_n => self%inv_n)
-         !$omp parallel do simd schedule(static) if(size(spectrum) >= parallel_points)
-         do m = 1, size(spectrum)
-            spectrum(m) = spectrum(m)*(multiplier(m)*inv_n)
-         end do
-      end associate
+      call multiply_spectrum(self%fft%spectrum, multiplier, self%inv_n)
       call self%fft%backward()
    end subroutine multiply_in_buffer
 

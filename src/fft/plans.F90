@@ -16,7 +16,6 @@ module lc_fft_plans
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_base_strings, only: to_string
-   use lc_base_threads, only: parallel_points
    implicit none (type, external)
    private
    public :: fft_plan
@@ -196,14 +195,8 @@ contains
    !> spectrum <- Fourier coefficients of real_buffer (r2c / (nx ny)). real_buffer is kept.
    subroutine forward(self)
       class(fft_plan), intent(inout) :: self
-      real(wp) :: scale
-      integer :: m
       call self%forward_unscaled()
-      scale = 1.0_wp/self%n
-      !$omp parallel do simd schedule(static) num_threads(self%threads) if(self%threads > 1 .and. self%n >= parallel_points)
-      do m = 1, self%nk
-         self%spectrum(m) = self%spectrum(m)*scale
-      end do
+      self%spectrum = self%spectrum*(1.0_wp/self%n)
    end subroutine forward
 
    !> spectrum <- n times the Fourier coefficients (the bare r2c): for operators that fold
