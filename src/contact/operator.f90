@@ -514,7 +514,7 @@ contains
    !> fft%real_buffer <- multiplier * fft%real_buffer with a complex multiplier.
    subroutine multiply_complex_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
-      complex(wp), intent(in) :: multiplier(:)
+      complex(wp), contiguous, intent(in) :: multiplier(:)
       call self%fft%forward_unscaled()
       call multiply_complex(self%fft%spectrum, multiplier, self%inv_n)
       call self%fft%backward()
@@ -523,7 +523,8 @@ contains
    !> w = multiplier * p through the plans; the 1/n of the forward transform is folded in.
    subroutine apply_real(self, multiplier, p, w)
       class(compliance_operator), intent(inout) :: self
-      real(wp), intent(in) :: multiplier(:), p(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
       call multiply_in_buffer(self, multiplier)
@@ -533,7 +534,7 @@ contains
    !> fft%real_buffer <- multiplier * fft%real_buffer.
    subroutine multiply_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
-      real(wp), intent(in) :: multiplier(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
       call self%fft%forward_unscaled()
       call multiply_spectrum(self%fft%spectrum, multiplier, self%inv_n)
       call self%fft%backward()
@@ -542,7 +543,7 @@ contains
    !> The same with a complex multiplier.
    subroutine apply_complex(self, multiplier, p, w)
       class(compliance_operator), intent(inout) :: self
-      complex(wp), intent(in) :: multiplier(:)
+      complex(wp), contiguous, intent(in) :: multiplier(:)
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
