@@ -25,7 +25,7 @@ pytest:
 # The solver tests on the portable core (the package picks the x86-64-v3 one where the
 # processor runs it): both builds must pass on any x86-64 machine.
 BASELINE_TESTS := tests/test_solver.py tests/test_kernel_branches.py tests/test_build.py \
-	tests/test_viscoelastic.py tests/test_areal_reference.py tests/test_gfmd.py
+	tests/test_viscoelastic.py tests/test_areal_reference.py tests/test_gfmd.py tests/test_threads.py
 test-baseline:
 	@./tools/bootstrap.sh
 	LAYERCONTACT_ISA=baseline $(PY) -m pytest $(BASELINE_TESTS)

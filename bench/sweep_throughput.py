@@ -25,7 +25,7 @@ and (d) checks that nothing threaded is left (measured: no gain).
 threads), e.g. ``--build-openmp`` or by hand::
 
     python3 -m venv build/venv-openmp
-    build/venv-openmp/bin/pip install . -Csetup-args=-Dopenmp=true
+    build/venv-openmp/bin/pip install . -Csetup-args=-Dopenmp=enabled
 
 (``build/`` is git-ignored.) Without it they are skipped.
 
@@ -90,7 +90,7 @@ def build_openmp() -> None:
         subprocess.run([python, "-m", "venv", str(OPENMP_VENV)], check=True)
         subprocess.run([str(OPENMP_VENV / "bin" / "pip"), "install", "-q", "--upgrade", "pip"], check=True)
     pip = str(OPENMP_VENV / "bin" / "pip")
-    subprocess.run([pip, "install", "-q", str(ROOT), "-Csetup-args=-Dopenmp=true"], check=True)
+    subprocess.run([pip, "install", "-q", str(ROOT), "-Csetup-args=-Dopenmp=enabled"], check=True)
 
 
 def write_sweep(directory: Path, name: str, realisations: int, processes: int, threads: int) -> Path:

@@ -291,6 +291,42 @@ subroutine py_fft_pair_seconds(n, repeats, rounds, seconds, stat, errmsg)
    end do
 end subroutine py_fft_pair_seconds
 
+!> Seconds of one unscaled r2c + c2r pair of an nx x ny grid (ny = 1: a line) on `threads`
+!> threads, as a solve's operator runs it (the best of `rounds` means of `repeats` pairs).
+subroutine py_grid_fft_pair_seconds(nx, ny, threads, repeats, rounds, seconds, stat, errmsg)
+   use, intrinsic :: iso_fortran_env, only: int64
+   use lc_base_errors, only: error_type, status_of
+   use lc_base_threads, only: solve_threads, use_threads
+   use lc_fft_plans, only: fft_plan
+   implicit none (type, external)
+   integer, intent(in) :: nx, ny, threads, repeats, rounds
+   real(8), intent(out) :: seconds
+   integer, intent(out) :: stat
+   character(len=1024), intent(out) :: errmsg
+   type(error_type), allocatable :: error
+   type(fft_plan) :: fft
+   integer(int64) :: start, finish, rate
+   integer :: i, r, used
+   seconds = huge(1d0)
+   call solve_threads(threads, used, error)
+   if (.not. allocated(error)) then
+      call use_threads(used)
+      call fft%init(nx, ny, used, error)
+   end if
+   call status_of(error, stat, errmsg)
+   if (allocated(error)) return
+   call random_number(fft%real_buffer)
+   do r = 1, rounds
+      call system_clock(start, rate)
+      do i = 1, repeats
+         call fft%forward_unscaled()
+         call fft%backward()
+      end do
+      call system_clock(finish)
+      seconds = min(seconds, real(finish - start, 8)/rate/repeats)
+   end do
+end subroutine py_grid_fft_pair_seconds
+
 !> What the build and the processor offer: level = 3 if the processor runs the x86-64-v3
 !> build (AVX2, FMA), else 1; isa = the instruction set this extension was compiled for.
 subroutine py_cpu_level(level, isa)

@@ -97,6 +97,9 @@ module lc_result
       !> the smallest gap that double precision resolves at this load (see solve_on_grid)
       real(wp) :: gap_resolution = 0.0_wp
       real(wp) :: wall_time = 0.0_wp          !< seconds spent in the solver
+      !> threads the solve ran on (&solver threads, or what the job was given: lc_base_threads)
+      integer :: omp_threads = 1
+      integer :: mpi_ranks = 1                !< processes sharing the grid (1: this build has no MPI)
       !> areal contacts, with &output leakage: the Reynolds leakage of the gap (lc_leakage_reynolds)
       type(leakage_result), allocatable :: leakage
    end type contact_result
@@ -145,6 +148,8 @@ contains
          & real_scalar('residual', res%residual), &
          & real_scalar('gap_resolution', res%gap_resolution), &
          & real_scalar('wall_time', res%wall_time, 's'), &
+         & integer_scalar('omp_threads', res%omp_threads), &
+         & integer_scalar('mpi_ranks', res%mpi_ranks), &
          & real_scalar('friction', res%friction), &
          & integer_scalar('n_spots', res%n_spots), &
          & real_scalar('contact_length', res%contact_length, 'L'), &

@@ -83,8 +83,8 @@ module lc_scene
       !> start from the solution on the grid of every second point (recursively): the
       !> contact set is then nearly known and the fine-grid iterations few
       logical :: coarse_start = .true.
-      !> FFTW threads (1 = no threading)
-      integer :: threads = 1
+      !> threads of one solve; 0: what the job was given (lc_base_threads)
+      integer :: threads = 0
       !> progress on standard error: a line per grid level and every 2 s within one
       logical :: verbose = .false.
       !> target error of the observables: when set, &scene n and tol are chosen by the

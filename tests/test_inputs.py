@@ -170,7 +170,7 @@ BAD = [
     ("&output\n gap_bins = -1\n/\n", "twice (at most once each)"),   # the harness adds its own &output
     ("&solver\n max_iter = 0\n/\n", "allowed: 1 <= max_iter <= 10000000"),
     ("&solver\n memory = 0\n/\n", "allowed: 1 <= memory <= 100"),
-    ("&solver\n threads = 0\n/\n", "allowed: 1 <= threads <= 1024"),
+    ("&solver\n threads = -1\n/\n", "allowed: 0 <= threads <= 1024"),
     ("&solver\n target_error = 0.9\n/\n", "&solver: target_error"),
     ("&profile\n kind = 'file'\n file = 'nope.h5'\n/\n", "&profile: file = 'nope.h5' is not found"),
     # strings that the scene could keep only cut are refused, not cut

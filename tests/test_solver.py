@@ -256,12 +256,6 @@ def test_coarse_start_needs_an_even_grid():
     assert a.iterations == b.iterations and np.array_equal(a.pressure, b.pressure)
 
 
-def test_threads_need_an_openmp_build(rough_profile):
-    with pytest.raises(lc.LayercontactError, match="-Dopenmp=true") as err:
-        lc.solve_line(rough_profile, mean_pressure=0.01, threads=2)
-    assert err.value.code == 2
-
-
 @pytest.mark.parametrize("method", ["cg", "multigrid"])
 @pytest.mark.parametrize("n", [1024, 8192])
 @pytest.mark.parametrize("ratio", [0.05, 0.25, 0.7])

@@ -52,6 +52,8 @@ need() {
 need "Fortran compiler ($fc)" 'command -v "$fc"' gfortran "gfortran in PATH, or FC=... (module load gcc)"
 need "C compiler ($cc)" 'command -v "$cc"' gcc "cc in PATH, or CC=..."
 need "pkg-config" 'command -v pkg-config' pkg-config "pkg-config (or pkgconf) in PATH"
+# (the threads of a solve need nothing more: gfortran brings OpenMP, libfftw3-dev FFTW's
+# fftw3_omp; a build without fftw3_omp runs on one thread)
 need "FFTW 3" 'has_pc fftw3' libfftw3-dev "fftw3.pc in PKG_CONFIG_PATH (module load fftw)"
 need "LAPACK" 'has_pc lapack' "liblapack-dev libopenblas-dev" \
   "lapack.pc in PKG_CONFIG_PATH (module load openblas, or a LAPACK with its pkg-config file)"

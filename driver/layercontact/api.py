@@ -116,6 +116,10 @@ class LineResult:
     #: the smallest gap, relative to the profile's height range, that double precision
     #: resolves at this load; above ``tol`` the run reports ``converged = False``
     gap_resolution: float = 0.0
+    #: the threads the solve ran on (``threads``, or what the job was given) and the
+    #: processes sharing its grid (1: this build has no MPI)
+    omp_threads: int = 1
+    mpi_ranks: int = 1
     n_spots: int = 0
     spots: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
     mean_gap: float = float("nan")
@@ -194,8 +198,11 @@ def solve_line(
     that is not given (None) takes that variable's default: ``period`` 1, ``thickness``
     ``inf`` (a half-space), ``young`` 1, ``poisson`` 0.5, ``friction`` 0, ``stress``
     True, ``method`` ``'auto'``, ``tol`` 1e-10, ``max_iter`` 100000, ``memory`` 12,
-    ``threads`` 1, ``precondition`` and ``coarse_start`` True. A bad value raises
-    :class:`InputError` with the message the namelist file would get.
+    ``threads`` 0, ``precondition`` and ``coarse_start`` True. A bad value raises
+    :class:`InputError` with the message the namelist file would get. ``threads``: the
+    threads of the solve; 0 takes what the job was given (``OMP_NUM_THREADS``, else Slurm's
+    ``SLURM_CPUS_PER_TASK``, else the CPUs this process may run on); the result's
+    ``omp_threads`` says how many ran (1 in a build without OpenMP).
 
     Give ``mean_pressure`` (load control), ``normalised_pressure`` (the load in the seed's
     scale ``E* Lambda0/period``) or ``penetration`` (displacement control, finite
@@ -411,6 +418,10 @@ class ArealResult:
     #: the smallest gap, relative to the profile's height range, that double precision
     #: resolves at this load; above ``tol`` the run reports ``converged = False``
     gap_resolution: float = 0.0
+    #: the threads the solve ran on (``threads``, or what the job was given) and the
+    #: processes sharing its grid (1: this build has no MPI)
+    omp_threads: int = 1
+    mpi_ranks: int = 1
     dissipated_power: float = 0.0
     monotone: bool = True
     normalised_pressure: float = float("nan")

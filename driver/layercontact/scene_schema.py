@@ -263,8 +263,10 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("solver", "coarse_start", "logical", ".true.", "", "both", ".true. or .false.",
              "start from the solution on the grid of every second point (recursively, down to 512)",
              "scene%solver%coarse_start"),
-    Variable("solver", "threads", "integer", "1", "", "both", "1 <= threads <= 1024",
-             "FFTW threads (build with `-Dopenmp=true`)", "scene%solver%threads", interval="[1, 1024]"),
+    Variable("solver", "threads", "integer", "0", "", "both", "0 <= threads <= 1024",
+             "threads of one solve (OpenMP loops and FFTW's threads); 0: what the job was given "
+             "(`OMP_NUM_THREADS`, else `SLURM_CPUS_PER_TASK`, else the CPUs the process may run on); "
+             "a build without OpenMP runs 1", "scene%solver%threads", interval="[0, 1024]"),
     Variable("solver", "target_error", "real", "not set", "1", "both",
              "1e-4 <= target_error <= 0.3 (the rule was measured for 1e-3 .. 1e-1)",
              "instead of `n` (`nx`, `ny`) and `tol`: the accuracy rule picks them (see "

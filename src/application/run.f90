@@ -232,6 +232,7 @@ contains
             & 'WARNING: the leakage solve did not reach leakage_tol (k_eff is an upper bound)'
       end if
       write (unit, '(2x, a, t34, a14)') 'solver', trim(result%solver)
+      write (unit, int_fmt) 'threads (OpenMP)', result%omp_threads
       write (unit, int_fmt) 'iterations', result%iterations
       if (result%outer_iterations > 1) write (unit, int_fmt) 'outer (Anderson) iterations', result%outer_iterations
       write (unit, real_fmt) 'residual', result%residual

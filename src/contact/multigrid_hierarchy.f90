@@ -26,7 +26,8 @@ module lc_contact_multigrid_hierarchy
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
    use lc_fft_plans, only: fft_plan
-   use lc_contact_operator, only: compliance_operator
+   use lc_contact_operator, only: compliance_operator, multiply_spectrum, multiply_complex
+   use lc_base_threads, only: active_threads, parallel_points, reduction_blocks, block_range
    implicit none (type, external)
    private
    interface
@@ -611,35 +612,39 @@ contains
    end subroutine apply_stiffness
 
    !> y = buffer + f and x.buffer in one pass (see copy)
-   pure subroutine read_out(buffer, x, f, y, dot)
+   subroutine read_out(buffer, x, f, y, dot)
       real(wp), contiguous, intent(in) :: buffer(:), x(:)
       real(wp), intent(in) :: f
       real(wp), contiguous, intent(out) :: y(:)
       real(wp), intent(out) :: dot
-      integer :: j
-      dot = 0.0_wp
-      !$omp simd reduction(+:dot)
-      do j = 1, size(x)
-         dot = dot + x(j)*buffer(j)
-         y(j) = buffer(j) + f
+      real(wp) :: partial
+      real(wp) :: block_sums(reduction_blocks(size(x)))
+      integer :: j, block, first, last
+      ! (by blocks, added in order: the same bits on any number of threads)
+      !$omp parallel do schedule(static) private(first, last, partial) if(size(x) >= parallel_points)
+      do block = 1, size(block_sums)
+         call block_range(block, size(x), first, last)
+         partial = 0.0_wp
+         !$omp simd reduction(+:partial)
+         do j = first, last
+            partial = partial + x(j)*buffer(j)
+            y(j) = buffer(j) + f
+         end do
+         block_sums(block) = partial
       end do
+      dot = sum(block_sums)
    end subroutine read_out
 
    !> The buffer of level t times its circulant, counted in pairs of the finest grid.
    subroutine transform(h, t)
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
-      integer :: k
       associate (lv => h%level(t))
       call lv%fft%forward_unscaled()
       if (h%complex) then
-         do k = 1, size(lv%symbol)
-            lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%cmultiplier(k)
-         end do
+         call multiply_complex(lv%fft%spectrum, lv%cmultiplier)
       else
-         do k = 1, size(lv%symbol)
-            lv%fft%spectrum(k) = lv%fft%spectrum(k)*lv%multiplier(k)
-         end do
+         call multiply_spectrum(lv%fft%spectrum, lv%multiplier)
       end if
       call lv%fft%backward()
       h%pairs = h%pairs + real(lv%n, wp)/h%n_fine
@@ -816,7 +821,8 @@ contains
             lv%fft => op%fft
          else
             allocate (lv%plan)
-            call lv%plan%init(lv%nx, lv%ny, 1, error)
+            ! (FFTW's threads on the grids large enough for them to pay)
+            call lv%plan%init(lv%nx, lv%ny, merge(active_threads(), 1, m >= parallel_points), error)
             if (allocated(error)) return
             lv%fft => lv%plan
          end if

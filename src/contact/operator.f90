@@ -23,12 +23,13 @@ module lc_contact_operator
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_base_strings, only: to_string
-   use lc_fft_plans, only: fft_plan, fft_threads_available
+   use lc_fft_plans, only: fft_plan
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    implicit none (type, external)
    private
-   public :: compliance_operator, build_operator
+   public :: compliance_operator, build_operator, multiply_spectrum, multiply_complex
 
    real(wp), parameter :: pi = acos(-1.0_wp)
    !> The Fourier preconditioner of the inner CG is (|J*(kV)|/|J*(k1 V)|)^preconditioner_exponent/M:
@@ -112,12 +113,6 @@ contains
       real(wp), allocatable :: factor(:)
       integer :: i, mx, nkx
 
-      if (threads > 1 .and. .not. fft_threads_available()) then
-         call fatal_error(error, '&solver: threads > 1 needs a build with FFTW threads ' // &
-            & '(meson option -Dopenmp=true, e.g. pip install . -Csetup-args=-Dopenmp=true); allowed here: threads = 1', &
-            & code_input)
-         return
-      end if
       call op%fft%init(grid%nx, grid%ny, threads, error)
       if (allocated(error)) return
       op%grid = grid
@@ -377,20 +372,39 @@ contains
    !> spectrum <- spectrum * multiplier/n, and energy = (1/n) sum over the whole spectrum of
    !> multiplier |spectrum|^2 (the modes of the half spectrum stand for two, q and -q, but
    !> those of each row's columns mx = 0 and, for even nx, mx = nx/2 for one).
-   pure subroutine multiply_with_energy(spectrum, multiplier, inv_n, nkx, even, energy)
-      complex(wp), intent(inout) :: spectrum(:)
-      real(wp), intent(in) :: multiplier(:), inv_n
+   subroutine multiply_with_energy(spectrum, multiplier, inv_n, nkx, even, energy)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: inv_n
       integer, intent(in) :: nkx
       logical, intent(in) :: even
       real(wp), intent(out) :: energy
-      real(wp) :: f, twice, once
-      integer :: m, first, last
+      real(wp) :: once
+      real(wp) :: block_sums(reduction_blocks(size(spectrum)))
+      integer :: first, last, block
       once = 0.0_wp
       do first = 1, size(spectrum), nkx
          once = once + multiplier(first)*inv_n*abs(spectrum(first))**2
          last = first + nkx - 1
          if (even .and. nkx > 1) once = once + multiplier(last)*inv_n*abs(spectrum(last))**2
       end do
+      ! (by blocks on the solve's threads, their sums added in order: lc_base_threads)
+      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
+      do block = 1, size(block_sums)
+         call block_range(block, size(spectrum), first, last)
+         block_sums(block) = multiplied_energy(spectrum(first:last), multiplier(first:last), inv_n)
+      end do
+      energy = 2.0_wp*sum(block_sums) - once
+   end subroutine multiply_with_energy
+
+   !> multiply_with_energy on a block: spectrum <- spectrum * multiplier/n and the sum of
+   !> multiplier/n |spectrum|^2 before.
+   real(wp) function multiplied_energy(spectrum, multiplier, inv_n) result(twice)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: inv_n
+      real(wp) :: f
+      integer :: m
       twice = 0.0_wp
       !$omp simd reduction(+:twice) private(f)
       do m = 1, size(spectrum)
@@ -398,8 +412,53 @@ contains
          twice = twice + f*(real(spectrum(m), wp)**2 + aimag(spectrum(m))**2)
          spectrum(m) = spectrum(m)*f
       end do
-      energy = 2.0_wp*twice - once
-   end subroutine multiply_with_energy
+   end function multiplied_energy
+
+   !> spectrum <- spectrum * multiplier (times scale), by blocks on the solve's threads.
+   subroutine multiply_spectrum(spectrum, multiplier, scale)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in), optional :: scale
+      real(wp) :: f
+      integer :: block, first, last
+      f = 1.0_wp
+      if (present(scale)) f = scale
+      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
+      do block = 1, reduction_blocks(size(spectrum))
+         call block_range(block, size(spectrum), first, last)
+         call multiply_real_block(spectrum(first:last), multiplier(first:last), f)
+      end do
+   end subroutine multiply_spectrum
+
+   !> The same with a complex multiplier.
+   subroutine multiply_complex(spectrum, multiplier, scale)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      complex(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in), optional :: scale
+      real(wp) :: f
+      integer :: block, first, last
+      f = 1.0_wp
+      if (present(scale)) f = scale
+      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
+      do block = 1, reduction_blocks(size(spectrum))
+         call block_range(block, size(spectrum), first, last)
+         call multiply_complex_block(spectrum(first:last), multiplier(first:last), f)
+      end do
+   end subroutine multiply_complex
+
+   pure subroutine multiply_real_block(spectrum, multiplier, f)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: f
+      spectrum = spectrum*(multiplier*f)
+   end subroutine multiply_real_block
+
+   pure subroutine multiply_complex_block(spectrum, multiplier, f)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      complex(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: f
+      spectrum = spectrum*(multiplier*f)
+   end subroutine multiply_complex_block
 
    !> fft%real_buffer <- P fft%real_buffer with the preconditioner P (see metric_in_buffer).
    subroutine inverse_metric_in_buffer(self)
@@ -459,16 +518,17 @@ contains
    !> fft%real_buffer <- multiplier * fft%real_buffer with a complex multiplier.
    subroutine multiply_complex_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
-      complex(wp), intent(in) :: multiplier(:)
+      complex(wp), contiguous, intent(in) :: multiplier(:)
       call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
+      call multiply_complex(self%fft%spectrum, multiplier, self%inv_n)
       call self%fft%backward()
    end subroutine multiply_complex_in_buffer
 
    !> w = multiplier * p through the plans; the 1/n of the forward transform is folded in.
    subroutine apply_real(self, multiplier, p, w)
       class(compliance_operator), intent(inout) :: self
-      real(wp), intent(in) :: multiplier(:), p(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p
       call multiply_in_buffer(self, multiplier)
@@ -478,16 +538,16 @@ contains
    !> fft%real_buffer <- multiplier * fft%real_buffer.
    subroutine multiply_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
-      real(wp), intent(in) :: multiplier(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
       call self%fft%forward_unscaled()
-      self%fft%spectrum = self%fft%spectrum*(multiplier*self%inv_n)
+      call multiply_spectrum(self%fft%spectrum, multiplier, self%inv_n)
       call self%fft%backward()
    end subroutine multiply_in_buffer
 
    !> The same with a complex multiplier.
    subroutine apply_complex(self, multiplier, p, w)
       class(compliance_operator), intent(inout) :: self
-      complex(wp), intent(in) :: multiplier(:)
+      complex(wp), contiguous, intent(in) :: multiplier(:)
       real(wp), intent(in) :: p(:)
       real(wp), intent(out) :: w(:)
       self%fft%real_buffer = p

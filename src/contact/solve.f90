@@ -29,6 +29,7 @@ module lc_contact_solve
    use lc_contact_solver_multigrid, only: allowed_rise
    use lc_contact_progress, only: progress_log
    use lc_base_memory, only: check_memory
+   use lc_base_threads, only: solve_threads, use_threads, active_threads
    implicit none (type, external)
    private
    public :: solve_contact, scene_mean_pressure
@@ -46,6 +47,9 @@ module lc_contact_solve
    !> are solved to this tolerance instead: the fine grid's iterations do not need a closer
    !> start (docs/numerics.md, "The coarse start").
    real(wp), parameter :: multigrid_coarse_tol = 1.0e-3_wp
+   !> A line of fewer points runs on one thread whatever &solver threads says: its transforms
+   !> and passes are too short for a second thread to pay (docs/decisions/022-threads.md).
+   integer, parameter :: smallest_threaded_line = 262144
 
 contains
 
@@ -82,8 +86,12 @@ contains
       integer :: n
 
       call system_clock(start, rate)
+      call solve_threads(scene%solver%threads, result%omp_threads, error)
+      if (allocated(error)) return
       call progress%begin(scene%solver%verbose)
       grid = grid_of(scene)
+      if (grid%is_line() .and. grid%points() < smallest_threaded_line) result%omp_threads = 1
+      call use_threads(result%omp_threads)
       kernel = kernel_of(scene)
       n = grid%points()
       if (size(height) /= n) then
@@ -181,7 +189,7 @@ contains
 
       ! (the operator first: which methods run depends on it, and refusals come before any
       ! coarse solve)
-      call build_operator(op, grid, kernel, friction, scene%solver%threads, error)
+      call build_operator(op, grid, kernel, friction, active_threads(), error)
       if (allocated(error)) return
       indicators = measure_problem(op, scene%solver%method, load_control)
       call plan_solve(indicators, scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid), plan, error)

@@ -9,6 +9,9 @@
 !>    res = max_j | min(p_j/p_ref, gap_j/g_ref) |
 !> (zero exactly at the solution) falls to tol; p_ref = p_m (load control) or the
 !> current mean pressure, g_ref is given by the caller (the profile's peak-to-valley).
+!>
+!> The passes over the grid run on the solve's threads (lc_base_threads); their sums add
+!> blocks of a fixed size in order, so that the iterates do not depend on the thread count.
 module lc_contact_solver_cg
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp
@@ -17,6 +20,7 @@ module lc_contact_solver_cg
    use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
    implicit none (type, external)
    private
@@ -254,8 +258,42 @@ contains
    end subroutine constrained_cg
 
    !> One pass after w = M p was computed: p <- load_scale p, d = load_scale w - b, and the
-   !> sums of the state.
+   !> sums of the state (fresh_state_range on the blocks of the grid, on the solve's threads;
+   !> the blocks' sums added in order: the same bits on any number of threads).
    subroutine fresh_state(p, w, b, load_scale, d, sums)
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(in) :: w(:), b(:)
+      real(wp), intent(in) :: load_scale
+      real(wp), contiguous, intent(out) :: d(:)
+      type(grid_sums), intent(out) :: sums
+      type(grid_sums) :: parts(reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(parts)
+         call block_range(block, size(p), first, last)
+         call fresh_state_range(p(first:last), w(first:last), b(first:last), load_scale, d(first:last), parts(block))
+      end do
+      sums = added(parts)
+   end subroutine fresh_state
+
+   !> The sums of the blocks' sums, in order, and the largest of their maxima.
+   pure type(grid_sums) function added(parts) result(sums)
+      type(grid_sums), intent(in) :: parts(:)
+      integer :: block
+      sums = grid_sums()
+      do block = 1, size(parts)
+         sums%contact = sums%contact + parts(block)%contact
+         sums%d_contact = sums%d_contact + parts(block)%d_contact
+         sums%b_contact = sums%b_contact + parts(block)%b_contact
+         sums%p_sum = sums%p_sum + parts(block)%p_sum
+         sums%w_max = max(sums%w_max, parts(block)%w_max)
+         sums%p_max = max(sums%p_max, parts(block)%p_max)
+      end do
+   end function added
+
+   !> One pass after w = M p was computed: p <- load_scale p, d = load_scale w - b, and the
+   !> sums of the state.
+   subroutine fresh_state_range(p, w, b, load_scale, d, sums)
       real(wp), contiguous, intent(inout) :: p(:)
       real(wp), contiguous, intent(in) :: w(:), b(:)
       real(wp), intent(in) :: load_scale
@@ -284,7 +322,7 @@ contains
          p_sum = p_sum + pj
       end do
       sums = grid_sums(contact, d_contact, b_contact, w_max, p_max, p_sum)
-   end subroutine fresh_state
+   end subroutine fresh_state_range
 
    !> The sums of the state after p <- load_scale p, d <- load_scale d + (load_scale - 1) b.
    pure subroutine scale_sums(sums, load_scale)
@@ -297,12 +335,31 @@ contains
       sums%p_sum = load_scale*sums%p_sum
    end subroutine scale_sums
 
+   !> evaluate_state_range on the blocks of the grid (see fresh_state).
+   subroutine evaluate_state(p, d, b, load_scale, s, p_scale, g_scale, g_floor, gnorm, residual, masked_gap)
+      real(wp), contiguous, intent(inout) :: p(:), d(:)
+      real(wp), contiguous, intent(in) :: b(:)
+      real(wp), intent(in) :: load_scale, s, p_scale, g_scale, g_floor
+      real(wp), intent(out) :: gnorm, residual
+      real(wp), contiguous, intent(inout) :: masked_gap(:)
+      real(wp) :: gnorms(reduction_blocks(size(p))), residuals(reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(gnorms)
+         call block_range(block, size(p), first, last)
+         call evaluate_state_range(p(first:last), d(first:last), b(first:last), load_scale, s, p_scale, g_scale, &
+            & g_floor, gnorms(block), residuals(block), masked_gap(first:last))
+      end do
+      gnorm = sum(gnorms)
+      residual = maxval(residuals)
+   end subroutine evaluate_state
+
    !> One pass: scale p by load_scale and d so that d + b scales alike, then the
    !> complementarity residual and the squared norm of the gap g = d - s on the contact set;
    !> g on the contact set (0 elsewhere) goes into `masked_gap`, the preconditioner's input.
    !> (The stores are unconditional: a store under a condition keeps the loop from being
    !> vectorised, which costs more than the stores.)
-   subroutine evaluate_state(p, d, b, load_scale, s, p_scale, g_scale, g_floor, gnorm, residual, masked_gap)
+   subroutine evaluate_state_range(p, d, b, load_scale, s, p_scale, g_scale, g_floor, gnorm, residual, masked_gap)
       real(wp), contiguous, intent(inout) :: p(:), d(:)
       real(wp), contiguous, intent(in) :: b(:)
       real(wp), intent(in) :: load_scale, s, p_scale, g_scale, g_floor
@@ -331,15 +388,33 @@ contains
       ! a NaN or Inf gap or pressure (which max() may skip) makes the sum non-finite:
       ! count it as infinitely wrong
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
-   end subroutine evaluate_state
+   end subroutine evaluate_state_range
 
    !> One pass over the preconditioned residual z (the buffer after the inverse metric):
-   !> gz_sum = sum g z and z_mean = <z> over the contact set.
+   !> gz_sum = sum g z and z_mean = <z> over the contact set (by blocks: see fresh_state).
    subroutine preconditioned_products(p, d, s, z, gz_sum, z_mean)
       real(wp), contiguous, intent(in) :: p(:), d(:), z(:)
       real(wp), intent(in) :: s
       real(wp), intent(out) :: gz_sum, z_mean
-      real(wp) :: z_sum, contact, inside
+      real(wp) :: parts(3, reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(parts, 2)
+         call block_range(block, size(p), first, last)
+         call preconditioned_products_range(p(first:last), d(first:last), s, z(first:last), parts(1, block), &
+            & parts(2, block), parts(3, block))
+      end do
+      gz_sum = sum(parts(1, :))
+      z_mean = sum(parts(2, :))/max(sum(parts(3, :)), 1.0_wp)
+   end subroutine preconditioned_products
+
+   !> One pass over a block of the preconditioned residual z: gz_sum = sum g z, z_sum = sum z
+   !> over the contact set and contact its points.
+   subroutine preconditioned_products_range(p, d, s, z, gz_sum, z_sum, contact)
+      real(wp), contiguous, intent(in) :: p(:), d(:), z(:)
+      real(wp), intent(in) :: s
+      real(wp), intent(out) :: gz_sum, z_sum, contact
+      real(wp) :: inside
       integer :: j
       gz_sum = 0.0_wp
       z_sum = 0.0_wp
@@ -351,13 +426,31 @@ contains
          z_sum = z_sum + z(j)*inside
          contact = contact + inside
       end do
-      z_mean = z_sum/max(contact, 1.0_wp)
-   end subroutine preconditioned_products
+   end subroutine preconditioned_products_range
+
+   !> new_direction_range on the blocks of the grid (see fresh_state).
+   subroutine new_direction(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
+      real(wp), contiguous, intent(in) :: p(:), d(:)
+      real(wp), intent(in) :: s, z_mean, beta, t_shift
+      logical, intent(in) :: preconditioned
+      real(wp), contiguous, intent(inout) :: t(:), buffer(:)
+      real(wp), intent(out) :: gt_sum, t_sum
+      real(wp) :: parts(2, reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(parts, 2)
+         call block_range(block, size(p), first, last)
+         call new_direction_range(p(first:last), d(first:last), s, preconditioned, z_mean, beta, t_shift, &
+            & t(first:last), buffer(first:last), parts(1, block), parts(2, block))
+      end do
+      gt_sum = sum(parts(1, :))
+      t_sum = sum(parts(2, :))
+   end subroutine new_direction
 
    !> One pass: the new direction t = (e + beta (t - t_shift)) on the contact set (0
    !> elsewhere), with e = z - z_mean (preconditioned; z in the buffer) or the gap g; t is
    !> also written into the buffer (the transform's input). gt_sum = sum g t, t_sum = sum t.
-   subroutine new_direction(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
+   subroutine new_direction_range(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
       real(wp), contiguous, intent(in) :: p(:), d(:)
       real(wp), intent(in) :: s, z_mean, beta, t_shift
       logical, intent(in) :: preconditioned
@@ -381,7 +474,35 @@ contains
          gt_sum = gt_sum + g*tj
          t_sum = t_sum + tj
       end do
-   end subroutine new_direction
+   end subroutine new_direction_range
+
+   !> update_range on the blocks of the grid (see fresh_state).
+   subroutine update(p, d, b, s, tau, t, r, reenter, sums, t_left, n_changed, entered)
+      real(wp), contiguous, intent(inout) :: p(:), d(:), r(:)
+      real(wp), contiguous, intent(in) :: b(:), t(:)
+      real(wp), intent(in) :: s, tau
+      logical, intent(in) :: reenter
+      type(grid_sums), intent(inout) :: sums
+      real(wp), intent(out) :: t_left
+      integer, intent(out) :: n_changed
+      logical, intent(out) :: entered
+      type(grid_sums) :: parts(reduction_blocks(size(p)))
+      real(wp) :: lefts(size(parts))
+      integer :: changed(size(parts))
+      logical :: entries(size(parts))
+      integer :: block, first, last
+      parts = sums
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(parts)
+         call block_range(block, size(p), first, last)
+         call update_range(p(first:last), d(first:last), b(first:last), s, tau, t(first:last), r(first:last), &
+            & reenter, parts(block), lefts(block), changed(block), entries(block))
+      end do
+      sums = added(parts)
+      t_left = sum(lefts)
+      n_changed = sum(changed)
+      entered = any(entries)
+   end subroutine update
 
    !> One pass: p <- p - tau t clipped at zero, overlapping points (p = 0, g < 0) let in,
    !> d <- d - tau r (r = M t, in the buffer); r then keeps the change of p that was not
@@ -392,7 +513,7 @@ contains
    !> (a safeguarded iteration restarts its conjugacy then). `reenter`: a point clipped by
    !> this step is let in again at once if its gap is negative (the safeguarded iteration);
    !> otherwise it stays out until the next evaluation.
-   subroutine update(p, d, b, s, tau, t, r, reenter, sums, t_left, n_changed, entered)
+   subroutine update_range(p, d, b, s, tau, t, r, reenter, sums, t_left, n_changed, entered)
       real(wp), contiguous, intent(inout) :: p(:), d(:), r(:)
       real(wp), contiguous, intent(in) :: b(:), t(:)
       real(wp), intent(in) :: s, tau
@@ -446,7 +567,7 @@ contains
       sums%p_sum = p_sum
       n_changed = nint(changed_count)
       entered = entered_count > 0.0_wp
-   end subroutine update
+   end subroutine update_range
 
    !> Load the overlapping points out of contact (p = 0, g = d - s < 0) with the pressure
    !> -g/M_jj of a first step; n_changed: how many.

@@ -20,7 +20,8 @@
 !>
 !> The images are stored centred on the contact set under load control: a constant added
 !> to w everywhere only moves s. w is recomputed as G_eff p to confirm convergence, so the
-!> fields returned belong together. Stopping rule and residual as in lc_contact_solver_cg.
+!> fields returned belong together. Stopping rule and residual as in lc_contact_solver_cg,
+!> and the passes over the grid threaded as there.
 module lc_contact_solver_gcr
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp
@@ -30,6 +31,7 @@ module lc_contact_solver_gcr
    use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    implicit none (type, external)
    private
    public :: constrained_gcr, gcr_outcome, gcr_solver
@@ -341,7 +343,46 @@ contains
       integer, intent(out) :: n_contact
       real(wp), intent(out) :: residual
       real(wp), intent(out) :: norm2   !< sum of gap^2 over the contact set
-      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, p_scale, g_scale, g_floor, g, c, inside, check
+      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, p_scale, g_scale, g_floor, check
+      real(wp) :: sums(5, reduction_blocks(size(p)))
+      integer :: block, first, last
+      ! (the passes on blocks of the grid, by procedures of their own, which vectorise: sums by
+      ! blocks, added in order, the same bits on any number of threads)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(sums, 2)
+         call block_range(block, size(p), first, last)
+         call scale_and_sum(p(first:last), w(first:last), b(first:last), load_scale, sums(:, block))
+      end do
+      w_max = maxval(sums(4, :))
+      p_max = maxval(sums(5, :))
+      contact = sum(sums(1, :))
+      gap_sum = sum(sums(2, :))
+      p_sum = sum(sums(3, :))
+      n_contact = nint(contact)
+      if (load_control) s = gap_sum/max(contact, 1.0_wp)
+      p_scale = 1.0_wp/max(merge(mean_pressure, p_sum/size(p), load_control), tiny(1.0_wp))
+      g_scale = 1.0_wp/g_ref
+      g_floor = rounding_floor(w_max, b_max, p_max, m_max)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(sums, 2)
+         call block_range(block, size(p), first, last)
+         call gaps_and_residual(p(first:last), w(first:last), b(first:last), s, p_scale, g_scale, g_floor, &
+            & gap(first:last), masked(first:last), sums(1:3, block))
+      end do
+      check = sum(sums(1, :))
+      norm2 = sum(sums(2, :))
+      residual = maxval(sums(3, :))
+      if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
+   end subroutine evaluate
+
+   !> evaluate's first pass on a block: p and w scaled by load_scale; sums = (points in
+   !> contact, sum of w - b over them, sum p, max |w|, max p).
+   subroutine scale_and_sum(p, w, b, load_scale, sums)
+      real(wp), contiguous, intent(inout) :: p(:), w(:)
+      real(wp), contiguous, intent(in) :: b(:)
+      real(wp), intent(in) :: load_scale
+      real(wp), intent(out) :: sums(5)
+      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, inside
       integer :: j
       contact = 0.0_wp
       gap_sum = 0.0_wp
@@ -360,11 +401,19 @@ contains
          w_max = max(w_max, abs(w(j)))
          p_max = max(p_max, p(j))
       end do
-      n_contact = nint(contact)
-      if (load_control) s = gap_sum/max(contact, 1.0_wp)
-      p_scale = 1.0_wp/max(merge(mean_pressure, p_sum/size(p), load_control), tiny(1.0_wp))
-      g_scale = 1.0_wp/g_ref
-      g_floor = rounding_floor(w_max, b_max, p_max, m_max)
+      sums = [contact, gap_sum, p_sum, w_max, p_max]
+   end subroutine scale_and_sum
+
+   !> evaluate's second pass on a block: the gap, -gap on the contact set in `masked`;
+   !> sums = (sum of gap + p (finite unless a value is not), sum of gap^2 over the contact
+   !> set, the largest complementarity term).
+   subroutine gaps_and_residual(p, w, b, s, p_scale, g_scale, g_floor, gap, masked, sums)
+      real(wp), contiguous, intent(in) :: p(:), w(:), b(:)
+      real(wp), intent(in) :: s, p_scale, g_scale, g_floor
+      real(wp), contiguous, intent(out) :: gap(:), masked(:)
+      real(wp), intent(out) :: sums(3)
+      real(wp) :: residual, check, norm2, g, c, inside
+      integer :: j
       residual = 0.0_wp
       check = 0.0_wp
       norm2 = 0.0_wp
@@ -379,17 +428,31 @@ contains
          residual = max(residual, merge(c, 0.0_wp, abs(g) > g_floor))
          check = check + g + p(j)
       end do
-      if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
-   end subroutine evaluate
+      sums = [check, norm2, residual]
+   end subroutine gaps_and_residual
 
    !> The mean of v over the contact set (p > 0) under load control, 0 otherwise (one pass).
    real(wp) function set_mean(p, load_control, v) result(mean)
       real(wp), contiguous, intent(in) :: p(:), v(:)
       logical, intent(in) :: load_control
-      real(wp) :: v_sum, contact, inside
-      integer :: j
+      real(wp) :: sums(2, reduction_blocks(size(p)))
+      integer :: block, first, last
       mean = 0.0_wp
       if (.not. load_control) return
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(sums, 2)
+         call block_range(block, size(p), first, last)
+         call set_sums(p(first:last), v(first:last), sums(:, block))
+      end do
+      mean = sum(sums(1, :))/max(sum(sums(2, :)), 1.0_wp)
+   end function set_mean
+
+   !> On a block: sums = (sum of v over the contact set, its points).
+   subroutine set_sums(p, v, sums)
+      real(wp), contiguous, intent(in) :: p(:), v(:)
+      real(wp), intent(out) :: sums(2)
+      real(wp) :: v_sum, contact, inside
+      integer :: j
       v_sum = 0.0_wp
       contact = 0.0_wp
       !$omp simd reduction(+:v_sum, contact) private(inside)
@@ -398,8 +461,8 @@ contains
          v_sum = v_sum + v(j)*inside
          contact = contact + inside
       end do
-      mean = v_sum/max(contact, 1.0_wp)
-   end function set_mean
+      sums = [v_sum, contact]
+   end subroutine set_sums
 
    !> d = z on the contact set, minus its mean there under load control, 0 elsewhere; z
    !> (the buffer) is overwritten by d, the next transform's input.
@@ -411,7 +474,7 @@ contains
       real(wp) :: mean, inside
       integer :: j
       mean = set_mean(p, load_control, z)
-      !$omp simd private(inside)
+      !$omp parallel do simd schedule(static) private(inside) if(size(p) >= parallel_points)
       do j = 1, size(p)
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
          d(j) = (z(j) - mean)*inside
@@ -425,9 +488,23 @@ contains
       real(wp), contiguous, intent(in) :: p(:), v(:)
       logical, intent(in) :: load_control
       real(wp), intent(out) :: centre, norm
-      real(wp) :: v2_sum, inside, x
-      integer :: j
+      real(wp) :: sums(reduction_blocks(size(p)))
+      integer :: block, first, last
       centre = set_mean(p, load_control, v)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(sums)
+         call block_range(block, size(p), first, last)
+         sums(block) = centred_squares(p(first:last), v(first:last), centre)
+      end do
+      norm = sqrt(sum(sums))
+   end subroutine set_norm
+
+   !> On a block: the sum of (v - centre)^2 over the contact set.
+   real(wp) function centred_squares(p, v, centre) result(v2_sum)
+      real(wp), contiguous, intent(in) :: p(:), v(:)
+      real(wp), intent(in) :: centre
+      real(wp) :: inside, x
+      integer :: j
       v2_sum = 0.0_wp
       !$omp simd reduction(+:v2_sum) private(inside, x)
       do j = 1, size(p)
@@ -435,18 +512,22 @@ contains
          x = (v(j) - centre)*inside
          v2_sum = v2_sum + x*x
       end do
-      norm = sqrt(v2_sum)
-   end subroutine set_norm
+   end function centred_squares
 
    !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
    !> (The stored images are centred on the set, so the mean of a need not be removed.)
-   pure subroutine history_products(images, p, a, coeff)
+   subroutine history_products(images, p, a, coeff)
       real(wp), intent(in) :: images(:, :), p(:), a(:)
       real(wp), intent(out) :: coeff(:)
       real(wp) :: c
-      integer :: i, i0, i1, k
-      coeff = 0.0_wp
-      do i0 = 1, size(a), block_rows
+      real(wp), allocatable :: partial(:, :)
+      integer :: i, i0, i1, k, block
+      ! (each block's products apart, then added block by block in order: the same bits on
+      ! any number of threads)
+      allocate (partial(size(coeff), (size(a) + block_rows - 1)/block_rows))
+      !$omp parallel do schedule(static) private(i0, i1, k, c) if(size(a) >= parallel_points)
+      do block = 1, size(partial, 2)
+         i0 = (block - 1)*block_rows + 1
          i1 = min(size(a), i0 + block_rows - 1)
          do k = 1, size(coeff)
             c = 0.0_wp
@@ -454,16 +535,21 @@ contains
             do i = i0, i1
                c = c + a(i)*images(i, k)*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
             end do
-            coeff(k) = coeff(k) + c
+            partial(k, block) = c
          end do
+      end do
+      coeff = 0.0_wp
+      do block = 1, size(partial, 2)
+         coeff = coeff + partial(:, block)
       end do
    end subroutine history_products
 
    !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks.
-   pure subroutine subtract_history(dirs, images, coeff, d, a)
+   subroutine subtract_history(dirs, images, coeff, d, a)
       real(wp), intent(in) :: dirs(:, :), images(:, :), coeff(:)
       real(wp), intent(inout) :: d(:), a(:)
       integer :: i, i0, i1, k
+      !$omp parallel do schedule(static) private(i1, k) if(size(a) >= parallel_points)
       do i0 = 1, size(a), block_rows
          i1 = min(size(a), i0 + block_rows - 1)
          do k = 1, size(coeff)
@@ -484,9 +570,24 @@ contains
       real(wp), intent(in) :: centre, norm
       real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
       real(wp), intent(out) :: alpha
-      real(wp) :: scale, inside
+      real(wp) :: sums(reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(sums)
+         call block_range(block, size(p), first, last)
+         sums(block) = scaled_step(p(first:last), gap(first:last), centre, 1.0_wp/norm, d(first:last), &
+            & a(first:last), d_unit(first:last), a_unit(first:last))
+      end do
+      alpha = sum(sums)
+   end subroutine normalised_step
+
+   !> normalised_step on a block: d_unit, a_unit and the block's part of alpha.
+   real(wp) function scaled_step(p, gap, centre, scale, d, a, d_unit, a_unit) result(alpha)
+      real(wp), contiguous, intent(in) :: p(:), gap(:), d(:), a(:)
+      real(wp), intent(in) :: centre, scale
+      real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
+      real(wp) :: inside
       integer :: j
-      scale = 1.0_wp/norm
       alpha = 0.0_wp
       !$omp simd reduction(+:alpha) private(inside)
       do j = 1, size(p)
@@ -495,7 +596,7 @@ contains
          a_unit(j) = (a(j) - centre)*scale
          alpha = alpha - gap(j)*a_unit(j)*inside
       end do
-   end subroutine normalised_step
+   end function scaled_step
 
    !> One pass: p <- p + alpha d and w <- w + alpha a; points out of contact with a negative
    !> gap are let in with -let_in_scale gap (Polonsky & Keer's rule: the preconditioned step
@@ -510,7 +611,33 @@ contains
       integer, intent(out) :: n_clipped
       logical, intent(out) :: entered
       real(wp), intent(out) :: p_sum
-      real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count
+      real(wp) :: clip_count, enter_count, changed_count
+      real(wp) :: sums(4, reduction_blocks(size(p)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, size(sums, 2)
+         call block_range(block, size(p), first, last)
+         call update_block(p(first:last), w(first:last), gap(first:last), d(first:last), a(first:last), alpha, &
+            & let_in_scale, delta(first:last), sums(:, block))
+      end do
+      ! (the counts are exact in any order; the sum of p added block by block in order)
+      clip_count = sum(sums(1, :))
+      enter_count = sum(sums(2, :))
+      changed_count = sum(sums(3, :))
+      p_sum = sum(sums(4, :))
+      n_changed = nint(changed_count)
+      n_clipped = nint(clip_count)
+      entered = enter_count > 0.0_wp
+   end subroutine update
+
+   !> update on a block; sums = (points clipped, let in, changed, sum of the new p).
+   subroutine update_block(p, w, gap, d, a, alpha, let_in_scale, delta, sums)
+      real(wp), contiguous, intent(inout) :: p(:), w(:)
+      real(wp), contiguous, intent(in) :: gap(:), d(:), a(:)
+      real(wp), intent(in) :: alpha, let_in_scale
+      real(wp), contiguous, intent(out) :: delta(:)
+      real(wp), intent(out) :: sums(4)
+      real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count, p_sum
       integer :: j
       clip_count = 0.0_wp
       enter_count = 0.0_wp
@@ -531,10 +658,8 @@ contains
          p(j) = p_new
          p_sum = p_sum + p_new
       end do
-      n_changed = nint(changed_count)
-      n_clipped = nint(clip_count)
-      entered = enter_count > 0.0_wp
-   end subroutine update
+      sums = [clip_count, enter_count, changed_count, p_sum]
+   end subroutine update_block
 
    !> The factor that scales p (and w = G p, linear in p) to the load, from sum p; a vanished
    !> p is reset to uniform (w stale then, factor 1).
@@ -561,7 +686,7 @@ contains
       real(wp) :: count_negative
       integer :: j
       count_negative = 0.0_wp
-      !$omp simd reduction(+:count_negative)
+      !$omp parallel do simd schedule(static) reduction(+:count_negative) if(size(p) >= parallel_points)
       do j = 1, size(p)
          delta(j) = merge(-p(j), 0.0_wp, p(j) < 0.0_wp)
          count_negative = count_negative + merge(1.0_wp, 0.0_wp, p(j) < 0.0_wp)
@@ -580,10 +705,10 @@ contains
       logical, intent(in) :: load_control
       real(wp), intent(inout) :: dirs(:, :), images(:, :)
       integer, intent(inout) :: columns, newest
-      real(wp), allocatable :: gram(:, :), sums(:), centre(:), length(:)
+      real(wp), allocatable :: gram(:, :), sums(:), centre(:), length(:), block_gram(:, :, :), block_sums(:, :)
       integer, allocatable :: order(:)
       real(wp) :: contact, x
-      integer :: i, i0, i1, k, l, m, info
+      integer :: i, i0, i1, k, l, m, info, block
 
       m = columns
       ! oldest first
@@ -592,14 +717,18 @@ contains
          order(k) = modulo(newest - m + k - 1, size(dirs, 2)) + 1
       end do
       allocate (gram(m, m), sums(m), centre(m), length(m))
-      gram = 0.0_wp
-      sums = 0.0_wp
       contact = count(p > 0.0_wp)
-      do i0 = 1, size(p), block_rows
+      ! (each block of rows apart, then added block by block in order: the same bits on any
+      ! number of threads)
+      allocate (block_gram(m, m, (size(p) + block_rows - 1)/block_rows), block_sums(m, (size(p) + block_rows - 1)/block_rows))
+      !$omp parallel do schedule(static) private(i0, i1, k, l, x) if(size(p) >= parallel_points)
+      do block = 1, size(block_gram, 3)
+         i0 = (block - 1)*block_rows + 1
          i1 = min(size(p), i0 + block_rows - 1)
          do k = 1, m
+            block_sums(k, block) = 0.0_wp
             do i = i0, i1
-               if (p(i) > 0.0_wp) sums(k) = sums(k) + images(i, order(k))
+               if (p(i) > 0.0_wp) block_sums(k, block) = block_sums(k, block) + images(i, order(k))
             end do
             do l = 1, k
                x = 0.0_wp
@@ -607,8 +736,16 @@ contains
                do i = i0, i1
                   x = x + images(i, order(k))*images(i, order(l))*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
                end do
-               gram(k, l) = gram(k, l) + x
+               block_gram(k, l, block) = x
             end do
+         end do
+      end do
+      gram = 0.0_wp
+      sums = 0.0_wp
+      do block = 1, size(block_gram, 3)
+         do k = 1, m
+            sums(k) = sums(k) + block_sums(k, block)
+            gram(k, 1:k) = gram(k, 1:k) + block_gram(k, 1:k, block)
          end do
       end do
       centre = 0.0_wp
@@ -639,6 +776,7 @@ contains
          return
       end if
       ! forward substitution, row block by row block: new_k = (old_k - sum_{l<k} L(k,l) new_l)/L(k,k)
+      !$omp parallel do schedule(static) private(i1, k, l) if(size(p) >= parallel_points)
       do i0 = 1, size(p), block_rows
          i1 = min(size(p), i0 + block_rows - 1)
          do k = 1, m

@@ -18,7 +18,7 @@ module lc_fft_plans
    use lc_base_strings, only: to_string
    implicit none (type, external)
    private
-   public :: fft_plan, fft_threads_available
+   public :: fft_plan
 
    !> Surfaces of at least this many points are transformed in two passes: the rows (r2c),
    !> then the columns of the half spectrum in blocks of `column_block` adjacent columns.
@@ -37,6 +37,7 @@ module lc_fft_plans
       integer :: n = 0    !< real points nx*ny
       integer :: nk = 0   !< spectral coefficients (nx/2 + 1)*ny
       integer :: nx = 0, ny = 1
+      integer :: threads = 1   !< threads a transform runs on
       real(c_double), pointer, contiguous :: real_buffer(:) => null()
       complex(c_double_complex), pointer, contiguous :: spectrum(:) => null()
       type(c_ptr), private :: r2c = c_null_ptr, c2r = c_null_ptr
@@ -65,17 +66,9 @@ module lc_fft_plans
 
 contains
 
-   !> True if this build links FFTW's OpenMP threads.
-   pure logical function fft_threads_available()
-#ifdef LC_OPENMP
-      fft_threads_available = .true.
-#else
-      fft_threads_available = .false.
-#endif
-   end function fft_threads_available
-
-   !> Make plans and buffers for nx x ny points (ny = 1: a line) with `threads` FFTW threads
-   !> (ignored without OpenMP).
+   !> Make plans and buffers for nx x ny points (ny = 1: a line) for `threads` threads
+   !> (ignored without OpenMP): FFTW's threads for the rows (and for a whole surface below
+   !> split_points), OpenMP over the blocks of columns of a two-pass surface.
    subroutine init(self, nx, ny, threads, error)
       class(fft_plan), intent(inout) :: self
       integer, intent(in) :: nx, ny, threads
@@ -83,9 +76,10 @@ contains
       integer(c_int) :: status
 
       call self%destroy()
+      self%threads = max(threads, 1)
 #ifdef LC_OPENMP
       status = fftw_init_threads()
-      call fftw_plan_with_nthreads(int(threads, c_int))
+      call fftw_plan_with_nthreads(int(self%threads, c_int))
 #else
       status = int(threads, c_int)
 #endif
@@ -140,6 +134,10 @@ contains
       self%c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], ny, self%spectrum, [nkx], 1_c_int, nkx, self%real_buffer, &
          & [nx], 1_c_int, nx, ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
       block = int(min(column_block, nkx), c_int)
+      ! (each block's plan runs on one thread: the blocks are shared out among the threads)
+#ifdef LC_OPENMP
+      call fftw_plan_with_nthreads(1_c_int)
+#endif
       self%columns_forward = fftw_plan_many_dft(1_c_int, [ny], block, self%spectrum, [ny], nkx, 1_c_int, &
          & self%in_place, [ny], nkx, 1_c_int, FFTW_FORWARD, in_place_column)
       self%columns_backward = fftw_plan_many_dft(1_c_int, [ny], block, self%spectrum, [ny], nkx, 1_c_int, &
@@ -170,6 +168,9 @@ contains
       nx = int(self%nx, c_int)
       ny = int(self%ny, c_int)
       nkx = nx/2 + 1
+#ifdef LC_OPENMP
+      call fftw_plan_with_nthreads(int(self%threads, c_int))
+#endif
       self%rows_r2c = fftw_plan_many_dft_r2c(1_c_int, [nx], ny, self%real_buffer, [nx], 1_c_int, nx, &
          & self%spectrum, [nkx], 1_c_int, nkx, FFTW_ESTIMATE)
       self%rows_c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], ny, self%spectrum, [nkx], 1_c_int, nkx, &
@@ -219,9 +220,13 @@ contains
       type(c_ptr), intent(in) :: block_plan, last_plan
       integer :: first, nkx
       nkx = self%nx/2 + 1
+      ! (fftw_execute_dft on new arrays is thread-safe; each block is transformed by the same
+      ! plan whatever the thread count, so the bits do not depend on it)
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
       do first = 1, nkx - self%last_block, column_block
          call fftw_execute_dft(block_plan, self%spectrum(first:), self%in_place(first:))
       end do
+      !$omp end parallel do
       if (self%last_block > 0) then
          first = nkx - self%last_block + 1
          call fftw_execute_dft(last_plan, self%spectrum(first:), self%in_place(first:))
@@ -245,6 +250,7 @@ contains
       self%last_forward = c_null_ptr
       self%last_backward = c_null_ptr
       self%split = .false.
+      self%threads = 1
       self%last_block = 0
       if (c_associated(self%real_memory)) call fftw_free(self%real_memory)
       if (c_associated(self%complex_memory)) call fftw_free(self%complex_memory)

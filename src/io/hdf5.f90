@@ -1,7 +1,8 @@
 !> HDF5 output (self-describing result file, written atomically) and profile input.
 !>
 !> Layout written by `write_results` (units: lengths L, stresses S, as in the input):
-!>   /                     attrs layercontact_version, layercontact_build, geometry, convention, units
+!>   /                     attrs layercontact_version, layercontact_build, geometry, convention, units,
+!>                         omp_threads, mpi_ranks (the threads and processes the solve ran on)
 !>   /input/namelist       the namelist text; /input attrs: every scene variable that is set
 !>   /profile/x, height    grid positions j*period/n and the rigid profile r(x)
 !>   /fields/pressure, gap, displacement_z
@@ -232,6 +233,8 @@ contains
          call write_attr_string(file, 'geometry', trim(scene%geometry), st)
          call write_attr_string(file, 'convention', convention, st)
          call write_attr_string(file, 'units', units_note, st)
+         call write_attr_int(file, 'omp_threads', result%omp_threads, st)
+         call write_attr_int(file, 'mpi_ranks', result%mpi_ranks, st)
          call write_provenance(file, st)
          if (present(run)) then
             call write_attr_string(file, 'input_file', run%input_file, st)

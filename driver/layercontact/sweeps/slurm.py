@@ -463,7 +463,7 @@ scene_list={scene_list}
 scenes_per_task={scenes_per_task}
 submission={submission}
 host=${{SLURMD_NODENAME:-$HOSTNAME}}
-# the scenes are single-threaded unless &solver threads says otherwise
+# each scene's solve runs on the task's CPUs (&solver threads = 0, the default, takes OMP_NUM_THREADS)
 export OMP_NUM_THREADS=${{SLURM_CPUS_PER_TASK:-1}} OPENBLAS_NUM_THREADS=1
 # the run records' times are UTC
 export TZ=UTC

@@ -741,13 +741,16 @@ def _pool_context() -> multiprocessing.context.BaseContext:
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
-def _start_worker(directory: str, sweep_pid: int) -> None:
+def _start_worker(directory: str, sweep_pid: int, threads: int) -> None:
     """A worker runs in the caller's working directory (a forkserver keeps its own),
     leaves Ctrl-C to the sweep's process (which ends the scenes in flight and stops),
     and ends when that process is gone (killed with SIGKILL, it cannot stop its workers).
     On Ctrl-C the sweep's process ends its workers with SIGTERM, whose default action ends
-    one at once, inside the library too."""
+    one at once, inside the library too. Its scenes' solves take ``threads`` threads where
+    ``&solver threads`` is not given and the sweep's environment sets no
+    ``OMP_NUM_THREADS``: the workers share the CPUs."""
     os.chdir(directory)
+    os.environ.setdefault("OMP_NUM_THREADS", str(threads))
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
@@ -773,8 +776,10 @@ def _run_pending(
     outcomes: dict[int, dict[str, object]] = {}
     bar = tqdm(total=total, initial=total - len(pending), desc=name, unit="scene", file=sys.stderr,
                disable=not progress)
-    pool = ProcessPoolExecutor(max_workers=min(processes, len(pending)), mp_context=_pool_context(),
-                               initializer=_start_worker, initargs=(os.getcwd(), os.getpid()))
+    workers = min(processes, len(pending))
+    threads = max(1, len(os.sched_getaffinity(0)) // workers)
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context(),
+                               initializer=_start_worker, initargs=(os.getcwd(), os.getpid(), threads))
     futures = {}
     try:
         futures = {
