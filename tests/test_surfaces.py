@@ -265,7 +265,7 @@ def bad_files(tmp_path, surface):
     cases.append(("line.h5", None, 2, "holds shape (240,)"))
     cases.append(("line.h5", "/other", 2, "has no dataset '/other'"))
     (tmp_path / "text.h5").write_text("not HDF5\n")
-    cases.append(("text.h5", None, 4, "cannot be opened as HDF5"))
+    cases.append(("text.h5", None, 2, "is not an HDF5 file"))
     np.save(tmp_path / "single.npy", surface.astype(np.float32))
     cases.append(("single.npy", None, 2, "dtype '<f4'"))
     np.save(tmp_path / "big_endian.npy", surface.astype(">f8"))

@@ -274,7 +274,8 @@ def test_ctrl_c_stops_the_sweep_cleanly_and_a_rerun_resumes(tmp_path):
                        base=BASE.replace("n = 256", "n = 65536"))
     command = [sys.executable, "-m", "layercontact", "sweep", str(path), "--no-progress"]
     proc = subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True,
+                            preexec_fn=interactive_sigint)
     results = tmp_path / "out/s/results"
     deadline = time.monotonic() + 120
     while not (results.is_dir() and any(results.glob("*.h5"))) and time.monotonic() < deadline:
@@ -290,6 +291,13 @@ def test_ctrl_c_stops_the_sweep_cleanly_and_a_rerun_resumes(tmp_path):
     assert rerun.returncode == 0, rerun.stderr
     skipped = int(rerun.stderr.split("sweep 's': ")[1].split(" of 200 scenes already")[0])
     assert skipped >= done - 2   # a result being written at the signal may be cut (its .tmp is not a result)
+
+
+def interactive_sigint() -> None:
+    """In the child, before it starts: SIGINT's default action, as in a terminal. A test
+    run as a background job inherits SIGINT ignored, and Python then takes no Ctrl-C."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def descendants(pid: int) -> set[int]:
@@ -515,7 +523,7 @@ def test_ctrl_c_ends_the_scenes_in_flight_at_once_and_a_rerun_completes(tmp_path
     env = {**os.environ, "LAYERCONTACT_TEST_SWEEP": marker.split("=")[1]}
     command = [sys.executable, "-m", "layercontact", "sweep", str(path), "--no-progress"]
     proc = subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True, env=env)
+                            start_new_session=True, env=env, preexec_fn=interactive_sigint)
     runs = tmp_path / "out/s/runs"
     deadline = time.monotonic() + 300
 
