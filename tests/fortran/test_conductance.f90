@@ -18,24 +18,19 @@ program test_conductance
    use lc_greens_kernel, only: layer_kernel, make_kernel
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_observables_conductance, only: contact_conductance, contact_stiffness, masked_outcome
+   use lc_test_checks, only: check, finish
    implicit none (type, external)
 
    real(wp), parameter :: tol_exact = 1.0e-13_wp
    real(wp), parameter :: tol_same = 1.0e-10_wp
    real(wp), parameter :: tol_strip = 1.0e-3_wp
    real(wp), parameter :: pi = acos(-1.0_wp)
-   integer :: failures
 
-   failures = 0
    call check_trivial()
    call check_strips()
    call check_barber()
    call check_refusal()
-   if (failures > 0) then
-      write (*, '(a, i0, a)') 'FAILED: ', failures, ' check(s)'
-      error stop 1
-   end if
-   write (*, '(a)') 'all conductance checks passed'
+   call finish('conductance')
 
 contains
 
@@ -43,17 +38,6 @@ contains
    real(wp) function infinite()
       infinite = ieee_value(1.0_wp, ieee_positive_inf)
    end function infinite
-
-   subroutine check(ok, what)
-      logical, intent(in) :: ok
-      character(len=*), intent(in) :: what
-      if (ok) then
-         write (*, '(a)') 'ok    ' // what
-      else
-         write (*, '(a)') 'FAIL  ' // what
-         failures = failures + 1
-      end if
-   end subroutine check
 
    !> Full contact on a layer conducts sigma/h, on a half-space without bound; none, nothing.
    subroutine check_trivial()

@@ -10,35 +10,19 @@ program test_leakage
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
    use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
+   use lc_test_checks, only: check, finish
    implicit none (type, external)
 
    real(wp), parameter :: tol_exact = 1.0e-12_wp
    real(wp), parameter :: tol_solve = 1.0e-10_wp
-   integer :: failures
 
-   failures = 0
    call check_uniform()
    call check_stripes()
    call check_blocked()
    call check_diagonal_channel()
-   if (failures > 0) then
-      write (*, '(a, i0, a)') 'FAILED: ', failures, ' check(s)'
-      error stop 1
-   end if
-   write (*, '(a)') 'all leakage checks passed'
+   call finish('leakage')
 
 contains
-
-   subroutine check(ok, what)
-      logical, intent(in) :: ok
-      character(len=*), intent(in) :: what
-      if (ok) then
-         write (*, '(a)') 'ok    ' // what
-      else
-         write (*, '(a)') 'FAIL  ' // what
-         failures = failures + 1
-      end if
-   end subroutine check
 
    subroutine leakage_of(g, nx, ny, lx, ly, tol, res)
       real(wp), intent(in) :: g(:), lx, ly, tol

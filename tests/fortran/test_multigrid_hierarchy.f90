@@ -17,13 +17,12 @@ program test_multigrid_hierarchy
    use lc_contact_operator, only: compliance_operator
    use lc_contact_multigrid_hierarchy, only: hierarchy, build_hierarchy, set_grid, set_contact, level_operator, &
       & penalty, solve_rows, worst_row_smoothing
+   use lc_test_checks, only: check, finish
    implicit none (type, external)
 
    real(wp), parameter :: tol_identity = 1.0e-12_wp
    real(wp), parameter :: pi = acos(-1.0_wp)
-   integer :: failures
 
-   failures = 0
    ! (expected: how each grid is made of the one before, 'b' both axes halved, 'x', 'y')
    call check_galerkin('line, real symbol', 512, 1, 1.0_wp, 1.0_wp, .false., 'xxx')
    call check_galerkin('line, complex symbol', 512, 1, 1.0_wp, 1.0_wp, .true., 'xxx')
@@ -35,24 +34,9 @@ program test_multigrid_hierarchy
    call check_rows('rows, complex symbol', 32, 16, .true.)
    call check_rows('rows, stiff across the rows, more rows than points along them', 16, 64, .true., 4.0_wp)
    call check_rows('rows, more than twice as many points along x as along y', 64, 16, .true.)
-   if (failures > 0) then
-      write (*, '(a, i0, a)') 'FAILED: ', failures, ' check(s)'
-      error stop 1
-   end if
-   write (*, '(a)') 'all multigrid hierarchy checks passed'
+   call finish('multigrid hierarchy')
 
 contains
-
-   subroutine check(ok, what)
-      logical, intent(in) :: ok
-      character(len=*), intent(in) :: what
-      if (ok) then
-         write (*, '(a)') 'ok    ' // what
-      else
-         write (*, '(a)') 'FAIL  ' // what
-         failures = failures + 1
-      end if
-   end subroutine check
 
    !> The hierarchy of the symbol K = sqrt((ax kx)^2 + (ay ky)^2) (1 + 0.4 i sin(2 pi kx/nx)
    !> if complex) on an nx x ny grid with about 30 % of the points in contact: its halvings
