@@ -97,6 +97,11 @@ module lc_result
       !> the smallest gap that double precision resolves at this load (see solve_on_grid)
       real(wp) :: gap_resolution = 0.0_wp
       real(wp) :: wall_time = 0.0_wp          !< seconds spent in the solver
+      !> of wall_time: the finest grid's set-up (checks, operator: plans and multipliers) and
+      !> the coarse start (the solves on the coarser grids, their set-up included); the rest
+      !> is the finest grid's iterations (s)
+      real(wp) :: setup_time = 0.0_wp
+      real(wp) :: coarse_time = 0.0_wp
       !> threads the solve ran on (&solver threads, or what the job was given: lc_base_threads)
       integer :: omp_threads = 1
       integer :: mpi_ranks = 1                !< processes sharing the grid (1: this build has no MPI)
@@ -148,6 +153,8 @@ contains
          & real_scalar('residual', res%residual), &
          & real_scalar('gap_resolution', res%gap_resolution), &
          & real_scalar('wall_time', res%wall_time, 's'), &
+         & real_scalar('setup_time', res%setup_time, 's'), &
+         & real_scalar('coarse_time', res%coarse_time, 's'), &
          & integer_scalar('omp_threads', res%omp_threads), &
          & integer_scalar('mpi_ranks', res%mpi_ranks), &
          & real_scalar('friction', res%friction), &

@@ -120,6 +120,11 @@ class LineResult:
     #: processes sharing its grid (1: this build has no MPI)
     omp_threads: int = 1
     mpi_ranks: int = 1
+    #: of ``wall_time`` (s): the finest grid's set-up (operator: FFT plans, multipliers) and
+    #: the coarse start (the solves on the coarser grids); the rest is the finest grid's
+    #: iterations
+    setup_time: float = 0.0
+    coarse_time: float = 0.0
     n_spots: int = 0
     spots: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
     mean_gap: float = float("nan")
@@ -422,6 +427,11 @@ class ArealResult:
     #: processes sharing its grid (1: this build has no MPI)
     omp_threads: int = 1
     mpi_ranks: int = 1
+    #: of ``wall_time`` (s): the finest grid's set-up (operator: FFT plans, multipliers) and
+    #: the coarse start (the solves on the coarser grids); the rest is the finest grid's
+    #: iterations
+    setup_time: float = 0.0
+    coarse_time: float = 0.0
     dissipated_power: float = 0.0
     monotone: bool = True
     normalised_pressure: float = float("nan")

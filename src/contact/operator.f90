@@ -27,6 +27,7 @@ module lc_contact_operator
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range
+   use lc_base_pages, only: advise_huge_pages
    implicit none (type, external)
    private
    public :: compliance_operator, build_operator, multiply_spectrum, multiply_complex
@@ -133,7 +134,11 @@ contains
       op%coupled = kernel%coupled(friction)
 
       allocate (op%metric(op%nk))
-      if (op%coupled) allocate (op%full(op%nk))
+      call advise_huge_pages(op%metric)
+      if (op%coupled) then
+         allocate (op%full(op%nk))
+         call advise_huge_pages(op%full)
+      end if
       ! h/M with the static compliance (0 for a half-space)
       op%metric(1) = kernel%normal_uniform(real(op%compliance(1), wp))
       if (op%coupled) op%full(1) = op%metric(1)
@@ -155,6 +160,7 @@ contains
          if (op%coupled) op%full(i) = g
       end do
       allocate (op%preconditioner(op%nk))
+      call advise_huge_pages(op%preconditioner)
       where (op%metric > 0.0_wp)
          op%preconditioner = 1.0_wp/op%metric
       elsewhere
@@ -204,6 +210,7 @@ contains
       real(wp), allocatable :: unit_load(:)
       if (allocated(self%column)) return
       allocate (unit_load(self%n), self%column(self%n))
+      call advise_huge_pages(self%column)
       unit_load = 0.0_wp
       unit_load(1) = 1.0_wp
       call self%apply_metric(unit_load, self%column)
@@ -482,6 +489,8 @@ contains
       end if
       if (allocated(self%inverse_full)) deallocate (self%inverse_full)
       allocate (self%inverse_full(self%nk), unit_load(n))
+      call advise_huge_pages(self%inverse_full)
+      call advise_huge_pages(unit_load)
       where (abs(g) > 0.0_wp)
          self%inverse_full = 1.0_wp/g
       elsewhere
@@ -489,7 +498,10 @@ contains
       end where
       unit_load = 0.0_wp
       unit_load(1) = 1.0_wp
-      if (.not. allocated(self%full_column)) allocate (self%full_column(n))
+      if (.not. allocated(self%full_column)) then
+         allocate (self%full_column(n))
+         call advise_huge_pages(self%full_column)
+      end if
       self%fft%real_buffer = unit_load
       call multiply_complex_in_buffer(self, g)
       self%full_column = self%fft%real_buffer

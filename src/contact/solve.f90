@@ -29,6 +29,7 @@ module lc_contact_solve
    use lc_contact_solver_multigrid, only: allowed_rise
    use lc_contact_progress, only: progress_log
    use lc_base_memory, only: check_memory
+   use lc_base_pages, only: advise_huge_pages
    use lc_base_threads, only: solve_threads, use_threads, active_threads
    implicit none (type, external)
    private
@@ -128,6 +129,9 @@ contains
       g_ref = maxval(height) - minval(height)
       if (g_ref <= 0.0_wp) g_ref = scene%period   ! flat punch: any length scale will do
       allocate (state%p(n), state%w(n), state%gap(n))
+      call advise_huge_pages(state%p)
+      call advise_huge_pages(state%w)
+      call advise_huge_pages(state%gap)
       if (load_control) then
          pm = scene_mean_pressure(scene, height)
          if (.not. (pm > 0.0_wp .and. ieee_is_finite(pm))) then
@@ -144,6 +148,8 @@ contains
          state%p = 0.0_wp
          state%s = scene%penetration - lambda_max
       end if
+      call system_clock(finish)
+      result%setup_time = real(finish - start, wp)/real(rate, wp)
       call solve_on_grid(scene, grid, kernel, height, friction, load_control, pm, g_ref, op, state, result, &
          & progress, error)
       if (allocated(error)) return
@@ -185,22 +191,29 @@ contains
       type(solve_outcome) :: outcome
       real(wp) :: uniform, plain
       integer :: coarse_pairs, coarse_iterations
+      integer(i8) :: start, finish, rate
       logical :: coarse_multigrid, started
 
       ! (the operator first: which methods run depends on it, and refusals come before any
       ! coarse solve)
+      call system_clock(start, rate)
       call build_operator(op, grid, kernel, friction, active_threads(), error)
       if (allocated(error)) return
       indicators = measure_problem(op, scene%solver%method, load_control)
       call plan_solve(indicators, scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid), plan, error)
       if (allocated(error)) return
+      call system_clock(finish)
+      result%setup_time = result%setup_time + real(finish - start, wp)/real(rate, wp)
       coarse_pairs = 0
       coarse_iterations = 0
       coarse_multigrid = .false.
       if (plan%coarse_start) then
+         call system_clock(start)
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, state, coarse_pairs, &
             & coarse_iterations, coarse_multigrid, progress, error)
          if (allocated(error)) return
+         call system_clock(finish)
+         result%coarse_time = real(finish - start, wp)/real(rate, wp)
       end if
       if (trim(scene%solver%method) == 'auto') then
          ! (the start decides what the fine grid is: the rules of lc_contact_policy, step 3)

@@ -21,6 +21,7 @@ module lc_contact_solver_cg
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range
+   use lc_base_pages, only: advise_huge_pages
    use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
    implicit none (type, external)
    private
@@ -104,6 +105,7 @@ contains
       n = size(p)
       associate (d => gap)
       allocate (t(n))
+      call advise_huge_pages(t)
       call op%prepare_cg()
       buffer => op%buffer()
       t = 0.0_wp

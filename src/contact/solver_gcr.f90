@@ -32,6 +32,7 @@ module lc_contact_solver_gcr
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range
+   use lc_base_pages, only: advise_huge_pages
    implicit none (type, external)
    private
    public :: constrained_gcr, gcr_outcome, gcr_solver
@@ -154,6 +155,10 @@ contains
       ! the real-space diagonal of the preconditioner, for letting points in
       kappa = merge(op%inverse_diagonal, 1.0_wp, precondition)
       allocate (dirs(n, memory), images(n, memory), d(n), coeff(memory), p_best(n))
+      call advise_huge_pages(dirs)
+      call advise_huge_pages(images)
+      call advise_huge_pages(d)
+      call advise_huge_pages(p_best)
       buffer => op%buffer()
       p = max(p, 0.0_wp)
       if (load_control) call normalise(p, mean_pressure)
@@ -471,16 +476,31 @@ contains
       logical, intent(in) :: load_control
       real(wp), contiguous, intent(inout) :: z(:)
       real(wp), contiguous, intent(out) :: d(:)
-      real(wp) :: mean, inside
-      integer :: j
+      real(wp) :: mean
+      integer :: block, first, last
       mean = set_mean(p, load_control, z)
-      !$omp parallel do simd schedule(static) private(inside) if(size(p) >= parallel_points)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, reduction_blocks(size(p))
+         call block_range(block, size(p), first, last)
+         call project_block(p(first:last), mean, z(first:last), d(first:last))
+      end do
+   end subroutine project_on_set
+
+   !> project_on_set on a block.
+   subroutine project_block(p, mean, z, d)
+      real(wp), contiguous, intent(in) :: p(:)
+      real(wp), intent(in) :: mean
+      real(wp), contiguous, intent(inout) :: z(:)
+      real(wp), contiguous, intent(out) :: d(:)
+      real(wp) :: inside
+      integer :: j
+      !$omp simd private(inside)
       do j = 1, size(p)
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
          d(j) = (z(j) - mean)*inside
          z(j) = d(j)
       end do
-   end subroutine project_on_set
+   end subroutine project_block
 
    !> The mean of v over the contact set (`centre`, 0 without load control) and the norm of
    !> v - centre on the set.
@@ -517,26 +537,18 @@ contains
    !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
    !> (The stored images are centred on the set, so the mean of a need not be removed.)
    subroutine history_products(images, p, a, coeff)
-      real(wp), intent(in) :: images(:, :), p(:), a(:)
+      real(wp), contiguous, intent(in) :: images(:, :), p(:), a(:)
       real(wp), intent(out) :: coeff(:)
-      real(wp) :: c
-      real(wp), allocatable :: partial(:, :)
-      integer :: i, i0, i1, k, block
+      real(wp) :: partial(size(coeff), (size(a) + block_rows - 1)/block_rows)
+      integer :: i0, i1, block
       ! (each block's products apart, then added block by block in order: the same bits on
-      ! any number of threads)
-      allocate (partial(size(coeff), (size(a) + block_rows - 1)/block_rows))
-      !$omp parallel do schedule(static) private(i0, i1, k, c) if(size(a) >= parallel_points)
+      ! any number of threads; the block's loops in a procedure of their own, which
+      ! vectorises: decisions/022)
+      !$omp parallel do schedule(static) private(i0, i1) if(size(a) >= parallel_points)
       do block = 1, size(partial, 2)
          i0 = (block - 1)*block_rows + 1
          i1 = min(size(a), i0 + block_rows - 1)
-         do k = 1, size(coeff)
-            c = 0.0_wp
-            !$omp simd reduction(+:c)
-            do i = i0, i1
-               c = c + a(i)*images(i, k)*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
-            end do
-            partial(k, block) = c
-         end do
+         call block_products(images, p, a, i0, i1, partial(:, block))
       end do
       coeff = 0.0_wp
       do block = 1, size(partial, 2)
@@ -544,23 +556,56 @@ contains
       end do
    end subroutine history_products
 
+   !> history_products on the rows i0..i1: a on the contact set once (a 0/1 weight: the
+   !> products are those of a times the weight, to the bit), then its product with each image.
+   subroutine block_products(images, p, a, i0, i1, coeff)
+      real(wp), contiguous, intent(in) :: images(:, :), p(:), a(:)
+      integer, intent(in) :: i0, i1
+      real(wp), intent(out) :: coeff(:)
+      real(wp) :: masked(i1 - i0 + 1), c
+      integer :: i, k
+      !$omp simd
+      do i = i0, i1
+         masked(i - i0 + 1) = a(i)*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
+      end do
+      do k = 1, size(coeff)
+         c = 0.0_wp
+         !$omp simd reduction(+:c)
+         do i = i0, i1
+            c = c + masked(i - i0 + 1)*images(i, k)
+         end do
+         coeff(k) = c
+      end do
+   end subroutine block_products
+
    !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks.
    subroutine subtract_history(dirs, images, coeff, d, a)
-      real(wp), intent(in) :: dirs(:, :), images(:, :), coeff(:)
-      real(wp), intent(inout) :: d(:), a(:)
-      integer :: i, i0, i1, k
-      !$omp parallel do schedule(static) private(i1, k) if(size(a) >= parallel_points)
+      real(wp), contiguous, intent(in) :: dirs(:, :), images(:, :)
+      real(wp), intent(in) :: coeff(:)
+      real(wp), contiguous, intent(inout) :: d(:), a(:)
+      integer :: i0, i1
+      !$omp parallel do schedule(static) private(i1) if(size(a) >= parallel_points)
       do i0 = 1, size(a), block_rows
          i1 = min(size(a), i0 + block_rows - 1)
-         do k = 1, size(coeff)
-            !$omp simd
-            do i = i0, i1
-               d(i) = d(i) - coeff(k)*dirs(i, k)
-               a(i) = a(i) - coeff(k)*images(i, k)
-            end do
-         end do
+         call subtract_block(dirs, images, coeff, i0, i1, d, a)
       end do
    end subroutine subtract_history
+
+   !> subtract_history on the rows i0..i1.
+   subroutine subtract_block(dirs, images, coeff, i0, i1, d, a)
+      real(wp), contiguous, intent(in) :: dirs(:, :), images(:, :)
+      real(wp), intent(in) :: coeff(:)
+      integer, intent(in) :: i0, i1
+      real(wp), contiguous, intent(inout) :: d(:), a(:)
+      integer :: i, k
+      do k = 1, size(coeff)
+         !$omp simd
+         do i = i0, i1
+            d(i) = d(i) - coeff(k)*dirs(i, k)
+            a(i) = a(i) - coeff(k)*images(i, k)
+         end do
+      end do
+   end subroutine subtract_block
 
    !> The direction d scaled by 1/norm, and its image a centred (whole grid) and scaled alike,
    !> into d_unit and a_unit; alpha = (-gap, a_unit) on the contact set: the step along
@@ -703,12 +748,12 @@ contains
    subroutine reorthonormalise(p, load_control, dirs, images, columns, newest)
       real(wp), contiguous, intent(in) :: p(:)
       logical, intent(in) :: load_control
-      real(wp), intent(inout) :: dirs(:, :), images(:, :)
+      real(wp), contiguous, intent(inout) :: dirs(:, :), images(:, :)
       integer, intent(inout) :: columns, newest
       real(wp), allocatable :: gram(:, :), sums(:), centre(:), length(:), block_gram(:, :, :), block_sums(:, :)
       integer, allocatable :: order(:)
-      real(wp) :: contact, x
-      integer :: i, i0, i1, k, l, m, info, block
+      real(wp) :: contact
+      integer :: i0, i1, k, l, m, info, block
 
       m = columns
       ! oldest first
@@ -721,24 +766,11 @@ contains
       ! (each block of rows apart, then added block by block in order: the same bits on any
       ! number of threads)
       allocate (block_gram(m, m, (size(p) + block_rows - 1)/block_rows), block_sums(m, (size(p) + block_rows - 1)/block_rows))
-      !$omp parallel do schedule(static) private(i0, i1, k, l, x) if(size(p) >= parallel_points)
+      !$omp parallel do schedule(static) private(i0, i1) if(size(p) >= parallel_points)
       do block = 1, size(block_gram, 3)
          i0 = (block - 1)*block_rows + 1
          i1 = min(size(p), i0 + block_rows - 1)
-         do k = 1, m
-            block_sums(k, block) = 0.0_wp
-            do i = i0, i1
-               if (p(i) > 0.0_wp) block_sums(k, block) = block_sums(k, block) + images(i, order(k))
-            end do
-            do l = 1, k
-               x = 0.0_wp
-               !$omp simd reduction(+:x)
-               do i = i0, i1
-                  x = x + images(i, order(k))*images(i, order(l))*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
-               end do
-               block_gram(k, l, block) = x
-            end do
-         end do
+         call block_gram_on_set(images, order, p, i0, i1, block_sums(:, block), block_gram(:, :, block))
       end do
       gram = 0.0_wp
       sums = 0.0_wp
@@ -776,21 +808,10 @@ contains
          return
       end if
       ! forward substitution, row block by row block: new_k = (old_k - sum_{l<k} L(k,l) new_l)/L(k,k)
-      !$omp parallel do schedule(static) private(i1, k, l) if(size(p) >= parallel_points)
+      !$omp parallel do schedule(static) private(i1) if(size(p) >= parallel_points)
       do i0 = 1, size(p), block_rows
          i1 = min(size(p), i0 + block_rows - 1)
-         do k = 1, m
-            images(i0:i1, order(k)) = images(i0:i1, order(k)) - centre(k)
-            do l = 1, k - 1
-               !$omp simd
-               do i = i0, i1
-                  dirs(i, order(k)) = dirs(i, order(k)) - gram(k, l)*dirs(i, order(l))
-                  images(i, order(k)) = images(i, order(k)) - gram(k, l)*images(i, order(l))
-               end do
-            end do
-            dirs(i0:i1, order(k)) = dirs(i0:i1, order(k))/gram(k, k)
-            images(i0:i1, order(k)) = images(i0:i1, order(k))/gram(k, k)
-         end do
+         call substitute_block(gram, centre, order, i0, i1, dirs, images)
       end do
       ! (slots oldest first, so that the sweeps over the history keep their order)
       if (any(order /= [(k, k=1, m)])) then
@@ -799,6 +820,51 @@ contains
       end if
       newest = m
    end subroutine reorthonormalise
+
+   !> reorthonormalise's products on the rows i0..i1: sums(k) = the sum of image order(k)
+   !> over the contact set, gram(k, l) = the product of images order(k) and order(l) there
+   !> (l <= k).
+   subroutine block_gram_on_set(images, order, p, i0, i1, sums, gram)
+      real(wp), contiguous, intent(in) :: images(:, :), p(:)
+      integer, intent(in) :: order(:), i0, i1
+      real(wp), intent(out) :: sums(:), gram(:, :)
+      real(wp) :: x
+      integer :: i, k, l
+      do k = 1, size(order)
+         sums(k) = 0.0_wp
+         do i = i0, i1
+            if (p(i) > 0.0_wp) sums(k) = sums(k) + images(i, order(k))
+         end do
+         do l = 1, k
+            x = 0.0_wp
+            !$omp simd reduction(+:x)
+            do i = i0, i1
+               x = x + images(i, order(k))*images(i, order(l))*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
+            end do
+            gram(k, l) = x
+         end do
+      end do
+   end subroutine block_gram_on_set
+
+   !> reorthonormalise's forward substitution on the rows i0..i1 (gram: the Cholesky factor).
+   subroutine substitute_block(gram, centre, order, i0, i1, dirs, images)
+      real(wp), intent(in) :: gram(:, :), centre(:)
+      integer, intent(in) :: order(:), i0, i1
+      real(wp), contiguous, intent(inout) :: dirs(:, :), images(:, :)
+      integer :: i, k, l
+      do k = 1, size(order)
+         images(i0:i1, order(k)) = images(i0:i1, order(k)) - centre(k)
+         do l = 1, k - 1
+            !$omp simd
+            do i = i0, i1
+               dirs(i, order(k)) = dirs(i, order(k)) - gram(k, l)*dirs(i, order(l))
+               images(i, order(k)) = images(i, order(k)) - gram(k, l)*images(i, order(l))
+            end do
+         end do
+         dirs(i0:i1, order(k)) = dirs(i0:i1, order(k))/gram(k, k)
+         images(i0:i1, order(k)) = images(i0:i1, order(k))/gram(k, k)
+      end do
+   end subroutine substitute_block
 
    !> keep_clipped, after a step clipped a few points: the stored directions without them
    !> (zero there, and under load control their sum over the smaller set restored to zero

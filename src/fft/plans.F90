@@ -16,6 +16,7 @@ module lc_fft_plans
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_base_strings, only: to_string
+   use lc_base_pages, only: advise_huge_pages
    implicit none (type, external)
    private
    public :: fft_plan
@@ -96,6 +97,8 @@ contains
       end if
       call c_f_pointer(self%real_memory, self%real_buffer, [self%n])
       call c_f_pointer(self%complex_memory, self%spectrum, [self%nk])
+      call advise_huge_pages(self%real_buffer)
+      call advise_huge_pages(self%spectrum)
       self%real_buffer = 0.0_wp
       ! FFTW's dimensions are in C order: the last one (x) is contiguous
       if (ny == 1) then
