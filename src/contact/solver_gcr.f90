@@ -539,11 +539,12 @@ contains
    subroutine history_products(images, p, a, coeff)
       real(wp), contiguous, intent(in) :: images(:, :), p(:), a(:)
       real(wp), intent(out) :: coeff(:)
-      real(wp) :: partial(size(coeff), (size(a) + block_rows - 1)/block_rows)
+      real(wp), allocatable :: partial(:, :)
       integer :: i0, i1, block
       ! (each block's products apart, then added block by block in order: the same bits on
       ! any number of threads; the block's loops in a procedure of their own, which
-      ! vectorises: decisions/022)
+      ! vectorises: decisions/022; on the heap: 10 to 80 products per 2048 rows)
+      allocate (partial(size(coeff), (size(a) + block_rows - 1)/block_rows))
       !$omp parallel do schedule(static) private(i0, i1) if(size(a) >= parallel_points)
       do block = 1, size(partial, 2)
          i0 = (block - 1)*block_rows + 1
@@ -556,8 +557,8 @@ contains
       end do
    end subroutine history_products
 
-   !> history_products on the rows i0..i1: a on the contact set once (a 0/1 weight: the
-   !> products are those of a times the weight, to the bit), then its product with each image.
+   !> history_products on the rows i0..i1: a weighted by the contact set once (the weight is
+   !> 0 or 1, so the weighted a is exact), then its product with each image.
    subroutine block_products(images, p, a, i0, i1, coeff)
       real(wp), contiguous, intent(in) :: images(:, :), p(:), a(:)
       integer, intent(in) :: i0, i1
