@@ -1,0 +1,2 @@
+module lc_profiles_height_slabs
+end module
