@@ -21,7 +21,7 @@ module lc_io_hdf5_slabs
    use mpi_f08, only: MPI_Comm, MPI_Comm_rank, MPI_Comm_size, MPI_Gatherv, MPI_DOUBLE_PRECISION, MPI_Allreduce, &
       & MPI_IN_PLACE, MPI_INTEGER8, MPI_SUM, MPI_MIN
    use hdf5, only: hid_t, hsize_t, h5open_f, h5close_f, h5eset_auto_f, h5pcreate_f, h5pclose_f, h5fcreate_f, &
-      & h5fclose_f, h5fget_filesize_f, H5P_FILE_ACCESS_F, H5F_ACC_TRUNC_F
+      & h5fclose_f, h5fflush_f, H5F_SCOPE_GLOBAL_F, H5P_FILE_ACCESS_F, H5F_ACC_TRUNC_F
 #ifdef LC_PARALLEL_HDF5
    use hdf5, only: h5pset_fapl_mpio_f, h5pset_dxpl_mpio_f, H5P_DATASET_XFER_F, H5FD_MPIO_COLLECTIVE_F
    use mpi_f08, only: MPI_INFO_NULL
@@ -32,7 +32,7 @@ module lc_io_hdf5_slabs
    use lc_base_slab, only: row_slab
    use lc_scene, only: scene_type
    use lc_result, only: contact_result
-   use lc_io_files, only: reserve_space, free_bytes
+   use lc_io_files, only: free_bytes
    use lc_io_hdf5, only: map_writer, h5_status, temporary_name, delete_file, write_contents, publish, map_bytes, &
       & announce_large, check_sizes, run_record, write_results
    use lc_io_mpi_agree, only: agree_error, shared_error, broadcast_text, broadcast_real
@@ -134,13 +134,11 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(contact_result), intent(in), optional :: companion
       type(run_record), intent(in), optional :: run
-      character(len=:), allocatable :: tmp, reason
+      character(len=:), allocatable :: tmp
       type(h5_status) :: st
       type(slab_writer), allocatable :: maps
       integer(hid_t) :: fapl, file
-      integer(hsize_t) :: bytes
       integer :: ignore, hdferr
-      logical :: ok
 
       tmp = broadcast_text(temporary_name(filename), root, comm)
       if (slab%rank == root) then
@@ -168,16 +166,13 @@ contains
          call move_alloc(maps, st%maps)
          call write_contents(file, scene, namelist_text, height, result, version, st, companion, run)
          call agree_status(st, comm)
-         ! the disk blocks up to the file's end, before the close writes HDF5's metadata
+         ! HDF5's metadata to the file while it is open, so that a full disk fails here, agreed,
+         ! rather than in the close (MPI-IO files have no size to reserve before it: HDF5 1.10's
+         ! MPI-IO driver does not tell their end)
          if (st%hdferr == 0) then
-            call h5fget_filesize_f(file, bytes, st%hdferr)
-            if (st%hdferr /= 0) st%object = 'the size of the file'
-         end if
-         if (st%hdferr == 0 .and. slab%rank == root) then
-            call reserve_space(tmp, int(bytes, i8), ok, reason)
-            if (.not. ok) then
-               st%hdferr = -1
-               st%object = 'reserving the disk space of its ' // to_string(int(bytes, i8)) // ' bytes (' // reason // ')'
+            call h5fflush_f(file, H5F_SCOPE_GLOBAL_F, st%hdferr)
+            if (st%hdferr /= 0) then
+               st%object = 'the writing of its metadata'
                st%free = free_bytes(tmp)
             end if
          end if
