@@ -1,8 +1,8 @@
 """Command line of layercontact.
 
     python -m layercontact run FILE.nml [--png PICTURE | --no-png]
-    python -m layercontact sweep FILE.nml [--processes N] [--no-progress] [--dry-run]
-    python -m layercontact sweep FILE.nml --slurm [--dry-run] [Slurm options]
+    python -m layercontact sweep FILE.nml [--processes N] [--ranks-per-scene K] [--no-progress] [--dry-run]
+    python -m layercontact sweep FILE.nml --slurm [--ranks-per-scene K] [--dry-run] [Slurm options]
     python -m layercontact status DIR [--all]
     python -m layercontact collect DIR
     python -m layercontact convert INPUT OUTPUT.h5 [--unit UNIT] [--channel N]
@@ -41,6 +41,7 @@ Exit codes:
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 import sys
 from pathlib import Path
 

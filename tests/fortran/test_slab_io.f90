@@ -9,6 +9,9 @@
 !>                            against the closed form the test wrote them with;
 !>   test_slab_io DIR fail R  rank R passes one height too few (a slab that is not its
 !>                            rows): every rank must return the same error, no file;
+!>   test_slab_io DIR keep    as write, without &output overwrite, into DIR/slabs.h5 which
+!>                            the test wrote before: every rank returns rank 0's error (the
+!>                            move into place refuses), the file there is kept;
 !>   test_slab_io DIR few     DIR/few.txt holds 2 rows: on 3 or more ranks every rank
 !>                            must refuse it with the same error (code 2).
 !>
@@ -60,6 +63,9 @@ program test_slab_io
       call get_command_argument(3, argument)
       read (argument, *) failing
       call write_slabs(trim(dir) // '/failed.h5', failing)
+   case ('keep')
+      scene%overwrite = .false.
+      call write_slabs(trim(dir) // '/slabs.h5', -1)
    case ('few')
       call read_few()
    end select

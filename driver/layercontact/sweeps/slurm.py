@@ -659,6 +659,9 @@ def job_script(
         "# `python -m layercontact sweep --slurm`; `python -m layercontact status` reads the",
         "# results; submitting again runs only the scenes that are missing or failed.",
     ]
+    if options.ranks_per_scene > 1:
+        head.append(f"# Each scene runs on {options.ranks_per_scene} MPI ranks (srun --mpi=pmix), "
+                    f"{options.cpus_per_task} CPU(s) per rank.")
     setup = ["", "# environment set-up", *options.setup_lines] if options.setup_lines else []
     body = _SCRIPT_BODY.format(
         workdir=shlex.quote(str(workdir)),
