@@ -726,9 +726,10 @@ def test_ranks_per_scene_gives_array_tasks_of_k_ranks_started_by_srun(tmp_path, 
     assert "# Each scene runs on 4 MPI ranks (srun --mpi=pmix), 2 CPU(s) per rank." in script
     assert subprocess.run(["bash", "-n"], input=script, text=True).returncode == 0
 
-    # one rank (the default): the executable alone, one task
+    # one rank (the default): the executable alone, one task (a dry run's script is
+    # replaced by the next one)
     assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 0
-    script = (tmp_path / "out/a/slurm/a_002.sbatch").read_text()
+    script = (tmp_path / "out/a/slurm/a_001.sbatch").read_text()
     assert "#SBATCH --ntasks=1\n" in script and "srun" not in script
     assert '  "$executable" "$sweep_directory/scenes/$scene.nml"' in script
 

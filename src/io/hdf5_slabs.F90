@@ -184,11 +184,12 @@ contains
          end if
          call agree_status(st, comm)
       end if
+      ! the transfer list, with the writer that holds it (in st once the file was created)
+      if (allocated(maps)) call move_alloc(maps, st%maps)
       select type (m => st%maps)
       type is (slab_writer)
          call h5pclose_f(m%xfer, ignore)
       end select
-      if (allocated(maps)) call h5pclose_f(maps%xfer, ignore)
       call h5pclose_f(fapl, ignore)
       call h5close_f(ignore)
       ! every rank's writes are in the closed file; rank 0 checks it and moves it into place

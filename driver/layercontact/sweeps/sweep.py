@@ -662,7 +662,7 @@ def check_ranks_per_scene(plan: SweepPlan, ranks: object) -> int:
     """
     if isinstance(ranks, bool) or not isinstance(ranks, int) or ranks < 1:
         raise ValueError(f"--ranks-per-scene = {ranks!r} is not allowed; allowed: an integer >= 1")
-    scene = plan.nml.get("scene", {})
+    scene = plan.base.get("scene", {})
     geometry = str(scene.get("geometry", "line")).strip().lower()
     if ranks > 1 and geometry != "areal":
         raise ValueError(
