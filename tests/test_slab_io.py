@@ -93,10 +93,11 @@ def items(f: h5py.File) -> dict[str, object]:
     return found
 
 
-@pytest.mark.parametrize("ranks", [1, 2, 3, 4])
-def test_slab_file_is_the_serial_file_and_slab_reads_are_the_file_rows(program, tmp_path, ranks):
+@pytest.mark.parametrize("ranks,precision", [(1, "double"), (2, "double"), (3, "double"), (4, "double"),
+                                             (3, "single")])
+def test_slab_file_is_the_serial_file_and_slab_reads_are_the_file_rows(program, tmp_path, ranks, precision):
     write_height_files(tmp_path)
-    run = mpirun(program, ranks, tmp_path, "write")
+    run = mpirun(program, ranks, tmp_path, "write", precision)
     assert run.returncode == 0, run.stdout + run.stderr
     # every rank's checks of the heights it read (its rows, each height exact) passed
     assert run.stdout.count("all slab I/O checks passed") == ranks, run.stdout
@@ -119,20 +120,24 @@ def test_slab_file_is_the_serial_file_and_slab_reads_are_the_file_rows(program, 
                 if key != "created":
                     assert np.array_equal(x.attrs[key], y.attrs[key]), (name, key)
         assert parallel.attrs["mpi_ranks"] == ranks
+        assert parallel["fields/gap"].dtype == np.dtype("<f4" if precision == "single" else "<f8")
         # the maps more than half zeros are deflated in chunks of whole rows, the others contiguous
         assert parallel["fields/pressure"].compression == "gzip"
         assert parallel["fields/gap"].chunks is None
 
         # the maps against the closed forms of the program (cos and sin of two libraries:
-        # a few units in the last place of values of order 1, hence 1e-14)
+        # a few units in the last place of values of order 1, hence 1e-14; float32 maps:
+        # rounded to 2**-24 relative, values below 3.5, hence 3.5 * 2**-24 < 3e-7)
+        atol = 3e-7 if precision == "single" else 1e-14
         x = np.arange(NX) * LX / NX
         y = (np.arange(NY) * LY / NY)[:, None]
         cap = np.maximum(0.0, np.cos(2 * np.pi * x / LX) * np.cos(2 * np.pi * y / LY) - 0.5)
-        np.testing.assert_allclose(parallel["fields/pressure"][()], cap, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(parallel["fields/pressure"][()], cap, rtol=0, atol=atol)
         np.testing.assert_allclose(parallel["fields/gap"][()], 1 + np.sin(2 * np.pi * x / LX) + 0.25 * y,
-                                   rtol=0, atol=1e-14)
-        np.testing.assert_array_equal(parallel["fields/displacement_z"][()],
-                                      1e-3 * (np.arange(NX) + 1000 * np.arange(NY)[:, None]))
+                                   rtol=0, atol=atol)
+        np.testing.assert_allclose(parallel["fields/displacement_z"][()],
+                                   1e-3 * (np.arange(NX) + 1000 * np.arange(NY)[:, None]), rtol=1e-7 if
+                                   precision == "single" else 1e-15, atol=0)
         assert np.count_nonzero(cap) < cap.size / 2
 
 

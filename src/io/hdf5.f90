@@ -15,7 +15,7 @@
 !> (h5open_f/h5close_f) and switches off HDF5's own error printing: failures come back as
 !> `error_type` messages naming the file and the object instead.
 module lc_io_hdf5
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_char, c_null_char, c_ptr, c_loc, c_size_t
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_char, c_null_char, c_ptr, c_loc, c_size_t, c_float
    use, intrinsic :: iso_fortran_env, only: error_unit
    use hdf5, only: hid_t, hsize_t, size_t, h5kind_to_type, H5_INTEGER_KIND, h5open_f, h5close_f, h5eset_auto_f, &
       & h5fis_hdf5_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5fget_filesize_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
@@ -26,7 +26,7 @@ module lc_io_hdf5
       & h5screate_f, h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
       & h5sget_simple_extent_dims_f, H5S_SCALAR_F, h5sselect_hyperslab_f, H5S_SELECT_SET_F, H5P_DEFAULT_F, &
       & h5tcopy_f, h5tset_size_f, h5tset_strpad_f, h5tclose_f, h5tget_class_f, &
-      & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_IEEE_F32LE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
+      & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_REAL, H5T_IEEE_F32LE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
       & h5acreate_f, h5awrite_f, h5aclose_f, &
       & h5dcreate_f, h5dopen_f, h5dwrite_f, h5dread_f, h5dclose_f, h5dget_space_f, h5dget_type_f
    use lc_base_kinds, only: wp, i8
@@ -863,8 +863,15 @@ contains
          if (st%hdferr == 0) then
             call h5dcreate_f(loc, name, file_type, space, dset, st%hdferr, dcpl_id=dcpl)
             if (st%hdferr == 0) then
-               if (size(values) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, held(:rank), st%hdferr, &
-                  & mem_space_id=memory, file_space_id=space, xfer_prp=st%maps%transfer())
+               if (size(values) > 0 .and. file_type == H5T_IEEE_F32LE) then
+                  ! rounded here (to nearest, as HDF5's conversion does): parallel HDF5 1.10
+                  ! writes a deflated dataset collectively only without a type conversion
+                  call h5dwrite_f(dset, H5T_NATIVE_REAL, real(values, c_float), held(:rank), st%hdferr, &
+                     & mem_space_id=memory, file_space_id=space, xfer_prp=st%maps%transfer())
+               else if (size(values) > 0) then
+                  call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, held(:rank), st%hdferr, &
+                     & mem_space_id=memory, file_space_id=space, xfer_prp=st%maps%transfer())
+               end if
                if (st%hdferr == 0) call write_attr_string(dset, 'units', units, st)
                call close_dataset(dset, st)
             end if

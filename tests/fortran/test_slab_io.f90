@@ -1,7 +1,8 @@
 !> The result file and the height files by slabs of rows on several MPI ranks, run by
 !> tests/test_slab_io.py under `mpirun -n P`:
 !>
-!>   test_slab_io DIR write   every rank writes its rows of closed-form maps into
+!>   test_slab_io DIR write [single]
+!>                            every rank writes its rows of closed-form maps into
 !>                            DIR/slabs.h5 (lc_io_hdf5_slabs); rank 0 writes the same
 !>                            result whole into DIR/serial.h5 (lc_io_hdf5), for the test to
 !>                            compare; then every rank reads its rows of DIR/heights.h5,
@@ -57,6 +58,9 @@ program test_slab_io
 
    select case (trim(mode))
    case ('write')
+      ! `write single`: the maps stored as float32 (&output precision), converted by HDF5
+      call get_command_argument(3, argument)
+      if (trim(argument) == 'single') scene%precision = 'single'
       call write_both()
       call read_all()
    case ('fail')
@@ -145,6 +149,17 @@ contains
       res%mpi_ranks = ranks
    end function result_of
 
+   !> The frictionless companion: the same maps but the shear, other scalars.
+   function companion_of(y_start, rows) result(res)
+      integer, intent(in) :: y_start, rows
+      type(contact_result) :: res
+      res = result_of(y_start, rows)
+      deallocate (res%displacement_x, res%shear, res%stress_xx)
+      res%friction = 0.0_wp
+      res%contact_fraction = 0.2_wp
+      res%residual_history = [1.0_wp, 1.0e-9_wp]
+   end function companion_of
+
    !> This rank's rows into `filename`; rank `failing` passes one height too few.
    subroutine write_slabs(filename, failing)
       character(len=*), intent(in) :: filename
@@ -157,7 +172,8 @@ contains
       height = rows_of('height', slab%y_start, slab%ny_local)
       if (rank == failing) height = height(2:)
       call write_result_slabs(filename, scene, '&scene geometry = ''areal'' /', height, &
-         & result_of(slab%y_start, slab%ny_local), '0.1.0-test', slab, MPI_COMM_WORLD, error, run=run)
+         & result_of(slab%y_start, slab%ny_local), '0.1.0-test', slab, MPI_COMM_WORLD, error, &
+         & companion=companion_of(slab%y_start, slab%ny_local), run=run)
    end subroutine write_slabs
 
    subroutine write_both()
@@ -173,7 +189,7 @@ contains
          run%started = '2026-01-02T03:04:05Z'
          run%seconds = 1.5_wp
          call write_results(trim(dir) // '/serial.h5', scene, '&scene geometry = ''areal'' /', &
-            & rows_of('height', 0, ny), result_of(0, ny), version='0.1.0-test', error=error, run=run)
+            & rows_of('height', 0, ny), result_of(0, ny), companion_of(0, ny), '0.1.0-test', error, run)
          call check(.not. allocated(error), 'the whole result is written by one rank')
       end if
    end subroutine write_both
