@@ -58,8 +58,8 @@ def program() -> Path:
 def mpirun(program: Path, ranks: int, directory: Path, *arguments: str) -> subprocess.CompletedProcess:
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1")
-    return subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(program), str(directory), *arguments],
-                          env=env, capture_output=True, text=True, timeout=300)
+    command = ["mpirun", "--oversubscribe", "-n", str(ranks), str(program), str(directory), *arguments]
+    return subprocess.run(command, env=env, capture_output=True, text=True, timeout=300)
 
 
 def heights() -> np.ndarray:

@@ -721,8 +721,8 @@ def test_ranks_per_scene_gives_array_tasks_of_k_ranks_started_by_srun(tmp_path, 
     # one array task per scene, of 4 tasks (ranks) of 2 CPUs each
     assert head[:4] == ["--job-name=lc-a", "--array=0-1", "--ntasks=4", "--cpus-per-task=2"]
     run = [line.strip() for line in script.splitlines() if '"$executable"' in line and "scenes/" in line]
-    assert run == ['srun --mpi=pmix --ntasks=4 --cpus-per-task=2 "$executable" "$sweep_directory/scenes/$scene.nml" '
-                   '>"$sweep_directory/logs/$scene.log" 2>&1 &']
+    assert run == ['srun --mpi=pmix --ntasks=4 --cpus-per-task=2 "$executable" '
+                   '"$sweep_directory/scenes/$scene.nml" >"$sweep_directory/logs/$scene.log" 2>&1 &']
     assert "# Each scene runs on 4 MPI ranks (srun --mpi=pmix), 2 CPU(s) per rank." in script
     assert subprocess.run(["bash", "-n"], input=script, text=True).returncode == 0
 

@@ -82,8 +82,8 @@ def _parser() -> argparse.ArgumentParser:
         type=int,
         default=1,
         metavar="K",
-        help="MPI ranks of each (areal) scene: here under mpirun -n K, with --slurm srun in tasks of --ntasks=K "
-        "(default 1)",
+        help="MPI ranks of each (areal) scene: here under mpirun -n K, with --slurm srun in tasks of "
+        "--ntasks=K (default 1)",
     )
     sweep_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep_p.add_argument(

@@ -582,7 +582,8 @@ done
 def launch_prefix(options: SlurmOptions) -> str:
     """What runs the executable in a task: itself on one rank; on K ranks, ``srun`` of the
     task's K tasks (Open MPI programs start under Slurm through PMIx), each with the task's
-    CPUs per rank."""
+    CPUs per rank (given again: srun does not take the job's --cpus-per-task from Slurm
+    22.05 on)."""
     if options.ranks_per_scene == 1:
         return ""
     return (f"srun --mpi=pmix --ntasks={options.ranks_per_scene} "

@@ -666,9 +666,9 @@ def check_ranks_per_scene(plan: SweepPlan, ranks: object) -> int:
     geometry = str(scene.get("geometry", "line")).strip().lower()
     if ranks > 1 and geometry != "areal":
         raise ValueError(
-            f"--ranks-per-scene = {ranks} is not allowed for the sweep {plan.source}: its scenes are lines "
-            f"(&scene geometry = '{geometry}'), which run on one process; allowed: 1 (several ranks share the "
-            "rows of an areal scene)"
+            f"--ranks-per-scene = {ranks} is not allowed for the sweep {plan.source}: its scenes are "
+            f"lines (&scene geometry = '{geometry}'), which run on one process; allowed: 1 (several ranks "
+            "share the rows of an areal scene)"
         )
     return ranks
 
@@ -694,8 +694,8 @@ def mpi_command(ranks: int) -> list[str]:
     return [mpirun, "-n", str(ranks), "--bind-to", "none", executable]
 
 
-def _solve(scene_file: str, result_file: str, record_file: str,
-           launcher: list[str] | None = None) -> dict[str, object]:
+def _solve(scene_file: str, result_file: str, record_file: str, launcher: list[str] | None = None,
+           environment: dict[str, str] | None = None) -> dict[str, object]:
     """Worker: run one scene file, return its result columns (or its error); its run
     record says it is running, then how it ended. The scene's lock is held throughout: a
     scene that another sweep of the same directory completed meanwhile is not run again,
@@ -706,19 +706,20 @@ def _solve(scene_file: str, result_file: str, record_file: str,
             return _outcome(_result_columns(Path(result_file)))
         for left in stale_temporary_results(Path(result_file).parent, Path(scene_file).stem):
             left.unlink(missing_ok=True)
-        return _run_scene(scene_file, result_file, record_file, launcher)
+        return _run_scene(scene_file, result_file, record_file, launcher, environment)
 
 
-def _run_scene(scene_file: str, result_file: str, record_file: str,
-               launcher: list[str] | None = None) -> dict[str, object]:
+def _run_scene(scene_file: str, result_file: str, record_file: str, launcher: list[str] | None = None,
+               environment: dict[str, str] | None = None) -> dict[str, object]:
     """Run one scene file with its run record (see :func:`_solve`): in this process, or,
-    with a ``launcher`` (:func:`mpi_command`), by the executable on several MPI ranks."""
+    with a ``launcher`` (:func:`mpi_command`), by the executable on several MPI ranks, in
+    the sweep's ``environment``."""
     record = provenance.start_record(Path(scene_file).stem)
     provenance.write_record(Path(record_file), record)
     start = time.monotonic()
     try:
         if launcher:
-            code = _launch(launcher, scene_file)
+            code = _launch(launcher, scene_file, environment)
         else:
             run_to_file(scene_file)
             code = 0
@@ -742,13 +743,16 @@ def _log_file(scene_file: str) -> Path:
     return Path(scene_file).parent.parent / "logs" / (Path(scene_file).stem + ".log")
 
 
-def _launch(launcher: list[str], scene_file: str) -> int:
-    """Run the executable on a scene under ``launcher``; its exit code (the executable's:
-    0 converged, 3 not converged, 2 bad input, 4 I/O, 5 internal)."""
+def _launch(launcher: list[str], scene_file: str, environment: dict[str, str] | None) -> int:
+    """Run the executable on a scene under ``launcher`` in ``environment`` (the sweep's:
+    a worker started by a fork server has the environment of that server's start); its
+    exit code (the executable's: 0 converged, 3 not converged, 2 bad input, 4 I/O, 5
+    internal)."""
     log = _log_file(scene_file)
     log.parent.mkdir(parents=True, exist_ok=True)
     with open(log, "w") as out:
-        return subprocess.run([*launcher, scene_file], stdout=out, stderr=subprocess.STDOUT).returncode
+        return subprocess.run([*launcher, scene_file], stdout=out, stderr=subprocess.STDOUT,
+                              env=environment).returncode
 
 
 def _launch_failure(launcher: list[str], code: int, scene_file: str) -> str:
@@ -860,12 +864,16 @@ def _run_pending(
     workers = min(processes, len(pending))
     threads = max(1, len(os.sched_getaffinity(0)) // (workers * ranks))
     launcher = mpi_command(ranks) if ranks > 1 else None
+    # each rank of a launched scene takes its share of the CPUs as threads
+    environment = {**os.environ, "OMP_NUM_THREADS": os.environ.get("OMP_NUM_THREADS", str(threads))} \
+        if launcher else None
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context(),
                                initializer=_start_worker, initargs=(os.getcwd(), os.getpid(), threads))
     futures = {}
     try:
         futures = {
-            pool.submit(_solve, str(s.scene_file), str(s.result_file), str(_record_file(s)), launcher): s
+            pool.submit(_solve, str(s.scene_file), str(s.result_file), str(_record_file(s)), launcher,
+                        environment): s
             for s in pending
         }
         for future in as_completed(futures):
