@@ -6,12 +6,15 @@
 !> ranks make the same HDF5 calls, through MPI-IO, each writes its rows of every map by a
 !> collective hyperslab, and rank 0 the data of what every rank holds whole (coordinates,
 !> histories, lists). Parallel HDF5 (1.10.2 and later) writes filtered datasets
-!> collectively, so the deflated maps stay deflated.
+!> collectively (without a type conversion: float32 maps are rounded before the write), so
+!> the deflated maps stay deflated.
 !>
 !> The file is complete or absent as the serial writer's (docs/guarantees.md): every rank
 !> writes into rank 0's temporary name; the ranks agree on whether any of them failed
-!> (at the sizes, the creation, the writes, the close) before rank 0 checks the closed
-!> file and moves it into place, and all return rank 0's verdict. The scalars of the result
+!> (at the sizes, the creation, the writes, the flush of HDF5's metadata, the close) before rank 0 checks the closed
+!> file and moves it into place, and all return rank 0's verdict. (Within the writes the
+!> ranks make the same collective HDF5 calls on the same metadata, so a failing call fails on
+!> all of them; they agree at the end of each step.) The scalars of the result
 !> (reductions over the whole grid) must be the same on every rank; the provenance that is
 !> not (the host, the time, the run's wall time) is rank 0's.
 !>
