@@ -73,6 +73,8 @@ def write_height_files(directory: Path) -> None:
     np.save(directory / "heights.npy", heights())
     np.savetxt(directory / "heights.txt", heights())
     np.savetxt(directory / "few.txt", heights()[:2])
+    with h5py.File(directory / "few.h5", "w") as f:
+        f["h"] = heights()[:2]
 
 
 def slabs(output: str) -> list[tuple[int, int, int]]:
@@ -167,11 +169,11 @@ def test_a_refused_move_keeps_the_old_file_on_every_rank(program, tmp_path):
     assert not list(tmp_path.glob("*.tmp"))
 
 
-@pytest.mark.parametrize("ranks", [3, 4])
-def test_a_height_file_with_fewer_rows_than_ranks_is_refused_on_every_rank(program, tmp_path, ranks):
+@pytest.mark.parametrize("ranks,name", [(3, "few.txt"), (4, "few.txt"), (3, "few.h5")])
+def test_a_height_file_with_fewer_rows_than_ranks_is_refused_on_every_rank(program, tmp_path, ranks, name):
     write_height_files(tmp_path)
-    run = mpirun(program, ranks, tmp_path, "few")
+    run = mpirun(program, ranks, tmp_path, "few", name)
     assert run.returncode == 2, run.stdout + run.stderr
     errors = [line for line in run.stdout.splitlines() if line.startswith("error ")]
     assert len(errors) == ranks and len(set(errors)) == 1
-    assert "few.txt' holds 2 rows" in errors[0] and f"{ranks} MPI ranks" in errors[0]
+    assert f"{name}' holds 2 rows" in errors[0] and f"{ranks} MPI ranks" in errors[0]

@@ -30,11 +30,12 @@ module lc_profiles_height_file
    use lc_base_errors, only: error_type, fatal_error, code_input, code_io, code_internal
    use lc_base_strings, only: to_string, lower_case
    use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
+   use lc_base_slab, only: row_slab, slab_of, empty_rank
    implicit none (type, external)
    private
    public :: read_height_file, named, shape_text
    ! for the reader of one file by several processes (lc_profiles_height_slabs)
-   public :: check_height_path, read_hdf5, check_heights, is_hdf5_name
+   public :: check_height_path, read_hdf5, check_heights, is_hdf5_name, too_few_rows
 
    !> The largest rank HDF5 allows (H5S_MAX_RANK).
    integer, parameter :: max_rank = 32
@@ -125,6 +126,16 @@ contains
       end do
    end subroutine check_heights
 
+   !> The refusal of a file whose ny rows leave some of `ranks` processes without a row.
+   pure function too_few_rows(filename, ny, ranks) result(message)
+      character(len=*), intent(in) :: filename
+      integer, intent(in) :: ny, ranks
+      character(len=:), allocatable :: message
+      message = named(filename) // ' holds ' // to_string(ny) // ' rows, which leave some of the ' // &
+         & to_string(ranks) // ' MPI ranks without a row (blocks of ceiling(ny/ranks) rows); allowed: ' // &
+         & 'a file whose rows fill every rank'
+   end function too_few_rows
+
    !> "&profile: file = '<filename>'", the start of every message.
    pure function named(filename) result(s)
       character(len=*), intent(in) :: filename
@@ -143,11 +154,12 @@ contains
    ! ---------------------------------------------------------------------------------------
    ! HDF5
 
-   !> The heights of an HDF5 file's dataset: all of them, or, with `rows`, the rows
-   !> rows(y_start, ny) returns for the dataset's ny rows (height(nx, ny_local)), read through
-   !> the file access list `access` and the transfer list `xfer` (a collective MPI-IO read
-   !> by several processes: lc_profiles_height_slabs). `sizes` are the dataset's (nx, ny).
-   subroutine read_hdf5(filename, dataset, height, error, sizes, access, xfer, rows)
+   !> The heights of an HDF5 file's dataset: all of them, or, with `ranks` and `rank`, the
+   !> rows of that rank (lc_base_slab: height(nx, ny_local)), read through the file access
+   !> list `access` and the transfer list `xfer` (a collective MPI-IO read by several
+   !> processes: lc_profiles_height_slabs). `sizes` are the dataset's (nx, ny). A dataset
+   !> whose rows leave a rank without one is refused (on every rank alike, before any read).
+   subroutine read_hdf5(filename, dataset, height, error, sizes, access, xfer, ranks, rank)
       character(len=*), intent(in) :: filename, dataset
       real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
@@ -156,17 +168,12 @@ contains
       integer(hid_t), intent(in), optional :: access
       !> a transfer list made by the caller
       integer(hid_t), intent(in), optional :: xfer
-      interface
-         !> the first row (0-based) and the number of rows to read of a dataset of ny rows
-         subroutine rows_of(ny, y_start, ny_local)
-            integer, intent(in) :: ny
-            integer, intent(out) :: y_start, ny_local
-         end subroutine rows_of
-      end interface
-      procedure(rows_of), optional :: rows
+      !> the processes sharing the rows, and this one's number (0-based)
+      integer, intent(in), optional :: ranks, rank
       integer(hid_t) :: fapl, file, dset, space, dtype, memory, transfer
       integer(hsize_t) :: dims(max_rank), maxdims(max_rank), held(2)
-      integer :: hdferr, ignore, rank, class, i, y_start, ny_local
+      integer :: hdferr, ignore, dataset_rank, class, i, y_start, ny_local
+      type(row_slab) :: slab
       character(len=:), allocatable :: found
       logical :: is_hdf5
 
@@ -206,17 +213,18 @@ contains
                & 'allowed: the path of a 1D or 2D floating-point dataset in the file', code_input)
          else
             call h5dget_space_f(dset, space, hdferr)
-            call h5sget_simple_extent_ndims_f(space, rank, ignore)
+            call h5sget_simple_extent_ndims_f(space, dataset_rank, ignore)
             dims = 0
-            if (rank >= 1 .and. rank <= max_rank) call h5sget_simple_extent_dims_f(space, dims, maxdims, ignore)
+            if (dataset_rank >= 1 .and. dataset_rank <= max_rank) &
+               & call h5sget_simple_extent_dims_f(space, dims, maxdims, ignore)
             call h5sclose_f(space, ignore)
             call h5dget_type_f(dset, dtype, ignore)
             call h5tget_class_f(dtype, class, ignore)
             call h5tclose_f(dtype, ignore)
-            if (class /= H5T_FLOAT_F .or. rank < 1 .or. rank > 2) then
+            if (class /= H5T_FLOAT_F .or. dataset_rank < 1 .or. dataset_rank > 2) then
                ! The Fortran API lists the dimensions fastest first; print them in C order.
                found = '('
-               do i = rank, 1, -1
+               do i = dataset_rank, 1, -1
                   found = found // to_string(int(dims(i), i8))
                   if (i > 1) found = found // ', '
                end do
@@ -226,11 +234,20 @@ contains
                   & '; allowed: a 1D or 2D floating-point dataset (C order, as h5py writes height[ny, nx])', &
                   & code_input)
             else
-               if (rank == 1) dims(2) = 1
+               if (dataset_rank == 1) dims(2) = 1
                if (present(sizes)) sizes = dims(1:2)
                y_start = 0
                ny_local = int(dims(2))
-               if (present(rows)) call rows(int(dims(2)), y_start, ny_local)
+               if (present(ranks) .and. present(rank)) then
+                  slab = slab_of(int(dims(1)), int(dims(2)), ranks, rank)
+                  y_start = slab%y_start
+                  ny_local = slab%ny_local
+                  if (empty_rank(int(dims(2)), ranks)) then
+                     call fatal_error(error, too_few_rows(filename, int(dims(2)), ranks), code_input)
+                  end if
+               end if
+            end if
+            if (.not. allocated(error)) then
                held = [dims(1), int(ny_local, hsize_t)]
                allocate (height(held(1), held(2)))
                call h5dget_space_f(dset, space, hdferr)

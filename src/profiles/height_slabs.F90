@@ -14,10 +14,9 @@ module lc_profiles_height_slabs
 #endif
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_input
-   use lc_base_strings, only: to_string
    use lc_base_slab, only: row_slab, slab_of, empty_rank
    use lc_profiles_height_file, only: read_height_file, check_height_path, read_hdf5, check_heights, is_hdf5_name, &
-      & named
+      & too_few_rows
    use lc_io_mpi_agree, only: agree_error, shared_error
    implicit none (type, external)
    private
@@ -64,9 +63,7 @@ contains
       integer(hid_t) :: fapl, xfer
       integer(hsize_t) :: sizes(2)
       integer :: hdferr, ignore
-      logical :: too_few
 
-      too_few = .false.
       call check_height_path(filename, error)
       call agree_error(error, comm)
       if (allocated(error)) return
@@ -81,32 +78,15 @@ contains
 #else
       call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, ignore)
 #endif
-      call read_hdf5(filename, dataset, height, error, sizes, fapl, xfer, rows)
+      call read_hdf5(filename, dataset, height, error, sizes, fapl, xfer, ranks, rank)
       call h5pclose_f(fapl, ignore)
       if (xfer /= H5P_DEFAULT_F) call h5pclose_f(xfer, ignore)
       call h5close_f(ignore)
-      if (too_few) call fatal_error(error, too_few_rows(filename, int(sizes(2)), ranks), code_input)
       if (.not. allocated(error)) then
          slab = slab_of(int(sizes(1)), int(sizes(2)), ranks, rank)
          call check_heights(filename, height, slab%y_start, error)
       end if
       call agree_error(error, comm)
-   contains
-      !> This rank's rows of a dataset of ny rows (when a rank would have none, every rank
-      !> reads the first row, and the dataset is refused after the read, on every rank alike).
-      subroutine rows(ny, y_start, ny_local)
-         integer, intent(in) :: ny
-         integer, intent(out) :: y_start, ny_local
-         type(row_slab) :: mine
-         mine = slab_of(1, ny, ranks, rank)
-         y_start = mine%y_start
-         ny_local = mine%ny_local
-         too_few = empty_rank(ny, ranks)
-         if (too_few) then
-            y_start = 0
-            ny_local = 1
-         end if
-      end subroutine rows
    end subroutine read_hdf5_rows
 
    !> Rank 0 reads the whole file and sends every rank its rows.
@@ -146,12 +126,4 @@ contains
          & MPI_DOUBLE_PRECISION, root, comm)
    end subroutine read_scattered
 
-   pure function too_few_rows(filename, ny, ranks) result(message)
-      character(len=*), intent(in) :: filename
-      integer, intent(in) :: ny, ranks
-      character(len=:), allocatable :: message
-      message = named(filename) // ' holds ' // to_string(ny) // ' rows, which leave some of the ' // &
-         & to_string(ranks) // ' MPI ranks without a row (blocks of ceiling(ny/ranks) rows); allowed: ' // &
-         & 'a file whose rows fill every rank'
-   end function too_few_rows
 end module lc_profiles_height_slabs

@@ -13,8 +13,8 @@
 !>   test_slab_io DIR keep    as write, without &output overwrite, into DIR/slabs.h5 which
 !>                            the test wrote before: every rank returns rank 0's error (the
 !>                            move into place refuses), the file there is kept;
-!>   test_slab_io DIR few     DIR/few.txt holds 2 rows: on 3 or more ranks every rank
-!>                            must refuse it with the same error (code 2).
+!>   test_slab_io DIR few F   DIR/F (few.txt, few.h5) holds 2 rows: on 3 or more ranks
+!>                            every rank must refuse it with the same error (code 2).
 !>
 !> Every rank prints 'rank R rows Y0 NY' for its slab and 'error CODE MESSAGE' for an
 !> error; the exit status is 1 when a check fails, else the error's code (0: none).
@@ -71,7 +71,8 @@ program test_slab_io
       scene%overwrite = .false.
       call write_slabs(trim(dir) // '/slabs.h5', -1)
    case ('few')
-      call read_few()
+      call get_command_argument(3, argument)
+      call read_few(trim(argument))
    end select
 
    code = 0
@@ -218,9 +219,10 @@ contains
       end do
    end subroutine read_all
 
-   subroutine read_few()
+   subroutine read_few(name)
+      character(len=*), intent(in) :: name
       real(wp), allocatable :: height(:, :)
       type(row_slab) :: rows
-      call read_height_slab(trim(dir) // '/few.txt', '/h', MPI_COMM_WORLD, height, rows, error)
+      call read_height_slab(trim(dir) // '/' // name, '/h', MPI_COMM_WORLD, height, rows, error)
    end subroutine read_few
 end program test_slab_io
