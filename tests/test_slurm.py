@@ -680,3 +680,92 @@ def test_a_task_removes_only_temporary_files_of_ended_runs_of_its_host(tmp_path,
     assert not files["ended"].exists() and not files["earlier version"].exists()
     assert files["alive here"].read_bytes() == b"partial" and files["elsewhere"].read_bytes() == b"partial"
     assert (results / "s_0000.h5").is_file()
+
+
+# ---------------------------------------------------------------------------------------
+# scenes on several MPI ranks (--ranks-per-scene)
+
+#: a small areal scene (16 x 16 points: each of 2 ranks holds 8 rows)
+AREAL_BASE = """\
+&scene
+   geometry = 'areal'
+   n = 16
+/
+&layer
+   thickness = 0.2
+   poisson = 0.5
+/
+&profile
+   kind = 'self_affine'
+   short_wavelength = 0.25
+   rms_gradient = 0.1
+/
+&loading
+   normalised_pressure = 0.2
+/
+"""
+
+
+def write_areal_sweep(directory: Path, settings: str = "", name: str = "a") -> Path:
+    path = directory / f"{name}.nml"
+    path.write_text(AREAL_BASE + f"&sweep\n directory = 'out/{name}'\n seed = 1, 2\n{settings}/\n")
+    return path
+
+
+def test_ranks_per_scene_gives_array_tasks_of_k_ranks_started_by_srun(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    path = write_areal_sweep(tmp_path, " slurm_cpus_per_task = 2\n")
+    assert main(["sweep", str(path), "--slurm", "--dry-run", "--ranks-per-scene", "4"]) == 0
+    script = (tmp_path / "out/a/slurm/a_001.sbatch").read_text()
+    head = [line.removeprefix("#SBATCH ") for line in script.splitlines() if line.startswith("#SBATCH")]
+    # one array task per scene, of 4 tasks (ranks) of 2 CPUs each
+    assert head[:4] == ["--job-name=lc-a", "--array=0-1", "--ntasks=4", "--cpus-per-task=2"]
+    run = [line.strip() for line in script.splitlines() if '"$executable"' in line and "scenes/" in line]
+    assert run == ['srun --mpi=pmix --ntasks=4 --cpus-per-task=2 "$executable" '
+                   '"$sweep_directory/scenes/$scene.nml" >"$sweep_directory/logs/$scene.log" 2>&1 &']
+    assert "# Each scene runs on 4 MPI ranks (srun --mpi=pmix), 2 CPU(s) per rank." in script
+    assert subprocess.run(["bash", "-n"], input=script, text=True).returncode == 0
+
+    # one rank (the default): the executable alone, one task (a dry run's script is
+    # replaced by the next one)
+    assert main(["sweep", str(path), "--slurm", "--dry-run"]) == 0
+    script = (tmp_path / "out/a/slurm/a_001.sbatch").read_text()
+    assert "#SBATCH --ntasks=1\n" in script and "srun" not in script
+    assert '  "$executable" "$sweep_directory/scenes/$scene.nml"' in script
+
+
+@pytest.mark.parametrize("slurm_flag", [[], ["--slurm", "--dry-run"]], ids=["local", "slurm"])
+def test_ranks_per_scene_below_one_or_for_lines_is_refused_before_anything_is_written(
+    slurm_flag, tmp_path, monkeypatch, capsys
+):
+    monkeypatch.chdir(tmp_path)
+    areal = write_areal_sweep(tmp_path)
+    assert main(["sweep", str(areal), *slurm_flag, "--ranks-per-scene", "0"]) == 2
+    assert "--ranks-per-scene = 0 is not allowed; allowed: an integer >= 1" in capsys.readouterr().err
+    line = write_sweep(tmp_path)
+    assert main(["sweep", str(line), *slurm_flag, "--ranks-per-scene", "2"]) == 2
+    err = capsys.readouterr().err
+    assert "--ranks-per-scene = 2 is not allowed" in err and "lines (&scene geometry = 'line')" in err
+    assert "allowed: 1" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_scene_on_two_ranks_runs_in_a_slurm_array_task(slurm_cluster, tmp_path, monkeypatch, capsys):
+    # the task gets two Slurm tasks; srun starts the executable on both (PMIx), and the
+    # scene's result is written
+    monkeypatch.setenv("SLURM_CONF", str(slurm_cluster))
+    monkeypatch.chdir(tmp_path)
+    path = write_areal_sweep(tmp_path, " slurm_time = '5'\n")
+    out = tmp_path / "out/a"
+    assert main(["sweep", str(path), "--slurm", "--ranks-per-scene", "2",
+                 "--setup", "echo task ranks: $SLURM_NTASKS"]) == 0
+    assert "submitted Slurm job" in capsys.readouterr().out
+    wait_for(lambda: sweep_status.sweep_status(out).finished, "the scenes on two ranks")
+    assert main(["collect", str(out)]) == 0
+    summary = lc.read_summary(out / "a_summary.h5")
+    assert (summary["error"] == "").all() and len(summary["error"]) == 2
+    outputs = list((out / "slurm").glob("a_001_*.out"))
+    assert len(outputs) == 2
+    for output in outputs:
+        text = output.read_text()
+        assert "task ranks: 2" in text and ": exit 0 on " in text, text

@@ -555,3 +555,49 @@ def test_ctrl_c_ends_the_scenes_in_flight_at_once_and_a_rerun_completes(tmp_path
     rerun = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=900)
     assert rerun.returncode == 0, rerun.stderr
     assert len(list((tmp_path / "out/s/results").glob("*.h5"))) == 2
+
+
+#: a small areal scene for sweeps of scenes on several MPI ranks
+AREAL_BASE = """\
+&scene
+   geometry = 'areal'
+   n = 16
+/
+&layer
+   thickness = 0.2
+   poisson = 0.5
+/
+&profile
+   kind = 'self_affine'
+   short_wavelength = 0.25
+   rms_gradient = 0.1
+/
+&loading
+   normalised_pressure = 0.2
+/
+"""
+
+
+def test_a_local_sweep_on_two_ranks_per_scene_runs_each_scene_under_mpirun(tmp_path, monkeypatch):
+    """Each scene runs as `mpirun -n 2 layercontact SCENE.nml` (its output in logs/); the
+    results equal the scenes solved in this process, to the solver's tolerance."""
+    if shutil.which("mpirun") is None:
+        if os.environ.get("LAYERCONTACT_REQUIRE_MPI"):
+            pytest.fail("mpirun not found (LAYERCONTACT_REQUIRE_MPI is set)")
+        pytest.skip("mpirun not found")
+    monkeypatch.chdir(tmp_path)
+    # Open MPI as root, and 2 ranks where fewer cores are free
+    monkeypatch.setenv("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    monkeypatch.setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    monkeypatch.setenv("OMPI_MCA_rmaps_base_oversubscribe", "1")
+    path = tmp_path / "a.nml"
+    path.write_text(AREAL_BASE + "&sweep\n directory = 'out/a'\n seed = 1, 2\n/\n")
+    rows = lc.sweep(path, processes=1, progress=False, ranks_per_scene=2)
+    assert [row["error"] for row in rows] == ["", ""]
+    for row in rows:
+        stem = Path(row["scene_file"]).stem
+        assert (tmp_path / "out/a/logs" / f"{stem}.log").exists()
+        alone = lc.run(tmp_path / row["scene_file"])
+        # both solves meet &solver tol (1e-8 by default, relative): 1e-6 leaves them room
+        assert row["contact_fraction"] == pytest.approx(alone.contact_fraction, rel=1e-6)
+        assert row["mean_pressure"] == pytest.approx(alone.mean_pressure, rel=1e-6)

@@ -28,15 +28,28 @@ done
 hypre_include=${hypre_include:-/usr/include/hypre}
 
 has_pc() { command -v pkg-config >/dev/null 2>&1 && pkg-config --exists "$@" 2>/dev/null; }
-# a library the C compiler links by name (its default paths, LIBRARY_PATH, pkg-config HYPRE)
-has_library() {
+# a library the C compiler links by name (its default paths, LIBRARY_PATH)
+links() {
   local found
   found=$("$cc" -print-file-name="lib$1.so" 2>/dev/null) || return 1
   [ "$found" != "lib$1.so" ] && return 0
   for dir in ${LIBRARY_PATH//:/ } ${LD_LIBRARY_PATH//:/ }; do
     [ -e "$dir/lib$1.so" ] || [ -e "$dir/lib$1.a" ] && return 0
   done
-  has_pc HYPRE
+  return 1
+}
+# the same, or pkg-config HYPRE's
+has_library() { links "$1" || has_pc HYPRE; }
+# an HDF5 built with MPI-IO: its pkg-config flavours, its parallel compiler wrapper, or
+# H5_HAVE_PARALLEL in the H5pubconf.h that pkg-config hdf5 points at
+parallel_hdf5() {
+  has_pc hdf5-openmpi || has_pc hdf5-mpich || command -v h5pfc || {
+    local dir
+    for dir in $(pkg-config --cflags-only-I hdf5 2>/dev/null); do
+      grep -qs 'define H5_HAVE_PARALLEL 1' "${dir#-I}/H5pubconf.h" && return 0
+    done
+    return 1
+  }
 }
 
 # What the build needs: "name|found?|Debian packages|how else to provide it"
@@ -59,6 +72,12 @@ need "LAPACK" 'has_pc lapack' "liblapack-dev libopenblas-dev" \
   "lapack.pc in PKG_CONFIG_PATH (module load openblas, or a LAPACK with its pkg-config file)"
 need "HDF5 with Fortran" 'has_pc hdf5 || command -v h5fc || command -v h5pfc' libhdf5-dev \
   "hdf5.pc in PKG_CONFIG_PATH or h5fc in PATH (module load hdf5, a build with Fortran)"
+# one surface on several MPI ranks: FFTW's MPI transforms and HDF5's MPI-IO (result files
+# written by slabs of rows)
+need "FFTW 3 MPI" 'links fftw3_mpi' libfftw3-mpi-dev \
+  "libfftw3_mpi in the compiler's or LIBRARY_PATH's directories (module load fftw, its MPI build)"
+need "parallel HDF5 (MPI-IO)" 'parallel_hdf5' libhdf5-openmpi-dev \
+  "hdf5-openmpi.pc in PKG_CONFIG_PATH or h5pfc in PATH (module load hdf5, its MPI build: hdf5-mpi, phdf5)"
 need "MPI (C), for hypre" 'has_pc ompi-c || has_pc mpi-c || has_pc mpich || command -v mpicc' libopenmpi-dev \
   "mpicc in PATH or its pkg-config file (module load openmpi, the MPI hypre was built with)"
 need "hypre" '[ -f "$hypre_include/HYPRE_parcsr_ls.h" ] && has_library HYPRE' libhypre-dev \

@@ -1,8 +1,8 @@
 """Command line of layercontact.
 
     python -m layercontact run FILE.nml [--png PICTURE | --no-png]
-    python -m layercontact sweep FILE.nml [--processes N] [--no-progress] [--dry-run]
-    python -m layercontact sweep FILE.nml --slurm [--dry-run] [Slurm options]
+    python -m layercontact sweep FILE.nml [--processes N] [--ranks-per-scene K] [--no-progress] [--dry-run]
+    python -m layercontact sweep FILE.nml --slurm [--ranks-per-scene K] [--dry-run] [Slurm options]
     python -m layercontact status DIR [--all]
     python -m layercontact collect DIR
     python -m layercontact convert INPUT OUTPUT.h5 [--unit UNIT] [--channel N]
@@ -41,6 +41,7 @@ Exit codes:
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 import sys
 from pathlib import Path
 
@@ -75,6 +76,14 @@ def _parser() -> argparse.ArgumentParser:
     sweep_p.add_argument("nml", help="sweep namelist file")
     sweep_p.add_argument(
         "--processes", type=int, help="worker processes (default: &sweep processes, or the CPUs allocated)"
+    )
+    sweep_p.add_argument(
+        "--ranks-per-scene",
+        type=int,
+        default=1,
+        metavar="K",
+        help="MPI ranks of each (areal) scene: here under mpirun -n K, with --slurm srun in tasks of "
+        "--ntasks=K (default 1)",
     )
     sweep_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep_p.add_argument(
@@ -146,7 +155,8 @@ def main(argv: list[str] | None = None) -> int:
             flag = OPTIONS[next(iter(given))].flag
             print(f"layercontact: error: {flag} applies only with --slurm", file=sys.stderr)
             return 2
-        return sweep_command(args.nml, args.processes, not args.no_progress, args.dry_run, args.max_scenes)
+        return sweep_command(args.nml, args.processes, not args.no_progress, args.dry_run, args.max_scenes,
+                             args.ranks_per_scene)
     if args.command == "status":
         return status_command(args.directory, args.all)
     if args.command == "collect":
@@ -194,7 +204,7 @@ def run_command(args: argparse.Namespace) -> int:
 
 
 def sweep_command(nml: str, processes: int | None, progress: bool, dry_run: bool = False,
-                  max_scenes: int | None = None) -> int:
+                  max_scenes: int | None = None, ranks_per_scene: int = 1) -> int:
     """``python -m layercontact sweep``: run the sweep, print where the summary is and
     which scenes failed. Exit code 0 all converged, 1 some scene failed or did not
     converge (the others ran), 2 bad sweep (nothing ran)."""
@@ -202,7 +212,8 @@ def sweep_command(nml: str, processes: int | None, progress: bool, dry_run: bool
 
     try:
         plan = read_sweep(nml, max_scenes)
-        rows = execute(plan, processes=processes, progress=progress, dry_run=dry_run)
+        rows = execute(plan, processes=processes, progress=progress, dry_run=dry_run,
+                       ranks_per_scene=ranks_per_scene)
     except _BAD_SWEEP as err:
         print(f"layercontact: error: {err}", file=sys.stderr)
         return 2
@@ -246,7 +257,7 @@ def slurm_command(args: argparse.Namespace) -> int:
     job array of the scenes that are missing or failed; record the job id."""
     from .sweeps.slurm import SlurmError, resolve_options
     from .sweeps.submit import submit_sweep
-    from .sweeps.sweep import read_sweep
+    from .sweeps.sweep import check_ranks_per_scene, read_sweep
 
     if args.processes is not None:
         print(
@@ -258,6 +269,7 @@ def slurm_command(args: argparse.Namespace) -> int:
     try:
         plan = read_sweep(args.nml, args.max_scenes)
         options = resolve_options(plan.slurm, _slurm_values(args))
+        options = replace(options, ranks_per_scene=check_ranks_per_scene(plan, args.ranks_per_scene))
         outcome = submit_sweep(plan, options, dry_run=args.dry_run)
     except _BAD_SWEEP as err:
         print(f"layercontact: error: {err}", file=sys.stderr)

@@ -15,7 +15,7 @@
 !> (h5open_f/h5close_f) and switches off HDF5's own error printing: failures come back as
 !> `error_type` messages naming the file and the object instead.
 module lc_io_hdf5
-   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_char, c_null_char, c_ptr, c_loc, c_size_t
+   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_char, c_null_char, c_ptr, c_loc, c_size_t, c_float
    use, intrinsic :: iso_fortran_env, only: error_unit
    use hdf5, only: hid_t, hsize_t, size_t, h5kind_to_type, H5_INTEGER_KIND, h5open_f, h5close_f, h5eset_auto_f, &
       & h5fis_hdf5_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5fget_filesize_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
@@ -24,9 +24,9 @@ module lc_io_hdf5
       & h5pset_deflate_f, h5pset_shuffle_f, &
       & h5gcreate_f, h5gclose_f, h5iget_name_f, &
       & h5screate_f, h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
-      & h5sget_simple_extent_dims_f, H5S_SCALAR_F, &
+      & h5sget_simple_extent_dims_f, H5S_SCALAR_F, h5sselect_hyperslab_f, H5S_SELECT_SET_F, H5P_DEFAULT_F, &
       & h5tcopy_f, h5tset_size_f, h5tset_strpad_f, h5tclose_f, h5tget_class_f, &
-      & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_IEEE_F32LE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
+      & H5T_FORTRAN_S1, H5T_STR_NULLTERM_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_REAL, H5T_IEEE_F32LE, H5T_NATIVE_INTEGER, H5T_FLOAT_F, &
       & h5acreate_f, h5awrite_f, h5aclose_f, &
       & h5dcreate_f, h5dopen_f, h5dwrite_f, h5dread_f, h5dclose_f, h5dget_space_f, h5dget_type_f
    use lc_base_kinds, only: wp, i8
@@ -40,6 +40,9 @@ module lc_io_hdf5
    implicit none (type, external)
    private
    public :: check_output, write_results, run_record, utc_now
+   ! for the writers of one file by several processes (lc_io_hdf5_slabs)
+   public :: map_writer, h5_status, temporary_name, delete_file, write_contents, publish, map_bytes, announce_large, &
+      & check_sizes
 
    character(len=*), parameter :: convention = 'P: x = sliding direction of the indenter, z into the layer, ' // &
       & 'p > 0 compressive, w = u_z > 0 indentation, tau = +mu_c p'
@@ -50,8 +53,6 @@ module lc_io_hdf5
       & 'unit width per unit mean pressure gradient: g^3 for a uniform gap g); wall_time s; ' // &
       & 'the others are dimensionless (fractions, residuals, tolerances, flags 0/1) or counts'
 
-   !> Sticky status of a sequence of HDF5 calls: after the first failure every helper does
-   !> nothing, so a writer reads as a plain list of objects and is checked once at the end.
    !> How a run was started, for the result's provenance (root attributes @input_file,
    !> @started, @run_wall_time).
    type :: run_record
@@ -60,10 +61,34 @@ module lc_io_hdf5
       real(wp) :: seconds = 0.0_wp                  !< from the start to the write (s)
    end type run_record
 
+   !> How the maps of a result reach its file. This default writes whole maps from one
+   !> process; lc_io_hdf5_slabs extends it for maps whose rows y are spread over several MPI
+   !> ranks that write one file together: every rank makes the same HDF5 calls, each writes
+   !> its rows of a map, one rank the data of what every rank holds whole.
+   type :: map_writer
+   contains
+      !> the rows y_start+1 .. y_start+ny_local of a map of ny rows that this process holds
+      procedure :: rows => whole_rows
+      !> whether more than half of a map's values (all processes' rows) are exact zeros
+      procedure :: mostly_zeros => whole_mostly_zeros
+      !> the dataset transfer property list for the maps' writes
+      procedure :: transfer => default_transfer
+      !> whether this process writes the data of the datasets every process holds whole
+      procedure :: writes_whole => always_writes
+      !> a text (host, time) as all processes write it: one process's
+      procedure :: agreed_text => own_text
+      !> a real (run time) as all processes write it: one process's
+      procedure :: agreed_real => own_real
+   end type map_writer
+
+   !> Sticky status of a sequence of HDF5 calls: after the first failure every helper does
+   !> nothing, so a writer reads as a plain list of objects and is checked once at the end.
+   !> It also carries how the maps are written.
    type :: h5_status
       integer :: hdferr = 0
       character(len=:), allocatable :: object   !< path of the object that failed
       integer(i8) :: free = -1                  !< bytes free on the file system then (-1: unknown)
+      class(map_writer), allocatable :: maps    !< unallocated: whole maps from this process
    end type h5_status
 
    interface
@@ -193,11 +218,8 @@ contains
       type(run_record), intent(in), optional :: run
       character(len=:), allocatable :: tmp
       type(h5_status) :: st
-      integer(hid_t) :: fapl, file, group
-      character(len=:), allocatable :: reason
-      integer :: ignore, j, n
-      integer(i8) :: maps
-      logical :: synced
+      integer(hid_t) :: fapl, file
+      integer :: ignore, n
 
       n = size(height)
       call check_sizes(result, n, 'result', error)
@@ -207,16 +229,10 @@ contains
          if (allocated(error)) return
       end if
 
-      tmp = filename // '.' // host_name() // '.' // to_string(int(c_getpid())) // '.tmp'
+      tmp = temporary_name(filename)
       call delete_file(tmp, error)
       if (allocated(error)) return
-      ! a large file takes seconds to reach the disk: say so meanwhile, as the solver's progress does
-      maps = map_bytes(scene, result, present(companion))
-      if (maps >= large_file) then
-         write (error_unit, '(a)') "layercontact: writing result file '" // filename // "' (" // &
-            & to_string(maps/10_i8**6) // ' MB of maps)'
-         flush (error_unit)
-      end if
+      call announce_large(filename, map_bytes(scene, result, present(companion)))
 
       call h5open_f(st%hdferr)
       call h5eset_auto_f(0, ignore)
@@ -228,51 +244,105 @@ contains
          if (st%hdferr /= 0) st%object = 'the file itself'
       end if
       if (st%hdferr == 0) then
-         call write_attr_string(file, 'layercontact_version', version, st)
-         call write_attr_string(file, 'layercontact_build', build_isa, st)
-         call write_attr_string(file, 'geometry', trim(scene%geometry), st)
-         call write_attr_string(file, 'convention', convention, st)
-         call write_attr_string(file, 'units', units_note, st)
-         call write_attr_int(file, 'omp_threads', result%omp_threads, st)
-         call write_attr_int(file, 'mpi_ranks', result%mpi_ranks, st)
-         call write_provenance(file, st)
-         if (present(run)) then
-            call write_attr_string(file, 'input_file', run%input_file, st)
-            call write_attr_string(file, 'started', run%started, st)
-            call write_attr_real(file, 'run_wall_time', run%seconds, st)
-         end if
-
-         call create_group(file, 'input', group, st)
-         call write_dataset_string(group, 'namelist', namelist_text, st)
-         call write_scene_attrs(group, scene, st)
-         call close_group(group, st)
-
-         if (scene%fields) then
-            call create_group(file, 'profile', group, st)
-            call write_dataset_1d(group, 'x', [(j*scene%period/scene%n, j=0, scene%n - 1)], 'L', st)
-            if (is_areal(scene)) then
-               associate (ly => merge(scene%period_y, scene%period, scene%period_y > 0.0_wp))
-                  call write_dataset_1d(group, 'y', [(j*ly/scene%ny, j=0, scene%ny - 1)], 'L', st)
-               end associate
-            end if
-            call write_field(group, 'height', height, 'L', scene, st)
-            call close_group(group, st)
-         end if
-
-         if (present(companion)) then
-            call write_solution(file, result, scene, st, &
-               & a_over_a0=result%contact_fraction / companion%contact_fraction)
-            call create_group(file, 'companion', group, st)
-            call write_solution(group, companion, scene, st)
-            call close_group(group, st)
-         else
-            call write_solution(file, result, scene, st)
-         end if
+         call write_contents(file, scene, namelist_text, height, result, version, st, companion, run)
          call close_file(file, tmp, st)
       end if
       call h5pclose_f(fapl, ignore)
       call h5close_f(ignore)
+      call publish(tmp, filename, scene%overwrite, st, error)
+   end subroutine write_results
 
+   !> This run's own temporary file for `filename`: filename.HOST.PID.tmp, so that two runs
+   !> never share it.
+   function temporary_name(filename) result(tmp)
+      character(len=*), intent(in) :: filename
+      character(len=:), allocatable :: tmp
+      tmp = filename // '.' // host_name() // '.' // to_string(int(c_getpid())) // '.tmp'
+   end function temporary_name
+
+   !> A large file takes seconds to reach the disk: say so meanwhile, as the solver's
+   !> progress does.
+   subroutine announce_large(filename, maps)
+      character(len=*), intent(in) :: filename
+      !> the bytes of the maps (map_bytes)
+      integer(i8), intent(in) :: maps
+      if (maps < large_file) return
+      write (error_unit, '(a)') "layercontact: writing result file '" // filename // "' (" // &
+         & to_string(maps/10_i8**6) // ' MB of maps)'
+      flush (error_unit)
+   end subroutine announce_large
+
+   !> Everything a result file holds, written into the open `file`: the root's attributes,
+   !> /input, /profile, the solution and the companion's. `height` and the result's maps are
+   !> the rows st%maps says this process holds.
+   subroutine write_contents(file, scene, namelist_text, height, result, version, st, companion, run)
+      integer(hid_t), intent(in) :: file
+      type(scene_type), intent(in) :: scene
+      character(len=*), intent(in) :: namelist_text
+      real(wp), intent(in) :: height(:)
+      type(contact_result), intent(in) :: result
+      character(len=*), intent(in) :: version
+      type(h5_status), intent(inout) :: st
+      type(contact_result), intent(in), optional :: companion
+      type(run_record), intent(in), optional :: run
+      integer(hid_t) :: group
+      integer :: j
+
+      if (.not. allocated(st%maps)) allocate (map_writer :: st%maps)
+      call write_attr_string(file, 'layercontact_version', version, st)
+      call write_attr_string(file, 'layercontact_build', build_isa, st)
+      call write_attr_string(file, 'geometry', trim(scene%geometry), st)
+      call write_attr_string(file, 'convention', convention, st)
+      call write_attr_string(file, 'units', units_note, st)
+      call write_attr_int(file, 'omp_threads', result%omp_threads, st)
+      call write_attr_int(file, 'mpi_ranks', result%mpi_ranks, st)
+      call write_provenance(file, st)
+      if (present(run)) then
+         call write_attr_string(file, 'input_file', run%input_file, st)
+         call write_attr_string(file, 'started', run%started, st)
+         call write_attr_real(file, 'run_wall_time', st%maps%agreed_real(run%seconds), st)
+      end if
+
+      call create_group(file, 'input', group, st)
+      call write_dataset_string(group, 'namelist', namelist_text, st)
+      call write_scene_attrs(group, scene, st)
+      call close_group(group, st)
+
+      if (scene%fields) then
+         call create_group(file, 'profile', group, st)
+         call write_dataset_1d(group, 'x', [(j*scene%period/scene%n, j=0, scene%n - 1)], 'L', st)
+         if (is_areal(scene)) then
+            associate (ly => merge(scene%period_y, scene%period, scene%period_y > 0.0_wp))
+               call write_dataset_1d(group, 'y', [(j*ly/scene%ny, j=0, scene%ny - 1)], 'L', st)
+            end associate
+         end if
+         call write_field(group, 'height', height, 'L', scene, st)
+         call close_group(group, st)
+      end if
+
+      if (present(companion)) then
+         call write_solution(file, result, scene, st, &
+            & a_over_a0=result%contact_fraction / companion%contact_fraction)
+         call create_group(file, 'companion', group, st)
+         call write_solution(group, companion, scene, st)
+         call close_group(group, st)
+      else
+         call write_solution(file, result, scene, st)
+      end if
+   end subroutine write_contents
+
+   !> After the temporary file `tmp` is closed: on a failure recorded in `st` delete it and
+   !> return error code_io naming the file, the object and the space left; else check it
+   !> (check_on_disk) and move it to `filename` (move_into_place).
+   subroutine publish(tmp, filename, overwrite, st, error)
+      character(len=*), intent(in) :: tmp, filename
+      !> &output overwrite
+      logical, intent(in) :: overwrite
+      type(h5_status), intent(inout) :: st
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: reason
+      integer :: ignore
+      logical :: synced
       if (st%hdferr /= 0) then
          ignore = c_remove(tmp // c_null_char)
          if (.not. allocated(st%object)) st%object = 'the HDF5 library'
@@ -283,11 +353,11 @@ contains
       end if
       call check_on_disk(tmp, filename, error)
       if (allocated(error)) return
-      call move_into_place(tmp, filename, scene%overwrite, error)
+      call move_into_place(tmp, filename, overwrite, error)
       if (allocated(error)) return
       ! the new name on the disk too (a file system that cannot sync a directory has done it)
       call sync_path(parent_of(filename), .true., synced, reason)
-   end subroutine write_results
+   end subroutine publish
 
    !> Close a written file so that none of HDF5's writes can fail: HDF5 1.10 writes the
    !> metadata it caches when the file closes, and a failed write of it leaves the library
@@ -712,7 +782,7 @@ contains
          if (st%hdferr == 0) then
             call h5dcreate_f(loc, name, stype, space, dset, st%hdferr)
             if (st%hdferr == 0) then
-               call h5dwrite_f(dset, stype, value // c_null_char, [1_hsize_t], st%hdferr)
+               if (st%maps%writes_whole()) call h5dwrite_f(dset, stype, value // c_null_char, [1_hsize_t], st%hdferr)
                call close_dataset(dset, st)
             end if
             call h5sclose_f(space, ignore)
@@ -739,7 +809,8 @@ contains
          call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, space, dset, st%hdferr)
          if (st%hdferr == 0) then
             ! nothing to transfer for an empty history (and no element to point the C call at)
-            if (size(values) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, st%hdferr)
+            if (size(values) > 0 .and. st%maps%writes_whole()) &
+               & call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, st%hdferr)
             if (st%hdferr == 0) call write_attr_string(dset, 'units', units, st)
             call close_dataset(dset, st)
          end if
@@ -754,7 +825,8 @@ contains
    !> the disk writes and saves little on dense maps. A map whose values are mostly exact
    !> zeros (the pressure and the shear outside the contact) is stored in chunks of whole rows
    !> with shuffle + deflate level 1, which there costs little and saves ~90 %
-   !> (docs/decisions/020-result-writing.md).
+   !> (docs/decisions/020-result-writing.md). `values` are the rows st%maps says this
+   !> process holds (all of them when one process writes).
    subroutine write_field(loc, name, values, units, scene, st)
       integer(hid_t), intent(in) :: loc
       character(len=*), intent(in) :: name
@@ -762,18 +834,26 @@ contains
       character(len=*), intent(in) :: units
       type(scene_type), intent(in) :: scene
       type(h5_status), intent(inout) :: st
-      integer(hid_t) :: space, dset, dcpl, file_type
-      integer(hsize_t) :: dims(2), chunk(2)
-      integer :: rank, ignore
+      integer(hid_t) :: space, memory, dset, dcpl, file_type
+      integer(hsize_t) :: dims(2), chunk(2), held(2)
+      integer :: rank, ignore, y_start, ny_local
       if (st%hdferr /= 0) return
       rank = merge(2, 1, is_areal(scene))
       dims = [int(scene%n, hsize_t), int(max(scene%ny, 1), hsize_t)]
+      call st%maps%rows(int(dims(2)), y_start, ny_local)
+      held = [dims(1), int(ny_local, hsize_t)]
       file_type = H5T_NATIVE_DOUBLE
       if (trim(scene%precision) == 'single') file_type = H5T_IEEE_F32LE
       call h5screate_simple_f(rank, dims(:rank), space, st%hdferr)
+      memory = space
+      ! this process's rows: a block of whole rows of the file's dataspace
+      if (st%hdferr == 0 .and. any(held /= dims)) then
+         call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, [0_hsize_t, int(y_start, hsize_t)], held, st%hdferr)
+         if (st%hdferr == 0) call h5screate_simple_f(rank, held(:rank), memory, st%hdferr)
+      end if
       if (st%hdferr == 0) then
          call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl, st%hdferr)
-         if (st%hdferr == 0 .and. mostly_zeros(values)) then
+         if (st%hdferr == 0 .and. st%maps%mostly_zeros(values)) then
             ! chunks of about 2**16 values (512 KiB in double): whole rows of a surface
             chunk = [min(dims(1), 65536_hsize_t), max(1_hsize_t, min(dims(2), 65536_hsize_t/dims(1)))]
             call h5pset_chunk_f(dcpl, rank, chunk(:rank), st%hdferr)
@@ -783,16 +863,65 @@ contains
          if (st%hdferr == 0) then
             call h5dcreate_f(loc, name, file_type, space, dset, st%hdferr, dcpl_id=dcpl)
             if (st%hdferr == 0) then
-               if (size(values) > 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims(:rank), st%hdferr)
+               if (size(values) > 0 .and. file_type == H5T_IEEE_F32LE) then
+                  ! rounded here (to nearest, as HDF5's conversion does): parallel HDF5 1.10
+                  ! writes a deflated dataset collectively only without a type conversion
+                  call h5dwrite_f(dset, H5T_NATIVE_REAL, real(values, c_float), held(:rank), st%hdferr, &
+                     & mem_space_id=memory, file_space_id=space, xfer_prp=st%maps%transfer())
+               else if (size(values) > 0) then
+                  call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, held(:rank), st%hdferr, &
+                     & mem_space_id=memory, file_space_id=space, xfer_prp=st%maps%transfer())
+               end if
                if (st%hdferr == 0) call write_attr_string(dset, 'units', units, st)
                call close_dataset(dset, st)
             end if
          end if
          call h5pclose_f(dcpl, ignore)
-         call h5sclose_f(space, ignore)
       end if
+      if (memory /= space) call h5sclose_f(memory, ignore)
+      call h5sclose_f(space, ignore)
       if (st%hdferr /= 0 .and. .not. allocated(st%object)) call failed(loc, name, st)
    end subroutine write_field
+
+   ! The default map_writer: one process, whole maps.
+
+   !> All ny rows.
+   pure subroutine whole_rows(self, ny, y_start, ny_local)
+      class(map_writer), intent(in) :: self
+      integer, intent(in) :: ny
+      integer, intent(out) :: y_start, ny_local
+      y_start = 0
+      ny_local = ny
+   end subroutine whole_rows
+
+   logical function whole_mostly_zeros(self, values)
+      class(map_writer), intent(in) :: self
+      real(wp), intent(in) :: values(:)
+      whole_mostly_zeros = mostly_zeros(values)
+   end function whole_mostly_zeros
+
+   integer(hid_t) function default_transfer(self)
+      class(map_writer), intent(in) :: self
+      default_transfer = H5P_DEFAULT_F
+   end function default_transfer
+
+   logical function always_writes(self)
+      class(map_writer), intent(in) :: self
+      always_writes = .true.
+   end function always_writes
+
+   function own_text(self, text) result(agreed)
+      class(map_writer), intent(in) :: self
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: agreed
+      agreed = text
+   end function own_text
+
+   real(wp) function own_real(self, value)
+      class(map_writer), intent(in) :: self
+      real(wp), intent(in) :: value
+      own_real = value
+   end function own_real
 
    !> Whether more than half of the values are exact zeros (a map deflate shrinks cheaply).
    pure logical function mostly_zeros(values)
@@ -827,8 +956,8 @@ contains
          & 'SLURM_ARRAY_TASK_ID', 'SLURM_CLUSTER_NAME', 'SLURM_RESTART_COUNT']
       integer :: i, length, status
 
-      call write_attr_string(loc, 'host', host_name(), st)
-      call write_attr_string(loc, 'created', utc_now(), st)
+      call write_attr_string(loc, 'host', st%maps%agreed_text(host_name()), st)
+      call write_attr_string(loc, 'created', st%maps%agreed_text(utc_now()), st)
       do i = 1, size(slurm)
          call get_environment_variable(trim(slurm(i)), value, length, status)
          if (status == 0 .and. length > 0) call write_attr_string(loc, lower_case(trim(slurm(i))), trim(value), st)

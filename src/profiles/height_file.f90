@@ -24,14 +24,18 @@ module lc_profiles_height_file
    use hdf5, only: hid_t, hsize_t, h5open_f, h5close_f, h5eset_auto_f, h5fis_hdf5_f, h5fopen_f, h5fclose_f, H5F_ACC_RDONLY_F, &
       & H5F_CLOSE_STRONG_F, h5pcreate_f, h5pclose_f, h5pset_fclose_degree_f, H5P_FILE_ACCESS_F, h5dopen_f, h5dclose_f, &
       & h5dread_f, h5dget_space_f, h5dget_type_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
-      & h5sget_simple_extent_dims_f, h5tget_class_f, h5tclose_f, H5T_NATIVE_DOUBLE, H5T_FLOAT_F
+      & h5sget_simple_extent_dims_f, h5tget_class_f, h5tclose_f, H5T_NATIVE_DOUBLE, H5T_FLOAT_F, &
+      & h5screate_simple_f, h5sselect_hyperslab_f, H5S_SELECT_SET_F, H5P_DEFAULT_F
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input, code_io, code_internal
    use lc_base_strings, only: to_string, lower_case
    use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
+   use lc_base_slab, only: row_slab, slab_of, empty_rank
    implicit none (type, external)
    private
    public :: read_height_file, named, shape_text
+   ! for the reader of one file by several processes (lc_profiles_height_slabs)
+   public :: check_height_path, read_hdf5, check_heights, is_hdf5_name, too_few_rows
 
    !> The largest rank HDF5 allows (H5S_MAX_RANK).
    integer, parameter :: max_rank = 32
@@ -51,26 +55,10 @@ contains
       !> Heights (L): (nx, ny) of a surface, (n, 1) of a 1D array
       real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
-      integer :: ix, iy, kind
-      character(len=:), allocatable :: detail
 
-      ! a file that is not there, or not a regular file (a FIFO would block the read until
-      ! a writer comes, a directory or a device holds no heights), is bad input (exit 2),
-      ! from every route; one that is there but cannot be read is an I/O failure (4)
-      call path_kind(filename, kind, detail)
-      if (kind == kind_missing) then
-         call fatal_error(error, named(filename) // ' is not found; allowed: an existing file (HDF5, .npy or ' // &
-            & 'text), relative to the working directory', code_input)
-         return
-      else if (kind == kind_unknown) then
-         call fatal_error(error, named(filename) // ' cannot be examined: ' // detail, code_io)
-         return
-      else if (kind /= kind_regular) then
-         call fatal_error(error, named(filename) // ' is ' // kind_name(kind) // '; allowed: a regular file ' // &
-            & '(HDF5, .npy or text)', code_input)
-         return
-      end if
-      if (ends_with(filename, '.h5') .or. ends_with(filename, '.hdf5')) then
+      call check_height_path(filename, error)
+      if (allocated(error)) return
+      if (is_hdf5_name(filename)) then
          call read_hdf5(filename, dataset, height, error)
       else if (ends_with(filename, '.npy')) then
          call read_npy(filename, height, error)
@@ -83,24 +71,70 @@ contains
          if (allocated(height)) deallocate (height)
          return
       end if
+      call check_heights(filename, height, 0, error)
+      if (allocated(error)) deallocate (height)
+   end subroutine read_height_file
+
+   !> A file that is not there, or not a regular file (a FIFO would block the read until a
+   !> writer comes, a directory or a device holds no heights), is bad input (exit 2), from
+   !> every route; one that is there but cannot be examined is an I/O failure (4).
+   subroutine check_height_path(filename, error)
+      character(len=*), intent(in) :: filename
+      type(error_type), allocatable, intent(out) :: error
+      integer :: kind
+      character(len=:), allocatable :: detail
+      call path_kind(filename, kind, detail)
+      if (kind == kind_missing) then
+         call fatal_error(error, named(filename) // ' is not found; allowed: an existing file (HDF5, .npy or ' // &
+            & 'text), relative to the working directory', code_input)
+      else if (kind == kind_unknown) then
+         call fatal_error(error, named(filename) // ' cannot be examined: ' // detail, code_io)
+      else if (kind /= kind_regular) then
+         call fatal_error(error, named(filename) // ' is ' // kind_name(kind) // '; allowed: a regular file ' // &
+            & '(HDF5, .npy or text)', code_input)
+      end if
+   end subroutine check_height_path
+
+   !> Whether the file name says HDF5 ('.h5', '.hdf5').
+   pure logical function is_hdf5_name(filename)
+      character(len=*), intent(in) :: filename
+      is_hdf5_name = ends_with(filename, '.h5') .or. ends_with(filename, '.hdf5')
+   end function is_hdf5_name
+
+   !> Heights read are some, and all finite; `y_start` rows of the file come before those of
+   !> `height` (for the row named in the message).
+   subroutine check_heights(filename, height, y_start, error)
+      character(len=*), intent(in) :: filename
+      real(wp), intent(in) :: height(:, :)
+      integer, intent(in) :: y_start
+      type(error_type), allocatable, intent(out) :: error
+      integer :: ix, iy
       if (size(height) == 0) then
          call fatal_error(error, named(filename) // ' holds no heights; allowed: one or more rows of heights', &
             & code_input)
-         deallocate (height)
          return
       end if
       do iy = 1, size(height, 2)
          do ix = 1, size(height, 1)
             if (.not. ieee_is_finite(height(ix, iy))) then
                call fatal_error(error, named(filename) // ' holds the height ' // to_string(height(ix, iy)) // &
-                  & ' at (ix, iy) = (' // to_string(ix - 1) // ', ' // to_string(iy - 1) // &
+                  & ' at (ix, iy) = (' // to_string(ix - 1) // ', ' // to_string(y_start + iy - 1) // &
                   & '), 0-based; allowed: finite heights', code_input)
-               deallocate (height)
                return
             end if
          end do
       end do
-   end subroutine read_height_file
+   end subroutine check_heights
+
+   !> The refusal of a file whose ny rows leave some of `ranks` processes without a row.
+   pure function too_few_rows(filename, ny, ranks) result(message)
+      character(len=*), intent(in) :: filename
+      integer, intent(in) :: ny, ranks
+      character(len=:), allocatable :: message
+      message = named(filename) // ' holds ' // to_string(ny) // ' rows, which leave some of the ' // &
+         & to_string(ranks) // ' MPI ranks without a row (blocks of ceiling(ny/ranks) rows); allowed: ' // &
+         & 'a file whose rows fill every rank'
+   end function too_few_rows
 
    !> "&profile: file = '<filename>'", the start of every message.
    pure function named(filename) result(s)
@@ -120,20 +154,40 @@ contains
    ! ---------------------------------------------------------------------------------------
    ! HDF5
 
-   subroutine read_hdf5(filename, dataset, height, error)
+   !> The heights of an HDF5 file's dataset: all of them, or, with `ranks` and `rank`, the
+   !> rows of that rank (lc_base_slab: height(nx, ny_local)), read through the file access
+   !> list `access` and the transfer list `xfer` (a collective MPI-IO read by several
+   !> processes: lc_profiles_height_slabs). `sizes` are the dataset's (nx, ny). A dataset
+   !> whose rows leave a rank without one is refused (on every rank alike, before any read).
+   subroutine read_hdf5(filename, dataset, height, error, sizes, access, xfer, ranks, rank)
       character(len=*), intent(in) :: filename, dataset
       real(wp), allocatable, intent(out) :: height(:, :)
       type(error_type), allocatable, intent(out) :: error
-      integer(hid_t) :: fapl, file, dset, space, dtype
-      integer(hsize_t) :: dims(max_rank), maxdims(max_rank)
-      integer :: hdferr, ignore, rank, class, i
+      integer(hsize_t), intent(out), optional :: sizes(2)
+      !> a file access list made by the caller (closed by the caller)
+      integer(hid_t), intent(in), optional :: access
+      !> a transfer list made by the caller
+      integer(hid_t), intent(in), optional :: xfer
+      !> the processes sharing the rows, and this one's number (0-based)
+      integer, intent(in), optional :: ranks, rank
+      integer(hid_t) :: fapl, file, dset, space, dtype, memory, transfer
+      integer(hsize_t) :: dims(max_rank), maxdims(max_rank), held(2)
+      integer :: hdferr, ignore, dataset_rank, class, i, y_start, ny_local
+      type(row_slab) :: slab
       character(len=:), allocatable :: found
       logical :: is_hdf5
 
       call h5open_f(hdferr)
       call h5eset_auto_f(0, ignore)
-      call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, ignore)
-      call h5pset_fclose_degree_f(fapl, H5F_CLOSE_STRONG_F, ignore)
+      if (present(access)) then
+         fapl = access
+      else
+         call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, ignore)
+         call h5pset_fclose_degree_f(fapl, H5F_CLOSE_STRONG_F, ignore)
+      end if
+      transfer = H5P_DEFAULT_F
+      if (present(xfer)) transfer = xfer
+      if (present(sizes)) sizes = 0
       reading: block
          if (hdferr /= 0) then
             call fatal_error(error, named(filename) // ': cannot initialise HDF5 to read it', code_internal)
@@ -159,17 +213,18 @@ contains
                & 'allowed: the path of a 1D or 2D floating-point dataset in the file', code_input)
          else
             call h5dget_space_f(dset, space, hdferr)
-            call h5sget_simple_extent_ndims_f(space, rank, ignore)
+            call h5sget_simple_extent_ndims_f(space, dataset_rank, ignore)
             dims = 0
-            if (rank >= 1 .and. rank <= max_rank) call h5sget_simple_extent_dims_f(space, dims, maxdims, ignore)
+            if (dataset_rank >= 1 .and. dataset_rank <= max_rank) &
+               & call h5sget_simple_extent_dims_f(space, dims, maxdims, ignore)
             call h5sclose_f(space, ignore)
             call h5dget_type_f(dset, dtype, ignore)
             call h5tget_class_f(dtype, class, ignore)
             call h5tclose_f(dtype, ignore)
-            if (class /= H5T_FLOAT_F .or. rank < 1 .or. rank > 2) then
+            if (class /= H5T_FLOAT_F .or. dataset_rank < 1 .or. dataset_rank > 2) then
                ! The Fortran API lists the dimensions fastest first; print them in C order.
                found = '('
-               do i = rank, 1, -1
+               do i = dataset_rank, 1, -1
                   found = found // to_string(int(dims(i), i8))
                   if (i > 1) found = found // ', '
                end do
@@ -179,9 +234,34 @@ contains
                   & '; allowed: a 1D or 2D floating-point dataset (C order, as h5py writes height[ny, nx])', &
                   & code_input)
             else
-               if (rank == 1) dims(2) = 1
-               allocate (height(dims(1), dims(2)))
-               call h5dread_f(dset, H5T_NATIVE_DOUBLE, height, dims(1:2), hdferr)
+               if (dataset_rank == 1) dims(2) = 1
+               if (present(sizes)) sizes = dims(1:2)
+               y_start = 0
+               ny_local = int(dims(2))
+               if (present(ranks) .and. present(rank)) then
+                  slab = slab_of(int(dims(1)), int(dims(2)), ranks, rank)
+                  y_start = slab%y_start
+                  ny_local = slab%ny_local
+                  if (empty_rank(int(dims(2)), ranks)) then
+                     call fatal_error(error, too_few_rows(filename, int(dims(2)), ranks), code_input)
+                  end if
+               end if
+            end if
+            if (.not. allocated(error)) then
+               held = [dims(1), int(ny_local, hsize_t)]
+               allocate (height(held(1), held(2)))
+               call h5dget_space_f(dset, space, hdferr)
+               memory = space
+               if (hdferr == 0 .and. held(2) /= dims(2)) then
+                  ! the rows y_start+1 .. y_start+ny_local of the file's [ny, nx] (a 1D dataset has one)
+                  call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, [0_hsize_t, int(y_start, hsize_t)], held, &
+                     & hdferr)
+                  if (hdferr == 0) call h5screate_simple_f(2, held, memory, hdferr)
+               end if
+               if (hdferr == 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, height, held, hdferr, mem_space_id=memory, &
+                  & file_space_id=space, xfer_prp=transfer)
+               if (memory /= space) call h5sclose_f(memory, ignore)
+               call h5sclose_f(space, ignore)
                if (hdferr /= 0) call fatal_error(error, named(filename) // ": cannot read dataset '" // dataset // "'", &
                   & code_io)
             end if
@@ -189,7 +269,7 @@ contains
          end if
          call h5fclose_f(file, ignore)
       end block reading
-      call h5pclose_f(fapl, ignore)
+      if (.not. present(access)) call h5pclose_f(fapl, ignore)
       call h5close_f(ignore)
    end subroutine read_hdf5
 

@@ -85,8 +85,11 @@ class SlurmOptions:
         Memory of one array task (``--mem``): a number of megabytes or a number with
         ``K``, ``M``, ``G`` or ``T``.
     cpus_per_task : int
-        CPUs of one array task; its scenes run one after the other, each with
-        ``OMP_NUM_THREADS`` set to this (for ``&solver threads``).
+        CPUs of one array task (of each of its MPI ranks); its scenes run one after the
+        other, each with ``OMP_NUM_THREADS`` set to this (for ``&solver threads``).
+    ranks_per_scene : int
+        MPI ranks of each scene (``--ntasks`` of an array task): with more than 1 a task
+        runs its scenes by ``srun --mpi=pmix``, each rank on ``cpus_per_task`` CPUs.
     scenes_per_task : int
         Consecutive scenes run by one array task.
     array_limit : int or None
@@ -107,6 +110,7 @@ class SlurmOptions:
     time: str | None = None
     memory: str | None = None
     cpus_per_task: int = 1
+    ranks_per_scene: int = 1
     scenes_per_task: int = 1
     array_limit: int | None = None
     sbatch_lines: tuple[str, ...] = field(default_factory=tuple)
@@ -557,7 +561,7 @@ for scene in "${{scenes[@]}}"; do
     fi
   done
   # in the background, so that the trap runs at once when a signal arrives
-  "$executable" "$sweep_directory/scenes/$scene.nml" >"$sweep_directory/{logs}/$scene.log" 2>&1 &
+  {launch}"$executable" "$sweep_directory/scenes/$scene.nml" >"$sweep_directory/{logs}/$scene.log" 2>&1 &
   child=$!
   wait "$child"
   code=$?
@@ -573,6 +577,17 @@ done
 # a task with a scene that failed or did not converge ends FAILED in Slurm's accounting
 [ "$failures" -eq 0 ]
 """
+
+
+def launch_prefix(options: SlurmOptions) -> str:
+    """What runs the executable in a task: itself on one rank; on K ranks, ``srun`` of the
+    task's K tasks (Open MPI programs start under Slurm through PMIx), each with the task's
+    CPUs per rank (given again: srun does not take the job's --cpus-per-task from Slurm
+    22.05 on)."""
+    if options.ranks_per_scene == 1:
+        return ""
+    return (f"srun --mpi=pmix --ntasks={options.ranks_per_scene} "
+            f"--cpus-per-task={options.cpus_per_task} ")
 
 
 def job_script(
@@ -636,7 +651,7 @@ def job_script(
     sbatch = [
         f"--job-name={options.job_name or 'lc-' + name}",
         f"--array={array}",
-        "--ntasks=1",
+        f"--ntasks={options.ranks_per_scene}",
         f"--cpus-per-task={options.cpus_per_task}",
         f"--chdir={_sbatch_path('the working directory (submit from another one)', workdir)}",
         f"--output={output}",
@@ -659,6 +674,9 @@ def job_script(
         "# `python -m layercontact sweep --slurm`; `python -m layercontact status` reads the",
         "# results; submitting again runs only the scenes that are missing or failed.",
     ]
+    if options.ranks_per_scene > 1:
+        head.append(f"# Each scene runs on {options.ranks_per_scene} MPI ranks (srun --mpi=pmix), "
+                    f"{options.cpus_per_task} CPU(s) per rank.")
     setup = ["", "# environment set-up", *options.setup_lines] if options.setup_lines else []
     body = _SCRIPT_BODY.format(
         workdir=shlex.quote(str(workdir)),
@@ -669,6 +687,7 @@ def job_script(
         submission=submission,
         runs=RUNS,
         logs=LOGS,
+        launch=launch_prefix(options),
     )
     return "\n".join(head + setup) + "\n" + body
 

@@ -35,7 +35,9 @@ import io
 import itertools
 import json
 import math
+import shutil
 import signal
+import subprocess
 import threading
 import multiprocessing
 import os
@@ -649,7 +651,51 @@ def _scene_lock(record_file: Path) -> Iterator[None]:
             fcntl.flock(lock, fcntl.LOCK_UN)
 
 
-def _solve(scene_file: str, result_file: str, record_file: str) -> dict[str, object]:
+def check_ranks_per_scene(plan: SweepPlan, ranks: object) -> int:
+    """The MPI ranks each scene of ``plan`` runs on (``--ranks-per-scene``), checked: an
+    integer >= 1, and 1 for line scenes (a line is solved on one process).
+
+    Raises
+    ------
+    ValueError
+        Naming the option, the value and what is allowed.
+    """
+    if isinstance(ranks, bool) or not isinstance(ranks, int) or ranks < 1:
+        raise ValueError(f"--ranks-per-scene = {ranks!r} is not allowed; allowed: an integer >= 1")
+    scene = plan.base.get("scene", {})
+    geometry = str(scene.get("geometry", "line")).strip().lower()
+    if ranks > 1 and geometry != "areal":
+        raise ValueError(
+            f"--ranks-per-scene = {ranks} is not allowed for the sweep {plan.source}: its scenes are "
+            f"lines (&scene geometry = '{geometry}'), which run on one process; allowed: 1 (several ranks "
+            "share the rows of an areal scene)"
+        )
+    return ranks
+
+
+def mpi_command(ranks: int) -> list[str]:
+    """The start of the command line that runs one scene on ``ranks`` MPI ranks here:
+    ``mpirun -n K --bind-to none`` (several scenes run at once: no rank is pinned to a core
+    another scene's rank has) and the installed ``layercontact`` executable.
+
+    Raises
+    ------
+    ValueError
+        When mpirun or the executable is not found.
+    """
+    from .slurm import default_executable
+
+    mpirun = shutil.which("mpirun")
+    executable = default_executable()
+    if mpirun is None or executable is None:
+        missing = "mpirun" if mpirun is None else "the layercontact executable"
+        raise ValueError(f"--ranks-per-scene = {ranks} runs each scene under mpirun, but {missing} is not "
+                         "found on PATH; allowed: 1, or install MPI (Debian: openmpi-bin) and layercontact")
+    return [mpirun, "-n", str(ranks), "--bind-to", "none", executable]
+
+
+def _solve(scene_file: str, result_file: str, record_file: str, launcher: list[str] | None = None,
+           environment: dict[str, str] | None = None) -> dict[str, object]:
     """Worker: run one scene file, return its result columns (or its error); its run
     record says it is running, then how it ended. The scene's lock is held throughout: a
     scene that another sweep of the same directory completed meanwhile is not run again,
@@ -660,18 +706,28 @@ def _solve(scene_file: str, result_file: str, record_file: str) -> dict[str, obj
             return _outcome(_result_columns(Path(result_file)))
         for left in stale_temporary_results(Path(result_file).parent, Path(scene_file).stem):
             left.unlink(missing_ok=True)
-        return _run_scene(scene_file, result_file, record_file)
+        return _run_scene(scene_file, result_file, record_file, launcher, environment)
 
 
-def _run_scene(scene_file: str, result_file: str, record_file: str) -> dict[str, object]:
-    """Run one scene file with its run record (see :func:`_solve`)."""
+def _run_scene(scene_file: str, result_file: str, record_file: str, launcher: list[str] | None = None,
+               environment: dict[str, str] | None = None) -> dict[str, object]:
+    """Run one scene file with its run record (see :func:`_solve`): in this process, or,
+    with a ``launcher`` (:func:`mpi_command`), by the executable on several MPI ranks, in
+    the sweep's ``environment``."""
     record = provenance.start_record(Path(scene_file).stem)
     provenance.write_record(Path(record_file), record)
     start = time.monotonic()
     try:
-        run_to_file(scene_file)
-        outcome = _outcome(_result_columns(Path(result_file)))
-        code = 0 if not outcome["error"] else 3
+        if launcher:
+            code = _launch(launcher, scene_file, environment)
+        else:
+            run_to_file(scene_file)
+            code = 0
+        if code in (0, 3):  # a result file (converged or not)
+            outcome = _outcome(_result_columns(Path(result_file)))
+            code = 0 if not outcome["error"] else 3
+        else:
+            outcome = _failure(_launch_failure(launcher or [], code, scene_file))
     except LayercontactError as err:  # reported in the summary, the other scenes go on
         outcome, code = _failure(f"{type(err).__name__}: {err}"), err.code
     except Exception as err:  # same, for a failure outside the library (e.g. reading h5)
@@ -679,6 +735,34 @@ def _run_scene(scene_file: str, result_file: str, record_file: str) -> dict[str,
     finished = provenance.finish_record(record, code, time.monotonic() - start, outcome["error"])
     provenance.write_record(Path(record_file), finished)
     return outcome
+
+
+def _log_file(scene_file: str) -> Path:
+    """The executable's output of a scene run under mpirun: DIRECTORY/logs/STEM.log, as a
+    Slurm task writes it."""
+    return Path(scene_file).parent.parent / "logs" / (Path(scene_file).stem + ".log")
+
+
+def _launch(launcher: list[str], scene_file: str, environment: dict[str, str] | None) -> int:
+    """Run the executable on a scene under ``launcher`` in ``environment`` (the sweep's:
+    a worker started by a fork server has the environment of that server's start); its
+    exit code (the executable's: 0 converged, 3 not converged, 2 bad input, 4 I/O, 5
+    internal)."""
+    log = _log_file(scene_file)
+    log.parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "w") as out:
+        return subprocess.run([*launcher, scene_file], stdout=out, stderr=subprocess.STDOUT,
+                              env=environment).returncode
+
+
+def _launch_failure(launcher: list[str], code: int, scene_file: str) -> str:
+    """The error of a scene whose launched run failed: the command, its exit code and the
+    last lines of its log."""
+    try:
+        tail = _log_file(scene_file).read_text(errors="replace").strip().splitlines()[-3:]
+    except OSError:
+        tail = []
+    return f"{' '.join(launcher[:3])}: exit code {code}" + (": " + " | ".join(tail) if tail else "")
 
 
 def result_matches(result_file: Path, text: str) -> bool:
@@ -768,22 +852,28 @@ def _start_worker(directory: str, sweep_pid: int, threads: int) -> None:
 
 
 def _run_pending(
-    name: str, pending: list[Scene], total: int, processes: int, progress: bool
+    name: str, pending: list[Scene], total: int, processes: int, progress: bool, ranks: int = 1
 ) -> dict[int, dict[str, object]]:
-    """Run ``pending`` scenes in a process pool; outcomes by scene index."""
+    """Run ``pending`` scenes in a process pool, each on ``ranks`` MPI ranks (under
+    mpirun when more than 1); outcomes by scene index."""
     from tqdm import tqdm
 
     outcomes: dict[int, dict[str, object]] = {}
     bar = tqdm(total=total, initial=total - len(pending), desc=name, unit="scene", file=sys.stderr,
                disable=not progress)
     workers = min(processes, len(pending))
-    threads = max(1, len(os.sched_getaffinity(0)) // workers)
+    threads = max(1, len(os.sched_getaffinity(0)) // (workers * ranks))
+    launcher = mpi_command(ranks) if ranks > 1 else None
+    # each rank of a launched scene takes its share of the CPUs as threads
+    environment = {**os.environ, "OMP_NUM_THREADS": os.environ.get("OMP_NUM_THREADS", str(threads))} \
+        if launcher else None
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context(),
                                initializer=_start_worker, initargs=(os.getcwd(), os.getpid(), threads))
     futures = {}
     try:
         futures = {
-            pool.submit(_solve, str(s.scene_file), str(s.result_file), str(_record_file(s))): s
+            pool.submit(_solve, str(s.scene_file), str(s.result_file), str(_record_file(s)), launcher,
+                        environment): s
             for s in pending
         }
         for future in as_completed(futures):
@@ -847,10 +937,15 @@ def _resolve_processes(plan: SweepPlan, processes: int | None) -> int:
 
 
 def execute(plan: SweepPlan, processes: int | None = None, progress: bool = True,
-            dry_run: bool = False) -> list[dict[str, object]]:
+            dry_run: bool = False, ranks_per_scene: int = 1) -> list[dict[str, object]]:
     """Write and check the scenes of ``plan``, run those without a matching result,
     write the summary. See :func:`sweep`."""
-    workers = _resolve_processes(plan, processes)
+    ranks = check_ranks_per_scene(plan, ranks_per_scene)
+    if ranks > 1 and not dry_run:
+        mpi_command(ranks)  # mpirun and the executable are there, before anything runs
+    # the CPUs are shared by the scenes' ranks: K ranks per scene, CPUs/K scenes at once
+    workers = _resolve_processes(plan, processes) if processes is not None or plan.processes is not None \
+        else max(1, allocated_cpus() // ranks)
     scenes = write_scenes(plan)
     write_plan_record(plan, scenes)
     if dry_run:
@@ -859,7 +954,7 @@ def execute(plan: SweepPlan, processes: int | None = None, progress: bool = True
     if progress and len(pending) < len(scenes):
         print(f"sweep '{plan.name}': {len(scenes) - len(pending)} of {len(scenes)} scenes already have their "
               f"result (same input): skipped; running {len(pending)}", file=sys.stderr)
-    outcomes = _run_pending(plan.name, pending, len(scenes), workers, progress) if pending else {}
+    outcomes = _run_pending(plan.name, pending, len(scenes), workers, progress, ranks) if pending else {}
     rows = [_row(scene, outcomes) for scene in scenes]
     write_summary(rows, plan)
     return rows
@@ -892,7 +987,8 @@ def summary_row(planned: dict[str, object], outcome: dict[str, object],
 
 
 def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool = True,
-          dry_run: bool = False, max_scenes: int | None = None) -> list[dict[str, object]]:
+          dry_run: bool = False, max_scenes: int | None = None,
+          ranks_per_scene: int = 1) -> list[dict[str, object]]:
     """Run a parameter sweep file (a scene plus a ``&sweep`` group).
 
     Every scene is written to ``DIRECTORY/scenes/NAME_XXXX.nml`` and checked by the
@@ -916,6 +1012,11 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     max_scenes : int, optional
         The most scenes allowed (default: ``&sweep max_scenes``, else
         :data:`MAX_SCENES`); a sweep with more is refused before anything is planned.
+    ranks_per_scene : int
+        MPI ranks of each scene (default 1: solved in the worker process). With K > 1
+        every scene runs as ``mpirun -n K --bind-to none layercontact SCENE.nml`` (its
+        output in ``DIRECTORY/logs/``), and ``processes`` defaults to the CPUs divided
+        by K. Areal scenes only (a line runs on one process).
 
     Returns
     -------
@@ -936,7 +1037,8 @@ def sweep(path: str | os.PathLike, processes: int | None = None, progress: bool 
     LayercontactError
         A scene the library refuses (the message names the scene file and the variable).
     """
-    return execute(read_sweep(path, max_scenes), processes=processes, progress=progress, dry_run=dry_run)
+    return execute(read_sweep(path, max_scenes), processes=processes, progress=progress, dry_run=dry_run,
+                   ranks_per_scene=ranks_per_scene)
 
 
 def failed(rows: list[dict[str, object]]) -> list[dict[str, object]]:
