@@ -27,6 +27,7 @@ module lc_contact_operator
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range
+   use lc_base_parallel, only: global_sum, global_max, max_over_ranks, global_any, broadcast
    implicit none (type, external)
    private
    public :: compliance_operator, build_operator, multiply_spectrum, multiply_complex
@@ -47,8 +48,13 @@ module lc_contact_operator
    type :: compliance_operator
       type(grid_type) :: grid
       type(layer_kernel) :: kernel
-      integer :: n = 0                      !< grid points
-      integer :: nk = 0                     !< modes of the half spectrum
+      integer :: n = 0                      !< grid points (of this rank's slab, if distributed)
+      integer :: nk = 0                     !< modes of the half spectrum (of this rank's slab)
+      !> a surface shared among the job's ranks (lc_base_parallel): fields and multipliers
+      !> are this rank's slab of rows; `first_mode` - 1 modes lie before its first one. The
+      !> real-space columns (column updates of CG and GCR) are not made then.
+      logical :: distributed = .false.
+      integer :: first_mode = 1
       real(wp) :: friction = 0.0_wp
       logical :: coupled = .false.          !< complex multiplier (not symmetric)
       real(wp), allocatable :: metric(:)    !< M(q) = |G_eff(q)| on the half spectrum (L/S)
@@ -100,26 +106,30 @@ module lc_contact_operator
 contains
 
    !> Build the operator on `grid` for the layer `kernel` and Coulomb coefficient
-   !> `friction`, with `threads` FFTW threads.
-   subroutine build_operator(op, grid, kernel, friction, threads, error)
+   !> `friction`, with `threads` FFTW threads; `distributed`: on this rank's slab of a surface
+   !> shared among the job's ranks, if there are several.
+   subroutine build_operator(op, grid, kernel, friction, threads, error, distributed)
       type(compliance_operator), intent(out) :: op
       type(grid_type), intent(in) :: grid
       type(layer_kernel), intent(in) :: kernel
       real(wp), intent(in) :: friction
       integer, intent(in) :: threads
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: qx, qy, q, q_min, q_max
+      logical, intent(in), optional :: distributed
+      real(wp) :: qx, qy, q, q_min, q_max, extremes(2)
       complex(wp) :: g, one_minus_a, one_minus_b, c, t
       real(wp), allocatable :: factor(:)
-      integer :: i, mx, nkx
+      integer :: i, mx, nkx, mode
 
-      call op%fft%init(grid%nx, grid%ny, threads, error)
+      call op%fft%init(grid%nx, grid%ny, threads, error, distributed)
       if (allocated(error)) return
       op%grid = grid
       op%kernel = kernel
-      op%n = grid%points()
-      op%nk = grid%modes()
-      op%inv_n = 1.0_wp/op%n
+      op%distributed = op%fft%distributed
+      op%n = op%fft%n
+      op%nk = op%fft%nk
+      op%first_mode = op%fft%y_start*grid%nkx() + 1
+      op%inv_n = 1.0_wp/grid%points()
       op%friction = friction
       nkx = grid%nkx()
       ! C per column: a viscoelastic mode sees the frequency q_x V
@@ -134,14 +144,18 @@ contains
 
       allocate (op%metric(op%nk))
       if (op%coupled) allocate (op%full(op%nk))
-      ! h/M with the static compliance (0 for a half-space)
-      op%metric(1) = kernel%normal_uniform(real(op%compliance(1), wp))
-      if (op%coupled) op%full(1) = op%metric(1)
+      ! h/M with the static compliance (0 for a half-space), on the rank holding the mode
+      if (op%first_mode == 1) then
+         op%metric(1) = kernel%normal_uniform(real(op%compliance(1), wp))
+         if (op%coupled) op%full(1) = op%metric(1)
+      end if
 
       q_min = huge(1.0_wp)
       q_max = 0.0_wp
-      do i = 2, op%nk
-         call grid%wavevector(i, qx, qy)
+      do i = 1, op%nk
+         mode = op%first_mode + i - 1
+         if (mode == 1) cycle
+         call grid%wavevector(mode, qx, qy)
          q = hypot(qx, qy)
          q_min = min(q_min, q)
          q_max = max(q_max, q)
@@ -171,7 +185,14 @@ contains
       ! (always for elastic layers; not always for viscoelastic ones with friction).
       op%monotone = .true.
       if (op%coupled) op%monotone = all(real(op%full, wp) >= 0.0_wp)
-      op%metric_falls = .not. op%coupled .and. op%nk > 1
+      if (op%distributed) op%monotone = .not. global_any(.not. op%monotone)
+      if (op%distributed) then
+         extremes = [-q_min, q_max]
+         call max_over_ranks(extremes)
+         q_min = -extremes(1)
+         q_max = extremes(2)
+      end if
+      op%metric_falls = .not. op%coupled .and. grid%modes() > 1
       if (op%metric_falls) op%metric_falls = kernel%compliance_falls(q_min, q_max)
       call derive(op)
    end subroutine build_operator
@@ -181,20 +202,22 @@ contains
    subroutine derive(op)
       type(compliance_operator), intent(inout) :: op
       integer :: n, row, nkx, first, last
-      n = op%n
+      n = op%grid%points()
       nkx = op%grid%nkx()
       ! (1/n) sum over the whole spectrum, row by row of the half spectrum: modes
       ! 1..ceil(nx/2)-1 of a row stand for two, its mx = 0 and Nyquist modes for one
       op%diagonal = 0.0_wp
-      do row = 1, op%grid%ny
+      do row = 1, op%nk/nkx
          first = (row - 1)*nkx + 1
          last = row*nkx
          op%diagonal = op%diagonal + (op%metric(first) + 2*sum(op%metric(first + 1:last)) &
             & - merge(op%metric(last), 0.0_wp, mod(op%grid%nx, 2) == 0))
       end do
+      if (op%distributed) op%diagonal = global_sum(op%diagonal)
       op%diagonal = op%diagonal/n
       op%largest = maxval(op%metric)
       if (op%coupled) op%largest = max(op%largest, maxval(abs(op%full)))
+      if (op%distributed) op%largest = global_max(op%largest)
       if (allocated(op%column)) deallocate (op%column)
    end subroutine derive
 
@@ -202,7 +225,7 @@ contains
    subroutine prepare_cg(self)
       class(compliance_operator), intent(inout) :: self
       real(wp), allocatable :: unit_load(:)
-      if (allocated(self%column)) return
+      if (allocated(self%column) .or. self%distributed) return
       allocate (unit_load(self%n), self%column(self%n))
       unit_load = 0.0_wp
       unit_load(1) = 1.0_wp
@@ -217,12 +240,16 @@ contains
    subroutine drop_uniform_mode(self, uniform)
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(out) :: uniform
-      uniform = self%metric(1)
+      uniform = 0.0_wp
+      if (self%first_mode == 1) uniform = self%metric(1)
+      if (self%distributed) call broadcast(uniform)
       if (uniform == 0.0_wp) return   ! half-space, incompressible layer
       self%dropped_uniform = self%dropped_uniform + uniform
-      self%metric(1) = 0.0_wp
-      self%preconditioner(1) = 0.0_wp
-      if (self%coupled) self%full(1) = 0.0_wp
+      if (self%first_mode == 1) then
+         self%metric(1) = 0.0_wp
+         self%preconditioner(1) = 0.0_wp
+         if (self%coupled) self%full(1) = 0.0_wp
+      end if
       ! (derived afresh: subtracting uniform/n from the column would cancel catastrophically
       ! on thick layers, where it dominates)
       call derive(self)
@@ -242,7 +269,7 @@ contains
       integer, intent(in) :: i
       real(wp), intent(out) :: qx, qy
       integer, intent(out) :: mx
-      call self%grid%wavevector(i, qx, qy)
+      call self%grid%wavevector(self%first_mode + i - 1, qx, qy)
       mx = mod(i - 1, self%grid%nkx())
    end subroutine column_mode
 
@@ -363,6 +390,7 @@ contains
          call self%fft%forward_unscaled()
          call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, self%grid%nkx(), &
             & mod(self%grid%nx, 2) == 0, energy)
+         if (self%distributed) energy = global_sum(energy)
          call self%fft%backward()
       else
          call multiply_in_buffer(self, self%metric)
@@ -487,15 +515,20 @@ contains
       elsewhere
          self%inverse_full = (0.0_wp, 0.0_wp)
       end where
+      ! (the unit load at the first point, on the rank holding it)
       unit_load = 0.0_wp
-      unit_load(1) = 1.0_wp
-      if (.not. allocated(self%full_column)) allocate (self%full_column(n))
-      self%fft%real_buffer = unit_load
-      call multiply_complex_in_buffer(self, g)
-      self%full_column = self%fft%real_buffer
+      if (self%first_mode == 1) unit_load(1) = 1.0_wp
+      if (.not. self%distributed) then
+         if (.not. allocated(self%full_column)) allocate (self%full_column(n))
+         self%fft%real_buffer = unit_load
+         call multiply_complex_in_buffer(self, g)
+         self%full_column = self%fft%real_buffer
+      end if
       self%fft%real_buffer = unit_load
       call multiply_complex_in_buffer(self, self%inverse_full)
-      self%inverse_diagonal = self%fft%real_buffer(1)
+      self%inverse_diagonal = 0.0_wp
+      if (self%first_mode == 1) self%inverse_diagonal = self%fft%real_buffer(1)
+      if (self%distributed) call broadcast(self%inverse_diagonal)
    end subroutine prepare_gcr
 
    !> fft%real_buffer <- G_eff fft%real_buffer (see metric_in_buffer).
