@@ -118,11 +118,13 @@ contains
       call slab_rows(ny, ranks, rank, y_start, ny_local)
    end subroutine slab
 
-   !> The largest rank count that leaves every rank at least one row of ny.
-   pure integer function largest_rank_count(ny) result(p)
-      integer, intent(in) :: ny
+   !> The largest rank count up to `most` that leaves every rank at least one row of ny
+   !> (the last rank's slab starts at (P - 1) ceiling(ny/P), which must be below ny; the
+   !> counts allowed are not contiguous: 6 rows take 3 or 6 ranks, not 4 or 5).
+   pure integer function largest_rank_count(ny, most) result(p)
+      integer, intent(in) :: ny, most
       integer :: y_start, rows
-      do p = max(ny, 1), 2, -1
+      do p = max(min(ny, most), 1), 2, -1
          call slab_rows(ny, p, p - 1, y_start, rows)
          if (rows > 0) return
       end do
@@ -133,10 +135,11 @@ contains
    subroutine check_rank_count(ny, error)
       integer, intent(in) :: ny
       type(error_type), allocatable, intent(out) :: error
-      if (ranks > largest_rank_count(ny)) &
+      if (largest_rank_count(ny, ranks) < ranks) &
          & call fatal_error(error, '&scene ny = ' // to_string(ny) // ' rows cannot be shared among ' // &
-         & to_string(ranks) // ' MPI ranks (blocks of ceiling(ny/ranks) rows leave a rank without rows); ' // &
-         & 'allowed: at most ' // to_string(largest_rank_count(ny)) // ' ranks', code_input)
+         & to_string(ranks) // ' MPI ranks (slabs of ceiling(ny/ranks) rows leave a rank without rows); ' // &
+         & 'allowed: at most ' // to_string(largest_rank_count(ny, ranks)) // ' ranks here, or a count P ' // &
+         & 'with (P - 1) ceiling(ny/P) < ny', code_input)
    end subroutine check_rank_count
 
    !> The sum over the ranks (the ranks' partial sums added in rank order by MPI).
