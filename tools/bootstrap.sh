@@ -61,6 +61,11 @@ need "HDF5 with Fortran" 'has_pc hdf5 || command -v h5fc || command -v h5pfc' li
   "hdf5.pc in PKG_CONFIG_PATH or h5fc in PATH (module load hdf5, a build with Fortran)"
 need "MPI (C), for hypre" 'has_pc ompi-c || has_pc mpi-c || has_pc mpich || command -v mpicc' libopenmpi-dev \
   "mpicc in PATH or its pkg-config file (module load openmpi, the MPI hypre was built with)"
+# one surface on several MPI ranks (docs/decisions/023-mpi-slabs.md): FFTW-MPI and mpirun;
+# a build without them runs each solve in one process
+need "FFTW-MPI" '[ -f "$(pkg-config --variable=includedir fftw3 2>/dev/null)/fftw3-mpi.f03" ] && has_library fftw3_mpi' \
+  libfftw3-mpi-dev "fftw3-mpi.f03 beside fftw3.f03 and libfftw3_mpi (module load fftw, its MPI build)"
+need "mpirun" 'command -v mpirun' openmpi-bin "mpirun in PATH (module load openmpi)"
 need "hypre" '[ -f "$hypre_include/HYPRE_parcsr_ls.h" ] && has_library HYPRE' libhypre-dev \
   "HYPRE_parcsr_ls.h in HYPRE_INCLUDE (now $hypre_include) and libHYPRE in LIBRARY_PATH (module load hypre)"
 

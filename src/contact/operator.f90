@@ -50,11 +50,14 @@ module lc_contact_operator
       type(layer_kernel) :: kernel
       integer :: n = 0                      !< grid points (of this rank's slab, if distributed)
       integer :: nk = 0                     !< modes of the half spectrum (of this rank's slab)
-      !> a surface shared among the job's ranks (lc_base_parallel): fields and multipliers
-      !> are this rank's slab of rows; `first_mode` - 1 modes lie before its first one. The
-      !> real-space columns (column updates of CG and GCR) are not made then.
+      !> a surface shared among the job's ranks (lc_base_parallel): fields are this rank's
+      !> slab of rows, multipliers its columns of the transposed spectrum (lc_fft_plans,
+      !> `mode_indices`); `holds_uniform`: its first mode is q = 0; `once`: its modes that
+      !> stand for themselves only (mx = 0, and nx/2 for even nx). The real-space columns
+      !> (column updates of CG and GCR) are not made then.
       logical :: distributed = .false.
-      integer :: first_mode = 1
+      logical :: holds_uniform = .true.
+      integer, allocatable :: once(:)
       real(wp) :: friction = 0.0_wp
       logical :: coupled = .false.          !< complex multiplier (not symmetric)
       real(wp), allocatable :: metric(:)    !< M(q) = |G_eff(q)| on the half spectrum (L/S)
@@ -119,7 +122,7 @@ contains
       real(wp) :: qx, qy, q, q_min, q_max, extremes(2)
       complex(wp) :: g, one_minus_a, one_minus_b, c, t
       real(wp), allocatable :: factor(:)
-      integer :: i, mx, nkx, mode
+      integer :: i, mx, my, nkx
 
       call op%fft%init(grid%nx, grid%ny, threads, error, distributed)
       if (allocated(error)) return
@@ -128,7 +131,11 @@ contains
       op%distributed = op%fft%distributed
       op%n = op%fft%n
       op%nk = op%fft%nk
-      op%first_mode = op%fft%y_start*grid%nkx() + 1
+      op%holds_uniform = .true.
+      if (op%distributed) then
+         op%holds_uniform = op%nk > 0 .and. op%fft%x_start == 0
+         op%once = pack([(i, i=1, op%nk)], [(once_mode(op, i), i=1, op%nk)])
+      end if
       op%inv_n = 1.0_wp/grid%points()
       op%friction = friction
       nkx = grid%nkx()
@@ -145,7 +152,7 @@ contains
       allocate (op%metric(op%nk))
       if (op%coupled) allocate (op%full(op%nk))
       ! h/M with the static compliance (0 for a half-space), on the rank holding the mode
-      if (op%first_mode == 1) then
+      if (op%holds_uniform) then
          op%metric(1) = kernel%normal_uniform(real(op%compliance(1), wp))
          if (op%coupled) op%full(1) = op%metric(1)
       end if
@@ -153,13 +160,12 @@ contains
       q_min = huge(1.0_wp)
       q_max = 0.0_wp
       do i = 1, op%nk
-         mode = op%first_mode + i - 1
-         if (mode == 1) cycle
-         call grid%wavevector(mode, qx, qy)
+         call op%fft%mode_indices(i, mx, my)
+         if (mx == 0 .and. my == 0) cycle
+         call grid%wavevector(my*nkx + mx + 1, qx, qy)
          q = hypot(qx, qy)
          q_min = min(q_min, q)
          q_max = max(q_max, q)
-         mx = mod(i - 1, nkx)
          call kernel%factors(q, qx, one_minus_a, one_minus_b, c, t)
          g = 2.0_wp/q*op%compliance(mx + 1)*(one_minus_a - (0.0_wp, 1.0_wp)*friction*c*(qx/q))
          ! A Nyquist column mode is its own mirror image (q_x = +-pi/dx), so its multiplier is
@@ -178,7 +184,8 @@ contains
       if (kernel%viscoelastic) then
          factor = (abs(op%compliance)/abs(op%compliance(2)))**preconditioner_exponent
          do i = 1, op%nk
-            op%preconditioner(i) = op%preconditioner(i)*factor(mod(i - 1, nkx) + 1)
+            call op%fft%mode_indices(i, mx, my)
+            op%preconditioner(i) = op%preconditioner(i)*factor(mx + 1)
          end do
       end if
       ! The solution is unique when the operator is monotone, Re G_eff >= 0 on every mode
@@ -207,13 +214,17 @@ contains
       ! (1/n) sum over the whole spectrum, row by row of the half spectrum: modes
       ! 1..ceil(nx/2)-1 of a row stand for two, its mx = 0 and Nyquist modes for one
       op%diagonal = 0.0_wp
-      do row = 1, op%nk/nkx
-         first = (row - 1)*nkx + 1
-         last = row*nkx
-         op%diagonal = op%diagonal + (op%metric(first) + 2*sum(op%metric(first + 1:last)) &
-            & - merge(op%metric(last), 0.0_wp, mod(op%grid%nx, 2) == 0))
-      end do
-      if (op%distributed) op%diagonal = global_sum(op%diagonal)
+      if (op%distributed) then
+         ! (this rank's columns: every mode twice, less those standing for themselves)
+         op%diagonal = global_sum(2*sum(op%metric) - sum(op%metric(op%once)))
+      else
+         do row = 1, op%grid%ny
+            first = (row - 1)*nkx + 1
+            last = row*nkx
+            op%diagonal = op%diagonal + (op%metric(first) + 2*sum(op%metric(first + 1:last)) &
+               & - merge(op%metric(last), 0.0_wp, mod(op%grid%nx, 2) == 0))
+         end do
+      end if
       op%diagonal = op%diagonal/n
       op%largest = maxval(op%metric)
       if (op%coupled) op%largest = max(op%largest, maxval(abs(op%full)))
@@ -241,11 +252,11 @@ contains
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(out) :: uniform
       uniform = 0.0_wp
-      if (self%first_mode == 1) uniform = self%metric(1)
+      if (self%holds_uniform) uniform = self%metric(1)
       if (self%distributed) call broadcast(uniform)
       if (uniform == 0.0_wp) return   ! half-space, incompressible layer
       self%dropped_uniform = self%dropped_uniform + uniform
-      if (self%first_mode == 1) then
+      if (self%holds_uniform) then
          self%metric(1) = 0.0_wp
          self%preconditioner(1) = 0.0_wp
          if (self%coupled) self%full(1) = 0.0_wp
@@ -269,8 +280,9 @@ contains
       integer, intent(in) :: i
       real(wp), intent(out) :: qx, qy
       integer, intent(out) :: mx
-      call self%grid%wavevector(self%first_mode + i - 1, qx, qy)
-      mx = mod(i - 1, self%grid%nkx())
+      integer :: my
+      call self%fft%mode_indices(i, mx, my)
+      call self%grid%wavevector(my*self%grid%nkx() + mx + 1, qx, qy)
    end subroutine column_mode
 
    !> w = M p with the real symmetric metric.
@@ -388,9 +400,12 @@ contains
       real(wp), intent(out), optional :: energy
       if (present(energy)) then
          call self%fft%forward_unscaled()
-         call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, self%grid%nkx(), &
-            & mod(self%grid%nx, 2) == 0, energy)
-         if (self%distributed) energy = global_sum(energy)
+         if (self%distributed) then
+            call multiply_with_energy_of_columns(self%fft%spectrum, self%metric, self%inv_n, self%once, energy)
+         else
+            call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, self%grid%nkx(), &
+               & mod(self%grid%nx, 2) == 0, energy)
+         end if
          call self%fft%backward()
       else
          call multiply_in_buffer(self, self%metric)
@@ -424,6 +439,36 @@ contains
       end do
       energy = 2.0_wp*sum(block_sums) - once
    end subroutine multiply_with_energy
+
+   !> multiply_with_energy on this rank's columns of a distributed spectrum (the modes
+   !> `once` stand for themselves only), the energy summed over the ranks.
+   subroutine multiply_with_energy_of_columns(spectrum, multiplier, inv_n, once, energy)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: inv_n
+      integer, intent(in) :: once(:)
+      real(wp), intent(out) :: energy
+      real(wp) :: single
+      real(wp) :: block_sums(reduction_blocks(size(spectrum)))
+      integer :: first, last, block
+      single = sum(multiplier(once)*inv_n*abs(spectrum(once))**2)
+      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
+      do block = 1, size(block_sums)
+         call block_range(block, size(spectrum), first, last)
+         block_sums(block) = multiplied_energy(spectrum(first:last), multiplier(first:last), inv_n)
+      end do
+      energy = global_sum(2.0_wp*sum(block_sums) - single)
+   end subroutine multiply_with_energy_of_columns
+
+   !> True if mode i of the operator's spectrum stands for itself only (its column is mx = 0
+   !> or, for even nx, nx/2).
+   logical function once_mode(op, i)
+      type(compliance_operator), intent(in) :: op
+      integer, intent(in) :: i
+      integer :: mx, my
+      call op%fft%mode_indices(i, mx, my)
+      once_mode = mx == 0 .or. 2*mx == op%grid%nx
+   end function once_mode
 
    !> multiply_with_energy on a block: spectrum <- spectrum * multiplier/n and the sum of
    !> multiplier/n |spectrum|^2 before.
@@ -517,7 +562,7 @@ contains
       end where
       ! (the unit load at the first point, on the rank holding it)
       unit_load = 0.0_wp
-      if (self%first_mode == 1) unit_load(1) = 1.0_wp
+      if (self%fft%y_start == 0) unit_load(1) = 1.0_wp
       if (.not. self%distributed) then
          if (.not. allocated(self%full_column)) allocate (self%full_column(n))
          self%fft%real_buffer = unit_load
@@ -527,7 +572,7 @@ contains
       self%fft%real_buffer = unit_load
       call multiply_complex_in_buffer(self, self%inverse_full)
       self%inverse_diagonal = 0.0_wp
-      if (self%first_mode == 1) self%inverse_diagonal = self%fft%real_buffer(1)
+      if (self%fft%y_start == 0) self%inverse_diagonal = self%fft%real_buffer(1)
       if (self%distributed) call broadcast(self%inverse_diagonal)
    end subroutine prepare_gcr
 

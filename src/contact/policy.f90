@@ -115,19 +115,20 @@ contains
       ind%coupled = op%coupled
       ind%viscoelastic = op%kernel%viscoelastic
       ind%monotone = op%monotone
-      ind%refusal = multigrid_refusal(op)
       ind%gfmd_refusal = ''
+      if (op%distributed) then
+         ! (the multigrid's and GFMD's measures read a whole spectrum: not taken on a slab)
+         ind%distributed = .true.
+         ind%refusal = distributed_refusal
+         return
+      end if
+      ind%refusal = multigrid_refusal(op)
       if (trim(method) == 'gfmd') ind%gfmd_refusal = gfmd_refusal(op)
       if (op%coupled .or. (len(ind%refusal) > 0 .and. .not. op%kernel%viscoelastic)) then
          ind%refusal = coupled_refusal(op, load_control)
          ind%rising = .not. op%coupled .and. len(ind%refusal) == 0
       end if
       if (len(ind%refusal) == 0 .and. (ind%coupled .or. ind%rising)) ind%metric_admitted = len(metric_refusal(op)) == 0
-      if (op%distributed) then
-         ind%distributed = .true.
-         ind%refusal = distributed_refusal
-         ind%rising = .false.
-      end if
    end function measure_problem
 
    !> Add what the start tells (the coarse start's iterations, 0 where none ran, whether it

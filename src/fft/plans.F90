@@ -8,11 +8,13 @@
 !>
 !> Distributed (`init` with `distributed`, under several MPI ranks: lc_base_parallel): the
 !> surface's rows are split into slabs, FFTW-MPI's r2c/c2r transform the whole surface, and
-!> `real_buffer` and `spectrum` hold this rank's slab: rows y_start+1 .. y_start+ny_local of
-!> the field and of the half spectrum (the same layout as the serial one, restricted to
-!> those rows: docs/decisions/023-mpi-slabs.md). FFTW-MPI pads the rows of its real arrays
-!> to 2(nx/2 + 1) values even out of place; the rows are copied between `real_buffer` (nx
-!> values a row, the layout of every field) and the padded array around each transform.
+!> `real_buffer` holds this rank's slab: rows y_start+1 .. y_start+ny_local of the field.
+!> The spectrum is transposed (FFTW_MPI_TRANSPOSED_OUT/IN, two global transposes a pair
+!> fewer: docs/decisions/023-mpi-slabs.md): this rank holds the columns mx = x_start ..
+!> x_start+nkx_local-1 of the half spectrum, each with all ny rows, my fastest
+!> (`mode_indices`). FFTW-MPI pads the rows of its real arrays to 2(nx/2 + 1) values even
+!> out of place; the rows are copied between `real_buffer` (nx values a row, the layout of
+!> every field) and the padded array around each transform.
 module lc_fft_plans
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_double_complex, c_size_t, &
       & c_f_pointer, c_associated, c_null_ptr
@@ -27,8 +29,9 @@ module lc_fft_plans
    use lc_base_parallel, only: is_distributed, slab
 #ifdef LC_MPI
    use lc_base_parallel, only: communicator
-   use lc_fft_fftw3_mpi, only: fftw_mpi_init, fftw_mpi_local_size_2d, fftw_mpi_plan_dft_r2c_2d, &
-      & fftw_mpi_plan_dft_c2r_2d, fftw_mpi_execute_dft_r2c, fftw_mpi_execute_dft_c2r
+   use lc_fft_fftw3_mpi, only: fftw_mpi_init, fftw_mpi_local_size_2d_transposed, fftw_mpi_plan_dft_r2c_2d, &
+      & fftw_mpi_plan_dft_c2r_2d, fftw_mpi_execute_dft_r2c, fftw_mpi_execute_dft_c2r, FFTW_MPI_TRANSPOSED_OUT, &
+      & FFTW_MPI_TRANSPOSED_IN
    use, intrinsic :: iso_c_binding, only: c_intptr_t
 #endif
    implicit none (type, external)
@@ -59,6 +62,8 @@ module lc_fft_plans
       !> otherwise); n and nk are then this slab's points and modes
       logical :: distributed = .false.
       integer :: y_start = 0, ny_local = 1
+      !> distributed: the columns of the half spectrum this rank holds (transposed)
+      integer :: x_start = 0, nkx_local = 0
       real(c_double), pointer, contiguous :: real_buffer(:) => null()
       complex(c_double_complex), pointer, contiguous :: spectrum(:) => null()
       type(c_ptr), private :: r2c = c_null_ptr, c2r = c_null_ptr
@@ -85,6 +90,7 @@ module lc_fft_plans
       procedure :: rows_forward_unscaled
       procedure :: rows_backward
       procedure :: destroy
+      procedure :: mode_indices
       final :: finalize
    end type fft_plan
 
@@ -157,7 +163,7 @@ contains
       integer, intent(in) :: nx, ny, threads
       type(error_type), allocatable, intent(out) :: error
 #ifdef LC_MPI
-      integer(c_intptr_t) :: local_complex, local_rows, local_start
+      integer(c_intptr_t) :: local_complex, local_rows, local_start, local_columns, column_start
       integer(c_int) :: status
       integer :: nkx
       if (.not. fftw_mpi_ready) then
@@ -179,16 +185,18 @@ contains
       self%ny = ny
       call slab(ny, self%y_start, self%ny_local)
       ! (the r2c's sizes: n0 = ny rows of nkx complex values, as FFTW-MPI's manual asks)
-      local_complex = fftw_mpi_local_size_2d(int(ny, c_intptr_t), int(nkx, c_intptr_t), communicator%MPI_VAL, &
-         & local_rows, local_start)
+      local_complex = fftw_mpi_local_size_2d_transposed(int(ny, c_intptr_t), int(nkx, c_intptr_t), &
+         & communicator%MPI_VAL, local_rows, local_start, local_columns, column_start)
       if (local_rows /= self%ny_local .or. local_start /= self%y_start) then
          call fatal_error(error, 'fft: FFTW-MPI gives this rank rows ' // to_string(int(local_start)) // ' + ' // &
             & to_string(int(local_rows)) // ', the slab contract ' // to_string(self%y_start) // ' + ' // &
             & to_string(self%ny_local), code_internal)
          return
       end if
+      self%x_start = int(column_start)
+      self%nkx_local = int(local_columns)
       self%n = nx*self%ny_local
-      self%nk = nkx*self%ny_local
+      self%nk = self%nkx_local*ny
       self%real_memory = fftw_alloc_real(int(max(self%n, 1), c_size_t))
       self%padded_memory = fftw_alloc_real(int(2*max(local_complex, 1_c_intptr_t), c_size_t))
       self%complex_memory = fftw_alloc_complex(int(max(local_complex, 1_c_intptr_t), c_size_t))
@@ -204,9 +212,9 @@ contains
       self%real_buffer = 0.0_wp
       self%padded = 0.0_wp
       self%r2c = fftw_mpi_plan_dft_r2c_2d(int(ny, c_intptr_t), int(nx, c_intptr_t), self%padded, self%spectrum, &
-         & communicator%MPI_VAL, FFTW_ESTIMATE)
+         & communicator%MPI_VAL, ior(FFTW_ESTIMATE, FFTW_MPI_TRANSPOSED_OUT))
       self%c2r = fftw_mpi_plan_dft_c2r_2d(int(ny, c_intptr_t), int(nx, c_intptr_t), self%spectrum, self%padded, &
-         & communicator%MPI_VAL, ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
+         & communicator%MPI_VAL, ior(ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT), FFTW_MPI_TRANSPOSED_IN))
       if (.not. (c_associated(self%r2c) .and. c_associated(self%c2r))) &
          & call fatal_error(error, 'fft: FFTW-MPI could not plan a transform of ' // to_string(nx) // ' x ' // &
          & to_string(ny) // ' points', code_internal)
@@ -215,6 +223,21 @@ contains
          & ' points on ' // to_string(threads) // ' threads)', code_internal)
 #endif
    end subroutine init_distributed
+
+   !> The column mx (0..nx/2) and row my (0..ny-1) of this plan's spectrum entry i (1-based):
+   !> mx fastest (serial), or my fastest in this rank's columns (distributed, transposed).
+   pure subroutine mode_indices(self, i, mx, my)
+      class(fft_plan), intent(in) :: self
+      integer, intent(in) :: i
+      integer, intent(out) :: mx, my
+      if (self%distributed) then
+         mx = self%x_start + (i - 1)/self%ny
+         my = mod(i - 1, self%ny)
+      else
+         mx = mod(i - 1, self%nx/2 + 1)
+         my = (i - 1)/(self%nx/2 + 1)
+      end if
+   end subroutine mode_indices
 
    !> padded <- real_buffer (distributed: nx values a row into rows of 2(nx/2 + 1)).
    subroutine pad_rows(self)
@@ -397,6 +420,8 @@ contains
       self%distributed = .false.
       self%y_start = 0
       self%ny_local = 1
+      self%x_start = 0
+      self%nkx_local = 0
       self%r2c = c_null_ptr
       self%c2r = c_null_ptr
       self%real_memory = c_null_ptr
