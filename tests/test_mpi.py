@@ -214,7 +214,7 @@ def test_a_failure_on_one_rank_ends_the_job_with_its_code(tmp_path):
     earlier.close()
     before = (tmp_path / "big.h5").read_bytes()
     wrapper = tmp_path / "rank1_limited.sh"
-    wrapper.write_text('#!/bin/sh\nif [ "$OMPI_COMM_WORLD_RANK" = 1 ]; then ulimit -v 900000; fi\nexec "$@"\n')
+    wrapper.write_text('#!/bin/sh\nif [ "$OMPI_COMM_WORLD_RANK" = 1 ]; then ulimit -v 450000; fi\nexec "$@"\n')
     wrapper.chmod(0o755)
     done = run_mpi(2, [str(wrapper), executable(), str(nml)], tmp_path)
     assert done.returncode == 5, done.stderr
