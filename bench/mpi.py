@@ -61,15 +61,18 @@ def scene(directory: Path, n: int) -> Path:
 
 def run(ranks: int, nml: Path) -> tuple[float, float, list[float], str]:
     """(solve s, run s, peak RSS MiB of each rank, solver) of one run; ranks 0: no launcher."""
-    timed = ["/usr/bin/time", "-f", "peak_rss_kib %M elapsed %e", executable(), str(nml)]
+    # (each rank's /usr/bin/time report in a file of its own: rank.N)
+    timed = ["sh", "-c", '/usr/bin/time -f "peak_rss_kib %M elapsed %e" -o "rank.${OMPI_COMM_WORLD_RANK:-0}" "$0" "$1"',
+             executable(), str(nml)]
     command = timed if ranks == 0 else ["mpirun", "--oversubscribe", "-n", str(ranks), *timed]
     done = subprocess.run(command, cwd=nml.parent, capture_output=True, text=True, env=environment(ranks > 0))
     if done.returncode != 0:
         sys.exit(f"bench/mpi.py: {' '.join(command)} failed ({done.returncode}):\n{done.stderr}")
     solve = float(re.search(r"solver time\s+(\S+)", done.stdout).group(1))
     solver = re.search(r"solver\s+(\S+)", done.stdout).group(1)
-    peaks = [int(k) / 1024 for k in re.findall(r"peak_rss_kib (\d+)", done.stderr)]
-    elapsed = max(float(e) for e in re.findall(r"elapsed (\S+)", done.stderr))
+    reports = [(nml.parent / f"rank.{r}").read_text() for r in range(max(ranks, 1))]
+    peaks = [int(re.search(r"peak_rss_kib (\d+)", text).group(1)) / 1024 for text in reports]
+    elapsed = max(float(re.search(r"elapsed (\S+)", text).group(1)) for text in reports)
     return solve, elapsed, peaks, solver
 
 
@@ -89,13 +92,15 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=2048)
     parser.add_argument("--repeats", type=int, default=1)
     parser.add_argument("--pairs-only", action="store_true")
+    parser.add_argument("--no-pairs", action="store_true", help="the solves only")
     parser.add_argument("--executable", help="the layercontact program (default: the installed one)")
     args = parser.parse_args()
     global EXECUTABLE
     EXECUTABLE = args.executable
     print(f"load average before: {os.getloadavg()[0]:.1f}")
-    print(f"FFT pair of {args.n}² (median of 7, slowest rank):")
-    pairs(args.n)
+    if not args.no_pairs:
+        print(f"FFT pair of {args.n}² (median of 7, slowest rank):")
+        pairs(args.n)
     if args.pairs_only:
         return
     with tempfile.TemporaryDirectory() as tmp:

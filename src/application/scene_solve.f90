@@ -34,11 +34,16 @@ contains
       real(wp), intent(in) :: friction
       type(contact_result), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
-      type(compliance_operator), target :: op
+      type(compliance_operator), allocatable, target :: op
+      type(grid_type) :: grid
+      allocate (op)
       call solve_contact(scene, height, friction, result, op, error)
       if (allocated(error)) return
       if (op%distributed) then
-         call observe_gathered(scene, height, friction, op%grid, result, error)
+         ! (the slab's operator is freed before rank 0 holds the whole fields)
+         grid = op%grid
+         deallocate (op)
+         call observe_gathered(scene, height, friction, grid, result, error)
          return
       end if
       call observe(scene, op, height, result)
