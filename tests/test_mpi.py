@@ -111,6 +111,8 @@ def run_mpi(ranks: int, command: list[str], cwd: Path) -> subprocess.CompletedPr
 def read(path: Path) -> tuple[dict[str, np.ndarray], dict[str, object], int]:
     with h5py.File(path, "r") as f:
         fields = {k: np.asarray(v) for k, v in f["fields"].items()}
+        # (the profile: made on the slabs by the distributed c2r, gathered to rank 0)
+        fields["profile height"] = np.asarray(f["profile/height"])
         scalars = dict(f["results"].attrs)
         ranks = int(f.attrs["mpi_ranks"])
     return fields, scalars, ranks

@@ -16,14 +16,14 @@ module lc_application_run
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
-   use lc_profiles_profile, only: make_profile
+   use lc_profiles_profile, only: make_profile, make_profile_slab
    use lc_profiles_measured, only: measured_grid, periodicity_mismatch, edge_jump_limit, edge_kink_limit
    use lc_application_scene_solve, only: solve_runs
    use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_application_accuracy, only: choose_resolution
    use lc_base_version, only: version_string, build_isa
    use lc_base_parallel, only: parallel_start, is_distributed, is_root, rank_count, this_rank, check_rank_count, &
-      & slab, barrier, abort_job
+      & barrier, abort_job, gather_rows, global_any
    implicit none (type, external)
    private
    public :: run_scene_file
@@ -74,7 +74,6 @@ contains
       real(wp), allocatable :: height(:), local_height(:)
       type(run_record) :: run
       integer(i8) :: start, finish, rate
-      integer :: y_start, ny_local
 
       converged = .false.
       call system_clock(start, rate)
@@ -108,17 +107,18 @@ contains
          call check_distributed(scene, error)
          if (allocated(error)) return
       end if
-      allocate (height(scene%n*scene%ny))
-      call make_profile(scene, height, error)
-      if (allocated(error)) return
-      if (unit >= 0) call warn_if_not_periodic(scene, height)
-      ! every rank made the whole profile (the same heights: the generator is seeded by
-      ! mode); each solves on its slab, rank 0 keeps the whole one for the result file
       if (is_distributed()) then
-         call slab(scene%ny, y_start, ny_local)
-         local_height = height(scene%n*y_start + 1:scene%n*(y_start + ny_local))
-         if (.not. is_root()) deallocate (height)
+         ! each rank makes its slab (a self-affine surface by the distributed c2r: its
+         ! phases are seeded by mode); rank 0 gathers the whole one for the result file
+         call make_profile_slab(scene, local_height, error)
+         if (global_failure(error)) return
+         call gather_rows(local_height, scene%n, scene%ny, height)
+      else
+         allocate (height(scene%n*scene%ny))
+         call make_profile(scene, height, error)
+         if (allocated(error)) return
       end if
+      if (unit >= 0) call warn_if_not_periodic(scene, height)
       ! bad input in the profile (a file's content) is found before anything is created
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
@@ -155,6 +155,15 @@ contains
          end if
       end if
    end subroutine run_scene
+
+   !> True if some rank failed (every rank's profile is checked alike, but a file may be
+   !> read by one rank only): the others then stop too, with their own or a common error.
+   logical function global_failure(error)
+      type(error_type), allocatable, intent(inout) :: error
+      global_failure = global_any(allocated(error))
+      if (global_failure .and. .not. allocated(error)) &
+         & call fatal_error(error, 'the profile failed on another MPI rank', code_input)
+   end function global_failure
 
    !> What a scene must be to be shared among the job's ranks: areal, with at least a row
    !> for each rank (lc_base_parallel).
