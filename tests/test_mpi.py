@@ -160,6 +160,28 @@ def test_distributed_runs_give_the_serial_answer(scene, tmp_path):
 
 
 @needs_mpi
+def test_observables_of_the_whole_map_on_rank_0(tmp_path):
+    """Surface stress, leakage, conductance and stiffness need the whole map: rank 0
+    computes them from the gathered fields, the serial run's values (stress fields too)."""
+    body = SCENES["coupled"].replace("coefficient = 0.5", "coefficient = 0.5, companion = .true.")
+    for name, out in (("serial", "serial.h5"), ("ranks", "ranks2.h5")):
+        nml = write_scene(tmp_path, name, 64, body, out)
+        nml.write_text(nml.read_text().replace("stress = .false.", "stress = .true., leakage = .true., "
+                                                "conductance = .true."))
+    assert run_serial(tmp_path / "serial.nml").returncode == 0
+    done = run_mpi(2, [executable(), str(tmp_path / "ranks.nml")], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert_same(tmp_path / "serial.h5", tmp_path / "ranks2.h5")
+    with h5py.File(tmp_path / "ranks2.h5", "r") as f, h5py.File(tmp_path / "serial.h5", "r") as g:
+        assert f["results"].attrs["conductance"] > 0 and f["results"].attrs["contact_stiffness"] > 0
+        assert any("stress" in name for name in f["fields"])
+        for name, value in g["leakage"].attrs.items():
+            # (its time, and its CG's residuals at the leakage tolerance, are not the answer)
+            if np.asarray(value).dtype.kind == "f" and not name.startswith(("wall_time", "residual")):
+                assert np.all(np.abs(f["leakage"].attrs[name] - value) <= SAME * np.abs(value) + VANISHING), name
+
+
+@needs_mpi
 def test_python_run_under_mpirun_gives_the_serial_answer(tmp_path):
     """`mpirun -n P python -m layercontact run` (the same library routine, in-process)."""
     nml = write_scene(tmp_path, "coupled", 64, SCENES["coupled"], "serial.h5")
