@@ -72,14 +72,16 @@ need "LAPACK" 'has_pc lapack' "liblapack-dev libopenblas-dev" \
   "lapack.pc in PKG_CONFIG_PATH (module load openblas, or a LAPACK with its pkg-config file)"
 need "HDF5 with Fortran" 'has_pc hdf5 || command -v h5fc || command -v h5pfc' libhdf5-dev \
   "hdf5.pc in PKG_CONFIG_PATH or h5fc in PATH (module load hdf5, a build with Fortran)"
-# one surface on several MPI ranks: FFTW's MPI transforms and HDF5's MPI-IO (result files
-# written by slabs of rows)
-need "FFTW 3 MPI" 'links fftw3_mpi' libfftw3-mpi-dev \
-  "libfftw3_mpi in the compiler's or LIBRARY_PATH's directories (module load fftw, its MPI build)"
+# result files written by slabs of rows on several MPI ranks: HDF5's MPI-IO
 need "parallel HDF5 (MPI-IO)" 'parallel_hdf5' libhdf5-openmpi-dev \
   "hdf5-openmpi.pc in PKG_CONFIG_PATH or h5pfc in PATH (module load hdf5, its MPI build: hdf5-mpi, phdf5)"
 need "MPI (C), for hypre" 'has_pc ompi-c || has_pc mpi-c || has_pc mpich || command -v mpicc' libopenmpi-dev \
   "mpicc in PATH or its pkg-config file (module load openmpi, the MPI hypre was built with)"
+# one surface on several MPI ranks (docs/decisions/023-mpi-slabs.md): FFTW-MPI and mpirun;
+# a build without them runs each solve in one process
+need "FFTW-MPI" '[ -f "$(pkg-config --variable=includedir fftw3 2>/dev/null)/fftw3-mpi.f03" ] && links fftw3_mpi' \
+  libfftw3-mpi-dev "fftw3-mpi.f03 beside fftw3.f03 and libfftw3_mpi (module load fftw, its MPI build)"
+need "mpirun" 'command -v mpirun' openmpi-bin "mpirun in PATH (module load openmpi)"
 need "hypre" '[ -f "$hypre_include/HYPRE_parcsr_ls.h" ] && has_library HYPRE' libhypre-dev \
   "HYPRE_parcsr_ls.h in HYPRE_INCLUDE (now $hypre_include) and libHYPRE in LIBRARY_PATH (module load hypre)"
 

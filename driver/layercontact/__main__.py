@@ -173,15 +173,34 @@ def main(argv: list[str] | None = None) -> int:
     return run_command(args)
 
 
+def _launched_rank() -> int:
+    """This process's rank in an MPI job (0 without a launcher): what the launchers set,
+    as the library's start of MPI reads them (src/base/launcher.c)."""
+    import os
+
+    for name in ("OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"):
+        if os.environ.get(name, "").isdigit():
+            return int(os.environ[name])
+    if os.environ.get("SLURM_STEP_ID") is not None and os.environ.get("SLURM_PROCID", "").isdigit():
+        return int(os.environ["SLURM_PROCID"])
+    return 0
+
+
 def run_command(args: argparse.Namespace) -> int:
-    """``python -m layercontact run``: exit codes as the executable's."""
+    """``python -m layercontact run``: exit codes as the executable's. Under ``mpirun -n P``
+    the ranks share the surface (docs/clusters.md, "One surface on several ranks"): rank 0
+    writes the result file, prints the summary and the messages, and draws the picture."""
+    root = _launched_rank() == 0
     out, converged, stat, errmsg = _core.py_run(args.nml, 1)
     try:
         _check(stat, errmsg)
     except LayercontactError as err:
-        print(f"layercontact: error: {err}", file=sys.stderr)
+        if root:
+            print(f"layercontact: error: {err}", file=sys.stderr)
         return err.code
     h5 = Path(out.decode().strip() if isinstance(out, bytes) else str(out).strip())
+    if not root:
+        return 0 if converged else 3
     if not args.no_png:
         import h5py
 

@@ -9,18 +9,21 @@ module lc_application_run
    use, intrinsic :: iso_fortran_env, only: error_unit
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input
+   use lc_base_strings, only: to_string
    use lc_io_files, only: path_kind, kind_name, kind_regular, kind_missing, kind_unknown
    use lc_scene, only: scene_type, not_set, is_areal, check_scene, foundation
    use lc_leakage_reynolds, only: leakage_memory_check
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
    use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
-   use lc_profiles_profile, only: make_profile
+   use lc_profiles_profile, only: make_profile, make_profile_slab
    use lc_profiles_measured, only: measured_grid, periodicity_mismatch, edge_jump_limit, edge_kink_limit
    use lc_application_scene_solve, only: solve_runs
    use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_application_accuracy, only: choose_resolution
    use lc_base_version, only: version_string, build_isa
+   use lc_base_parallel, only: parallel_start, is_distributed, is_root, rank_count, this_rank, check_rank_count, &
+      & barrier, abort_job, gather_rows, global_any
    implicit none (type, external)
    private
    public :: run_scene_file
@@ -29,7 +32,37 @@ contains
 
    !> Run the scene in `input`. converged = .false. means the solver stopped before its
    !> tolerance (results are still written). `unit` < 0 prints nothing.
+   !>
+   !> Under an MPI launcher with several ranks (docs/clusters.md, "One surface on several
+   !> ranks") an areal scene is solved distributed: each rank reads the namelist and makes
+   !> the profile, keeps its slab of rows, and rank 0 writes the result file and the
+   !> summary from the gathered fields. Input refused on every rank returns its error
+   !> there; a failure on some rank only (memory, I/O) ends the whole job (MPI_Abort) with
+   !> its exit code, since the other ranks would wait for it.
    subroutine run_scene_file(input, unit, output_file, converged, error)
+      character(len=*), intent(in) :: input
+      integer, intent(in) :: unit
+      character(len=:), allocatable, intent(out) :: output_file
+      logical, intent(out) :: converged
+      type(error_type), allocatable, intent(out) :: error
+      call parallel_start(error)
+      if (allocated(error)) return
+      call run_scene(input, merge(unit, -1, is_root()), output_file, converged, error)
+      if (.not. is_distributed()) return
+      if (allocated(error)) then
+         if (error%code /= code_input) then
+            write (error_unit, '(a)') 'layercontact: error on MPI rank ' // to_string(this_rank()) // ' of ' // &
+               & to_string(rank_count()) // ': ' // error%message
+            call abort_job(error%code)
+         end if
+         return
+      end if
+      ! (every rank returns once rank 0 wrote the result file)
+      call barrier()
+   end subroutine run_scene_file
+
+   !> run_scene_file on this rank.
+   subroutine run_scene(input, unit, output_file, converged, error)
       character(len=*), intent(in) :: input
       integer, intent(in) :: unit
       character(len=:), allocatable, intent(out) :: output_file
@@ -38,7 +71,7 @@ contains
       type(scene_type) :: scene
       type(contact_result) :: result, companion
       character(len=:), allocatable :: text
-      real(wp), allocatable :: height(:)
+      real(wp), allocatable :: height(:), local_height(:)
       type(run_record) :: run
       integer(i8) :: start, finish, rate
 
@@ -70,9 +103,21 @@ contains
          call check_scene(scene, error)
          if (allocated(error)) return
       end if
-      allocate (height(scene%n*scene%ny))
-      call make_profile(scene, height, error)
-      if (allocated(error)) return
+      if (is_distributed()) then
+         call check_distributed(scene, error)
+         if (allocated(error)) return
+      end if
+      if (is_distributed()) then
+         ! each rank makes its slab (a self-affine surface by the distributed c2r: its
+         ! phases are seeded by mode); rank 0 gathers the whole one for the result file
+         call make_profile_slab(scene, local_height, error)
+         if (global_failure(error)) return
+         call gather_rows(local_height, scene%n, scene%ny, height)
+      else
+         allocate (height(scene%n*scene%ny))
+         call make_profile(scene, height, error)
+         if (allocated(error)) return
+      end if
       if (unit >= 0) call warn_if_not_periodic(scene, height)
       ! bad input in the profile (a file's content) is found before anything is created
       call check_output(output_file, scene%overwrite, error)
@@ -85,10 +130,15 @@ contains
             & merge(2, 1, scene%companion)*merge(10, 4, scene%stress), error)
          if (allocated(error)) return
       end if
-      call solve_runs(scene, height, result, companion, error)
+      if (is_distributed()) then
+         call solve_runs(scene, local_height, result, companion, error)
+      else
+         call solve_runs(scene, height, result, companion, error)
+      end if
       if (allocated(error)) return
       converged = result%converged
       if (scene%companion) converged = converged .and. companion%converged
+      if (.not. is_root()) return
       call system_clock(finish)
       run%seconds = real(finish - start, wp)/real(rate, wp)
       if (scene%companion) then
@@ -104,7 +154,30 @@ contains
             call print_summary(unit, input, output_file, scene, result)
          end if
       end if
-   end subroutine run_scene_file
+   end subroutine run_scene
+
+   !> True if some rank failed (every rank's profile is checked alike, but a file may be
+   !> read by one rank only): the others then stop too, with their own or a common error.
+   logical function global_failure(error)
+      type(error_type), allocatable, intent(inout) :: error
+      global_failure = global_any(allocated(error))
+      if (global_failure .and. .not. allocated(error)) &
+         & call fatal_error(error, 'the profile failed on another MPI rank', code_input)
+   end function global_failure
+
+   !> What a scene must be to be shared among the job's ranks: areal, with at least a row
+   !> for each rank (lc_base_parallel).
+   subroutine check_distributed(scene, error)
+      type(scene_type), intent(in) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      if (.not. is_areal(scene)) then
+         call fatal_error(error, 'line scenes run on one rank: &scene n = ' // to_string(scene%n) // &
+            & ' is a line and this run has ' // to_string(rank_count()) // ' MPI ranks; allowed: 1 rank ' // &
+            & '(run it without mpirun, or with -n 1), or an areal scene (&scene ny > 1)', code_input)
+         return
+      end if
+      call check_rank_count(scene%ny, error)
+   end subroutine check_distributed
 
    !> A height file taken as one period (&profile boundary = 'periodic') whose heights jump
    !> or kink across the cell's edges is most likely a tilted or non-periodic measurement,

@@ -28,6 +28,7 @@ module lc_contact_operator
    use lc_greens_kernel, only: layer_kernel
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    use lc_base_pages, only: advise_huge_pages
+   use lc_base_parallel, only: global_sum, global_max, max_over_ranks, global_any, broadcast
    implicit none (type, external)
    private
    public :: compliance_operator, build_operator, multiply_spectrum, multiply_complex
@@ -48,8 +49,16 @@ module lc_contact_operator
    type :: compliance_operator
       type(grid_type) :: grid
       type(layer_kernel) :: kernel
-      integer :: n = 0                      !< grid points
-      integer :: nk = 0                     !< modes of the half spectrum
+      integer :: n = 0                      !< grid points (of this rank's slab, if distributed)
+      integer :: nk = 0                     !< modes of the half spectrum (of this rank's slab)
+      !> a surface shared among the job's ranks (lc_base_parallel): fields are this rank's
+      !> slab of rows, multipliers its columns of the transposed spectrum (lc_fft_plans,
+      !> `mode_indices`); `holds_uniform`: its first mode is q = 0; `once`: its modes that
+      !> stand for themselves only (mx = 0, and nx/2 for even nx). The real-space columns
+      !> (column updates of CG and GCR) are not made then.
+      logical :: distributed = .false.
+      logical :: holds_uniform = .true.
+      integer, allocatable :: once(:)
       real(wp) :: friction = 0.0_wp
       logical :: coupled = .false.          !< complex multiplier (not symmetric)
       real(wp), allocatable :: metric(:)    !< M(q) = |G_eff(q)| on the half spectrum (L/S)
@@ -101,26 +110,34 @@ module lc_contact_operator
 contains
 
    !> Build the operator on `grid` for the layer `kernel` and Coulomb coefficient
-   !> `friction`, with `threads` FFTW threads.
-   subroutine build_operator(op, grid, kernel, friction, threads, error)
+   !> `friction`, with `threads` FFTW threads; `distributed`: on this rank's slab of a surface
+   !> shared among the job's ranks, if there are several.
+   subroutine build_operator(op, grid, kernel, friction, threads, error, distributed)
       type(compliance_operator), intent(out) :: op
       type(grid_type), intent(in) :: grid
       type(layer_kernel), intent(in) :: kernel
       real(wp), intent(in) :: friction
       integer, intent(in) :: threads
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: qx, qy, q, q_min, q_max
+      logical, intent(in), optional :: distributed
+      real(wp) :: qx, qy, q, q_min, q_max, extremes(2)
       complex(wp) :: g, one_minus_a, one_minus_b, c, t
       real(wp), allocatable :: factor(:)
-      integer :: i, mx, nkx
+      integer :: i, mx, my, nkx
 
-      call op%fft%init(grid%nx, grid%ny, threads, error)
+      call op%fft%init(grid%nx, grid%ny, threads, error, distributed)
       if (allocated(error)) return
       op%grid = grid
       op%kernel = kernel
-      op%n = grid%points()
-      op%nk = grid%modes()
-      op%inv_n = 1.0_wp/op%n
+      op%distributed = op%fft%distributed
+      op%n = op%fft%n
+      op%nk = op%fft%nk
+      op%holds_uniform = .true.
+      if (op%distributed) then
+         op%holds_uniform = op%nk > 0 .and. op%fft%x_start == 0
+         op%once = pack([(i, i=1, op%nk)], [(once_mode(op, i), i=1, op%nk)])
+      end if
+      op%inv_n = 1.0_wp/grid%points()
       op%friction = friction
       nkx = grid%nkx()
       ! C per column: a viscoelastic mode sees the frequency q_x V
@@ -134,23 +151,26 @@ contains
       op%coupled = kernel%coupled(friction)
 
       allocate (op%metric(op%nk))
-      call advise_huge_pages(op%metric)
       if (op%coupled) then
          allocate (op%full(op%nk))
          call advise_huge_pages(op%full)
       end if
-      ! h/M with the static compliance (0 for a half-space)
-      op%metric(1) = kernel%normal_uniform(real(op%compliance(1), wp))
-      if (op%coupled) op%full(1) = op%metric(1)
+      call advise_huge_pages(op%metric)
+      ! h/M with the static compliance (0 for a half-space), on the rank holding the mode
+      if (op%holds_uniform) then
+         op%metric(1) = kernel%normal_uniform(real(op%compliance(1), wp))
+         if (op%coupled) op%full(1) = op%metric(1)
+      end if
 
       q_min = huge(1.0_wp)
       q_max = 0.0_wp
-      do i = 2, op%nk
-         call grid%wavevector(i, qx, qy)
+      do i = 1, op%nk
+         call op%fft%mode_indices(i, mx, my)
+         if (mx == 0 .and. my == 0) cycle
+         call grid%wavevector(my*nkx + mx + 1, qx, qy)
          q = hypot(qx, qy)
          q_min = min(q_min, q)
          q_max = max(q_max, q)
-         mx = mod(i - 1, nkx)
          call kernel%factors(q, qx, one_minus_a, one_minus_b, c, t)
          g = 2.0_wp/q*op%compliance(mx + 1)*(one_minus_a - (0.0_wp, 1.0_wp)*friction*c*(qx/q))
          ! A Nyquist column mode is its own mirror image (q_x = +-pi/dx), so its multiplier is
@@ -170,14 +190,22 @@ contains
       if (kernel%viscoelastic) then
          factor = (abs(op%compliance)/abs(op%compliance(2)))**preconditioner_exponent
          do i = 1, op%nk
-            op%preconditioner(i) = op%preconditioner(i)*factor(mod(i - 1, nkx) + 1)
+            call op%fft%mode_indices(i, mx, my)
+            op%preconditioner(i) = op%preconditioner(i)*factor(mx + 1)
          end do
       end if
       ! The solution is unique when the operator is monotone, Re G_eff >= 0 on every mode
       ! (always for elastic layers; not always for viscoelastic ones with friction).
       op%monotone = .true.
       if (op%coupled) op%monotone = all(real(op%full, wp) >= 0.0_wp)
-      op%metric_falls = .not. op%coupled .and. op%nk > 1
+      if (op%distributed) op%monotone = .not. global_any(.not. op%monotone)
+      if (op%distributed) then
+         extremes = [-q_min, q_max]
+         call max_over_ranks(extremes)
+         q_min = -extremes(1)
+         q_max = extremes(2)
+      end if
+      op%metric_falls = .not. op%coupled .and. grid%modes() > 1
       if (op%metric_falls) op%metric_falls = kernel%compliance_falls(q_min, q_max)
       call derive(op)
    end subroutine build_operator
@@ -187,20 +215,26 @@ contains
    subroutine derive(op)
       type(compliance_operator), intent(inout) :: op
       integer :: n, row, nkx, first, last
-      n = op%n
+      n = op%grid%points()
       nkx = op%grid%nkx()
       ! (1/n) sum over the whole spectrum, row by row of the half spectrum: modes
       ! 1..ceil(nx/2)-1 of a row stand for two, its mx = 0 and Nyquist modes for one
       op%diagonal = 0.0_wp
-      do row = 1, op%grid%ny
-         first = (row - 1)*nkx + 1
-         last = row*nkx
-         op%diagonal = op%diagonal + (op%metric(first) + 2*sum(op%metric(first + 1:last)) &
-            & - merge(op%metric(last), 0.0_wp, mod(op%grid%nx, 2) == 0))
-      end do
+      if (op%distributed) then
+         ! (this rank's columns: every mode twice, less those standing for themselves)
+         op%diagonal = global_sum(2*sum(op%metric) - sum(op%metric(op%once)))
+      else
+         do row = 1, op%grid%ny
+            first = (row - 1)*nkx + 1
+            last = row*nkx
+            op%diagonal = op%diagonal + (op%metric(first) + 2*sum(op%metric(first + 1:last)) &
+               & - merge(op%metric(last), 0.0_wp, mod(op%grid%nx, 2) == 0))
+         end do
+      end if
       op%diagonal = op%diagonal/n
       op%largest = maxval(op%metric)
       if (op%coupled) op%largest = max(op%largest, maxval(abs(op%full)))
+      if (op%distributed) op%largest = global_max(op%largest)
       if (allocated(op%column)) deallocate (op%column)
    end subroutine derive
 
@@ -208,7 +242,7 @@ contains
    subroutine prepare_cg(self)
       class(compliance_operator), intent(inout) :: self
       real(wp), allocatable :: unit_load(:)
-      if (allocated(self%column)) return
+      if (allocated(self%column) .or. self%distributed) return
       allocate (unit_load(self%n), self%column(self%n))
       call advise_huge_pages(self%column)
       unit_load = 0.0_wp
@@ -224,12 +258,16 @@ contains
    subroutine drop_uniform_mode(self, uniform)
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(out) :: uniform
-      uniform = self%metric(1)
+      uniform = 0.0_wp
+      if (self%holds_uniform) uniform = self%metric(1)
+      if (self%distributed) call broadcast(uniform)
       if (uniform == 0.0_wp) return   ! half-space, incompressible layer
       self%dropped_uniform = self%dropped_uniform + uniform
-      self%metric(1) = 0.0_wp
-      self%preconditioner(1) = 0.0_wp
-      if (self%coupled) self%full(1) = 0.0_wp
+      if (self%holds_uniform) then
+         self%metric(1) = 0.0_wp
+         self%preconditioner(1) = 0.0_wp
+         if (self%coupled) self%full(1) = 0.0_wp
+      end if
       ! (derived afresh: subtracting uniform/n from the column would cancel catastrophically
       ! on thick layers, where it dominates)
       call derive(self)
@@ -249,8 +287,9 @@ contains
       integer, intent(in) :: i
       real(wp), intent(out) :: qx, qy
       integer, intent(out) :: mx
-      call self%grid%wavevector(i, qx, qy)
-      mx = mod(i - 1, self%grid%nkx())
+      integer :: my
+      call self%fft%mode_indices(i, mx, my)
+      call self%grid%wavevector(my*self%grid%nkx() + mx + 1, qx, qy)
    end subroutine column_mode
 
    !> w = M p with the real symmetric metric.
@@ -368,8 +407,12 @@ contains
       real(wp), intent(out), optional :: energy
       if (present(energy)) then
          call self%fft%forward_unscaled()
-         call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, self%grid%nkx(), &
-            & mod(self%grid%nx, 2) == 0, energy)
+         if (self%distributed) then
+            call multiply_with_energy_of_columns(self%fft%spectrum, self%metric, self%inv_n, self%once, energy)
+         else
+            call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, self%grid%nkx(), &
+               & mod(self%grid%nx, 2) == 0, energy)
+         end if
          call self%fft%backward()
       else
          call multiply_in_buffer(self, self%metric)
@@ -403,6 +446,36 @@ contains
       end do
       energy = 2.0_wp*sum(block_sums) - once
    end subroutine multiply_with_energy
+
+   !> multiply_with_energy on this rank's columns of a distributed spectrum (the modes
+   !> `once` stand for themselves only), the energy summed over the ranks.
+   subroutine multiply_with_energy_of_columns(spectrum, multiplier, inv_n, once, energy)
+      complex(wp), contiguous, intent(inout) :: spectrum(:)
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      real(wp), intent(in) :: inv_n
+      integer, intent(in) :: once(:)
+      real(wp), intent(out) :: energy
+      real(wp) :: single
+      real(wp) :: block_sums(reduction_blocks(size(spectrum)))
+      integer :: first, last, block
+      single = sum(multiplier(once)*inv_n*abs(spectrum(once))**2)
+      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
+      do block = 1, size(block_sums)
+         call block_range(block, size(spectrum), first, last)
+         block_sums(block) = multiplied_energy(spectrum(first:last), multiplier(first:last), inv_n)
+      end do
+      energy = global_sum(2.0_wp*sum(block_sums) - single)
+   end subroutine multiply_with_energy_of_columns
+
+   !> True if mode i of the operator's spectrum stands for itself only (its column is mx = 0
+   !> or, for even nx, nx/2).
+   logical function once_mode(op, i)
+      type(compliance_operator), intent(in) :: op
+      integer, intent(in) :: i
+      integer :: mx, my
+      call op%fft%mode_indices(i, mx, my)
+      once_mode = mx == 0 .or. 2*mx == op%grid%nx
+   end function once_mode
 
    !> multiply_with_energy on a block: spectrum <- spectrum * multiplier/n and the sum of
    !> multiplier/n |spectrum|^2 before.
@@ -496,18 +569,23 @@ contains
       elsewhere
          self%inverse_full = (0.0_wp, 0.0_wp)
       end where
+      ! (the unit load at the first point, on the rank holding it)
       unit_load = 0.0_wp
-      unit_load(1) = 1.0_wp
-      if (.not. allocated(self%full_column)) then
-         allocate (self%full_column(n))
-         call advise_huge_pages(self%full_column)
+      if (self%fft%y_start == 0) unit_load(1) = 1.0_wp
+      if (.not. self%distributed) then
+         if (.not. allocated(self%full_column)) then
+            allocate (self%full_column(n))
+            call advise_huge_pages(self%full_column)
+         end if
+         self%fft%real_buffer = unit_load
+         call multiply_complex_in_buffer(self, g)
+         self%full_column = self%fft%real_buffer
       end if
       self%fft%real_buffer = unit_load
-      call multiply_complex_in_buffer(self, g)
-      self%full_column = self%fft%real_buffer
-      self%fft%real_buffer = unit_load
       call multiply_complex_in_buffer(self, self%inverse_full)
-      self%inverse_diagonal = self%fft%real_buffer(1)
+      self%inverse_diagonal = 0.0_wp
+      if (self%fft%y_start == 0) self%inverse_diagonal = self%fft%real_buffer(1)
+      if (self%distributed) call broadcast(self%inverse_diagonal)
    end subroutine prepare_gcr
 
    !> fft%real_buffer <- G_eff fft%real_buffer (see metric_in_buffer).

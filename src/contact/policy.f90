@@ -21,6 +21,7 @@
 !>     Newton method finishes.
 module lc_contact_policy
    use lc_base_kinds, only: wp
+   use lc_base_parallel, only: global_sum
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_base_strings, only: to_string, formatted
    use lc_contact_operator, only: compliance_operator
@@ -83,7 +84,14 @@ module lc_contact_policy
       !> where measured (a hard coupled surface from rows_multigrid_surface_points): the
       !> multigrid method smooths it by rows where the GCR is slow
       logical :: rows_ahead = .false.
+      !> a surface shared among the ranks of an MPI job (docs/decisions/023-mpi-slabs.md):
+      !> the constrained CG and GCR (and GCR keeping its history) solve it, the serial methods
+      !> (multigrid, Anderson, GFMD, dense Newton) do not
+      logical :: distributed = .false.
    end type problem_indicators
+
+   !> Why a distributed surface takes no multigrid method.
+   character(len=*), parameter :: distributed_refusal = 'multigrid is serial; distributed runs use gcr/cg'
 
    !> The methods to run, in turn, the coarse start before them, and why.
    type :: solve_plan
@@ -107,8 +115,14 @@ contains
       ind%coupled = op%coupled
       ind%viscoelastic = op%kernel%viscoelastic
       ind%monotone = op%monotone
-      ind%refusal = multigrid_refusal(op)
       ind%gfmd_refusal = ''
+      if (op%distributed) then
+         ! (the multigrid's and GFMD's measures read a whole spectrum: not taken on a slab)
+         ind%distributed = .true.
+         ind%refusal = distributed_refusal
+         return
+      end if
+      ind%refusal = multigrid_refusal(op)
       if (trim(method) == 'gfmd') ind%gfmd_refusal = gfmd_refusal(op)
       if (op%coupled .or. (len(ind%refusal) > 0 .and. .not. op%kernel%viscoelastic)) then
          ind%refusal = coupled_refusal(op, load_control)
@@ -130,6 +144,7 @@ contains
       ind%start_iterations = iterations
       ind%start_multigrid = took_multigrid
       ind%start_contacts = count(p > 0.0_wp)
+      if (ind%distributed) ind%start_contacts = global_sum(ind%start_contacts)
       if (trim(ind%method) /= 'auto' .or. len(ind%refusal) > 0) return
       if (ind%viscoelastic .and. ind%points >= lossy_points(ind%line)) ind%short_wave_loss = loss_among_short_waves(op)
       if (ind%coupled .and. .not. ind%line .and. hard(ind) .and. ind%points >= rows_multigrid_surface_points .and. &
@@ -148,6 +163,11 @@ contains
 
       first = trim(ind%method)
       why = ''
+      if (ind%distributed .and. all(trim(ind%method) /= [character(len=8) :: 'auto', 'cg', 'gcr', 'kept'])) then
+         call fatal_error(error, "&solver: method = '" // trim(ind%method) // "' runs on one MPI rank; a surface " // &
+            & "shared among ranks is solved by 'auto', 'cg' or 'gcr' (" // distributed_refusal // ')', code_input)
+         return
+      end if
       select case (trim(ind%method))
       case ('auto')
          call choose(ind, first, why)
@@ -207,10 +227,10 @@ contains
       end if
       if (plan%stages(plan%count) == 'gcr' .and. (trim(ind%method) == 'auto' .or. first == 'multigrid')) then
          call add(plan, 'kept')
-         call add(plan, 'anderson')
+         if (.not. ind%distributed) call add(plan, 'anderson')
       end if
-      if (trim(ind%method) == 'auto' .and. ind%points <= dense_points .and. ind%monotone .and. first /= 'newton') &
-         & call add(plan, 'newton')
+      if (trim(ind%method) == 'auto' .and. ind%points <= dense_points .and. ind%monotone .and. first /= 'newton' &
+         & .and. .not. ind%distributed) call add(plan, 'newton')
       plan%reason = why
       if (plan%count > 1) plan%reason = plan%reason // '; where it stalls, ' // fallbacks(plan)
    end subroutine plan_solve
@@ -245,6 +265,7 @@ contains
       if (ind%coupled) then
          first = 'gcr'
          why = 'a coupled operator (friction, or a sliding viscoelastic layer): the constrained GCR'
+         if (ind%distributed) why = why // ' (no multigrid method: ' // ind%refusal // ')'
       end if
       if (len(ind%refusal) > 0) return
 

@@ -4,6 +4,7 @@
 module lc_contact_residual
    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
    use lc_base_kinds, only: wp
+   use lc_base_parallel, only: global_sum
    implicit none (type, external)
    private
    public :: complementarity_residual, rounding_floor, normalise
@@ -35,14 +36,23 @@ contains
       floor = 256*epsilon(1.0_wp)*max(w_max, b_max, p_max*m_max)
    end function rounding_floor
 
-   !> Scale p to mean p_m (uniform if p vanished altogether).
-   pure subroutine normalise(p, mean_pressure)
+   !> Scale p to mean p_m (uniform if p vanished altogether); `across_ranks`: p is a slab of
+   !> a field shared among the job's ranks (the mean over all of them).
+   subroutine normalise(p, mean_pressure, across_ranks)
       real(wp), intent(inout) :: p(:)
       real(wp), intent(in) :: mean_pressure
-      real(wp) :: total
+      logical, intent(in), optional :: across_ranks
+      real(wp) :: total, points
       total = sum(p)
+      points = size(p)
+      if (present(across_ranks)) then
+         if (across_ranks) then
+            total = global_sum(total)
+            points = global_sum(points)
+         end if
+      end if
       if (total > 0.0_wp) then
-         p = p*(mean_pressure*size(p)/total)
+         p = p*(mean_pressure*points/total)
       else
          p = mean_pressure
       end if

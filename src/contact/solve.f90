@@ -16,7 +16,8 @@ module lc_contact_solve
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_base_strings, only: to_string
-   use lc_scene, only: scene_type, is_halfspace, not_set, grid_of, kernel_of, pressure_scale
+   use lc_scene, only: scene_type, is_halfspace, not_set, grid_of, kernel_of, pressure_scale, is_areal, &
+      & static_contact_modulus
    use lc_result, only: contact_result
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
@@ -31,6 +32,7 @@ module lc_contact_solve
    use lc_base_memory, only: check_memory
    use lc_base_pages, only: advise_huge_pages
    use lc_base_threads, only: solve_threads, use_threads, active_threads
+   use lc_base_parallel, only: is_distributed, slab, global_sum, global_max, allgather_rows, rank_count
    implicit none (type, external)
    private
    public :: solve_contact, scene_mean_pressure
@@ -68,7 +70,9 @@ contains
 
    !> Solve the scene on profile `height` (flat, x fastest: lc_base_grid) with Coulomb
    !> coefficient `friction` (the scene's, or 0 for the frictionless companion). `op`: the
-   !> operator of the grid solved, for the observables.
+   !> operator of the grid solved, for the observables. A surface under several MPI ranks
+   !> (lc_base_parallel) is solved distributed: `height` and the result's fields are this
+   !> rank's slab of rows, its scalars those of the whole surface.
    subroutine solve_contact(scene, height, friction, result, op, error)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in), target :: height(:)
@@ -84,7 +88,8 @@ contains
       integer(i8) :: start, finish, rate
       logical :: load_control, may_multigrid, coupled_memory
       real(wp), parameter :: pi = acos(-1.0_wp)
-      integer :: n
+      integer :: n, n_local, y_start, ny_local
+      logical :: distributed
 
       call system_clock(start, rate)
       call solve_threads(scene%solver%threads, result%omp_threads, error)
@@ -95,7 +100,13 @@ contains
       call use_threads(result%omp_threads)
       kernel = kernel_of(scene)
       n = grid%points()
-      if (size(height) /= n) then
+      distributed = is_distributed() .and. .not. grid%is_line()
+      n_local = n
+      if (distributed) then
+         call slab(grid%ny, y_start, ny_local)
+         n_local = grid%nx*ny_local
+      end if
+      if (size(height) /= n_local) then
          call fatal_error(error, 'solve: the profile has ' // to_string(size(height)) // ' heights, the grid ' &
             & // to_string(grid%nx) // ' x ' // to_string(grid%ny) // ' points', code_input)
          return
@@ -108,8 +119,9 @@ contains
          return
       end if
 
-      if (.not. all(ieee_is_finite(height))) then
-         call fatal_error(error, '&profile: the heights hold ' // to_string(count(.not. ieee_is_finite(height))) // &
+      if (global_count(count(.not. ieee_is_finite(height)), distributed) > 0) then
+         call fatal_error(error, '&profile: the heights hold ' // &
+            & to_string(global_count(count(.not. ieee_is_finite(height)), distributed)) // &
             & ' NaN or infinite values; allowed: finite heights', code_input)
          return
       end if
@@ -122,18 +134,26 @@ contains
       coupled_memory = kernel%coupled(friction)
       if (.not. coupled_memory .and. may_multigrid .and. grid%is_line()) &
          & coupled_memory = kernel%compliance_rise(2*pi/grid%lx, pi*grid%nx/grid%lx) > allowed_rise
-      call check_memory(n, coupled_memory, scene%solver%memory, scene%stress .and. grid%ny > 1, &
+      call check_memory(n_local, coupled_memory, scene%solver%memory, scene%stress .and. grid%ny > 1, &
          & may_multigrid, grid%is_line(), error)
       if (allocated(error)) return
       lambda_max = maxval(height)
       g_ref = maxval(height) - minval(height)
+      if (distributed) then
+         lambda_max = global_max(lambda_max)
+         g_ref = lambda_max + global_max(-minval(height))
+      end if
       if (g_ref <= 0.0_wp) g_ref = scene%period   ! flat punch: any length scale will do
-      allocate (state%p(n), state%w(n), state%gap(n))
+      allocate (state%p(n_local), state%w(n_local), state%gap(n_local))
       call advise_huge_pages(state%p)
       call advise_huge_pages(state%w)
       call advise_huge_pages(state%gap)
       if (load_control) then
-         pm = scene_mean_pressure(scene, height)
+         if (distributed) then
+            pm = distributed_mean_pressure(scene, height, lambda_max, n)
+         else
+            pm = scene_mean_pressure(scene, height)
+         end if
          if (.not. (pm > 0.0_wp .and. ieee_is_finite(pm))) then
             ! a flat surface has no relief to scale the seed's line pressure by
             call fatal_error(error, '&loading: normalised_pressure = ' // to_string(scene%normalised_pressure) // &
@@ -151,13 +171,19 @@ contains
       call system_clock(finish)
       result%setup_time = real(finish - start, wp)/real(rate, wp)
       call solve_on_grid(scene, grid, kernel, height, friction, load_control, pm, g_ref, op, state, result, &
-         & progress, error)
+         & progress, error, distributed=distributed)
       if (allocated(error)) return
 
       result%friction = friction
-      result%mean_pressure = sum(state%p)/n
+      if (distributed) then
+         result%mean_pressure = global_sum(sum(state%p))/n
+         result%contact_fraction = real(global_count(count(state%p > 0.0_wp), distributed), wp)/n
+      else
+         result%mean_pressure = sum(state%p)/n
+         result%contact_fraction = real(count(state%p > 0.0_wp), wp)/n
+      end if
       result%penetration = state%s + lambda_max
-      result%contact_fraction = real(count(state%p > 0.0_wp), wp)/n
+      if (distributed) result%mpi_ranks = rank_count()
       ! (moved, not copied: on a 4096^2 grid a field is 128 MiB)
       call move_alloc(state%p, result%pressure)
       call move_alloc(state%gap, result%gap)
@@ -167,12 +193,37 @@ contains
       result%wall_time = real(finish - start, wp)/real(rate, wp)
    end subroutine solve_contact
 
+   !> The count over the ranks (distributed) or this one's.
+   integer function global_count(count, distributed)
+      integer, intent(in) :: count
+      logical, intent(in) :: distributed
+      global_count = count
+      if (distributed) global_count = global_sum(count)
+   end function global_count
+
+   !> scene_mean_pressure on this rank's slab `height` of a distributed surface of n points
+   !> whose highest point is lambda_max: the relief Lambda0 from the whole surface.
+   real(wp) function distributed_mean_pressure(scene, height, lambda_max, n) result(pm)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: height(:), lambda_max
+      integer, intent(in) :: n
+      real(wp) :: lambda0
+      if (scene%mean_pressure /= not_set) then
+         pm = scene%mean_pressure
+      else if (is_areal(scene) .and. .not. is_halfspace(scene)) then
+         pm = scene%normalised_pressure*pressure_scale(scene, height)
+      else
+         lambda0 = lambda_max - global_sum(sum(height))/n
+         pm = scene%normalised_pressure*static_contact_modulus(scene)*lambda0/scene%period
+      end if
+   end function distributed_mean_pressure
+
    !> Build the operator on the grid of `height` and solve: state%p is the starting guess
    !> on entry and the solution on exit, state%w = G_eff p, state%gap; state%s the constant
    !> of the gap (given under displacement control, found under load control). Sets the
    !> solver statistics of `result` and returns the plan it followed.
    recursive subroutine solve_on_grid(scene, grid, kernel, height, friction, load_control, pm, g_ref, op, state, &
-         & result, progress, error, followed)
+         & result, progress, error, followed, distributed)
       type(scene_type), intent(in) :: scene
       type(grid_type), intent(in) :: grid
       type(layer_kernel), intent(in) :: kernel
@@ -185,6 +236,8 @@ contains
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
       type(solve_plan), intent(out), optional :: followed
+      !> `height` and the state are this rank's slab of a surface shared among the ranks
+      logical, intent(in), optional :: distributed
       type(problem_indicators) :: indicators
       type(solve_plan) :: plan
       type(contact_problem) :: problem
@@ -192,12 +245,14 @@ contains
       real(wp) :: uniform, plain
       integer :: coarse_pairs, coarse_iterations
       integer(i8) :: start, finish, rate
-      logical :: coarse_multigrid, started
+      logical :: coarse_multigrid, started, across_ranks
 
+      across_ranks = .false.
+      if (present(distributed)) across_ranks = distributed
       ! (the operator first: which methods run depends on it, and refusals come before any
       ! coarse solve)
       call system_clock(start, rate)
-      call build_operator(op, grid, kernel, friction, active_threads(), error)
+      call build_operator(op, grid, kernel, friction, active_threads(), error, across_ranks)
       if (allocated(error)) return
       indicators = measure_problem(op, scene%solver%method, load_control)
       call plan_solve(indicators, scene%solver%coarse_start .and. grid%can_coarsen(coarsest_grid), plan, error)
@@ -210,7 +265,7 @@ contains
       if (plan%coarse_start) then
          call system_clock(start)
          call coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, state, coarse_pairs, &
-            & coarse_iterations, coarse_multigrid, progress, error)
+            & coarse_iterations, coarse_multigrid, progress, error, across_ranks)
          if (allocated(error)) return
          call system_clock(finish)
          result%coarse_time = real(finish - start, wp)/real(rate, wp)
@@ -252,16 +307,26 @@ contains
       ! rounding of p_m) the solution is not resolved to tol in double precision: the run
       ! reports the residual without the floor and does not claim convergence.
       associate (p => state%p, w => state%w, gap => state%gap)
-         result%gap_resolution = rounding_floor(maxval(abs(w)), maxval(abs(height)), maxval(p), op%largest)/g_ref
+         if (across_ranks) then
+            result%gap_resolution = rounding_floor(global_max(maxval(abs(w))), global_max(maxval(abs(height))), &
+               & global_max(maxval(p)), op%largest)/g_ref
+         else
+            result%gap_resolution = rounding_floor(maxval(abs(w)), maxval(abs(height)), maxval(p), op%largest)/g_ref
+         end if
          if (result%converged) then
-            plain = complementarity_residual(p, gap, merge(pm, sum(p)/size(p), load_control), g_ref, 0.0_wp)
+            if (across_ranks) then
+               plain = global_max(complementarity_residual(p, gap, merge(pm, global_sum(sum(p))/grid%points(), &
+                  & load_control), g_ref, 0.0_wp))
+            else
+               plain = complementarity_residual(p, gap, merge(pm, sum(p)/size(p), load_control), g_ref, 0.0_wp)
+            end if
             if (plain > scene%solver%tol) then
                result%converged = .false.
                result%residual = plain
             end if
          end if
          if (progress%enabled) call progress%level_done(result%solver, result%converged, result%iterations, &
-            & result%residual, count(p > 0.0_wp)/real(size(p), wp))
+            & result%residual, global_count(count(p > 0.0_wp), across_ranks)/real(grid%points(), wp))
          ! the uniform mode's rigid shift (see drop_uniform_mode)
          w = w + uniform*pm
       end associate
@@ -274,8 +339,11 @@ contains
    !> of a starting guess (coarse_tol); its FFT pairs are returned in units of pairs of
    !> this grid (2 or 4 times as long each, on a line or a surface), with its iterations
    !> and whether its plan took the multigrid method: what the policy reads of it.
+   !> Distributed (`across_ranks`: height and state%p are this rank's slab): the coarse
+   !> problem is gathered to every rank and solved there, serially and identically; each
+   !> rank then takes its slab of the interpolated start.
    recursive subroutine coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, state, &
-         & pairs, iterations, took_multigrid, progress, error)
+         & pairs, iterations, took_multigrid, progress, error, across_ranks)
       type(scene_type), intent(in) :: scene
       type(grid_type), intent(in) :: grid
       type(layer_kernel), intent(in) :: kernel
@@ -286,6 +354,7 @@ contains
       logical, intent(out) :: took_multigrid
       type(progress_log), intent(inout) :: progress
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in) :: across_ranks
       type(scene_type) :: coarse
       type(grid_type) :: coarse_grid
       type(compliance_operator) :: coarse_op
@@ -293,7 +362,8 @@ contains
       type(contact_state) :: coarse_state
       type(solve_plan) :: coarse_plan
       real(wp), allocatable, target :: hc(:)
-      integer :: ratio
+      real(wp), allocatable :: whole(:)
+      integer :: ratio, y_start, ny_local
 
       pairs = 0
       iterations = 0
@@ -303,13 +373,26 @@ contains
       coarse%solver%tol = max(scene%solver%tol, coarse_tol*min(1.0_wp, real(coarse_tol_size, wp)/grid%nx))
       if (trim(scene%solver%method) == 'multigrid') coarse%solver%tol = max(scene%solver%tol, multigrid_coarse_tol)
       allocate (coarse_state%w(coarse_grid%points()), coarse_state%gap(coarse_grid%points()))
-      hc = restrict(grid, height)
-      coarse_state%p = restrict(grid, state%p)
+      if (across_ranks) then
+         call allgather_rows(height, grid%nx, grid%ny, whole)
+         hc = restrict(grid, whole)
+         call allgather_rows(state%p, grid%nx, grid%ny, whole)
+         coarse_state%p = restrict(grid, whole)
+      else
+         hc = restrict(grid, height)
+         coarse_state%p = restrict(grid, state%p)
+      end if
       coarse_state%s = state%s
       call solve_on_grid(coarse, coarse_grid, kernel, hc, friction, load_control, pm, g_ref, coarse_op, coarse_state, &
          & coarse_result, progress, error, coarse_plan)
       if (allocated(error)) return
-      call interpolate(grid, coarse_state%p, state%p)
+      if (across_ranks) then
+         call interpolate(grid, coarse_state%p, whole)
+         call slab(grid%ny, y_start, ny_local)
+         state%p = whole(grid%nx*y_start + 1:grid%nx*(y_start + ny_local))
+      else
+         call interpolate(grid, coarse_state%p, state%p)
+      end if
       if (load_control) state%s = coarse_state%s
       ratio = grid%points()/coarse_grid%points()
       pairs = (coarse_result%fft_pairs + ratio - 1)/ratio

@@ -23,8 +23,12 @@ module lc_contact_solver_cg
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    use lc_base_pages, only: advise_huge_pages
    use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
+   use lc_base_parallel, only: global_sum, global_max, sum_over_ranks, max_over_ranks
    implicit none (type, external)
    private
+   !> The solve's sums run over the job's ranks (an operator on a slab of a distributed
+   !> surface: lc_base_parallel); set by constrained_cg for its passes.
+   logical :: across_ranks = .false.
    public :: constrained_cg, cg_outcome, cg_solver
 
    !> Iterations without the residual halving after which the preconditioner is dropped.
@@ -102,9 +106,10 @@ contains
       ! transform (at n = 65536 they are compute-bound, not memory-bound:
       ! docs/decisions/000-line-solver-measurements.md), so every pass and every reduction
       ! saved shows.
-      n = size(p)
+      across_ranks = op%distributed
+      n = op%grid%points()
       associate (d => gap)
-      allocate (t(n))
+      allocate (t(size(p)))
       call advise_huge_pages(t)
       call op%prepare_cg()
       buffer => op%buffer()
@@ -114,7 +119,7 @@ contains
       gnorm_old = 1.0_wp
       restart = .true.
       p = max(p, 0.0_wp)
-      if (load_control) call normalise(p, mean_pressure)
+      if (load_control) call normalise(p, mean_pressure, across_ranks)
       preconditioned = precondition
       ! Where the metric falls with |q| (half-space, compressible layers) its masked Fourier
       ! inverse preconditions well at every scale; on broadband roughness points enter at
@@ -131,6 +136,7 @@ contains
       best = huge(1.0_wp)
       last_progress = 0
       b_max = maxval(abs(b))
+      if (across_ranks) b_max = global_max(b_max)
       m_max = op%largest
 
       stale = .true.
@@ -224,7 +230,7 @@ contains
             ! overlapping points in, as for an empty contact set, and start afresh
             call let_in_overlaps(p, d, s, 1.0_wp/op%diagonal, n_changed)
             if (n_changed > 0) then
-               if (load_control) call normalise(p, mean_pressure)
+               if (load_control) call normalise(p, mean_pressure, across_ranks)
                stale = .true.
             end if
             restart = .true.
@@ -235,7 +241,8 @@ contains
          ! points clipped or let in are added column by column (M is circulant) below
          call update(p, d, b, s, tau, t, buffer, safeguarded, sums, t_left, n_changed, entered)
          restart = entered .and. safeguarded
-         if (n_changed > column_updates) then
+         if (n_changed > column_updates .or. (n_changed > 0 .and. op%distributed)) then
+            ! (a distributed operator has no real-space column: the state is made afresh)
             stale = .true.
          else if (n_changed > 0) then
             call op%add_metric_columns(buffer, p, d, sums%d_contact)
@@ -249,7 +256,7 @@ contains
                ! within a few ulps of 1 it would only rescale rounding noise
                if (abs(load_scale - 1.0_wp) <= 8*epsilon(1.0_wp)) load_scale = 1.0_wp
             else
-               call normalise(p, mean_pressure)
+               call normalise(p, mean_pressure, across_ranks)
                stale = .true.
             end if
          end if
@@ -276,7 +283,24 @@ contains
          call fresh_state_range(p(first:last), w(first:last), b(first:last), load_scale, d(first:last), parts(block))
       end do
       sums = added(parts)
+      if (across_ranks) call add_over_ranks(sums)
    end subroutine fresh_state
+
+   !> The sums of the ranks' states (one message for the sums, one for the maxima).
+   subroutine add_over_ranks(sums)
+      type(grid_sums), intent(inout) :: sums
+      real(wp) :: totals(4), maxima(2)
+      totals = [sums%contact, sums%d_contact, sums%b_contact, sums%p_sum]
+      maxima = [sums%w_max, sums%p_max]
+      call sum_over_ranks(totals)
+      call max_over_ranks(maxima)
+      sums%contact = totals(1)
+      sums%d_contact = totals(2)
+      sums%b_contact = totals(3)
+      sums%p_sum = totals(4)
+      sums%w_max = maxima(1)
+      sums%p_max = maxima(2)
+   end subroutine add_over_ranks
 
    !> The sums of the blocks' sums, in order, and the largest of their maxima.
    pure type(grid_sums) function added(parts) result(sums)
@@ -354,6 +378,10 @@ contains
       end do
       gnorm = sum(gnorms)
       residual = maxval(residuals)
+      if (across_ranks) then
+         gnorm = global_sum(gnorm)
+         residual = global_max(residual)
+      end if
    end subroutine evaluate_state
 
    !> One pass: scale p by load_scale and d so that d + b scales alike, then the
@@ -398,7 +426,7 @@ contains
       real(wp), contiguous, intent(in) :: p(:), d(:), z(:)
       real(wp), intent(in) :: s
       real(wp), intent(out) :: gz_sum, z_mean
-      real(wp) :: parts(3, reduction_blocks(size(p)))
+      real(wp) :: parts(3, reduction_blocks(size(p))), totals(3)
       integer :: block, first, last
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(parts, 2)
@@ -406,8 +434,10 @@ contains
          call preconditioned_products_range(p(first:last), d(first:last), s, z(first:last), parts(1, block), &
             & parts(2, block), parts(3, block))
       end do
-      gz_sum = sum(parts(1, :))
-      z_mean = sum(parts(2, :))/max(sum(parts(3, :)), 1.0_wp)
+      totals = [sum(parts(1, :)), sum(parts(2, :)), sum(parts(3, :))]
+      if (across_ranks) call sum_over_ranks(totals)
+      gz_sum = totals(1)
+      z_mean = totals(2)/max(totals(3), 1.0_wp)
    end subroutine preconditioned_products
 
    !> One pass over a block of the preconditioned residual z: gz_sum = sum g z, z_sum = sum z
@@ -437,7 +467,7 @@ contains
       logical, intent(in) :: preconditioned
       real(wp), contiguous, intent(inout) :: t(:), buffer(:)
       real(wp), intent(out) :: gt_sum, t_sum
-      real(wp) :: parts(2, reduction_blocks(size(p)))
+      real(wp) :: parts(2, reduction_blocks(size(p))), totals(2)
       integer :: block, first, last
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(parts, 2)
@@ -447,6 +477,12 @@ contains
       end do
       gt_sum = sum(parts(1, :))
       t_sum = sum(parts(2, :))
+      if (across_ranks) then
+         totals = [gt_sum, t_sum]
+         call sum_over_ranks(totals)
+         gt_sum = totals(1)
+         t_sum = totals(2)
+      end if
    end subroutine new_direction
 
    !> One pass: the new direction t = (e + beta (t - t_shift)) on the contact set (0
@@ -492,6 +528,7 @@ contains
       real(wp) :: lefts(size(parts))
       integer :: changed(size(parts))
       logical :: entries(size(parts))
+      real(wp) :: totals(7)
       integer :: block, first, last
       parts = sums
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
@@ -504,6 +541,19 @@ contains
       t_left = sum(lefts)
       n_changed = sum(changed)
       entered = any(entries)
+      if (across_ranks) then
+         ! (the maxima are kept from the last full evaluation: the same on every rank)
+         totals = [sums%contact, sums%d_contact, sums%b_contact, sums%p_sum, t_left, real(n_changed, wp), &
+            & merge(1.0_wp, 0.0_wp, entered)]
+         call sum_over_ranks(totals)
+         sums%contact = totals(1)
+         sums%d_contact = totals(2)
+         sums%b_contact = totals(3)
+         sums%p_sum = totals(4)
+         t_left = totals(5)
+         n_changed = nint(totals(6))
+         entered = totals(7) > 0.0_wp
+      end if
    end subroutine update
 
    !> One pass: p <- p - tau t clipped at zero, overlapping points (p = 0, g < 0) let in,
@@ -588,6 +638,7 @@ contains
             n_changed = n_changed + 1
          end if
       end do
+      if (across_ranks) n_changed = global_sum(n_changed)
    end subroutine let_in_overlaps
 
    !> The fields returned from the raw gap d (= w - b): w = d + b, gap = d - s (in place).

@@ -33,8 +33,12 @@ module lc_contact_solver_gcr
    use lc_contact_solver, only: contact_solver
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range
    use lc_base_pages, only: advise_huge_pages
+   use lc_base_parallel, only: global_sum, global_max, sum_over_ranks, max_over_ranks
    implicit none (type, external)
    private
+   !> The solve's sums run over the job's ranks (an operator on a slab of a distributed
+   !> surface: lc_base_parallel); set by constrained_gcr for its passes.
+   logical :: across_ranks = .false.
    public :: constrained_gcr, gcr_outcome, gcr_solver
 
    !> Iterations without the residual halving after which the solve gives up (and reports
@@ -148,6 +152,7 @@ contains
       logical :: stale, entered, set_changed, projected, keep
       integer :: n_clipped, n_negative
 
+      across_ranks = op%distributed
       n = size(p)
       keep = .false.
       if (present(keep_clipped)) keep = keep_clipped
@@ -161,8 +166,9 @@ contains
       call advise_huge_pages(p_best)
       buffer => op%buffer()
       p = max(p, 0.0_wp)
-      if (load_control) call normalise(p, mean_pressure)
+      if (load_control) call normalise(p, mean_pressure, across_ranks)
       b_max = maxval(abs(b))
+      if (across_ranks) b_max = global_max(b_max)
       columns = 0
       newest = 0
       stale = .true.
@@ -199,7 +205,7 @@ contains
             best_residual = outcome%residual
             p_best = p
          end if
-         if (present(progress)) call progress%tick(it, outcome%residual, real(n_contact, wp)/n)
+         if (present(progress)) call progress%tick(it, outcome%residual, real(n_contact, wp)/op%grid%points())
          if (outcome%converged .or. it > max_iter) exit
          if (outcome%residual < 0.5_wp*best) then
             best = outcome%residual
@@ -229,7 +235,7 @@ contains
             if (n_negative > 0) then
                columns = 0
                newest = 0
-               if (n_negative > column_updates) then
+               if (n_negative > column_updates .or. op%distributed) then
                   call op%apply_full(p, w)
                   outcome%fft_pairs = outcome%fft_pairs + 1
                   since_fresh = 0
@@ -237,7 +243,7 @@ contains
                   call op%add_full_columns(d, w)
                end if
             end if
-            if (load_control) call scale_to_load(p, mean_pressure, stale, sum(p), load_scale)
+            if (load_control) call scale_to_load(p, mean_pressure, stale, total_pressure(p), load_scale)
             if (stale) cycle   ! (p vanished and was reset: w afresh first)
             call evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
                & n_contact, outcome%residual, residual_norm2, buffer)
@@ -274,7 +280,7 @@ contains
                stale = .true.
                cycle
             end if
-            if (load_control) call normalise(p, mean_pressure)
+            if (load_control) call normalise(p, mean_pressure, across_ranks)
             columns = 0
             newest = 0
             stale = .true.
@@ -296,7 +302,8 @@ contains
          step = alpha/norm
          call update(p, w, gap, dirs(:, newest), images(:, newest), alpha, step*kappa, buffer, n_changed, &
             & n_clipped, entered, p_sum)
-         if (n_changed > column_updates) then
+         if (n_changed > column_updates .or. (n_changed > 0 .and. op%distributed)) then
+            ! (a distributed operator has no real-space column: w is made afresh)
             stale = .true.
          else if (n_changed > 0) then
             call op%add_full_columns(buffer, w)
@@ -333,6 +340,20 @@ contains
       end if
    end subroutine constrained_gcr
 
+   !> sum p (over the ranks, across_ranks).
+   real(wp) function total_pressure(p) result(total)
+      real(wp), contiguous, intent(in) :: p(:)
+      total = sum(p)
+      if (across_ranks) total = global_sum(total)
+   end function total_pressure
+
+   !> The points of the field whose slab p is (over the ranks, across_ranks).
+   real(wp) function field_points(p) result(points)
+      real(wp), contiguous, intent(in) :: p(:)
+      points = size(p)
+      if (across_ranks) points = global_sum(points)
+   end function field_points
+
    !> Two passes: p and w scaled by load_scale, s (the mean of w - b over the contact set
    !> under load control), the gap w - b - s, the complementarity residual, and -gap on the
    !> contact set (0 elsewhere) in `masked`, the preconditioner's input.
@@ -349,7 +370,7 @@ contains
       real(wp), intent(out) :: residual
       real(wp), intent(out) :: norm2   !< sum of gap^2 over the contact set
       real(wp) :: contact, gap_sum, p_sum, w_max, p_max, p_scale, g_scale, g_floor, check
-      real(wp) :: sums(5, reduction_blocks(size(p)))
+      real(wp) :: sums(5, reduction_blocks(size(p))), totals(3), maxima(2)
       integer :: block, first, last
       ! (the passes on blocks of the grid, by procedures of their own, which vectorise: sums by
       ! blocks, added in order, the same bits on any number of threads)
@@ -363,9 +384,20 @@ contains
       contact = sum(sums(1, :))
       gap_sum = sum(sums(2, :))
       p_sum = sum(sums(3, :))
+      if (across_ranks) then
+         totals = [contact, gap_sum, p_sum]
+         maxima = [w_max, p_max]
+         call sum_over_ranks(totals)
+         call max_over_ranks(maxima)
+         contact = totals(1)
+         gap_sum = totals(2)
+         p_sum = totals(3)
+         w_max = maxima(1)
+         p_max = maxima(2)
+      end if
       n_contact = nint(contact)
       if (load_control) s = gap_sum/max(contact, 1.0_wp)
-      p_scale = 1.0_wp/max(merge(mean_pressure, p_sum/size(p), load_control), tiny(1.0_wp))
+      p_scale = 1.0_wp/max(merge(mean_pressure, p_sum/field_points(p), load_control), tiny(1.0_wp))
       g_scale = 1.0_wp/g_ref
       g_floor = rounding_floor(w_max, b_max, p_max, m_max)
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
@@ -377,6 +409,13 @@ contains
       check = sum(sums(1, :))
       norm2 = sum(sums(2, :))
       residual = maxval(sums(3, :))
+      if (across_ranks) then
+         totals(1:2) = [check, norm2]
+         call sum_over_ranks(totals(1:2))
+         check = totals(1)
+         norm2 = totals(2)
+         residual = global_max(residual)
+      end if
       if (.not. ieee_is_finite(check)) residual = huge(1.0_wp)
    end subroutine evaluate
 
@@ -440,7 +479,7 @@ contains
    real(wp) function set_mean(p, load_control, v) result(mean)
       real(wp), contiguous, intent(in) :: p(:), v(:)
       logical, intent(in) :: load_control
-      real(wp) :: sums(2, reduction_blocks(size(p)))
+      real(wp) :: sums(2, reduction_blocks(size(p))), totals(2)
       integer :: block, first, last
       mean = 0.0_wp
       if (.not. load_control) return
@@ -449,7 +488,9 @@ contains
          call block_range(block, size(p), first, last)
          call set_sums(p(first:last), v(first:last), sums(:, block))
       end do
-      mean = sum(sums(1, :))/max(sum(sums(2, :)), 1.0_wp)
+      totals = [sum(sums(1, :)), sum(sums(2, :))]
+      if (across_ranks) call sum_over_ranks(totals)
+      mean = totals(1)/max(totals(2), 1.0_wp)
    end function set_mean
 
    !> On a block: sums = (sum of v over the contact set, its points).
@@ -516,7 +557,11 @@ contains
          call block_range(block, size(p), first, last)
          sums(block) = centred_squares(p(first:last), v(first:last), centre)
       end do
-      norm = sqrt(sum(sums))
+      if (across_ranks) then
+         norm = sqrt(global_sum(sum(sums)))
+      else
+         norm = sqrt(sum(sums))
+      end if
    end subroutine set_norm
 
    !> On a block: the sum of (v - centre)^2 over the contact set.
@@ -555,6 +600,7 @@ contains
       do block = 1, size(partial, 2)
          coeff = coeff + partial(:, block)
       end do
+      if (across_ranks .and. size(coeff) > 0) call sum_over_ranks(coeff)
    end subroutine history_products
 
    !> history_products on the rows i0..i1: a weighted by the contact set once (the weight is
@@ -625,6 +671,7 @@ contains
             & a(first:last), d_unit(first:last), a_unit(first:last))
       end do
       alpha = sum(sums)
+      if (across_ranks) alpha = global_sum(alpha)
    end subroutine normalised_step
 
    !> normalised_step on a block: d_unit, a_unit and the block's part of alpha.
@@ -657,7 +704,7 @@ contains
       integer, intent(out) :: n_clipped
       logical, intent(out) :: entered
       real(wp), intent(out) :: p_sum
-      real(wp) :: clip_count, enter_count, changed_count
+      real(wp) :: clip_count, enter_count, changed_count, totals(4)
       real(wp) :: sums(4, reduction_blocks(size(p)))
       integer :: block, first, last
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
@@ -671,6 +718,14 @@ contains
       enter_count = sum(sums(2, :))
       changed_count = sum(sums(3, :))
       p_sum = sum(sums(4, :))
+      if (across_ranks) then
+         totals = [clip_count, enter_count, changed_count, p_sum]
+         call sum_over_ranks(totals)
+         clip_count = totals(1)
+         enter_count = totals(2)
+         changed_count = totals(3)
+         p_sum = totals(4)
+      end if
       n_changed = nint(changed_count)
       n_clipped = nint(clip_count)
       entered = enter_count > 0.0_wp
@@ -717,7 +772,7 @@ contains
       real(wp), intent(out) :: factor
       factor = 1.0_wp
       if (total > 0.0_wp) then
-         factor = mean_pressure*size(p)/total
+         factor = mean_pressure*field_points(p)/total
       else
          p = mean_pressure
          stale = .true.
@@ -738,6 +793,7 @@ contains
          count_negative = count_negative + merge(1.0_wp, 0.0_wp, p(j) < 0.0_wp)
          p(j) = p(j) + delta(j)
       end do
+      if (across_ranks) count_negative = global_sum(count_negative)
       n_negative = nint(count_negative)
    end subroutine clip_negative
 
@@ -752,6 +808,7 @@ contains
       real(wp), contiguous, intent(inout) :: dirs(:, :), images(:, :)
       integer, intent(inout) :: columns, newest
       real(wp), allocatable :: gram(:, :), sums(:), centre(:), length(:), block_gram(:, :, :), block_sums(:, :)
+      real(wp), allocatable :: flat(:)
       integer, allocatable :: order(:)
       real(wp) :: contact
       integer :: i0, i1, k, l, m, info, block
@@ -764,6 +821,7 @@ contains
       end do
       allocate (gram(m, m), sums(m), centre(m), length(m))
       contact = count(p > 0.0_wp)
+      if (across_ranks) contact = global_sum(contact)
       ! (each block of rows apart, then added block by block in order: the same bits on any
       ! number of threads)
       allocate (block_gram(m, m, (size(p) + block_rows - 1)/block_rows), block_sums(m, (size(p) + block_rows - 1)/block_rows))
@@ -781,6 +839,12 @@ contains
             gram(k, 1:k) = gram(k, 1:k) + block_gram(k, 1:k, block)
          end do
       end do
+      if (across_ranks) then
+         call sum_over_ranks(sums)
+         flat = reshape(gram, [m*m])
+         call sum_over_ranks(flat)
+         gram = reshape(flat, [m, m])
+      end if
       centre = 0.0_wp
       if (load_control) centre = sums/max(contact, 1.0_wp)
       do k = 1, m
@@ -891,12 +955,16 @@ contains
       clipped = pack([(j, j=1, size(p))], p == 0.0_wp .and. delta /= 0.0_wp)
       allocate (mean(columns))
       contact = count(p > 0.0_wp)
+      if (across_ranks) contact = global_sum(contact)
       buffer => op%buffer()
-      if (size(clipped) > clipped_columns) then
+      ! (a distributed operator has no real-space column: the images are made afresh)
+      if (size(clipped) > clipped_columns .or. op%distributed) then
          do k = 1, columns
             dirs(clipped, k) = 0.0_wp
             if (load_control) then
-               mean(k) = sum(dirs(:, k))/max(contact, 1.0_wp)
+               mean(k) = sum(dirs(:, k))
+               if (across_ranks) mean(k) = global_sum(mean(k))
+               mean(k) = mean(k)/max(contact, 1.0_wp)
                where (p > 0.0_wp) dirs(:, k) = dirs(:, k) - mean(k)
             end if
             buffer = dirs(:, k)
@@ -939,6 +1007,7 @@ contains
             n_changed = n_changed + 1
          end if
       end do
+      if (across_ranks) n_changed = global_sum(n_changed)
    end subroutine let_in_overlaps
    subroutine solve_by_gcr(self, problem, state, budget, outcome, progress, error)
       class(gcr_solver), intent(inout) :: self

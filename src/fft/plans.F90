@@ -5,6 +5,16 @@
 !> Convention: f(x_j) = sum_q f^(q) exp(i q.x_j). `forward` returns f^(q) on the half
 !> spectrum (r2c along x, divided by nx*ny); `backward` is its exact inverse (c2r, no
 !> scaling).
+!>
+!> Distributed (`init` with `distributed`, under several MPI ranks: lc_base_parallel): the
+!> surface's rows are split into slabs, FFTW-MPI's r2c/c2r transform the whole surface, and
+!> `real_buffer` holds this rank's slab: rows y_start+1 .. y_start+ny_local of the field.
+!> The spectrum is transposed (FFTW_MPI_TRANSPOSED_OUT/IN, two global transposes a pair
+!> fewer: docs/decisions/023-mpi-slabs.md): this rank holds the columns mx = x_start ..
+!> x_start+nkx_local-1 of the half spectrum, each with all ny rows, my fastest
+!> (`mode_indices`). FFTW-MPI pads the rows of its real arrays to 2(nx/2 + 1) values even
+!> out of place; the rows are copied between `real_buffer` (nx values a row, the layout of
+!> every field) and the padded array around each transform.
 module lc_fft_plans
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_double_complex, c_size_t, &
       & c_f_pointer, c_associated, c_null_ptr
@@ -17,6 +27,14 @@ module lc_fft_plans
    use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_base_strings, only: to_string
    use lc_base_pages, only: advise_huge_pages
+   use lc_base_parallel, only: is_distributed, slab
+#ifdef LC_MPI
+   use lc_base_parallel, only: communicator
+   use lc_fft_fftw3_mpi, only: fftw_mpi_init, fftw_mpi_local_size_2d_transposed, fftw_mpi_plan_dft_r2c_2d, &
+      & fftw_mpi_plan_dft_c2r_2d, fftw_mpi_execute_dft_r2c, fftw_mpi_execute_dft_c2r, FFTW_MPI_TRANSPOSED_OUT, &
+      & FFTW_MPI_TRANSPOSED_IN
+   use, intrinsic :: iso_c_binding, only: c_intptr_t
+#endif
    implicit none (type, external)
    private
    public :: fft_plan
@@ -29,6 +47,8 @@ module lc_fft_plans
    !> a two-pass transform'; bench/fft_plans.c).
    integer, parameter :: split_points = 800000
    integer, parameter :: column_block = 8
+   !> FFTW-MPI's own set-up is done (once per process)
+   logical :: fftw_mpi_ready = .false.
 
    !> An r2c/c2r plan pair with its buffers: copy data into `real_buffer`, call
    !> `forward`, work on `spectrum`, call `backward`, read `real_buffer`. Planning with
@@ -39,6 +59,12 @@ module lc_fft_plans
       integer :: nk = 0   !< spectral coefficients (nx/2 + 1)*ny
       integer :: nx = 0, ny = 1
       integer :: threads = 1   !< threads a transform runs on
+      !> the slab of a distributed surface: rows y_start+1 .. y_start+ny_local (all rows
+      !> otherwise); n and nk are then this slab's points and modes
+      logical :: distributed = .false.
+      integer :: y_start = 0, ny_local = 1
+      !> distributed: the columns of the half spectrum this rank holds (transposed)
+      integer :: x_start = 0, nkx_local = 0
       real(c_double), pointer, contiguous :: real_buffer(:) => null()
       complex(c_double_complex), pointer, contiguous :: spectrum(:) => null()
       type(c_ptr), private :: r2c = c_null_ptr, c2r = c_null_ptr
@@ -53,6 +79,9 @@ module lc_fft_plans
       type(c_ptr), private :: last_forward = c_null_ptr, last_backward = c_null_ptr
       !> the rows alone (plan_rows): r2c and c2r along x of each of the ny rows
       type(c_ptr), private :: rows_r2c = c_null_ptr, rows_c2r = c_null_ptr
+      !> distributed: FFTW-MPI's real array, rows padded to 2(nx/2 + 1) values
+      real(c_double), pointer, contiguous, private :: padded(:) => null()
+      type(c_ptr), private :: padded_memory = c_null_ptr
    contains
       procedure :: init
       procedure :: forward
@@ -62,6 +91,7 @@ module lc_fft_plans
       procedure :: rows_forward_unscaled
       procedure :: rows_backward
       procedure :: destroy
+      procedure :: mode_indices
       final :: finalize
    end type fft_plan
 
@@ -69,14 +99,22 @@ contains
 
    !> Make plans and buffers for nx x ny points (ny = 1: a line) for `threads` threads
    !> (ignored without OpenMP): FFTW's threads for the rows (and for a whole surface below
-   !> split_points), OpenMP over the blocks of columns of a two-pass surface.
-   subroutine init(self, nx, ny, threads, error)
+   !> split_points), OpenMP over the blocks of columns of a two-pass surface. `distributed`:
+   !> a surface shared among the job's ranks, if there are several (see the module).
+   subroutine init(self, nx, ny, threads, error, distributed)
       class(fft_plan), intent(inout) :: self
       integer, intent(in) :: nx, ny, threads
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: distributed
       integer(c_int) :: status
 
       call self%destroy()
+      if (present(distributed)) then
+         if (distributed .and. ny > 1 .and. is_distributed()) then
+            call init_distributed(self, nx, ny, threads, error)
+            return
+         end if
+      end if
       self%threads = max(threads, 1)
 #ifdef LC_OPENMP
       status = fftw_init_threads()
@@ -86,6 +124,7 @@ contains
 #endif
       self%nx = nx
       self%ny = ny
+      self%ny_local = ny
       self%n = nx*ny
       self%nk = (nx/2 + 1)*ny
       self%real_memory = fftw_alloc_real(int(self%n, c_size_t))
@@ -119,6 +158,109 @@ contains
          return
       end if
    end subroutine init
+
+   !> The plans and buffers of a surface shared among the job's ranks (FFTW-MPI, this
+   !> rank's slab of rows: see the module).
+   subroutine init_distributed(self, nx, ny, threads, error)
+      class(fft_plan), intent(inout) :: self
+      integer, intent(in) :: nx, ny, threads
+      type(error_type), allocatable, intent(out) :: error
+#ifdef LC_MPI
+      integer(c_intptr_t) :: local_complex, local_rows, local_start, local_columns, column_start
+      integer(c_int) :: status
+      integer :: nkx
+      if (.not. fftw_mpi_ready) then
+#ifdef LC_OPENMP
+         status = fftw_init_threads()
+#endif
+         call fftw_mpi_init()
+         fftw_mpi_ready = .true.
+      end if
+      self%threads = max(threads, 1)
+#ifdef LC_OPENMP
+      call fftw_plan_with_nthreads(int(self%threads, c_int))
+#else
+      status = int(threads, c_int)
+#endif
+      nkx = nx/2 + 1
+      self%distributed = .true.
+      self%nx = nx
+      self%ny = ny
+      call slab(ny, self%y_start, self%ny_local)
+      ! (the r2c's sizes: n0 = ny rows of nkx complex values, as FFTW-MPI's manual asks)
+      local_complex = fftw_mpi_local_size_2d_transposed(int(ny, c_intptr_t), int(nkx, c_intptr_t), &
+         & communicator%MPI_VAL, local_rows, local_start, local_columns, column_start)
+      if (local_rows /= self%ny_local .or. local_start /= self%y_start) then
+         call fatal_error(error, 'fft: FFTW-MPI gives this rank rows ' // to_string(int(local_start)) // ' + ' // &
+            & to_string(int(local_rows)) // ', the slab contract ' // to_string(self%y_start) // ' + ' // &
+            & to_string(self%ny_local), code_internal)
+         return
+      end if
+      self%x_start = int(column_start)
+      self%nkx_local = int(local_columns)
+      self%n = nx*self%ny_local
+      self%nk = self%nkx_local*ny
+      self%real_memory = fftw_alloc_real(int(max(self%n, 1), c_size_t))
+      self%padded_memory = fftw_alloc_real(int(2*max(local_complex, 1_c_intptr_t), c_size_t))
+      self%complex_memory = fftw_alloc_complex(int(max(local_complex, 1_c_intptr_t), c_size_t))
+      if (.not. (c_associated(self%real_memory) .and. c_associated(self%complex_memory) .and. &
+         & c_associated(self%padded_memory))) then
+         call fatal_error(error, 'fft: cannot allocate FFTW buffers for ' // to_string(nx) // ' x ' // &
+            & to_string(self%ny_local) // ' points (a slab of ' // to_string(ny) // ' rows)', code_internal)
+         return
+      end if
+      call c_f_pointer(self%real_memory, self%real_buffer, [self%n])
+      call c_f_pointer(self%padded_memory, self%padded, [2*local_complex])
+      call c_f_pointer(self%complex_memory, self%spectrum, [self%nk])
+      self%real_buffer = 0.0_wp
+      self%padded = 0.0_wp
+      self%r2c = fftw_mpi_plan_dft_r2c_2d(int(ny, c_intptr_t), int(nx, c_intptr_t), self%padded, self%spectrum, &
+         & communicator%MPI_VAL, ior(FFTW_ESTIMATE, FFTW_MPI_TRANSPOSED_OUT))
+      self%c2r = fftw_mpi_plan_dft_c2r_2d(int(ny, c_intptr_t), int(nx, c_intptr_t), self%spectrum, self%padded, &
+         & communicator%MPI_VAL, ior(ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT), FFTW_MPI_TRANSPOSED_IN))
+      if (.not. (c_associated(self%r2c) .and. c_associated(self%c2r))) &
+         & call fatal_error(error, 'fft: FFTW-MPI could not plan a transform of ' // to_string(nx) // ' x ' // &
+         & to_string(ny) // ' points', code_internal)
+#else
+      call fatal_error(error, 'fft: this build has no FFTW-MPI (' // to_string(nx) // ' x ' // to_string(ny) // &
+         & ' points on ' // to_string(threads) // ' threads)', code_internal)
+#endif
+   end subroutine init_distributed
+
+   !> The column mx (0..nx/2) and row my (0..ny-1) of this plan's spectrum entry i (1-based):
+   !> mx fastest (serial), or my fastest in this rank's columns (distributed, transposed).
+   pure subroutine mode_indices(self, i, mx, my)
+      class(fft_plan), intent(in) :: self
+      integer, intent(in) :: i
+      integer, intent(out) :: mx, my
+      if (self%distributed) then
+         mx = self%x_start + (i - 1)/self%ny
+         my = mod(i - 1, self%ny)
+      else
+         mx = mod(i - 1, self%nx/2 + 1)
+         my = (i - 1)/(self%nx/2 + 1)
+      end if
+   end subroutine mode_indices
+
+   !> padded <- real_buffer (distributed: nx values a row into rows of 2(nx/2 + 1)).
+   subroutine pad_rows(self)
+      class(fft_plan), intent(inout) :: self
+      integer :: row, stride
+      stride = 2*(self%nx/2 + 1)
+      do row = 0, self%ny_local - 1
+         self%padded(row*stride + 1:row*stride + self%nx) = self%real_buffer(row*self%nx + 1:(row + 1)*self%nx)
+      end do
+   end subroutine pad_rows
+
+   !> real_buffer <- padded (the inverse of pad_rows).
+   subroutine unpad_rows(self)
+      class(fft_plan), intent(inout) :: self
+      integer :: row, stride
+      stride = 2*(self%nx/2 + 1)
+      do row = 0, self%ny_local - 1
+         self%real_buffer(row*self%nx + 1:(row + 1)*self%nx) = self%padded(row*stride + 1:row*stride + self%nx)
+      end do
+   end subroutine unpad_rows
 
    !> The plans of a two-pass surface: rows r2c/c2r (contiguous), and the columns of the
    !> half spectrum in blocks of column_block (stride nkx, in place; unaligned, since a block
@@ -168,6 +310,10 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer(c_int) :: nx, ny, nkx
       if (c_associated(self%rows_r2c)) return
+      if (self%distributed) then
+         call fatal_error(error, 'fft: the rows alone are not planned on a distributed surface', code_internal)
+         return
+      end if
       nx = int(self%nx, c_int)
       ny = int(self%ny, c_int)
       nkx = nx/2 + 1
@@ -199,13 +345,20 @@ contains
    subroutine forward(self)
       class(fft_plan), intent(inout) :: self
       call self%forward_unscaled()
-      self%spectrum = self%spectrum*(1.0_wp/self%n)
+      self%spectrum = self%spectrum*(1.0_wp/(real(self%nx, wp)*self%ny))
    end subroutine forward
 
    !> spectrum <- n times the Fourier coefficients (the bare r2c): for operators that fold
    !> the 1/n into their multipliers and so save a pass over the spectrum.
    subroutine forward_unscaled(self)
       class(fft_plan), intent(inout) :: self
+#ifdef LC_MPI
+      if (self%distributed) then
+         call pad_rows(self)
+         call fftw_mpi_execute_dft_r2c(self%r2c, self%padded, self%spectrum)
+         return
+      end if
+#endif
       call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
       if (self%split) call transform_columns(self, self%columns_forward, self%last_forward)
    end subroutine forward_unscaled
@@ -213,6 +366,13 @@ contains
    !> real_buffer <- sum_q spectrum(q) exp(i q.x). The spectrum is destroyed.
    subroutine backward(self)
       class(fft_plan), intent(inout) :: self
+#ifdef LC_MPI
+      if (self%distributed) then
+         call fftw_mpi_execute_dft_c2r(self%c2r, self%spectrum, self%padded)
+         call unpad_rows(self)
+         return
+      end if
+#endif
       if (self%split) call transform_columns(self, self%columns_backward, self%last_backward)
       call fftw_execute_dft_c2r(self%c2r, self%spectrum, self%real_buffer)
    end subroutine backward
@@ -257,6 +417,14 @@ contains
       self%last_block = 0
       if (c_associated(self%real_memory)) call fftw_free(self%real_memory)
       if (c_associated(self%complex_memory)) call fftw_free(self%complex_memory)
+      if (c_associated(self%padded_memory)) call fftw_free(self%padded_memory)
+      self%padded_memory = c_null_ptr
+      self%padded => null()
+      self%distributed = .false.
+      self%y_start = 0
+      self%ny_local = 1
+      self%x_start = 0
+      self%nkx_local = 0
       self%r2c = c_null_ptr
       self%c2r = c_null_ptr
       self%real_memory = c_null_ptr

@@ -22,9 +22,10 @@ module lc_profiles_profile
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
    use lc_profiles_surface, only: self_affine_surface, sinusoid_surface, spherical_cap
    use lc_profiles_measured, only: measured_heights
+   use lc_base_parallel, only: slab
    implicit none (type, external)
    private
-   public :: make_profile, profile_statistics
+   public :: make_profile, make_profile_slab, profile_statistics
 
    real(wp), parameter :: pi = acos(-1.0_wp)
 
@@ -69,6 +70,40 @@ contains
 
    !> Heights of an areal scene's surface on its n x ny grid. The sinusoid's modes and the
    !> sphere's radius are checked here too, as the surface routines cannot fail.
+   !> This rank's slab of rows of an areal scene's profile (a surface shared among MPI
+   !> ranks, lc_base_parallel): a self-affine surface is made on the slabs by the distributed
+   !> c2r (the same heights as on one process, to rounding); the other kinds (cheap, or a
+   !> file every rank reads) are made whole and cut.
+   subroutine make_profile_slab(scene, height, error)
+      type(scene_type), intent(in) :: scene
+      real(wp), allocatable, intent(out) :: height(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: whole(:)
+      real(wp) :: period_y
+      integer :: y_start, rows
+      call slab(scene%ny, y_start, rows)
+      if (.not. (is_areal(scene) .and. trim(scene%profile%kind) == 'self_affine')) then
+         allocate (whole(scene%n*scene%ny))
+         call make_profile(scene, whole, error)
+         if (allocated(error)) return
+         height = whole(scene%n*y_start + 1:scene%n*(y_start + rows))
+         return
+      end if
+      allocate (height(scene%n*rows))
+      height = 0.0_wp
+      period_y = scene%period
+      if (scene%period_y /= not_set) period_y = scene%period_y
+      associate (p => scene%profile)
+         if (p%rms_gradient == not_set .and. p%rms_height == not_set) then
+            call self_affine_surface(scene%n, scene%ny, scene%period, period_y, p%hurst, p%seed, &
+               & p%rolloff_wavelength, p%short_wavelength, default_rms_gradient, not_set, height, error, .true.)
+         else
+            call self_affine_surface(scene%n, scene%ny, scene%period, period_y, p%hurst, p%seed, &
+               & p%rolloff_wavelength, p%short_wavelength, p%rms_gradient, p%rms_height, height, error, .true.)
+         end if
+      end associate
+   end subroutine make_profile_slab
+
    subroutine make_surface(scene, height, error)
       type(scene_type), intent(in) :: scene
       real(wp), intent(out) :: height(scene%n, scene%ny)

@@ -62,9 +62,12 @@ module lc_profiles_surface
 
 contains
 
-   !> Random isotropic self-affine surface (algorithm in the module header).
+   !> Random isotropic self-affine surface (algorithm in the module header). `distributed`
+   !> (a surface shared among MPI ranks): `height` is this rank's slab of rows
+   !> (lc_base_parallel), made by the distributed c2r from this rank's modes; every mode's
+   !> phase comes from its own index, so the surface is the same on any rank count.
    subroutine self_affine_surface(nx, ny, lx, ly, hurst, seed, rolloff_wavelength, short_wavelength, &
-      & rms_gradient, rms_height, height, error)
+      & rms_gradient, rms_height, height, error, distributed)
       !> Grid points along x and y (>= 4 each)
       integer, intent(in) :: nx, ny
       !> Periods along x and y (L)
@@ -81,16 +84,17 @@ contains
       real(wp), intent(in) :: rms_gradient
       !> Target rms height (L), or not_set
       real(wp), intent(in) :: rms_height
-      !> Heights r(x, y) (L)
-      real(wp), intent(out) :: height(nx, ny)
+      !> Heights r(x, y) (L): all ny rows, or this rank's slab (distributed)
+      real(wp), intent(out) :: height(nx, *)
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: distributed
 
       type(fft_plan) :: plan
+      integer :: column
       real(wp) :: rolloff, short, longest, kappa_r2, kappa_s2, kappa2, amplitude, sum_height, sum_gradient, scale
       complex(wp) :: coefficient
       integer :: mx, my, nkx, mx_max, my_max
 
-      height = 0.0_wp
       longest = max(lx, ly)
       rolloff = longest
       if (rolloff_wavelength /= not_set) rolloff = rolloff_wavelength
@@ -132,7 +136,7 @@ contains
          return
       end if
 
-      call plan%init(nx, ny, 1, error)
+      call plan%init(nx, ny, 1, error, distributed)
       if (allocated(error)) return
       nkx = nx/2 + 1
       plan%spectrum = (0.0_wp, 0.0_wp)
@@ -146,6 +150,16 @@ contains
             amplitude = (max(kappa2, kappa_r2)/kappa_r2)**(-0.5_wp*(1 + hurst))
             sum_height = sum_height + amplitude**2
             sum_gradient = sum_gradient + kappa2*amplitude**2
+            if (plan%distributed) then
+               ! (this rank's columns of the transposed spectrum: my fastest)
+               column = mx - plan%x_start
+               if (column < 0 .or. column >= plan%nkx_local) cycle
+               coefficient = amplitude/2*exp(cmplx(0.0_wp, 2*pi*splitmix64_uniform(seed, surface_mode_index(mx, my)), &
+                  & wp))
+               plan%spectrum(1 + modulo(my, ny) + ny*column) = coefficient
+               if (mx == 0) plan%spectrum(1 + modulo(-my, ny) + ny*column) = conjg(coefficient)
+               cycle
+            end if
             coefficient = amplitude/2*exp(cmplx(0.0_wp, 2*pi*splitmix64_uniform(seed, surface_mode_index(mx, my)), wp))
             plan%spectrum(1 + mx + nkx*modulo(my, ny)) = coefficient
             if (mx == 0) plan%spectrum(1 + nkx*modulo(-my, ny)) = conjg(coefficient)
@@ -159,7 +173,7 @@ contains
       end if
       plan%spectrum = scale*plan%spectrum
       call plan%backward()
-      height = reshape(plan%real_buffer, [nx, ny])
+      height(:, 1:plan%ny_local) = reshape(plan%real_buffer, [nx, plan%ny_local])
    end subroutine self_affine_surface
 
    !> Index of the random phase of mode (mx, my) (step 4 of the header): the Cantor pairing

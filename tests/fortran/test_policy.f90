@@ -17,6 +17,7 @@ program test_policy
    call check_explicit_methods()
    call check_refusals()
    call check_memory_view()
+   call check_distributed()
    if (failures > 0) then
       print '(a, i0, a)', 'test_policy: ', failures, ' check(s) FAILED'
       error stop 1
@@ -209,6 +210,27 @@ contains
       end if
       call report(name, error%code == code_input .and. index(error%message, message_has) > 0, error%message)
    end subroutine refused
+
+   !> A surface shared among MPI ranks: CG or GCR (and GCR keeping its history), never the
+   !> serial methods, however large or hard the grid; the serial methods refused by name.
+   subroutine check_distributed()
+      type(problem_indicators) :: ind
+      ind = problem(2048**2, .false., .false.)
+      ind%distributed = .true.
+      ind%refusal = 'multigrid is serial; distributed runs use gcr/cg'
+      call expect('distributed symmetric 2048^2', ind, .true., 'cg', 'multigrid is serial')
+      ind%coupled = .true.
+      ind%start_iterations = 40
+      call expect('distributed coupled 2048^2, hard start', ind, .true., 'gcr+kept', 'distributed runs use gcr/cg')
+      ind%points = 32**2
+      call expect('distributed coupled 32^2 (no dense Newton)', ind, .true., 'gcr+kept', 'the constrained GCR')
+      ind%method = 'anderson'
+      call refused('distributed anderson', ind, 'runs on one MPI rank')
+      ind%method = 'multigrid'
+      call refused('distributed multigrid', ind, 'runs on one MPI rank')
+      ind%method = 'gcr'
+      call expect('distributed gcr', ind, .true., 'gcr', '')
+   end subroutine check_distributed
 
    !> What the memory check provides for: every grid where some start could send the
    !> scene to the multigrid method.

@@ -1,0 +1,101 @@
+/* One r2c + c2r pair of an nx x ny surface (bench/mpi.py): FFTW's serial 2D plan, and
+ * FFTW-MPI's plans on the ranks of the job, in the natural layout (the spectrum by rows,
+ * as lc_fft_plans keeps it; with and without the row copies into FFTW-MPI's padded real
+ * array that the library makes around each transform) and with FFTW_MPI_TRANSPOSED_OUT/IN
+ * (the spectrum by columns kx: two transposes a pair fewer). FFTW_ESTIMATE, as the library.
+ *
+ *     mpicc -O2 bench/mpi_fft_pair.c -lfftw3_mpi -lfftw3 -o fft_pair && mpirun -n 2 ./fft_pair 2048 2048 10
+ *
+ * Prints one line per variant: the median over `repeats` pairs of the slowest rank (ms). */
+#include <fftw3-mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int compare(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *t, int n) {
+    qsort(t, n, sizeof *t, compare);
+    return t[n / 2];
+}
+
+int main(int argc, char **argv) {
+    int rank, size, repeats;
+    ptrdiff_t nx, ny, nkx, local_complex, local_rows, local_start, local_cols, local_col_start;
+    MPI_Init(&argc, &argv);
+    fftw_mpi_init();
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    nx = argc > 1 ? atol(argv[1]) : 2048;
+    ny = argc > 2 ? atol(argv[2]) : nx;
+    repeats = argc > 3 ? atoi(argv[3]) : 10;
+    nkx = nx / 2 + 1;
+    double *times = malloc(sizeof(double) * repeats);
+
+    if (size == 1) {   /* the serial plan */
+        double *real = fftw_alloc_real(nx * ny);
+        fftw_complex *spectrum = fftw_alloc_complex(nkx * ny);
+        memset(real, 0, sizeof(double) * nx * ny);
+        fftw_plan r2c = fftw_plan_dft_r2c_2d(ny, nx, real, spectrum, FFTW_ESTIMATE);
+        fftw_plan c2r = fftw_plan_dft_c2r_2d(ny, nx, spectrum, real, FFTW_ESTIMATE | FFTW_DESTROY_INPUT);
+        for (int k = -1; k < repeats; ++k) {
+            double t = MPI_Wtime();
+            fftw_execute(r2c);
+            fftw_execute(c2r);
+            if (k >= 0) times[k] = MPI_Wtime() - t;
+        }
+        printf("serial plan        %ld x %ld  1 rank   %9.2f ms\n", (long)nx, (long)ny, 1e3 * median(times, repeats));
+        fftw_destroy_plan(r2c);
+        fftw_destroy_plan(c2r);
+        fftw_free(real);
+        fftw_free(spectrum);
+    }
+
+    for (int variant = 0; variant < 3; ++variant) {
+        int transposed = variant == 2, copies = variant == 1;
+        if (transposed)
+            local_complex = fftw_mpi_local_size_2d_transposed(ny, nkx, MPI_COMM_WORLD, &local_rows, &local_start,
+                                                              &local_cols, &local_col_start);
+        else
+            local_complex = fftw_mpi_local_size_2d(ny, nkx, MPI_COMM_WORLD, &local_rows, &local_start);
+        double *padded = fftw_alloc_real(2 * local_complex);
+        double *rows = fftw_alloc_real(nx * local_rows + 1);
+        fftw_complex *spectrum = fftw_alloc_complex(local_complex);
+        memset(padded, 0, sizeof(double) * 2 * local_complex);
+        memset(rows, 0, sizeof(double) * (nx * local_rows + 1));
+        unsigned out = transposed ? FFTW_MPI_TRANSPOSED_OUT : 0, in = transposed ? FFTW_MPI_TRANSPOSED_IN : 0;
+        fftw_plan r2c = fftw_mpi_plan_dft_r2c_2d(ny, nx, padded, spectrum, MPI_COMM_WORLD, FFTW_ESTIMATE | out);
+        fftw_plan c2r = fftw_mpi_plan_dft_c2r_2d(ny, nx, spectrum, padded, MPI_COMM_WORLD,
+                                                 FFTW_ESTIMATE | FFTW_DESTROY_INPUT | in);
+        for (int k = -1; k < repeats; ++k) {
+            double t, slowest;
+            MPI_Barrier(MPI_COMM_WORLD);
+            t = MPI_Wtime();
+            if (copies)
+                for (ptrdiff_t j = 0; j < local_rows; ++j) memcpy(padded + j * 2 * nkx, rows + j * nx, sizeof(double) * nx);
+            fftw_execute(r2c);
+            fftw_execute(c2r);
+            if (copies)
+                for (ptrdiff_t j = 0; j < local_rows; ++j) memcpy(rows + j * nx, padded + j * 2 * nkx, sizeof(double) * nx);
+            t = MPI_Wtime() - t;
+            MPI_Allreduce(&t, &slowest, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+            if (k >= 0) times[k] = slowest;
+        }
+        if (rank == 0)
+            printf("%-18s %ld x %ld  %d rank%s %9.2f ms\n",
+                   transposed ? "mpi transposed" : copies ? "mpi rows + copies" : "mpi rows",
+                   (long)nx, (long)ny, size, size == 1 ? " " : "s", 1e3 * median(times, repeats));
+        fftw_destroy_plan(r2c);
+        fftw_destroy_plan(c2r);
+        fftw_free(padded);
+        fftw_free(rows);
+        fftw_free(spectrum);
+    }
+    free(times);
+    fftw_mpi_cleanup();
+    MPI_Finalize();
+    return 0;
+}

@@ -1,0 +1,52 @@
+/* Whether this process was started by an MPI launcher, and MPI's start and finish for a
+ * surface shared among the ranks of a job (lc_base_parallel).
+ *
+ * A plain `layercontact scene.nml` must not need mpirun: MPI is started only when a launcher's
+ * variables say the process is one of a job (Open MPI's mpirun: OMPI_COMM_WORLD_SIZE; PMIx:
+ * PMIX_RANK; PMI and Slurm's srun: PMI_SIZE, SLURM_NTASKS with SLURM_STEP_ID). Whoever comes
+ * first starts MPI, at thread level FUNNELED (the solve's OpenMP threads never call MPI): this
+ * file or the leakage's hypre glue (src/leakage/hypre_amg.c), which checks MPI_Initialized
+ * as this does. MPI is finished at exit by the one that started it.
+ */
+#include <stdlib.h>
+#include <string.h>
+#ifdef LC_MPI
+#include <mpi.h>
+#endif
+
+static int positive(const char *name) {
+    const char *value = getenv(name);
+    return value != NULL && atoi(value) > 0;
+}
+
+/* 1 if a launcher started this process as one of a job's ranks. */
+int lc_launched(void) {
+    if (positive("OMPI_COMM_WORLD_SIZE") || positive("PMI_SIZE")) return 1;
+    if (getenv("PMIX_RANK") != NULL) return 1;
+    /* srun sets SLURM_STEP_ID in each task; SLURM_NTASKS alone is set in a batch script too */
+    return positive("SLURM_NTASKS") && getenv("SLURM_STEP_ID") != NULL && getenv("SLURM_PROCID") != NULL;
+}
+
+#ifdef LC_MPI
+static int started_here = 0;
+
+static void finish_at_exit(void) {
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (started_here && !finalized) MPI_Finalize();
+}
+
+/* Start MPI under a launcher (if nobody did); 0 on success or when not launched. */
+int lc_mpi_start(void) {
+    int initialized = 0, provided = 0;
+    if (!lc_launched()) return 0;
+    MPI_Initialized(&initialized);
+    if (initialized) return 0;
+    if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) return 1;
+    started_here = 1;
+    atexit(finish_at_exit);
+    return 0;
+}
+#else
+int lc_mpi_start(void) { return 0; }
+#endif

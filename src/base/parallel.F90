@@ -1,0 +1,295 @@
+!> The ranks of a job sharing one surface (docs/decisions/023-mpi-slabs.md): the
+!> communicator, this rank and the rank count, this rank's slab of rows, and the global sums
+!> and maxima over the ranks. A build without MPI (no LC_MPI) compiles the one-rank version.
+!>
+!> The slab contract (FFTW-MPI's `fftw_mpi_local_size_2d` with n0 = ny, n1 = nx): a field
+!> f(nx, ny) (x fastest) is split by whole rows; with P ranks the block is ceiling(ny/P) rows
+!> and rank r holds rows y_start+1 .. y_start+ny_local (y_start = r*block). A rank count that
+!> would leave a rank without rows is refused (`check_rank_count`).
+!>
+!> One rank (no launcher, or a launcher with one process) is not distributed: every caller
+!> then takes the serial code path, and the reductions here return their argument.
+module lc_base_parallel
+   use, intrinsic :: iso_c_binding, only: c_int
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type, fatal_error, code_input, code_internal
+   use lc_base_strings, only: to_string
+   use lc_base_slab, only: row_slab, slab_of
+#ifdef LC_MPI
+   use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Allgatherv, &
+      & MPI_Gatherv, MPI_Scatterv, MPI_Bcast, MPI_Abort, MPI_Initialized, MPI_IN_PLACE, MPI_SUM, MPI_MAX, MPI_MIN, &
+      & MPI_LOR, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_Barrier
+#endif
+   implicit none (type, external)
+   private
+   public :: parallel_start, is_distributed, rank_count, this_rank, is_root, slab, slab_rows, check_rank_count
+   public :: largest_rank_count, global_sum, global_max, sum_over_ranks, max_over_ranks, global_any
+   public :: gather_rows, allgather_rows, scatter_rows
+   public :: broadcast, abort_job, mpi_available, barrier
+#ifdef LC_MPI
+   public :: communicator
+#endif
+
+   integer :: ranks = 1, rank = 0
+   logical :: started = .false.
+#ifdef LC_MPI
+   type(MPI_Comm) :: communicator
+#endif
+
+   interface global_sum
+      module procedure global_sum_scalar, global_sum_integer
+   end interface global_sum
+
+   interface
+      function lc_mpi_start() bind(c, name='lc_mpi_start') result(status)
+         import :: c_int
+         integer(c_int) :: status
+      end function lc_mpi_start
+   end interface
+
+contains
+
+   !> True if this build can share a surface among the ranks of a job (MPI and FFTW-MPI).
+   pure logical function mpi_available()
+#ifdef LC_MPI
+      mpi_available = .true.
+#else
+      mpi_available = .false.
+#endif
+   end function mpi_available
+
+   !> Start MPI when a launcher started this process (once; a plain run does nothing) and
+   !> take the job's ranks: MPI_COMM_WORLD.
+   subroutine parallel_start(error)
+      type(error_type), allocatable, intent(out) :: error
+#ifdef LC_MPI
+      logical :: initialized
+      integer :: value
+      if (started) return
+      if (lc_mpi_start() /= 0) then
+         call fatal_error(error, 'MPI could not be started under the launcher', code_internal)
+         return
+      end if
+      call MPI_Initialized(initialized)
+      started = .true.
+      if (.not. initialized) return
+      communicator = MPI_COMM_WORLD
+      call MPI_Comm_size(communicator, value)
+      ranks = value
+      call MPI_Comm_rank(communicator, value)
+      rank = value
+#else
+      started = .true.
+#endif
+   end subroutine parallel_start
+
+   !> More than one rank shares the surface.
+   logical function is_distributed()
+      is_distributed = ranks > 1
+   end function is_distributed
+
+   integer function rank_count()
+      rank_count = ranks
+   end function rank_count
+
+   integer function this_rank()
+      this_rank = rank
+   end function this_rank
+
+   !> Rank 0: the one that reads and writes files.
+   logical function is_root()
+      is_root = rank == 0
+   end function is_root
+
+   !> The slab of rank r of a surface of ny rows (lc_base_slab, the split FFTW-MPI and the
+   !> slab files share): its first row y_start (0-based) and its row count.
+   pure subroutine slab_rows(ny, p, r, y_start, ny_local)
+      integer, intent(in) :: ny, p, r
+      integer, intent(out) :: y_start, ny_local
+      type(row_slab) :: rows
+      rows = slab_of(1, ny, p, r)
+      y_start = min(rows%y_start, ny)
+      ny_local = rows%ny_local
+   end subroutine slab_rows
+
+   !> This rank's slab of a surface of ny rows.
+   subroutine slab(ny, y_start, ny_local)
+      integer, intent(in) :: ny
+      integer, intent(out) :: y_start, ny_local
+      call slab_rows(ny, ranks, rank, y_start, ny_local)
+   end subroutine slab
+
+   !> The largest rank count up to `most` that leaves every rank at least one row of ny
+   !> (the last rank's slab starts at (P - 1) ceiling(ny/P), which must be below ny; the
+   !> counts allowed are not contiguous: 6 rows take 3 or 6 ranks, not 4 or 5).
+   pure integer function largest_rank_count(ny, most) result(p)
+      integer, intent(in) :: ny, most
+      integer :: y_start, rows
+      do p = max(min(ny, most), 1), 2, -1
+         call slab_rows(ny, p, p - 1, y_start, rows)
+         if (rows > 0) return
+      end do
+      p = 1
+   end function largest_rank_count
+
+   !> Refuse a rank count that would leave a rank without rows of a surface of ny rows.
+   subroutine check_rank_count(ny, error)
+      integer, intent(in) :: ny
+      type(error_type), allocatable, intent(out) :: error
+      if (largest_rank_count(ny, ranks) < ranks) &
+         & call fatal_error(error, '&scene ny = ' // to_string(ny) // ' rows cannot be shared among ' // &
+         & to_string(ranks) // ' MPI ranks (slabs of ceiling(ny/ranks) rows leave a rank without rows); ' // &
+         & 'allowed: at most ' // to_string(largest_rank_count(ny, ranks)) // ' ranks here, or a count P ' // &
+         & 'with (P - 1) ceiling(ny/P) < ny', code_input)
+   end subroutine check_rank_count
+
+   !> The sum over the ranks (the ranks' partial sums added in rank order by MPI).
+   real(wp) function global_sum_scalar(x) result(total)
+      real(wp), intent(in) :: x
+      total = x
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Allreduce(x, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, communicator)
+#endif
+   end function global_sum_scalar
+
+   integer function global_sum_integer(x) result(total)
+      integer, intent(in) :: x
+      total = x
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Allreduce(x, total, 1, MPI_INTEGER, MPI_SUM, communicator)
+#endif
+   end function global_sum_integer
+
+   !> x <- its sum over the ranks, element by element (one message for several sums).
+   subroutine sum_over_ranks(x)
+      real(wp), contiguous, intent(inout) :: x(:)
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Allreduce(MPI_IN_PLACE, x, size(x), MPI_DOUBLE_PRECISION, MPI_SUM, communicator)
+#else
+      if (.false.) x = x
+#endif
+   end subroutine sum_over_ranks
+
+   real(wp) function global_max(x) result(largest)
+      real(wp), intent(in) :: x
+      largest = x
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Allreduce(x, largest, 1, MPI_DOUBLE_PRECISION, MPI_MAX, communicator)
+#endif
+   end function global_max
+
+   subroutine max_over_ranks(x)
+      real(wp), contiguous, intent(inout) :: x(:)
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Allreduce(MPI_IN_PLACE, x, size(x), MPI_DOUBLE_PRECISION, MPI_MAX, communicator)
+#else
+      if (.false.) x = x
+#endif
+   end subroutine max_over_ranks
+
+   logical function global_any(x) result(any_rank)
+      logical, intent(in) :: x
+      any_rank = x
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Allreduce(x, any_rank, 1, MPI_LOGICAL, MPI_LOR, communicator)
+#endif
+   end function global_any
+
+   !> x from rank 0 on every rank.
+   subroutine broadcast(x)
+      real(wp), intent(inout) :: x
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Bcast(x, 1, MPI_DOUBLE_PRECISION, 0, communicator)
+#else
+      if (.false.) x = x
+#endif
+   end subroutine broadcast
+
+   !> The counts and offsets (in values) of every rank's slab of a field of nx x ny.
+   subroutine slab_counts(nx, ny, counts, offsets)
+      integer, intent(in) :: nx, ny
+      integer, intent(out) :: counts(0:), offsets(0:)
+      integer :: r, y_start, rows
+      do r = 0, ranks - 1
+         call slab_rows(ny, ranks, r, y_start, rows)
+         counts(r) = nx*rows
+         offsets(r) = nx*y_start
+      end do
+   end subroutine slab_counts
+
+   !> The whole field (nx x ny) on rank 0 from every rank's slab `local` (`full` is
+   !> allocated on rank 0 only; one rank: a copy).
+   subroutine gather_rows(local, nx, ny, full)
+      real(wp), contiguous, intent(in) :: local(:)
+      integer, intent(in) :: nx, ny
+      real(wp), allocatable, intent(out) :: full(:)
+#ifdef LC_MPI
+      integer :: counts(0:ranks - 1), offsets(0:ranks - 1)
+      if (ranks > 1) then
+         call slab_counts(nx, ny, counts, offsets)
+         allocate (full(merge(nx*ny, 0, rank == 0)))
+         call MPI_Gatherv(local, size(local), MPI_DOUBLE_PRECISION, full, counts, offsets, MPI_DOUBLE_PRECISION, 0, &
+            & communicator)
+         return
+      end if
+#endif
+      full = local
+   end subroutine gather_rows
+
+   !> The whole field (nx x ny) on every rank from every rank's slab `local`.
+   subroutine allgather_rows(local, nx, ny, full)
+      real(wp), contiguous, intent(in) :: local(:)
+      integer, intent(in) :: nx, ny
+      real(wp), allocatable, intent(out) :: full(:)
+#ifdef LC_MPI
+      integer :: counts(0:ranks - 1), offsets(0:ranks - 1)
+      if (ranks > 1) then
+         call slab_counts(nx, ny, counts, offsets)
+         allocate (full(nx*ny))
+         call MPI_Allgatherv(local, size(local), MPI_DOUBLE_PRECISION, full, counts, offsets, MPI_DOUBLE_PRECISION, &
+            & communicator)
+         return
+      end if
+#endif
+      full = local
+   end subroutine allgather_rows
+
+   !> Every rank's slab `local` of the field `full` (nx x ny) that rank 0 holds.
+   subroutine scatter_rows(full, nx, ny, local)
+      real(wp), contiguous, intent(in) :: full(:)
+      integer, intent(in) :: nx, ny
+      real(wp), allocatable, intent(out) :: local(:)
+      integer :: y_start, rows
+#ifdef LC_MPI
+      integer :: counts(0:ranks - 1), offsets(0:ranks - 1)
+      if (ranks > 1) then
+         call slab_counts(nx, ny, counts, offsets)
+         call slab(ny, y_start, rows)
+         allocate (local(nx*rows))
+         call MPI_Scatterv(full, counts, offsets, MPI_DOUBLE_PRECISION, local, nx*rows, MPI_DOUBLE_PRECISION, 0, &
+            & communicator)
+         return
+      end if
+#endif
+      call slab(ny, y_start, rows)
+      local = full(nx*y_start + 1:nx*(y_start + rows))
+   end subroutine scatter_rows
+
+   !> Wait for every rank.
+   subroutine barrier()
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Barrier(communicator)
+#endif
+   end subroutine barrier
+
+   !> End every rank of the job with exit code `code` (a failure on one rank: the others
+   !> would wait for it in their next reduction). One rank: returns.
+   subroutine abort_job(code)
+      integer, intent(in) :: code
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Abort(communicator, code)
+#else
+      if (.false. .and. code > 0) return
+#endif
+   end subroutine abort_job
+end module lc_base_parallel

@@ -1,0 +1,246 @@
+"""One areal scene shared among the ranks of an MPI job (docs/decisions/023-mpi-slabs.md):
+`mpirun -n P layercontact scene.nml` and `mpirun -n P python -m layercontact run scene.nml`
+solve one surface split into slabs of rows, and give the serial run's fields and scalars.
+
+The oracle is the serial run of the same scene (no launcher: one process, the code path of
+a build without MPI). The distributed run transforms with FFTW-MPI and adds its sums over
+the ranks, so its rounding differs from the serial run's by some ulps per step, and where
+the serial CG or GCR updates a few points by the operator's real-space column the
+distributed one takes a transform instead. Both solves run to tol = 1e-13 (the
+complementarity residual relative to p_m and the relief); two solutions each that close
+to the exact one agree to about that, so SAME = 1e-10 relative (against a field's largest
+value, a scalar's size) is met with three decades to spare yet fails on any slab that is
+misplaced, any sum taken on one rank only, or a mode's wavevector taken from the local
+index (each of those moves the answer by percents). The run with 3 ranks splits the rows
+unevenly (64 = 22 + 22 + 20, 128 = 43 + 43 + 42).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+#: relative agreement of the distributed and the serial run (see the module docstring)
+SAME = 1e-10
+#: scalars that vanish physically (the interlocking friction of a frictionless elastic scene,
+#: zero but for the rounding of w', ~1e-18 here) are compared to this absolute floor
+VANISHING = 1e-14
+#: the counts and the time of a solve differ between runs by design: not compared
+NOT_COMPARED = {"wall_time", "residual", "iterations", "fft_pairs", "outer_iterations", "mpi_ranks",
+                "solver_reason", "omp_threads"}
+
+
+def executable() -> str:
+    """The installed `layercontact` program of this Python's environment."""
+    found = shutil.which("layercontact", path=sysconfig.get_path("scripts")) or shutil.which("layercontact")
+    assert found, "the layercontact executable is not installed (pip install . puts it in the venv's bin/)"
+    return found
+
+
+def mpi_build() -> bool:
+    """True where mpirun exists and the executable was built with FFTW-MPI."""
+    if shutil.which("mpirun") is None:
+        return False
+    linked = subprocess.run(["ldd", executable()], capture_output=True, text=True).stdout
+    return "libfftw3_mpi" in linked
+
+
+#: CI (.ci/run) sets LAYERCONTACT_REQUIRE_MPI: there these tests fail, not skip, without MPI
+needs_mpi = pytest.mark.skipif(not mpi_build() and not os.environ.get("LAYERCONTACT_REQUIRE_MPI"),
+                               reason="no mpirun or a build without FFTW-MPI")
+
+
+def launcher_env() -> dict[str, str]:
+    """The environment of an mpirun child: root allowed (CI runs as root), one thread."""
+    env = dict(os.environ)
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    return env
+
+
+def serial_env() -> dict[str, str]:
+    env = dict(os.environ)
+    env["OMP_NUM_THREADS"] = "1"
+    for name in [k for k in env if k.startswith(("OMPI_", "PMIX_", "PMI_"))]:
+        del env[name]
+    return env
+
+
+SCENES = {
+    # frictionless thin incompressible layer: the constrained CG
+    "frictionless": "&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.0 /\n",
+    # friction couples the fields (h/lambda 0.05, mu_c 0.5, nu 0.5): the constrained GCR
+    "coupled": "&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n",
+    # a sliding standard linear solid (serially the multigrid method may take it; distributed, GCR)
+    "viscoelastic": "&layer thickness = 0.05, poisson = 0.5 /\n"
+                    "&material model = 'sls', e0 = 1.0, e_inf = 10.0, tau = 1.0, speed = 0.5 /\n"
+                    "&friction coefficient = 0.0 /\n",
+}
+SIZES = {"frictionless": 64, "coupled": 64, "viscoelastic": 128}
+
+
+def write_scene(directory: Path, name: str, n: int, body: str, output: str) -> Path:
+    nml = directory / f"{name}.nml"
+    nml.write_text(
+        f"&scene geometry = 'areal', n = {n}, ny = {n} /\n" + body +
+        f"&profile kind = 'self_affine', hurst = 0.8, seed = 3, short_wavelength = {8 / n} /\n"
+        "&loading control = 'load', normalised_pressure = 0.15 /\n"
+        "&solver tol = 1e-13 /\n"
+        f"&output file = '{output}', overwrite = .true., stress = .false. /\n")
+    return nml
+
+
+def run_serial(nml: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([executable(), str(nml)], cwd=nml.parent, capture_output=True, text=True,
+                          env=serial_env(), timeout=600)
+
+
+def run_mpi(ranks: int, command: list[str], cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), *command], cwd=cwd, capture_output=True,
+                          text=True, env=launcher_env(), timeout=600)
+
+
+def read(path: Path) -> tuple[dict[str, np.ndarray], dict[str, object], int]:
+    with h5py.File(path, "r") as f:
+        fields = {k: np.asarray(v) for k, v in f["fields"].items()}
+        # (the profile: made on the slabs by the distributed c2r, gathered to rank 0)
+        fields["profile height"] = np.asarray(f["profile/height"])
+        scalars = dict(f["results"].attrs)
+        ranks = int(f.attrs["mpi_ranks"])
+    return fields, scalars, ranks
+
+
+def assert_same(serial: Path, distributed: Path) -> None:
+    fields_1, scalars_1, ranks_1 = read(serial)
+    fields_p, scalars_p, _ = read(distributed)
+    assert ranks_1 == 1
+    assert set(fields_1) == set(fields_p)
+    for name, field in fields_1.items():
+        scale = max(np.max(np.abs(field)), np.finfo(float).tiny)
+        assert np.max(np.abs(fields_p[name] - field)) <= SAME * scale, name
+    for name, value in scalars_1.items():
+        if name in NOT_COMPARED:
+            continue
+        other = scalars_p[name]
+        if isinstance(value, (bytes, str)):
+            assert other == value, name
+            continue
+        a, b = np.asarray(value, float), np.asarray(other, float)
+        assert np.all(np.abs(a - b) <= SAME * np.abs(a) + VANISHING), name
+
+
+@needs_mpi
+@pytest.mark.parametrize("scene", sorted(SCENES))
+def test_distributed_runs_give_the_serial_answer(scene, tmp_path):
+    """P = 1..4 ranks: every field and scalar of the serial run, and @mpi_ranks = P."""
+    nml = write_scene(tmp_path, scene, SIZES[scene], SCENES[scene], "serial.h5")
+    done = run_serial(nml)
+    assert done.returncode == 0, done.stderr
+    for ranks in (1, 2, 3, 4):
+        out = f"ranks{ranks}.h5"
+        nml_p = write_scene(tmp_path, f"{scene}{ranks}", SIZES[scene], SCENES[scene], out)
+        done = run_mpi(ranks, [executable(), str(nml_p)], tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert_same(tmp_path / "serial.h5", tmp_path / out)
+        with h5py.File(tmp_path / out, "r") as f:
+            assert int(f.attrs["mpi_ranks"]) == ranks
+            assert int(f["results"].attrs["mpi_ranks"]) == ranks
+            if ranks > 1:
+                assert "distributed runs use gcr/cg" in f["results"].attrs["solver_reason"].decode()
+        # one summary, from rank 0
+        assert done.stdout.count("result file") == 1
+
+
+@needs_mpi
+def test_observables_of_the_whole_map_on_rank_0(tmp_path):
+    """Surface stress, leakage, conductance and stiffness need the whole map: rank 0
+    computes them from the gathered fields, the serial run's values (stress fields too)."""
+    body = SCENES["coupled"].replace("coefficient = 0.5", "coefficient = 0.5, companion = .true.")
+    for name, out in (("serial", "serial.h5"), ("ranks", "ranks2.h5")):
+        nml = write_scene(tmp_path, name, 64, body, out)
+        nml.write_text(nml.read_text().replace("stress = .false.", "stress = .true., leakage = .true., "
+                                                "conductance = .true."))
+    assert run_serial(tmp_path / "serial.nml").returncode == 0
+    done = run_mpi(2, [executable(), str(tmp_path / "ranks.nml")], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert_same(tmp_path / "serial.h5", tmp_path / "ranks2.h5")
+    with h5py.File(tmp_path / "ranks2.h5", "r") as f, h5py.File(tmp_path / "serial.h5", "r") as g:
+        assert f["results"].attrs["conductance"] > 0 and f["results"].attrs["contact_stiffness"] > 0
+        assert any("stress" in name for name in f["fields"])
+        for name, value in g["leakage"].attrs.items():
+            # (its time, and its CG's residuals at the leakage tolerance, are not the answer)
+            if np.asarray(value).dtype.kind == "f" and not name.startswith(("wall_time", "residual")):
+                assert np.all(np.abs(f["leakage"].attrs[name] - value) <= SAME * np.abs(value) + VANISHING), name
+
+
+@needs_mpi
+def test_python_run_under_mpirun_gives_the_serial_answer(tmp_path):
+    """`mpirun -n P python -m layercontact run` (the same library routine, in-process)."""
+    nml = write_scene(tmp_path, "coupled", 64, SCENES["coupled"], "serial.h5")
+    assert run_serial(nml).returncode == 0
+    for ranks in (2, 3):
+        out = f"python{ranks}.h5"
+        nml_p = write_scene(tmp_path, f"python{ranks}", 64, SCENES["coupled"], out)
+        done = run_mpi(ranks, [sys.executable, "-m", "layercontact", "run", str(nml_p), "--no-png"], tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert_same(tmp_path / "serial.h5", tmp_path / out)
+        assert read(tmp_path / out)[2] == ranks
+
+
+@needs_mpi
+def test_too_many_ranks_for_the_rows_are_refused(tmp_path):
+    """ny = 6 on 4 ranks leaves the last without rows (blocks of 2): exit 2 before any work,
+    naming the variable, its value and the largest count allowed (3), one message, no file."""
+    nml = tmp_path / "few.nml"
+    nml.write_text("&scene geometry = 'areal', nx = 8, ny = 6 /\n&loading normalised_pressure = 0.1 /\n"
+                   "&output file = 'few.h5' /\n")
+    done = run_mpi(4, [executable(), str(nml)], tmp_path)
+    assert done.returncode == 2, done.stderr
+    assert "&scene ny = 6" in done.stderr and "at most 3 ranks" in done.stderr
+    assert done.stderr.count("layercontact: error:") == 1
+    assert not (tmp_path / "few.h5").exists()
+    # 3 ranks (2 rows each) are allowed
+    done = run_mpi(3, [executable(), str(nml)], tmp_path)
+    assert done.returncode == 0, done.stderr
+
+
+@needs_mpi
+def test_line_scenes_are_refused_on_several_ranks(tmp_path):
+    nml = tmp_path / "line.nml"
+    nml.write_text("&scene geometry = 'line', n = 256 /\n&loading normalised_pressure = 0.1 /\n"
+                   "&output file = 'line.h5' /\n")
+    done = run_mpi(2, [executable(), str(nml)], tmp_path)
+    assert done.returncode == 2
+    assert "line scenes run on one rank" in done.stderr
+    assert not (tmp_path / "line.h5").exists()
+    done = run_mpi(2, [sys.executable, "-m", "layercontact", "run", str(nml), "--no-png"], tmp_path)
+    assert done.returncode == 2
+    assert done.stderr.count("line scenes run on one rank") == 1
+
+
+@needs_mpi
+def test_a_failure_on_one_rank_ends_the_job_with_its_code(tmp_path):
+    """Rank 1 alone has too little address space for its slab (ulimit -v): it fails the
+    memory check (code 5), and the job ends with exit 5 and its message; the result file of
+    an earlier run is left as it was (rank 0 writes to a temporary file and renames)."""
+    nml = write_scene(tmp_path, "big", 1024, SCENES["coupled"], "big.h5")
+    (tmp_path / "big.h5").write_bytes(b"")
+    earlier = h5py.File(tmp_path / "big.h5", "w")
+    earlier.attrs["earlier"] = 1
+    earlier.close()
+    before = (tmp_path / "big.h5").read_bytes()
+    wrapper = tmp_path / "rank1_limited.sh"
+    wrapper.write_text('#!/bin/sh\nif [ "$OMPI_COMM_WORLD_RANK" = 1 ]; then ulimit -v 450000; fi\nexec "$@"\n')
+    wrapper.chmod(0o755)
+    done = run_mpi(2, [str(wrapper), executable(), str(nml)], tmp_path)
+    assert done.returncode == 5, done.stderr
+    assert "error on MPI rank 1 of 2" in done.stderr
+    assert (tmp_path / "big.h5").read_bytes() == before
