@@ -150,3 +150,29 @@ def test_gfmd_on_a_coupled_line():
     stiffness = np.max(1 / np.abs(t[..., 2, 2] + 0.5 * t[..., 2, 0]))
     bound = 2 * (TOL + 1e-13) * (stiffness * np.ptp(r) + P_M)
     assert np.max(np.abs(dyn.pressure - ref.pressure)) <= bound
+
+
+SLS = lc.StandardLinearSolid(e0=1.0, e_inf=10.0, tau=1.0)
+
+
+def test_gfmd_on_a_sliding_viscoelastic_layer_with_friction():
+    """A standard linear solid sliding slowly (k V tau ~ 1e-2: |Im G_n|/Re G_n small) with
+    friction: the contact of the default solver, pressures to the bound of the two tolerances
+    (pressure_bound with the glassy modulus E_inf = 10 E0, whose stiffness bounds the
+    viscoelastic layer's: |J*| >= 1/E_inf)."""
+    h = surface(n=32)
+    keys = dict(thickness=0.5, poisson=0.3, friction=0.5, material=SLS, speed=1e-3, mean_pressure=P_M, stress=False)
+    ref = lc.solve_areal(h, tol=1e-13, **keys)
+    dyn = lc.solve_areal(h, tol=TOL, method="gfmd", max_iter=20000, **keys)
+    assert dyn.solver == "gfmd" and dyn.converged and dyn.residual <= TOL
+    bound = SLS.e_inf / SLS.e0 * pressure_bound(h, 0.5, 0.3, 0.5, TOL + 1e-13)
+    assert np.max(np.abs(dyn.pressure - ref.pressure)) <= bound
+
+
+def test_gfmd_refuses_a_lossy_sliding_layer():
+    """At k V tau ~ 1 the loss gives the response to the pressure itself a phase
+    (|Im G_n|/Re G_n = 1.1 here), which no update of the friction traction removes: refused
+    before any step, naming the default method."""
+    with pytest.raises(lc.InputError, match="'gfmd' cannot solve this scene.*Im G_n.*'auto' \\(the default method\\)"):
+        lc.solve_areal(surface(n=32), thickness=0.5, poisson=0.3, friction=0.3, material=SLS, speed=1.0,
+                       mean_pressure=P_M, method="gfmd")
