@@ -327,26 +327,37 @@ contains
 
    !> The operator's multiplier split into the normal response to the pressure, G_n, and
    !> to the friction traction, G_x: G_eff = G_n + mu_c G_x (the operator's modes; G_x = 0
-   !> for a symmetric operator). A Nyquist column mode takes the mirror average (the real
-   !> part), as the operator's G_eff does; the uniform mode is the operator's.
+   !> for a symmetric operator). Where the layer's factors 1-A and c are real (one layer,
+   !> or a stack of elastic layers) G_eff/C = (2/|q|)((1-A) - i mu_c c q_x/|q|) splits into
+   !> its real and imaginary parts, from the operator's multiplier alone; elsewhere, and on
+   !> a Nyquist column (whose multiplier is the mirror average, the real part, of each),
+   !> from the layer's factors. The uniform mode is the operator's.
    subroutine split_multiplier(op, normal, tangential)
       type(compliance_operator), intent(in) :: op
       complex(wp), allocatable, intent(out) :: normal(:), tangential(:)
-      complex(wp) :: one_minus_a, one_minus_b, c, t, compliance
+      complex(wp) :: one_minus_a, one_minus_b, c, t, compliance, reduced
       real(wp) :: qx, qy, q
       integer :: i, mx
+      logical :: real_factors
       allocate (normal(op%nk), tangential(op%nk))
       tangential = (0.0_wp, 0.0_wp)
       if (.not. op%coupled) then
          normal = op%metric
          return
       end if
+      real_factors = .not. (op%kernel%layered .and. op%kernel%viscoelastic)
       normal(1) = op%full(1)
       do i = 2, op%nk
          call op%column_mode(i, qx, qy, mx)
+         compliance = op%compliance(mx + 1)
+         if (real_factors .and. 2*mx /= op%grid%nx .and. compliance /= (0.0_wp, 0.0_wp)) then
+            reduced = op%full(i)/compliance
+            normal(i) = compliance*real(reduced, wp)
+            if (op%friction > 0.0_wp) tangential(i) = compliance*cmplx(0.0_wp, aimag(reduced), wp)/op%friction
+            cycle
+         end if
          q = hypot(qx, qy)
          call op%kernel%factors(q, qx, one_minus_a, one_minus_b, c, t)
-         compliance = op%compliance(mx + 1)
          normal(i) = 2.0_wp/q*compliance*one_minus_a
          tangential(i) = -(0.0_wp, 2.0_wp)/q*compliance*c*(qx/q)
          if (2*mx == op%grid%nx) then
