@@ -123,7 +123,7 @@ contains
       real(wp), intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
       complex(wp), allocatable :: normal(:), tangential(:), stiffness(:), coupling(:), update_preconditioner(:)
-      real(wp), allocatable :: u(:), v(:), a(:), rho(:), lambda(:), p_best(:)
+      real(wp), allocatable :: u(:), v(:), a(:), lambda(:), p_best(:)
       real(wp), allocatable :: tau(:), offset(:), step_tau(:), tau_old(:), step_old(:), tx(:), dx(:, :), df(:, :)
       real(wp), allocatable :: gram(:, :), gamma(:), projection(:)
       real(wp), pointer, contiguous :: buffer(:)
@@ -144,8 +144,9 @@ contains
          stiffness = (0.0_wp, 0.0_wp)
          coupling = (0.0_wp, 0.0_wp)
       end where
+      deallocate (normal, tangential)   ! (the solve's memory: stiffness and coupling suffice)
       buffer => op%buffer()
-      allocate (u(n), v(n), a(n), rho(n), lambda(n), tau(n), offset(n))
+      allocate (u(n), v(n), a(n), lambda(n), tau(n), offset(n))
       b_max = maxval(abs(b))
       uniform = merge(mean_pressure, 0.0_wp, load_control)
       mass = maxval(abs(stiffness))
@@ -165,7 +166,7 @@ contains
          outcome%fft_pairs = outcome%fft_pairs + 1
          allocate (step_tau(n), tau_old(n), step_old(n), tx(n), dx(n, update_memory), df(n, update_memory))
          allocate (gram(update_memory, update_memory), gamma(update_memory), projection(update_memory))
-         allocate (update_preconditioner(size(normal)))
+         allocate (update_preconditioner(size(stiffness)))
       end if
       if (load_control) s = minval(u - b)
       u = max(u, b + s)
@@ -192,8 +193,7 @@ contains
          do j = 1, n
             buffer(j) = buffer(j) - offset(j) + uniform
             lambda(j) = merge(max(buffer(j), 0.0_wp), 0.0_wp, u(j) <= b(j) + s)
-            rho(j) = buffer(j) - lambda(j)
-            a(j) = -rho(j)/mass
+            a(j) = -(buffer(j) - lambda(j))/mass   ! -rho/m
          end do
          ! FIRE: mix the velocity towards the force, grow the step while the power is
          ! positive, stop and shrink it when it turns negative
@@ -247,7 +247,7 @@ contains
             ! the dynamics has relaxed the problem of the current traction well enough
             ! against what the traction itself is off by: update it
             since_update = since_update + 1
-            imbalance = maxval(abs(rho))
+            imbalance = mass*maxval(abs(a))   ! max |rho|
             mismatch = maxval(abs(friction*lambda - tau))
             if (mismatch > mismatch_floor .and. &
                & (imbalance <= update_ratio*mismatch .or. since_update >= update_max_steps)) then
