@@ -104,6 +104,7 @@ module lc_contact_operator
       procedure :: prepare_gcr
       procedure :: full_in_buffer
       procedure :: inverse_full_in_buffer
+      procedure :: multiply_complex_in_buffer
       procedure :: drop_uniform_mode
    end type compliance_operator
 
@@ -605,7 +606,8 @@ contains
       call multiply_complex_in_buffer(self, self%inverse_full)
    end subroutine inverse_full_in_buffer
 
-   !> fft%real_buffer <- multiplier * fft%real_buffer with a complex multiplier.
+   !> fft%real_buffer <- multiplier * fft%real_buffer with a complex multiplier on the half
+   !> spectrum (for a solver's own multipliers of the scene: lc_contact_solver_gfmd).
    subroutine multiply_complex_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
       complex(wp), contiguous, intent(in) :: multiplier(:)

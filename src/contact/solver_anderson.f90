@@ -23,6 +23,8 @@ module lc_contact_solver_anderson
    implicit none (type, external)
    private
    public :: anderson_coupled, anderson_outcome, anderson_solver
+   !> the mixing's passes and small least-squares problem (also for lc_contact_solver_gfmd)
+   public :: least_squares, history_products, mix
 
    !> Rows per block of the sweeps over the history (a few columns' blocks fit in L1/L2).
    integer, parameter :: block_rows = 2048

@@ -2,40 +2,55 @@
 !> against a hard wall, with FIRE (Campañá and Müser, Phys. Rev. B 74, 075420, for GFMD;
 !> Bitzek, Koskinen, Gähler, Moseler and Gumbsch, Phys. Rev. Lett. 97, 170201, for FIRE).
 !>
-!> The surface displacement u (= w) moves under the elastic force of the layer, the
-!> pressure p = K u per mode (K = 1/G_eff, the operator's stiffness; with friction the
-!> shear traction mu_c p is the in-plane load that G_eff contains, so the force is not the
-!> gradient of an energy), and the load; the rigid surface is a hard wall at a fixed
-!> position, u_j >= b_j + s, enforced by projection after each step. Under load control
-!> the uniform mode of u has no stiffness and the mean pressure p_m pushes the surface
-!> against the wall: p = K u + p_m. The wall carries lambda = max(p, 0) where u touches it;
-!> the unbalanced pressure rho = p - lambda drives the motion,
+!> The layer's normal response splits into the response to the pressure and to the friction
+!> traction tau = mu_c p, w = G_n p + G_x tau (convention P, lc_contact_operator:
+!> G_n = 2C(1-A)/|q|, G_x = -i 2C c q_x/|q|^2; G_eff = G_n + mu_c G_x). The surface
+!> displacement u (= w) moves under the elastic force of the layer, the pressure
+!> p = K_n (u - G_x tau) per mode (K_n = 1/G_n, symmetric for an elastic layer), and the
+!> load; the rigid surface is a hard wall at a fixed position, u_j >= b_j + s, enforced by
+!> projection after each step. Under load control the uniform mode of u has no stiffness
+!> and the mean pressure p_m pushes the surface against the wall: p = K_n (u - G_x tau) + p_m.
+!> The wall carries lambda = max(p, 0) where u touches it; the unbalanced pressure
+!> rho = p - lambda drives the motion,
 !>    m d2u/dt2 = -rho,
 !> with one mass m for every node, the largest stiffness of a mode, so that the stiffest
 !> mode has unit frequency; FIRE's damped semi-implicit Euler steps integrate it. A mass
 !> per mode equal to its stiffness (all modes at one frequency) is not used: with the
 !> wall's projection in real space it makes FIRE's step collapse (docs/decisions).
 !>
-!> Convergence is judged, as for the other solvers, on the complementarity residual of the
-!> pressure the wall carries (p = lambda, w = G_eff p, gap = w - b - s), not on an energy.
-!> A step costs one transform pair, a check one more.
+!> Friction. For the dynamics the friction traction is an external in-plane load on the
+!> contact nodes, held between updates, so the dynamics relaxes a symmetric problem (with tau in the stiffness, the
+!> force mu_c p is a follower force and FIRE stalls once mu_c |G_x|/G_n passes ~0.5). The
+!> traction is updated towards its fixed point tau = mu_c lambda whenever the dynamics has
+!> relaxed the current problem to a fraction update_ratio of the update's own mismatch
+!> max|mu_c lambda - tau| (an inexact inner relaxation; the velocities are kept). On a
+!> fixed contact set the plain update tau <- mu_c lambda has the eigenvalues +-i beta
+!> (beta = mu_c |G_x|/G_n up to 4.7 on the paper's thin layers), so the update is
+!> preconditioned per mode by the full-contact Jacobian 1 + a mu_c G_x/G_n, a the contact
+!> fraction of the moment (1 at full contact, where it is exact; ~identity at sparse
+!> contact, where the contact set decouples the modes), and accelerated by Anderson mixing
+!> (Walker and Ni) over the last update_memory updates. An update costs two transform
+!> pairs (docs/decisions/001-gfmd-masses.md, docs/numerics.md).
 !>
-!> The stiffness 1/G_eff of a coupled scene has a phase on each mode: the friction (or the
-!> loss of a sliding viscoelastic layer) makes it a follower force, and FIRE's damping
-!> relaxes the dynamics only while |Im G_eff|/Re G_eff stays small. gfmd_refusal measures
-!> that ratio on the operator before any step and refuses the scenes beyond the measured
-!> limit max_stiffness_phase (docs/decisions/001-gfmd-masses.md), naming the methods that
-!> solve them.
+!> Convergence is judged, as for the other solvers, on the complementarity residual of the
+!> pressure the wall carries (p = lambda, w = G_eff lambda, gap = w - b - s), not on an
+!> energy. A step costs one transform pair, a check one more.
+!>
+!> The loss of a sliding viscoelastic layer gives G_n itself a phase, which no traction
+!> update removes: gfmd_refusal measures |Im G_n|/Re G_n on the operator before any step
+!> and refuses the scenes beyond max_stiffness_phase, and the friction ratio
+!> mu_c |G_x|/|G_n| beyond max_friction_ratio, naming the methods that solve them.
 module lc_contact_solver_gfmd
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type
+   use lc_base_strings, only: formatted
    use lc_contact_operator, only: compliance_operator
    use lc_contact_residual, only: complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
-   use lc_base_errors, only: error_type
-   use lc_base_strings, only: formatted
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
+   use lc_contact_solver_anderson, only: least_squares, history_products, mix
    implicit none (type, external)
    private
    public :: gfmd, gfmd_outcome, gfmd_solver, gfmd_refusal
@@ -50,15 +65,28 @@ module lc_contact_solver_gfmd
    real(wp), parameter :: dt_start = 0.25_wp, dt_max = 1.0_wp
    !> Steps between two convergence checks (a check costs one transform pair).
    integer, parameter :: check_interval = 10
-   !> The largest |Im G_eff|/Re G_eff over the modes that the dynamics is given: measured
-   !> between the scenes that relax (ratio up to 0.47) and those that creep, stall or grow
-   !> (from 0.61) (docs/decisions/001-gfmd-masses.md).
+   !> The largest |Im G_n|/Re G_n over the modes (the loss of a sliding viscoelastic
+   !> layer): measured between the scenes that relax (ratio up to 0.47) and those that
+   !> creep, stall or grow (from 0.61) (docs/decisions/001-gfmd-masses.md).
    real(wp), parameter :: max_stiffness_phase = 0.5_wp
+   !> The largest friction ratio mu_c |G_x|/|G_n| over the modes that the traction update
+   !> relaxes: measured between the Fig. 3 scenes that converge and those that stall
+   !> (docs/decisions/001-gfmd-masses.md).
+   real(wp), parameter :: max_friction_ratio = 6.0_wp
+   !> The traction is updated once the largest unbalanced pressure is below this fraction
+   !> of the update's mismatch max|mu_c lambda - tau| (measured: 0.3 against 0.1 and 0.03
+   !> at h/lambda = 0.05, mu_c = 1: 1085 against 1206 and 1419 steps at 2 % contact, 539
+   !> against 799 and 1190 at 32 %), or after update_max_steps steps at the latest.
+   real(wp), parameter :: update_ratio = 0.3_wp
+   integer, parameter :: update_max_steps = 500
+   !> Updates the Anderson mixing of the traction remembers.
+   integer, parameter :: update_memory = 10
 
    !> What one GFMD solve did.
    type :: gfmd_outcome
       logical :: converged = .false.
       integer :: iterations = 0      !< time steps
+      integer :: updates = 0         !< updates of the friction traction
       integer :: checks = 0          !< convergence checks (the entries of the history)
       integer :: fft_pairs = 0
       real(wp) :: residual = huge(1.0_wp)
@@ -79,7 +107,8 @@ contains
    !> solution out (the best checked state if not converged); w = G_eff p; gap.
    !> history(k) receives the residual of the k-th check (every check_interval steps) when
    !> present.
-   subroutine gfmd(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, history, progress)
+   subroutine gfmd(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, error, &
+         & history, progress)
       type(compliance_operator), intent(inout) :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -90,44 +119,81 @@ contains
       real(wp), contiguous, intent(inout) :: p(:)
       real(wp), contiguous, intent(out) :: w(:), gap(:)
       type(gfmd_outcome), intent(out) :: outcome
+      type(error_type), allocatable, intent(out) :: error
       real(wp), intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
-      real(wp), allocatable :: u(:), v(:), a(:), rho(:), lambda(:), p_best(:)
+      complex(wp), allocatable :: normal(:), tangential(:), stiffness(:), coupling(:), update_preconditioner(:)
+      real(wp), allocatable :: u(:), v(:), a(:), lambda(:), p_best(:)
+      real(wp), allocatable :: tau(:), offset(:), step_tau(:), tau_old(:), step_old(:), tx(:), dx(:, :), df(:, :)
+      real(wp), allocatable :: gram(:, :), gamma(:), projection(:)
       real(wp), pointer, contiguous :: buffer(:)
-      real(wp) :: dt, alpha, power, v_norm, a_norm, s_best, uniform, b_max, mass, residual
-      integer :: step, since_negative, checks, n, j
+      real(wp) :: dt, alpha, power, v_norm, a_norm, s_best, uniform, b_max, mass, residual, friction
+      real(wp) :: imbalance, mismatch, mismatch_floor, contact_fraction
+      integer :: step, since_negative, checks, n, j, since_update, columns, newest
+      logical :: with_traction
 
       n = size(p)
-      call op%prepare_gcr()   ! the stiffness 1/G_eff
+      friction = op%friction
+      call split_multiplier(op, normal, tangential)
+      with_traction = friction > 0.0_wp .and. any(tangential /= (0.0_wp, 0.0_wp))
+      allocate (stiffness(size(normal)), coupling(size(normal)))
+      where (normal /= (0.0_wp, 0.0_wp))
+         stiffness = 1.0_wp/normal
+         coupling = tangential/normal
+      elsewhere
+         stiffness = (0.0_wp, 0.0_wp)
+         coupling = (0.0_wp, 0.0_wp)
+      end where
+      deallocate (normal, tangential)   ! (the solve's memory: stiffness and coupling suffice)
       buffer => op%buffer()
-      allocate (u(n), v(n), a(n), rho(n), lambda(n))
+      allocate (u(n), v(n), a(n), lambda(n), tau(n), offset(n))
       b_max = maxval(abs(b))
       uniform = merge(mean_pressure, 0.0_wp, load_control)
-      mass = maxval(abs(op%inverse_full))
-      ! start from the displacement of the guess; under load control the wall is placed
-      ! where it touches the highest point of the gap, and the load moves the surface
+      mass = maxval(abs(stiffness))
+      ! start from the displacement of the guess (its friction traction held); under load
+      ! control the wall is placed where it touches the highest point of the gap, and the
+      ! load moves the surface
       p = max(p, 0.0_wp)
       call op%apply_full(p, u)
+      outcome%fft_pairs = outcome%fft_pairs + 1
+      tau = 0.0_wp
+      offset = 0.0_wp
+      if (with_traction) then
+         tau = friction*p
+         buffer = tau
+         call op%multiply_complex_in_buffer(coupling)
+         offset = buffer
+         outcome%fft_pairs = outcome%fft_pairs + 1
+         allocate (step_tau(n), tau_old(n), step_old(n), tx(n), dx(n, update_memory), df(n, update_memory))
+         allocate (gram(update_memory, update_memory), gamma(update_memory), projection(update_memory))
+         allocate (update_preconditioner(size(stiffness)))
+      end if
       if (load_control) s = minval(u - b)
       u = max(u, b + s)
       v = 0.0_wp
       dt = dt_start
       alpha = fire_alpha0
       since_negative = 0
+      since_update = 0
+      columns = 0
+      newest = 0
       checks = 0
       p_best = p
       s_best = s
+      ! below this mismatch the traction is left as it is (the residual's rounding level)
+      mismatch_floor = 0.01_wp*tol*max(mean_pressure, maxval(p), tiny(1.0_wp))*friction
 
       do step = 1, max_iter
-         ! the layer's reaction p = K u (+ p_m), what the wall carries and what is left
+         ! the layer's reaction p = K_n u - K_n G_x tau (+ p_m), what the wall carries and
+         ! what is left
          buffer = u
-         call op%inverse_full_in_buffer()
+         call op%multiply_complex_in_buffer(stiffness)
          outcome%fft_pairs = outcome%fft_pairs + 1
          !$omp simd
          do j = 1, n
-            lambda(j) = merge(max(buffer(j) + uniform, 0.0_wp), 0.0_wp, u(j) <= b(j) + s)
-            rho(j) = buffer(j) + uniform - lambda(j)
-            a(j) = -rho(j)/mass
+            buffer(j) = buffer(j) - offset(j) + uniform
+            lambda(j) = merge(max(buffer(j), 0.0_wp), 0.0_wp, u(j) <= b(j) + s)
+            a(j) = -(buffer(j) - lambda(j))/mass   ! -rho/m
          end do
          ! FIRE: mix the velocity towards the force, grow the step while the power is
          ! positive, stop and shrink it when it turns negative
@@ -176,6 +242,20 @@ contains
             ! (a dynamics that blew up cannot recover)
             if (residual <= tol .or. .not. ieee_is_finite(power)) exit
          end if
+
+         if (with_traction) then
+            ! the dynamics has relaxed the problem of the current traction well enough
+            ! against what the traction itself is off by: update it
+            since_update = since_update + 1
+            imbalance = mass*maxval(abs(a))   ! max |rho|
+            mismatch = maxval(abs(friction*lambda - tau))
+            if (mismatch > mismatch_floor .and. &
+               & (imbalance <= update_ratio*mismatch .or. since_update >= update_max_steps)) then
+               call update_traction()
+               if (allocated(error)) return
+               since_update = 0
+            end if
+         end if
       end do
       outcome%converged = outcome%residual <= tol
       outcome%checks = checks
@@ -202,26 +282,122 @@ contains
          ! the load the wall carries must be the given one
          if (load_control) res = max(res, abs(sum(pressure)/n - mean_pressure)/mean_pressure)
       end subroutine check
+
+      !> tau <- the Anderson mixing of the preconditioned updates tau + P_a^-1 (mu_c lambda - tau),
+      !> P_a = 1 + a mu_c G_x/G_n (a: the contact fraction), and the offset K_n G_x tau of the
+      !> new traction (two transform pairs).
+      subroutine update_traction()
+         outcome%updates = outcome%updates + 1
+         contact_fraction = count(lambda > 0.0_wp)/real(n, wp)
+         update_preconditioner = 1.0_wp/(1.0_wp + (contact_fraction*friction)*coupling)
+         !$omp simd
+         do j = 1, n
+            buffer(j) = friction*lambda(j) - tau(j)
+         end do
+         call op%multiply_complex_in_buffer(update_preconditioner)
+         step_tau = buffer
+         if (outcome%updates > 1) then
+            newest = mod(newest, update_memory) + 1
+            columns = min(columns + 1, update_memory)
+            !$omp simd
+            do j = 1, n
+               dx(j, newest) = tau(j) - tau_old(j)
+               df(j, newest) = step_tau(j) - step_old(j)
+            end do
+         end if
+         tau_old = tau
+         step_old = step_tau
+         tx = tau + step_tau
+         if (columns == 0) then
+            tau = tx
+         else
+            call history_products(df(:, 1:columns), newest, step_tau, gram(1:columns, newest), &
+               & projection(1:columns))
+            gram(newest, 1:columns) = gram(1:columns, newest)
+            call least_squares(gram(1:columns, 1:columns), projection(1:columns), gamma(1:columns), error)
+            if (allocated(error)) return
+            call mix(tx, dx(:, 1:columns), df(:, 1:columns), gamma(1:columns), tau)
+         end if
+         buffer = tau
+         call op%multiply_complex_in_buffer(coupling)
+         offset = buffer
+         outcome%fft_pairs = outcome%fft_pairs + 2
+      end subroutine update_traction
    end subroutine gfmd
 
+   !> The operator's multiplier split into the normal response to the pressure, G_n, and
+   !> to the friction traction, G_x: G_eff = G_n + mu_c G_x (the operator's modes; G_x = 0
+   !> for a symmetric operator). Where the layer's factors 1-A and c are real (one layer,
+   !> or a stack of elastic layers) G_eff/C = (2/|q|)((1-A) - i mu_c c q_x/|q|) splits into
+   !> its real and imaginary parts, from the operator's multiplier alone; elsewhere, and on
+   !> a Nyquist column (whose multiplier is the mirror average, the real part, of each),
+   !> from the layer's factors. The uniform mode is the operator's.
+   subroutine split_multiplier(op, normal, tangential)
+      type(compliance_operator), intent(in) :: op
+      complex(wp), allocatable, intent(out) :: normal(:), tangential(:)
+      complex(wp) :: one_minus_a, one_minus_b, c, t, compliance, reduced
+      real(wp) :: qx, qy, q
+      integer :: i, mx
+      logical :: real_factors
+      allocate (normal(op%nk), tangential(op%nk))
+      tangential = (0.0_wp, 0.0_wp)
+      if (.not. op%coupled) then
+         normal = op%metric
+         return
+      end if
+      real_factors = .not. (op%kernel%layered .and. op%kernel%viscoelastic)
+      normal(1) = op%full(1)
+      do i = 2, op%nk
+         call op%column_mode(i, qx, qy, mx)
+         compliance = op%compliance(mx + 1)
+         if (real_factors .and. 2*mx /= op%grid%nx .and. compliance /= (0.0_wp, 0.0_wp)) then
+            reduced = op%full(i)/compliance
+            normal(i) = compliance*real(reduced, wp)
+            if (op%friction > 0.0_wp) tangential(i) = compliance*cmplx(0.0_wp, aimag(reduced), wp)/op%friction
+            cycle
+         end if
+         q = hypot(qx, qy)
+         call op%kernel%factors(q, qx, one_minus_a, one_minus_b, c, t)
+         normal(i) = 2.0_wp/q*compliance*one_minus_a
+         tangential(i) = -(0.0_wp, 2.0_wp)/q*compliance*c*(qx/q)
+         if (2*mx == op%grid%nx) then
+            normal(i) = real(normal(i), wp)
+            tangential(i) = real(tangential(i), wp)
+         end if
+      end do
+   end subroutine split_multiplier
+
    !> Why the damped dynamics cannot relax the scene of `op` ('' if it can): the ratio
-   !> |Im G_eff|/Re G_eff of some mode exceeds max_stiffness_phase.
+   !> |Im G_n|/Re G_n of some mode exceeds max_stiffness_phase (the loss of a sliding
+   !> viscoelastic layer), or the friction ratio mu_c |G_x|/|G_n| exceeds max_friction_ratio.
    function gfmd_refusal(op) result(refusal)
       type(compliance_operator), intent(in) :: op
       character(len=:), allocatable :: refusal
+      complex(wp), allocatable :: normal(:), tangential(:)
       real(wp) :: ratio
       refusal = ''
       if (.not. op%coupled) return
-      ratio = stiffness_phase(op%full)
-      if (ratio <= max_stiffness_phase) return
-      if (ratio < huge(1.0_wp)) then
-         refusal = 'its stiffness 1/G_eff is far from symmetric, |Im G_eff|/Re G_eff reaches ' // &
-            & formatted(ratio, '(g0.3)') // ' on a mode'
-      else
-         refusal = 'its stiffness 1/G_eff is far from symmetric, Re G_eff <= 0 on a mode'
+      call split_multiplier(op, normal, tangential)
+      ratio = stiffness_phase(normal)
+      if (ratio > max_stiffness_phase) then
+         if (ratio < huge(1.0_wp)) then
+            refusal = "its stiffness 1/G_n (the layer's normal response without friction) is far from symmetric, " // &
+               & '|Im G_n|/Re G_n reaches ' // formatted(ratio, '(g0.3)') // ' on a mode'
+         else
+            refusal = "its stiffness 1/G_n (the layer's normal response without friction) is far from symmetric, " // &
+               & 'Re G_n <= 0 on a mode'
+         end if
+         refusal = refusal // ' (the loss acts as a follower force; the damped dynamics relaxes up to ' // &
+            & formatted(max_stiffness_phase, '(g0.2)') // ')'
+         return
       end if
-      refusal = refusal // ' (the friction or the loss acts as a follower force; the damped dynamics relaxes up to ' // &
-         & formatted(max_stiffness_phase, '(g0.2)') // ')'
+      ratio = op%friction*friction_ratio(normal, tangential)
+      if (ratio > max_friction_ratio) then
+         refusal = 'its friction ratio mu_c |G_x|/|G_n| (the normal response to the friction traction against ' // &
+            & 'that to the pressure) reaches ' // formatted(ratio, '(g0.3)') // &
+            & ' on a mode; the update of the friction traction converges up to ' // &
+            & formatted(max_friction_ratio, '(g0.2)')
+      end if
    end function gfmd_refusal
 
    !> The largest |Im g|/Re g over the multipliers g /= 0 (huge where Re g <= 0).
@@ -239,6 +415,16 @@ contains
       end do
    end function stiffness_phase
 
+   !> The largest |g_x|/|g_n| over the modes with g_n /= 0.
+   pure real(wp) function friction_ratio(g_n, g_x) result(ratio)
+      complex(wp), intent(in) :: g_n(:), g_x(:)
+      integer :: i
+      ratio = 0.0_wp
+      do i = 1, size(g_n)
+         if (g_n(i) /= (0.0_wp, 0.0_wp)) ratio = max(ratio, abs(g_x(i))/abs(g_n(i)))
+      end do
+   end function friction_ratio
+
    !> s = the mean of w - b over the contact set (p > 0): the wall position the contact
    !> points agree on (unchanged without contact).
    pure subroutine contact_shift(p, w, b, s)
@@ -248,6 +434,7 @@ contains
       contact = count(p > 0.0_wp)
       if (contact > 0) s = sum(w - b, mask=p > 0.0_wp)/contact
    end subroutine contact_shift
+
    subroutine solve_by_gfmd(self, problem, state, budget, outcome, progress, error)
       class(gfmd_solver), intent(inout) :: self
       type(contact_problem), intent(in) :: problem
@@ -260,9 +447,10 @@ contains
       real(wp), allocatable :: history(:)
       allocate (history(budget))
       call gfmd(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
-         & problem%tol, budget, state%p, state%w, state%gap, dynamics, history, progress)
-      outcome = solve_outcome(converged=dynamics%converged, iterations=dynamics%iterations, outer_iterations=0, &
-         & fft_pairs=dynamics%fft_pairs, residual=dynamics%residual, &
+         & problem%tol, budget, state%p, state%w, state%gap, dynamics, error, history, progress)
+      if (allocated(error)) return
+      outcome = solve_outcome(converged=dynamics%converged, iterations=dynamics%iterations, &
+         & outer_iterations=dynamics%updates, fft_pairs=dynamics%fft_pairs, residual=dynamics%residual, &
          & history=history(1:min(dynamics%checks, size(history))))
    end subroutine solve_by_gfmd
 
