@@ -764,8 +764,11 @@ def test_a_scene_on_two_ranks_runs_in_a_slurm_array_task(slurm_cluster, tmp_path
     assert main(["collect", str(out)]) == 0
     summary = lc.read_summary(out / "a_summary.h5")
     assert (summary["error"] == "").all() and len(summary["error"]) == 2
-    outputs = list((out / "slurm").glob("a_001_*.out"))
-    assert len(outputs) == 2
-    for output in outputs:
+    # (a task writes its scene's record, then its exit line: wait for the line as well)
+    def exit_lines():
+        outputs = list((out / "slurm").glob("a_001_*.out"))
+        return len(outputs) == 2 and all(": exit " in output.read_text() for output in outputs)
+    wait_for(exit_lines, "the tasks' exit lines")
+    for output in (out / "slurm").glob("a_001_*.out"):
         text = output.read_text()
         assert "task ranks: 2" in text and ": exit 0 on " in text, text
