@@ -26,6 +26,8 @@ from layercontact.sweeps import status as sweep_status
 from layercontact.sweeps import sweep as sweep_module
 from layercontact.__main__ import main
 
+from areal_sweep import write_areal_sweep
+
 
 BASE = """\
 &scene
@@ -684,32 +686,6 @@ def test_a_task_removes_only_temporary_files_of_ended_runs_of_its_host(tmp_path,
 
 # ---------------------------------------------------------------------------------------
 # scenes on several MPI ranks (--ranks-per-scene)
-
-#: a small areal scene (16 x 16 points: each of 2 ranks holds 8 rows)
-AREAL_BASE = """\
-&scene
-   geometry = 'areal'
-   n = 16
-/
-&layer
-   thickness = 0.2
-   poisson = 0.5
-/
-&profile
-   kind = 'self_affine'
-   short_wavelength = 0.25
-   rms_gradient = 0.1
-/
-&loading
-   normalised_pressure = 0.2
-/
-"""
-
-
-def write_areal_sweep(directory: Path, settings: str = "", name: str = "a") -> Path:
-    path = directory / f"{name}.nml"
-    path.write_text(AREAL_BASE + f"&sweep\n directory = 'out/{name}'\n seed = 1, 2\n{settings}/\n")
-    return path
 
 
 def test_ranks_per_scene_gives_array_tasks_of_k_ranks_started_by_srun(tmp_path, monkeypatch, capsys):

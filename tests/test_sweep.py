@@ -21,6 +21,7 @@ import layercontact as lc
 from layercontact.sweeps import sweep as sweep_module
 from layercontact.__main__ import main
 from conftest import ROOT
+from areal_sweep import write_areal_sweep
 
 SWEEPS = sorted((ROOT / "inputs" / "sweeps").glob("*.nml"))
 
@@ -557,27 +558,6 @@ def test_ctrl_c_ends_the_scenes_in_flight_at_once_and_a_rerun_completes(tmp_path
     assert len(list((tmp_path / "out/s/results").glob("*.h5"))) == 2
 
 
-#: a small areal scene for sweeps of scenes on several MPI ranks
-AREAL_BASE = """\
-&scene
-   geometry = 'areal'
-   n = 16
-/
-&layer
-   thickness = 0.2
-   poisson = 0.5
-/
-&profile
-   kind = 'self_affine'
-   short_wavelength = 0.25
-   rms_gradient = 0.1
-/
-&loading
-   normalised_pressure = 0.2
-/
-"""
-
-
 def test_a_local_sweep_on_two_ranks_per_scene_runs_each_scene_under_mpirun(tmp_path, monkeypatch):
     """Each scene runs as `mpirun -n 2 layercontact SCENE.nml` (its output in logs/); the
     results equal the scenes solved in this process, to the solver's tolerance."""
@@ -590,8 +570,7 @@ def test_a_local_sweep_on_two_ranks_per_scene_runs_each_scene_under_mpirun(tmp_p
     monkeypatch.setenv("OMPI_ALLOW_RUN_AS_ROOT", "1")
     monkeypatch.setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
     monkeypatch.setenv("OMPI_MCA_rmaps_base_oversubscribe", "1")
-    path = tmp_path / "a.nml"
-    path.write_text(AREAL_BASE + "&sweep\n directory = 'out/a'\n seed = 1, 2\n/\n")
+    path = write_areal_sweep(tmp_path)
     rows = lc.sweep(path, processes=1, progress=False, ranks_per_scene=2)
     assert [row["error"] for row in rows] == ["", ""]
     for row in rows:
