@@ -210,21 +210,28 @@ def main() -> None:
           f"{ALLREDUCES_PER_ITERATION} MPI_Allreduce an iteration; node {args.node_memory:.0f} GiB, "
           f"{args.ranks_per_node} ranks a node")
     print("| n | P | serial (s) | ideal serial/P (s) | model (s) | speed-up | set-up | coarse start | "
-          "local FFT | transposes | passes | reductions | rank 0 (GiB) | other ranks (GiB) | node (GiB) |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "local FFT | transposes | passes | reductions | speed-up without the coarse start | rank 0 (GiB) | "
+          "other ranks (GiB) | node (GiB) |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for n in args.sizes:
         for ranks in args.ranks:
             t = model_time(n, ranks, coefficient, ref, args.bandwidth, args.latency)
+            serial_coarse = model_serial(n, coefficient, ref)["coarse"]
             m = model_memory(n, ranks, doubles)
             node = (m["rank0"] + (min(ranks, args.ranks_per_node) - 1) * m["other"]) / 2**30
             print(f"| {n} | {ranks} | {t['serial']:.1f} | {t['serial'] / ranks:.2f} | {t['total']:.2f} | "
                   f"{t['serial'] / t['total']:.1f} | {t['setup']:.2f} | {t['coarse']:.2f} | {t['fft']:.2f} | "
-                  f"{t['transpose']:.2f} | {t['passes']:.2f} | {t['reductions']:.3f} | {m['rank0'] / 2**30:.0f} | "
+                  f"{t['transpose']:.2f} | {t['passes']:.2f} | {t['reductions']:.3f} | "
+                  f"{(t['serial'] - serial_coarse) / (t['total'] - t['coarse']):.0f} | {m['rank0'] / 2**30:.0f} | "
                   f"{m['other'] / 2**30:.0f} | {node:.0f}{' (over)' if node > args.node_memory else ''} |")
     print()
     for n in args.sizes:
         p = coarse_dominates_from(n, coefficient, ref, args.bandwidth, args.latency)
-        print(f"{n}²: the coarse start takes over half the solve from P = {p}")
+        m = model_memory(n, max(args.ranks), doubles)
+        room = args.node_memory * 2**30 - m["rank0"]
+        fit = "rank 0 alone does not fit" if room < 0 else f"{1 + int(room // m['other'])} ranks fit on rank 0's node"
+        print(f"{n}²: the coarse start takes over half the solve from P = {p}; at P = {max(args.ranks)} "
+              f"{fit} ({m['rank0'] / 2**30:.0f} GiB rank 0, {m['other'] / 2**30:.0f} GiB each other rank)")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 
 
