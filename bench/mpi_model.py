@@ -30,8 +30,8 @@ The model (model_* functions, which take every measured part as an argument):
   coarse grid's serial solve (N/4 points at the same doubles per point), whichever is
   larger (the 2-rank peaks follow the larger, not the sum), plus on rank 0 the gathered
   fields (pressure, gap, displacement, heights: 4 doubles per point of the whole grid).
-Assumptions (flags): the iterations and pairs of the 2048² solve at every size (the
-coarse start keeps them about constant, docs/performance.md), one rank per core, no
+Assumptions (flags): the iterations, pairs and split of the 2048² solve at every size
+(they grow with the size: docs/performance.md says by how much), one rank per core, no
 overlap of communication with computation, the padding copies around each transform
 counted with the passes.
 """
@@ -46,7 +46,8 @@ import time
 # MPI_Allreduce calls in one plain GCR iteration with load control, counted in
 # src/contact/solver_gcr.f90 (evaluate: sum_over_ranks, max_over_ranks, field_points,
 # sum_over_ranks, global_max; project_on_set's set_mean; history_products; set_norm;
-# normalised_step; update; scale_to_load's field_points). An iteration that lets points
+# normalised_step; update; scale_to_load's field_points; one fewer where the compiler
+# skips merge's unused field_points). An iteration that lets points
 # in adds reorthonormalise's 3, one after a change of the set history_products,
 # clip_negative, total_pressure and another evaluate (8).
 ALLREDUCES_PER_ITERATION = 11
