@@ -177,7 +177,8 @@ def main() -> None:
     parser.add_argument("--ranks-per-node", type=int, default=64, help="(assumed)")
     parser.add_argument("--fft-coefficient", type=float, help="s per point log point (default: measured)")
     parser.add_argument("--memcpy-bandwidth", type=float, help="bytes/s on this machine (default: measured)")
-    parser.add_argument("--shared-latency", type=float, default=1e-6, help="s per message on one node (assumed)")
+    parser.add_argument("--shared-latency", type=float, default=1e-6,
+                        help="s per message on one node (assumed)")
     parser.add_argument("--reference", type=float, nargs=4, default=[2048, 12.75, 22, 64],
                         metavar=("N", "SOLVE_S", "ITERATIONS", "PAIRS"))
     parser.add_argument("--split", type=float, nargs=3, default=[0.05, 0.13, 0.82],
@@ -192,7 +193,8 @@ def main() -> None:
     coefficient = args.fft_coefficient or measure_fft_coefficient()
     memcpy = args.memcpy_bandwidth or measure_memcpy_bandwidth()
     doubles = args.serial_mib * MIB / 8.0 / ref["n"] ** 2
-    print(f"fit: {coefficient * 1e9:.3f} ns per point log point (2048² pair {pair_seconds(2048, coefficient) * 1e3:.0f} ms); "
+    print(f"fit: {coefficient * 1e9:.3f} ns per point log point "
+          f"(2048² pair {pair_seconds(2048, coefficient) * 1e3:.0f} ms); "
           f"memory copy {memcpy / 1e9:.1f} GB/s; serial peak {doubles:.1f} doubles per point")
 
     print(f"\nCheck on this machine ({ref['n']}², shared memory {memcpy / 1e9:.1f} GB/s, "
@@ -223,14 +225,16 @@ def main() -> None:
             print(f"| {n} | {ranks} | {t['serial']:.1f} | {t['serial'] / ranks:.2f} | {t['total']:.2f} | "
                   f"{t['serial'] / t['total']:.1f} | {t['setup']:.2f} | {t['coarse']:.2f} | {t['fft']:.2f} | "
                   f"{t['transpose']:.2f} | {t['passes']:.2f} | {t['reductions']:.3f} | "
-                  f"{(t['serial'] - serial_coarse) / (t['total'] - t['coarse']):.0f} | {m['rank0'] / 2**30:.0f} | "
+                  f"{(t['serial'] - serial_coarse) / (t['total'] - t['coarse']):.0f} | "
+                  f"{m['rank0'] / 2**30:.0f} | "
                   f"{m['other'] / 2**30:.0f} | {node:.0f}{' (over)' if node > args.node_memory else ''} |")
     print()
     for n in args.sizes:
         p = coarse_dominates_from(n, coefficient, ref, args.bandwidth, args.latency)
         m = model_memory(n, max(args.ranks), doubles)
         room = args.node_memory * 2**30 - m["rank0"]
-        fit = "rank 0 alone does not fit" if room < 0 else f"{1 + int(room // m['other'])} ranks fit on rank 0's node"
+        fit = ("rank 0 alone does not fit" if room < 0
+               else f"{1 + int(room // m['other'])} ranks fit on rank 0's node")
         print(f"{n}²: the coarse start takes over half the solve from P = {p}; at P = {max(args.ranks)} "
               f"{fit} ({m['rank0'] / 2**30:.0f} GiB rank 0, {m['other'] / 2**30:.0f} GiB each other rank)")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
