@@ -42,7 +42,7 @@ contains
    !> bench/memory.py measures them (docs/performance.md, 'Throughput and memory'; docs/numerics.md,
    !> 'Constants of the solvers and their measurements'), plus the in-plane fields of the
    !> stress observables.
-   pure integer(i8) function solve_bytes(points, coupled, memory, stress, multigrid, line) result(bytes)
+   pure integer(i8) function solve_bytes(points, coupled, memory, stress, multigrid, line, gfmd) result(bytes)
       integer, intent(in) :: points
       !> friction or a moving viscoelastic law: the GCR (or Anderson) history; or a frictionless
       !> line that may go to the coupled multigrid iteration (a thin incompressible layer)
@@ -51,6 +51,7 @@ contains
       logical, intent(in) :: stress
       logical, intent(in) :: multigrid   !< the multigrid solver and its coarse grids
       logical, intent(in) :: line
+      logical, intent(in) :: gfmd   !< &solver method = 'gfmd'
       integer :: doubles
       doubles = 15
       if (multigrid) doubles = merge(40, 27, line)
@@ -60,6 +61,10 @@ contains
       ! GCR's directions where a finishing phase stagnates, only where they fit in half the
       ! memory then left: not counted here)
       if (coupled .and. multigrid) doubles = max(doubles, merge(62, 66, line))
+      ! (GFMD's positions, velocities, forces and reaction, and with friction the traction's
+      ! update and its Anderson history of 10: peak resident 18.1 doubles per point
+      ! frictionless at 1024², 34.5-37.6 with friction at 1024² and 512², over the surface's)
+      if (gfmd) doubles = merge(38, 19, coupled)
       if (stress) doubles = doubles + 6
       bytes = 8_i8*doubles*points
    end function solve_bytes
@@ -97,13 +102,13 @@ contains
    end subroutine available_bytes
 
    !> Error code 5 if a solve of `points` grid points needs more than this process may use.
-   subroutine check_memory(points, coupled, memory, stress, multigrid, line, error)
+   subroutine check_memory(points, coupled, memory, stress, multigrid, line, gfmd, error)
       integer, intent(in) :: points, memory
-      logical, intent(in) :: coupled, stress, multigrid, line
+      logical, intent(in) :: coupled, stress, multigrid, line, gfmd
       type(error_type), allocatable, intent(out) :: error
       integer(i8) :: needed, available
       character(len=:), allocatable :: limit
-      needed = solve_bytes(points, coupled, memory, stress, multigrid, line)
+      needed = solve_bytes(points, coupled, memory, stress, multigrid, line, gfmd)
       call available_bytes(available, limit)
       if (needed <= available) return
       call fatal_error(error, 'not enough memory: this scene (' // to_string(points) // ' grid points) needs about ' &
