@@ -217,7 +217,7 @@ def per_scene_steps(directory: Path, name: str, sample: int) -> dict[str, float]
         local = scratch / f"{k}.nml"
         nml.write(local, force=True)
         t0 = time.perf_counter()
-        _, _, stat, errmsg = _core.py_run(str(local), 0)
+        _, _, stat, errmsg = _core.py_run(str(local), 0, -1)
         t1 = time.perf_counter()
         lc.read_result(out)
         t2 = time.perf_counter()

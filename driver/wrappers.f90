@@ -124,14 +124,15 @@ subroutine py_check_prony(form, equilibrium, nt, nv, capacity, times, values, st
 end subroutine py_check_prony
 
 !> Run a namelist file exactly like the executable (HDF5 written, nothing printed unless
-!> verbose = 1). converged: 0/1.
-subroutine py_run(input, verbose, output_file, converged, stat, errmsg)
+!> verbose = 1). converged: 0/1. communicator: the Fortran handle of an MPI communicator
+!> whose ranks share the scene (mpi4py's comm.py2f()), or -1 for the launcher's job.
+subroutine py_run(input, verbose, communicator, output_file, converged, stat, errmsg)
    use, intrinsic :: iso_fortran_env, only: output_unit
    use lc_base_errors, only: error_type, status_of
    use lc_application_run, only: run_scene_file
    implicit none (type, external)
    character(len=*), intent(in) :: input
-   integer, intent(in) :: verbose
+   integer, intent(in) :: verbose, communicator
    character(len=1024), intent(out) :: output_file
    integer, intent(out) :: converged, stat
    character(len=1024), intent(out) :: errmsg
@@ -139,7 +140,11 @@ subroutine py_run(input, verbose, output_file, converged, stat, errmsg)
    character(len=:), allocatable :: written
    logical :: ok
    output_file = ''
-   call run_scene_file(input, merge(output_unit, -1, verbose == 1), written, ok, error)
+   if (communicator == -1) then
+      call run_scene_file(input, merge(output_unit, -1, verbose == 1), written, ok, error)
+   else
+      call run_scene_file(input, merge(output_unit, -1, verbose == 1), written, ok, error, communicator)
+   end if
    converged = merge(1, 0, ok)
    if (allocated(written)) output_file = written
    call status_of(error, stat, errmsg)
@@ -338,6 +343,14 @@ subroutine py_cpu_level(level, isa)
    level = cpu_level()
    isa = build_isa
 end subroutine py_cpu_level
+
+!> 1 if this build can share a surface among MPI ranks (MPI and FFTW-MPI found), else 0.
+subroutine py_mpi_available(available)
+   use lc_base_parallel, only: mpi_available
+   implicit none (type, external)
+   integer, intent(out) :: available
+   available = merge(1, 0, mpi_available())
+end subroutine py_mpi_available
 
 !> The 3x3 surface compliance (lc_greens_kernel) of the layer of the scene in the namelist
 !> `text` for the wavevectors (qx, qy): (u_x^, u_y^, w^) = tensor(i, :, :) (tau_x^, tau_y^, p^).

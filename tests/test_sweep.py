@@ -558,6 +558,17 @@ def test_ctrl_c_ends_the_scenes_in_flight_at_once_and_a_rerun_completes(tmp_path
     assert len(list((tmp_path / "out/s/results").glob("*.h5"))) == 2
 
 
+def test_several_ranks_per_scene_need_a_build_with_mpi(tmp_path, monkeypatch):
+    """A build without MPI would run each scene's ranks as whole copies of the scene: the
+    sweep refuses --ranks-per-scene > 1 before any scene runs, and 1 stays allowed."""
+    from layercontact.sweeps.sweep import check_ranks_per_scene, read_sweep
+    plan = read_sweep(write_areal_sweep(tmp_path))
+    monkeypatch.setattr(lc.native.core, "py_mpi_available", lambda: 0)
+    with pytest.raises(ValueError, match="--ranks-per-scene = 2 is not allowed: this build of layercontact has no MPI"):
+        check_ranks_per_scene(plan, 2)
+    assert check_ranks_per_scene(plan, 1) == 1
+
+
 def test_a_local_sweep_on_two_ranks_per_scene_runs_each_scene_under_mpirun(tmp_path, monkeypatch):
     """Each scene runs as `mpirun -n 2 layercontact SCENE.nml` (its output in logs/); the
     results equal the scenes solved in this process, to the solver's tolerance."""

@@ -191,7 +191,7 @@ def run_command(args: argparse.Namespace) -> int:
     the ranks share the surface (docs/clusters.md, "One surface on several ranks"): rank 0
     writes the result file, prints the summary and the messages, and draws the picture."""
     root = _launched_rank() == 0
-    out, converged, stat, errmsg = _core.py_run(args.nml, 1)
+    out, converged, stat, errmsg = _core.py_run(args.nml, 1, -1)
     try:
         _check(stat, errmsg)
     except LayercontactError as err:

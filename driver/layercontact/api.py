@@ -745,13 +745,19 @@ def choose_resolution(filename: str | os.PathLike) -> tuple[int | tuple[int, int
     return (int(n) if ny == 1 else (int(n), int(ny))), float(tol)
 
 
-def run(filename: str | os.PathLike, verbose: bool = False) -> LineResult | ArealResult:
+def run(filename: str | os.PathLike, verbose: bool = False, comm=None) -> LineResult | ArealResult:
     """Run a namelist file exactly as the ``layercontact`` executable does (same library
     routine): the HDF5 result is written where ``&output file`` says, and read back.
     Raises :class:`LayercontactError` on bad input (nothing is written). Heights from a
     file taken as one period that jump or kink across the cell's edges give a
-    :class:`PeriodicityWarning` (the executable's warning on standard error)."""
-    result_file = run_to_file(filename, verbose)
+    :class:`PeriodicityWarning` (the executable's warning on standard error).
+
+    Under ``mpirun -n P`` an areal scene is shared among the job's P ranks, every rank
+    calling ``run`` with the same file (as ``python -m layercontact run`` does).
+    ``comm``: an mpi4py communicator whose ranks share the scene instead, e.g.
+    ``MPI.COMM_SELF`` for a script whose ranks each run scenes of their own; every rank of
+    ``comm`` must call ``run`` with the same file. Every rank gets the result."""
+    result_file = run_to_file(filename, verbose, comm)
     result = read_result(result_file)
     _warn_if_not_periodic(result, result_file)
     return result
@@ -775,9 +781,23 @@ def _warn_if_not_periodic(result, result_file: str) -> None:
         warn_if_not_periodic(np.reshape(result.height, (-1, np.shape(result.height)[-1])), file)
 
 
-def run_to_file(filename: str | os.PathLike, verbose: bool = False) -> str:
+def run_to_file(filename: str | os.PathLike, verbose: bool = False, comm=None) -> str:
     """Run a namelist file like :func:`run`, without reading the result back; returns the
     result file's path (for sweeps, which read only the scalars they tabulate)."""
-    out, converged, code, errmsg = _core.py_run(regular_file(filename, "namelist file"), 1 if verbose else 0)
+    out, converged, code, errmsg = _core.py_run(regular_file(filename, "namelist file"), 1 if verbose else 0,
+                                                _communicator_handle(comm))
     _check(code, errmsg)
     return out.decode().strip() if isinstance(out, bytes) else str(out).strip()
+
+
+def _communicator_handle(comm) -> int:
+    """The Fortran handle of an mpi4py communicator (-1: none, the launcher's job)."""
+    if comm is None:
+        return -1
+    if not (hasattr(comm, "py2f") and hasattr(comm, "Get_size")):
+        raise InputError(f"comm = {comm!r}; allowed: an mpi4py communicator (mpi4py.MPI.Comm) or None", 2)
+    if comm.Get_size() > 1 and not _core.py_mpi_available():
+        raise InputError(f"comm has {comm.Get_size()} ranks, but this build of layercontact has no MPI "
+                         "(meson option 'mpi': MPI for Fortran or FFTW-MPI not found); allowed: a "
+                         "communicator of one rank (MPI.COMM_SELF), or a build with MPI (docs/clusters.md)", 2)
+    return int(comm.py2f())

@@ -22,7 +22,7 @@ module lc_application_run
    use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_application_accuracy, only: choose_resolution
    use lc_base_version, only: version_string, build_isa
-   use lc_base_parallel, only: parallel_start, is_distributed, is_root, rank_count, this_rank, check_rank_count, &
+   use lc_base_parallel, only: parallel_start, parallel_end, is_distributed, is_root, rank_count, this_rank, check_rank_count, &
       & barrier, abort_job, gather_rows, global_any
    implicit none (type, external)
    private
@@ -36,29 +36,35 @@ contains
    !> Under an MPI launcher with several ranks (docs/clusters.md, "One surface on several
    !> ranks") an areal scene is solved distributed: each rank reads the namelist and makes
    !> the profile, keeps its slab of rows, and rank 0 writes the result file and the
-   !> summary from the gathered fields. Input refused on every rank returns its error
-   !> there; a failure on some rank only (memory, I/O) ends the whole job (MPI_Abort) with
-   !> its exit code, since the other ranks would wait for it.
-   subroutine run_scene_file(input, unit, output_file, converged, error)
+   !> summary from the gathered fields. `communicator`: the Fortran handle of the ranks to
+   !> share the scene among (a Python caller's mpi4py communicator), else the launcher's
+   !> job. Input refused on every rank returns its error there; a failure on some rank only
+   !> (memory, I/O) ends the whole job (MPI_Abort) with its exit code, since the other ranks
+   !> would wait for it.
+   subroutine run_scene_file(input, unit, output_file, converged, error, communicator)
       character(len=*), intent(in) :: input
       integer, intent(in) :: unit
       character(len=:), allocatable, intent(out) :: output_file
       logical, intent(out) :: converged
       type(error_type), allocatable, intent(out) :: error
-      call parallel_start(error)
+      integer, intent(in), optional :: communicator
+      converged = .false.
+      call parallel_start(error, communicator)
       if (allocated(error)) return
       call run_scene(input, merge(unit, -1, is_root()), output_file, converged, error)
-      if (.not. is_distributed()) return
-      if (allocated(error)) then
-         if (error%code /= code_input) then
-            write (error_unit, '(a)') 'layercontact: error on MPI rank ' // to_string(this_rank()) // ' of ' // &
-               & to_string(rank_count()) // ': ' // error%message
-            call abort_job(error%code)
+      if (is_distributed()) then
+         if (allocated(error)) then
+            if (error%code /= code_input) then
+               write (error_unit, '(a)') 'layercontact: error on MPI rank ' // to_string(this_rank()) // ' of ' // &
+                  & to_string(rank_count()) // ': ' // error%message
+               call abort_job(error%code)
+            end if
+         else
+            ! (every rank returns once rank 0 wrote the result file)
+            call barrier()
          end if
-         return
       end if
-      ! (every rank returns once rank 0 wrote the result file)
-      call barrier()
+      call parallel_end()
    end subroutine run_scene_file
 
    !> run_scene_file on this rank.

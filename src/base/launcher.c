@@ -27,6 +27,16 @@ int lc_launched(void) {
     return positive("SLURM_NTASKS") && getenv("SLURM_STEP_ID") != NULL && getenv("SLURM_PROCID") != NULL;
 }
 
+/* The number of ranks the launcher started (its variables), 0 where it does not say or no
+ * launcher started this process: a build without MPI refuses a job of several ranks. */
+int lc_launch_size(void) {
+    static const char *const sizes[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"};
+    for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++)
+        if (positive(sizes[i])) return atoi(getenv(sizes[i]));
+    if (lc_launched() && positive("SLURM_NTASKS")) return atoi(getenv("SLURM_NTASKS"));
+    return 0;
+}
+
 #ifdef LC_MPI
 static int started_here = 0;
 

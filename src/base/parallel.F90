@@ -22,7 +22,7 @@ module lc_base_parallel
 #endif
    implicit none (type, external)
    private
-   public :: parallel_start, is_distributed, rank_count, this_rank, is_root, slab, slab_rows, check_rank_count
+   public :: parallel_start, parallel_end, is_distributed, rank_count, this_rank, is_root, slab, slab_rows, check_rank_count
    public :: largest_rank_count, global_sum, global_max, sum_over_ranks, max_over_ranks, global_any
    public :: gather_rows, allgather_rows, scatter_rows
    public :: broadcast, abort_job, mpi_available, barrier
@@ -31,7 +31,6 @@ module lc_base_parallel
 #endif
 
    integer :: ranks = 1, rank = 0
-   logical :: started = .false.
 #ifdef LC_MPI
    type(MPI_Comm) :: communicator
 #endif
@@ -45,6 +44,10 @@ module lc_base_parallel
          import :: c_int
          integer(c_int) :: status
       end function lc_mpi_start
+      function lc_launch_size() bind(c, name='lc_launch_size') result(size)
+         import :: c_int
+         integer(c_int) :: size
+      end function lc_launch_size
    end interface
 
 contains
@@ -59,29 +62,49 @@ contains
    end function mpi_available
 
    !> Start MPI when a launcher started this process (once; a plain run does nothing) and
-   !> take the job's ranks: MPI_COMM_WORLD.
-   subroutine parallel_start(error)
+   !> take the job's ranks: MPI_COMM_WORLD, or the communicator whose Fortran handle is
+   !> `handle` (a caller's own, as mpi4py's `comm.py2f()` gives it: MPI already started).
+   !> Until parallel_end every caller works on these ranks. A build without MPI started as
+   !> one of several ranks is refused: each rank would solve the whole scene alone.
+   subroutine parallel_start(error, handle)
       type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: handle
 #ifdef LC_MPI
       logical :: initialized
       integer :: value
-      if (started) return
-      if (lc_mpi_start() /= 0) then
-         call fatal_error(error, 'MPI could not be started under the launcher', code_internal)
-         return
+      ranks = 1
+      rank = 0
+      if (.not. present(handle)) then
+         if (lc_mpi_start() /= 0) then
+            call fatal_error(error, 'MPI could not be started under the launcher', code_internal)
+            return
+         end if
       end if
       call MPI_Initialized(initialized)
-      started = .true.
       if (.not. initialized) return
       communicator = MPI_COMM_WORLD
+      if (present(handle)) communicator%MPI_VAL = handle
       call MPI_Comm_size(communicator, value)
       ranks = value
       call MPI_Comm_rank(communicator, value)
       rank = value
 #else
-      started = .true.
+      ranks = 1
+      rank = 0
+      if (present(handle)) return
+      if (lc_launch_size() > 1) call fatal_error(error, 'this build of layercontact has no MPI (meson option ' // &
+         & "'mpi': MPI for Fortran or FFTW-MPI not found) and was started as one of " // &
+         & to_string(int(lc_launch_size())) // ' ranks, each of which would solve the whole scene alone; ' // &
+         & 'allowed: one process (no mpirun, or mpirun -n 1), or a build with MPI (docs/clusters.md)', code_input)
 #endif
    end subroutine parallel_start
+
+   !> Back to one rank (MPI itself stays started: it is finished at exit): what runs after
+   !> a distributed run in the same process (a Python session's in-memory solves) is serial.
+   subroutine parallel_end()
+      ranks = 1
+      rank = 0
+   end subroutine parallel_end
 
    !> More than one rank shares the surface.
    logical function is_distributed()

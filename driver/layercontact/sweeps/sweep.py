@@ -57,6 +57,7 @@ import numpy as np
 from .. import scene_schema
 from . import provenance
 from ..api import LayercontactError, check_scene_file, regular_file, run_to_file
+from .. import native
 from .slurm import CONTROL_CHARACTERS, NO_CONTROL, SWEEP_VARIABLES, options_from_sweep
 
 SWEEP_GROUP = "sweep"
@@ -653,7 +654,8 @@ def _scene_lock(record_file: Path) -> Iterator[None]:
 
 def check_ranks_per_scene(plan: SweepPlan, ranks: object) -> int:
     """The MPI ranks each scene of ``plan`` runs on (``--ranks-per-scene``), checked: an
-    integer >= 1, and 1 for line scenes (a line is solved on one process).
+    integer >= 1, and 1 for line scenes (a line is solved on one process) or for a build
+    without MPI.
 
     Raises
     ------
@@ -669,6 +671,11 @@ def check_ranks_per_scene(plan: SweepPlan, ranks: object) -> int:
             f"--ranks-per-scene = {ranks} is not allowed for the sweep {plan.source}: its scenes are "
             f"lines (&scene geometry = '{geometry}'), which run on one process; allowed: 1 (several ranks "
             "share the rows of an areal scene)"
+        )
+    if ranks > 1 and not native.core.py_mpi_available():
+        raise ValueError(
+            f"--ranks-per-scene = {ranks} is not allowed: this build of layercontact has no MPI (meson option "
+            "'mpi': MPI for Fortran or FFTW-MPI not found); allowed: 1, or a build with MPI (docs/clusters.md)"
         )
     return ranks
 
