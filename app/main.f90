@@ -10,14 +10,13 @@ program layercontact
    use lc_application_run, only: run_scene_file
    use lc_io_namelist, only: default_scene, write_scene_namelist
    use lc_base_version, only: version_string, build_isa
-   use lc_base_parallel, only: is_root
    implicit none (type, external)
    character(len=*), parameter :: usage = 'usage: layercontact FILE.nml | --defaults [line|areal] | --help | --version'
    type(error_type), allocatable :: error
    character(len=:), allocatable :: input, output_file, text
    character(len=16) :: geometry
    integer :: length
-   logical :: converged
+   logical :: converged, root
 
    if (command_argument_count() < 1 .or. command_argument_count() > 2) then
       write (error_unit, '(a)') usage
@@ -54,14 +53,14 @@ program layercontact
       stop
    end select
 
-   call run_scene_file(input, output_unit, output_file, converged, error)
+   call run_scene_file(input, output_unit, output_file, converged, error, root=root)
    if (allocated(error)) then
       ! (under MPI every rank refuses bad input alike: rank 0 says why)
-      if (is_root()) write (error_unit, '(a)') 'layercontact: error: ' // error%message
+      if (root) write (error_unit, '(a)') 'layercontact: error: ' // error%message
       stop error%code, quiet=.true.
    end if
    if (.not. converged) then
-      if (is_root()) write (error_unit, '(a)') 'layercontact: warning: the solver did not reach its tolerance; ' // &
+      if (root) write (error_unit, '(a)') 'layercontact: warning: the solver did not reach its tolerance; ' // &
          & 'results written to ' // output_file // ' with converged = 0'
       stop code_not_converged, quiet=.true.
    end if

@@ -101,12 +101,12 @@ def test_a_communicator_must_be_one(tmp_path):
 DRIVER = """
 program launch
    use lc_base_errors, only: error_type
-   use lc_base_parallel, only: parallel_start, rank_count
+   use lc_base_parallel, only: parallel_start, rank_count, is_root
    implicit none
    type(error_type), allocatable :: error
    call parallel_start(error)
    if (allocated(error)) then
-      print '(i0, 1x, a)', error%code, error%message
+      print '(i0, 1x, l1, 1x, a)', error%code, is_root(), error%message
    else
       print '(a, 1x, i0)', 'ranks', rank_count()
    end if
@@ -143,15 +143,18 @@ def launch(program: Path, **variables: str) -> str:
     ({"OMPI_COMM_WORLD_SIZE": "3"}, True),                           # mpirun -n 3
     ({"PMI_SIZE": "2"}, True),                                       # a PMI launcher (MPICH's, srun's)
     ({"SLURM_NTASKS": "4"}, False),                                  # a batch script's own process
-    ({"SLURM_NTASKS": "4", "SLURM_STEP_ID": "0", "SLURM_PROCID": "1"}, True),   # srun -n 4
+    ({"SLURM_NTASKS": "4", "SLURM_STEP_ID": "0", "SLURM_PROCID": "0"}, True),   # srun -n 4
+    ({"SLURM_NTASKS": "4", "SLURM_STEP_ID": "0", "SLURM_PROCID": "1"}, True),
 ])
 def test_a_build_without_mpi_refuses_several_ranks(serial_launch, variables, refused):
     """Each of the ranks would solve the whole scene and write the same file: exit 2 (input)
-    with the rank count and what is allowed, before any work; one process runs."""
+    with the rank count and what is allowed, before any work, said by the launcher's rank 0
+    alone; one process runs."""
     said = launch(serial_launch, **variables)
     if refused:
         count = variables.get("OMPI_COMM_WORLD_SIZE") or variables.get("PMI_SIZE") or variables["SLURM_NTASKS"]
-        assert said.startswith("2 this build of layercontact has no MPI")
+        reporter = variables.get("SLURM_PROCID", "0") == "0"
+        assert said.startswith(f"2 {'T' if reporter else 'F'} this build of layercontact has no MPI")
         assert f"started as one of {count} ranks" in said and "allowed: one process" in said
     else:
         assert said == "ranks 1"

@@ -40,17 +40,22 @@ contains
    !> share the scene among (a Python caller's mpi4py communicator), else the launcher's
    !> job. Input refused on every rank returns its error there; a failure on some rank only
    !> (memory, I/O) ends the whole job (MPI_Abort) with its exit code, since the other ranks
-   !> would wait for it.
-   subroutine run_scene_file(input, unit, output_file, converged, error, communicator)
+   !> would wait for it. `root`: this process is the one that reports (rank 0 of the ranks).
+   subroutine run_scene_file(input, unit, output_file, converged, error, communicator, root)
       character(len=*), intent(in) :: input
       integer, intent(in) :: unit
       character(len=:), allocatable, intent(out) :: output_file
       logical, intent(out) :: converged
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: communicator
+      logical, intent(out), optional :: root
       converged = .false.
       call parallel_start(error, communicator)
-      if (allocated(error)) return
+      if (present(root)) root = is_root()
+      if (allocated(error)) then
+         call parallel_end()
+         return
+      end if
       call run_scene(input, merge(unit, -1, is_root()), output_file, converged, error)
       if (is_distributed()) then
          if (allocated(error)) then

@@ -37,6 +37,16 @@ int lc_launch_size(void) {
     return 0;
 }
 
+/* This process's rank as the launcher numbers it (0 where it does not say): the one of a
+ * refused job that reports why. */
+int lc_launch_rank(void) {
+    static const char *const ranks[] = {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK", "SLURM_PROCID"};
+    if (!lc_launched()) return 0;
+    for (size_t i = 0; i < sizeof ranks / sizeof *ranks; i++)
+        if (getenv(ranks[i]) != NULL) return atoi(getenv(ranks[i]));
+    return 0;
+}
+
 #ifdef LC_MPI
 static int started_here = 0;
 

@@ -48,6 +48,10 @@ module lc_base_parallel
          import :: c_int
          integer(c_int) :: size
       end function lc_launch_size
+      function lc_launch_rank() bind(c, name='lc_launch_rank') result(rank)
+         import :: c_int
+         integer(c_int) :: rank
+      end function lc_launch_rank
    end interface
 
 contains
@@ -92,6 +96,8 @@ contains
       ranks = 1
       rank = 0
       if (present(handle)) return
+      ! (the launcher's rank 0 is the one that says why)
+      if (lc_launch_size() > 1) rank = lc_launch_rank()
       if (lc_launch_size() > 1) call fatal_error(error, 'this build of layercontact has no MPI (meson option ' // &
          & "'mpi': MPI for Fortran or FFTW-MPI not found) and was started as one of " // &
          & to_string(int(lc_launch_size())) // ' ranks, each of which would solve the whole scene alone; ' // &
