@@ -159,6 +159,98 @@ def test_distributed_runs_give_the_serial_answer(scene, tmp_path):
         assert done.stdout.count("result file") == 1
 
 
+#: a grid of two coarse levels, 128 x 16 and 64 x 8 (the last coarse grid of at least 512
+#: points): on 2 ranks the first is solved on the slabs (8 rows a rank) and the second,
+#: 4 rows a rank, gathered onto every rank; on 3 and 4 ranks (6 and 4 rows a rank) both
+#: are gathered. src/contact/solve.f90: distributed_coarse_rows = 8.
+WIDE = "&scene geometry = 'areal', nx = 256, ny = 32 /\n"
+#: the coarse levels each rank count solves on the slabs (the others: gathered)
+ON_SLABS = {1: [], 2: ["128 x 16"], 3: [], 4: []}
+
+
+@needs_mpi
+def test_coarse_levels_on_the_slabs_and_gathered_give_the_serial_answer(tmp_path):
+    """The coarse start on its own slabs (the coarse rows moved between the two slab
+    layouts, interpolated with the next coarse row) and, below 8 rows a rank, gathered:
+    P = 1..4 give the serial answer, each level where ON_SLABS says (`&solver verbose`
+    names a level solved on the slabs). 64^2 in the test above covers 32 coarse rows on 3
+    ranks (11 + 11 + 10, on the slabs)."""
+    def wide(name: str, output: str) -> Path:
+        nml = write_scene(tmp_path, name, 32, SCENES["coupled"], output)
+        text = nml.read_text().replace("&scene geometry = 'areal', n = 32, ny = 32 /\n", WIDE)
+        nml.write_text(text.replace("&solver tol = 1e-13 /", "&solver tol = 1e-13, verbose = .true. /"))
+        return nml
+
+    done = run_serial(wide("serial", "serial.h5"))
+    assert done.returncode == 0, done.stderr
+    assert "128 x 16: gcr converged" in done.stderr and "64 x 8: gcr converged" in done.stderr
+    for ranks in (1, 2, 3, 4):
+        out = f"ranks{ranks}.h5"
+        done = run_mpi(ranks, [executable(), str(wide(f"wide{ranks}", out))], tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert_same(tmp_path / "serial.h5", tmp_path / out)
+        for level in ("128 x 16", "64 x 8"):
+            slabs = f"{level} on the slabs of {ranks} ranks: gcr converged"
+            whole = f"{level}: gcr converged"
+            assert (slabs in done.stderr) == (level in ON_SLABS[ranks]), (ranks, level)
+            assert (whole in done.stderr) == (level not in ON_SLABS[ranks]), (ranks, level)
+        if ranks > 1:
+            assert f"256 x 32 on the slabs of {ranks} ranks: gcr converged" in done.stderr
+
+
+@needs_mpi
+def test_anderson_on_the_slabs_gives_the_serial_answer(tmp_path):
+    """&solver method = 'anderson' on the coupled scene: its Gram matrix and projections
+    summed over the ranks, the same mixing on every rank; P = 1..4 give the serial answer
+    (both converged to tol 1e-13: SAME holds as for the other methods)."""
+    nml = write_scene(tmp_path, "serial", 64, SCENES["coupled"], "serial.h5")
+    nml.write_text(nml.read_text().replace("&solver tol = 1e-13 /", "&solver method = 'anderson', tol = 1e-13 /"))
+    assert "method = 'anderson', tol = 1e-13" in nml.read_text()
+    done = run_serial(nml)
+    assert done.returncode == 0, done.stderr
+    for ranks in (1, 2, 3, 4):
+        out = f"ranks{ranks}.h5"
+        nml_p = tmp_path / f"anderson{ranks}.nml"
+        nml_p.write_text(nml.read_text().replace("'serial.h5'", f"'{out}'"))
+        done = run_mpi(ranks, [executable(), str(nml_p)], tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert_same(tmp_path / "serial.h5", tmp_path / out)
+        with h5py.File(tmp_path / out, "r") as f:
+            assert f["results"].attrs["solver"].decode() == "anderson"
+            assert f["results"].attrs["converged"]
+            assert f["results"].attrs["outer_iterations"] > 1
+
+
+@pytest.fixture(scope="module")
+def redistribute_program() -> Path:
+    """tests/fortran/test_redistribute, built in build/unit (as tests/test_slab_io.py builds
+    its program) when needed."""
+    root = Path(__file__).resolve().parents[1]
+    build = root / "build" / "unit"
+    program = build / "tests" / "fortran" / "test_redistribute"
+    env = dict(os.environ, PATH=str(Path(sys.executable).parent) + os.pathsep + os.environ.get("PATH", ""))
+    if not (build / "build.ninja").exists():
+        subprocess.run(["meson", "setup", str(build), "-Dunit_tests=true", "--buildtype=debugoptimized"],
+                       cwd=root, env=env, check=True, capture_output=True)
+    built = subprocess.run(["ninja", "-C", str(build), "tests/fortran/test_redistribute"], env=env,
+                           capture_output=True, text=True)
+    assert built.returncode == 0 and program.exists(), built.stdout[-2000:]
+    return program
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [1, 2, 3, 4])
+def test_rows_move_between_slab_layouts(ranks, redistribute_program):
+    """lc_base_parallel's redistribute_rows under mpirun (tests/fortran/test_redistribute.f90:
+    every rank checks its rows against the closed form they were made from)."""
+    program = redistribute_program
+    done = subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(program)], capture_output=True,
+                          text=True, env=launcher_env(), timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("all redistribute_rows checks passed") == ranks
+    assert "FAIL" not in done.stdout
+
+
 @needs_mpi
 def test_observables_of_the_whole_map_on_rank_0(tmp_path):
     """Surface stress, leakage, conductance and stiffness need the whole map: rank 0

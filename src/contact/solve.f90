@@ -286,6 +286,8 @@ contains
          if (allocated(error)) return
       end if
       call progress%begin_level(grid%nx, grid%ny)
+      if (progress%enabled .and. across_ranks) &
+         & progress%level = progress%level // ' on the slabs of ' // to_string(rank_count()) // ' ranks'
       call progress%plan(plan%reason)
       uniform = 0.0_wp
       if (load_control) call op%drop_uniform_mode(uniform)
