@@ -44,9 +44,9 @@ module lc_contact_solve
    integer, parameter :: coarsest_grid = 512
    !> A distributed surface's coarse grid is itself solved on the slabs where each rank gets
    !> at least this many of its rows (ceiling((ny/2)/P) rows a rank); a thinner coarse grid
-   !> is gathered onto every rank and solved whole there, as its own coarse grids are: its
-   !> transforms are then too short for the global transposes' messages to pay
-   !> (docs/decisions/027-distributed-coarse-start.md).
+   !> is gathered onto every rank and solved whole there, as its own coarse grids are: a
+   !> thin slab pays its transforms' 2(P - 1) messages a pair for little work, while the
+   !> grid it would share is small (docs/decisions/027-distributed-coarse-start.md).
    integer, parameter :: distributed_coarse_rows = 8
    !> Tolerance of the coarse solves (or the scene's, if looser): a starting guess only
    !> needs to be closer than the discretisation difference between the two grids, which
