@@ -160,20 +160,25 @@ def test_distributed_runs_give_the_serial_answer(scene, tmp_path):
         assert done.stdout.count("result file") == 1
 
 
-#: a grid of two coarse levels, 128 x 16 and 64 x 8 (the last coarse grid of at least 512
-#: points): on 2 ranks the first is solved on the slabs (8 rows a rank) and the second,
-#: 4 rows a rank, gathered onto every rank; on 3 and 4 ranks (6 and 4 rows a rank) both
-#: are gathered. src/contact/solve.f90: distributed_coarse_rows = 8.
-WIDE = "&scene geometry = 'areal', nx = 256, ny = 32 /\n"
-#: the coarse levels each rank count solves on the slabs (the others: gathered)
-ON_SLABS = {1: [], 2: ["128 x 16"], 3: [], 4: []}
+#: grids, their fine level and coarse levels, and the coarse levels each rank count solves
+#: on the slabs (the others: gathered; src/contact/solve.f90: distributed_coarse_rows = 8).
+#: 256 x 32: 128 x 16 on the slabs on 2 ranks (8 rows a rank), 64 x 8 (4 a rank) gathered
+#: below it; on 3 and 4 ranks (6 and 4 rows a rank) both gathered. 64 x 42: the fine slabs
+#: of 2 ranks start at rows 0 and 21 (odd: the second samples its rows 22, 24, ..), the 21
+#: coarse rows on the slabs (11 + 10), the last one's next row periodic (row 0); on 3 and
+#: 4 ranks (7 and 6 rows a rank) gathered.
+COARSE_CASES = {
+    "256 x 32": (["128 x 16", "64 x 8"], {1: [], 2: ["128 x 16"], 3: [], 4: []}),
+    "64 x 42": (["32 x 21"], {1: [], 2: ["32 x 21"], 3: [], 4: []}),
+}
 
 
 @needs_mpi
-def test_coarse_levels_on_the_slabs_and_gathered_give_the_serial_answer(tmp_path):
+@pytest.mark.parametrize("fine", sorted(COARSE_CASES))
+def test_coarse_levels_on_the_slabs_and_gathered_give_the_serial_answer(fine, tmp_path):
     """The coarse start on its own slabs (the coarse rows moved between the two slab
     layouts, interpolated with the next coarse row) and, below 8 rows a rank, gathered:
-    P = 1..4 give the serial answer, each level where ON_SLABS says (`&solver verbose`
+    P = 1..4 give the serial answer, each level where COARSE_CASES says (`&solver verbose`
     names a level solved on the slabs). 64^2 in the test above covers 32 coarse rows on 3
     ranks (11 + 11 + 10, on the slabs).
 
@@ -183,34 +188,38 @@ def test_coarse_levels_on_the_slabs_and_gathered_give_the_serial_answer(tmp_path
     the serial ones unless a row of its heights or start is misplaced; the finest grid's
     iterations are the serial ones unless the interpolated start is (rounding, ~1e-16 of
     the fields, moves neither)."""
-    def wide(name: str, output: str) -> Path:
+    coarse_levels, on_slabs = COARSE_CASES[fine]
+    nx, ny = (int(size) for size in fine.split(" x "))
+
+    def scene(name: str, output: str) -> Path:
         nml = write_scene(tmp_path, name, 32, SCENES["coupled"], output)
-        text = nml.read_text().replace("&scene geometry = 'areal', n = 32, ny = 32 /\n", WIDE)
+        text = nml.read_text().replace("&scene geometry = 'areal', n = 32, ny = 32 /\n",
+                                       f"&scene geometry = 'areal', nx = {nx}, ny = {ny} /\n")
         nml.write_text(text.replace("&solver tol = 1e-13 /", "&solver tol = 1e-13, verbose = .true. /"))
         return nml
 
     def levels(log: str) -> dict[str, tuple[str, ...]]:
         found = re.findall(r"(\d+ x \d+)(?: on the slabs of \d ranks)?: gcr converged in (\d+) iterations, "
                            r"residual (\S+), contact fraction (\S+)", log)
-        return {level: (iterations,) if level == "256 x 32" else (iterations, residual, fraction)
+        return {level: (iterations,) if level == fine else (iterations, residual, fraction)
                 for level, iterations, residual, fraction in found}
 
-    done = run_serial(wide("serial", "serial.h5"))
+    done = run_serial(scene("serial", "serial.h5"))
     assert done.returncode == 0, done.stderr
     serial_levels = levels(done.stderr)
-    assert set(serial_levels) == {"256 x 32", "128 x 16", "64 x 8"}
+    assert set(serial_levels) == {fine, *coarse_levels}
     for ranks in (1, 2, 3, 4):
         out = f"ranks{ranks}.h5"
-        done = run_mpi(ranks, [executable(), str(wide(f"wide{ranks}", out))], tmp_path)
+        done = run_mpi(ranks, [executable(), str(scene(f"grid{ranks}", out))], tmp_path)
         assert done.returncode == 0, done.stderr
         assert_same(tmp_path / "serial.h5", tmp_path / out)
-        for level in ("128 x 16", "64 x 8"):
+        for level in coarse_levels:
             slabs = f"{level} on the slabs of {ranks} ranks: gcr converged"
             whole = f"{level}: gcr converged"
-            assert (slabs in done.stderr) == (level in ON_SLABS[ranks]), (ranks, level)
-            assert (whole in done.stderr) == (level not in ON_SLABS[ranks]), (ranks, level)
+            assert (slabs in done.stderr) == (level in on_slabs[ranks]), (ranks, level)
+            assert (whole in done.stderr) == (level not in on_slabs[ranks]), (ranks, level)
         if ranks > 1:
-            assert f"256 x 32 on the slabs of {ranks} ranks: gcr converged" in done.stderr
+            assert f"{fine} on the slabs of {ranks} ranks: gcr converged" in done.stderr
         assert levels(done.stderr) == serial_levels
 
 
