@@ -102,7 +102,8 @@ def main() -> None:
     parser.add_argument("--pairs-only", action="store_true")
     parser.add_argument("--no-pairs", action="store_true", help="the solves only")
     parser.add_argument("--executable", help="the layercontact program (default: the installed one)")
-    parser.add_argument("--before", help="another build's layercontact program, run alternately with this one")
+    parser.add_argument("--before",
+                        help="another build's layercontact program, run alternately with this one")
     args = parser.parse_args()
     global EXECUTABLE
     EXECUTABLE = args.executable
@@ -132,7 +133,8 @@ def main() -> None:
             serial = rows[(label, 0)]
             name = label + ("serial" if ranks == 0 else f"mpirun -n {ranks}")
             rss = "/".join(f"{p:.0f}" for p in peaks)
-            print(f"{name:<21}{solver:<8}{solve:>10.2f}{coarse:>11.2f}{elapsed:>9.2f}{serial[0] / solve:>13.2f}"
+            print(f"{name:<21}{solver:<8}{solve:>10.2f}{coarse:>11.2f}{elapsed:>9.2f}"
+                  f"{serial[0] / solve:>13.2f}"
                   f"{rss:>22}{max(peaks) / max(serial[2]):>11.2f}")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 

@@ -122,12 +122,14 @@ def model_coarse(n: int, ranks: int, s: dict, bandwidth: float, latency: float, 
         serial = s["coarse"] * level["share"]
         if level["on_slabs"]:
             side = level["rows"]
-            moves = 3 * (level["points"] * 8.0 * (ranks - 1) / ranks / ranks / bandwidth + (ranks - 1) * latency)
+            moves = 3 * (level["points"] * 8.0 * (ranks - 1) / ranks / ranks / bandwidth
+                         + (ranks - 1) * latency)
             seconds += (serial / ranks + own_pairs * transpose_seconds(side, side, ranks, bandwidth, latency)
                         + s["iterations"] * allreduces * allreduce_seconds(ranks, latency) + moves)
         else:
             if above is not None:
-                seconds += 2 * above * 8.0 * (ranks - 1) / ranks / bandwidth + allreduce_seconds(ranks, latency)
+                seconds += (2 * above * 8.0 * (ranks - 1) / ranks / bandwidth
+                            + allreduce_seconds(ranks, latency))
             seconds += serial
             above = None
             continue
@@ -190,7 +192,8 @@ def coarse_dominates_from(n: int, coefficient: float, ref: dict, bandwidth: floa
     return 0
 
 
-def best_speed_up(n: int, coefficient: float, ref: dict, bandwidth: float, latency: float) -> tuple[int, float]:
+def best_speed_up(n: int, coefficient: float, ref: dict, bandwidth: float,
+                  latency: float) -> tuple[int, float]:
     """The power-of-two P (up to 2^20) of the largest speed-up, and that speed-up."""
     best = (1, 1.0)
     for power in range(21):

@@ -229,7 +229,8 @@ def test_anderson_on_the_slabs_gives_the_serial_answer(tmp_path):
     summed over the ranks, the same mixing on every rank; P = 1..4 give the serial answer
     (both converged to tol 1e-13: SAME holds as for the other methods)."""
     nml = write_scene(tmp_path, "serial", 64, SCENES["coupled"], "serial.h5")
-    nml.write_text(nml.read_text().replace("&solver tol = 1e-13 /", "&solver method = 'anderson', tol = 1e-13 /"))
+    anderson = "&solver method = 'anderson', tol = 1e-13 /"
+    nml.write_text(nml.read_text().replace("&solver tol = 1e-13 /", anderson))
     assert "method = 'anderson', tol = 1e-13" in nml.read_text()
     done = run_serial(nml)
     assert done.returncode == 0, done.stderr
