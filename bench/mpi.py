@@ -3,14 +3,17 @@ solved serially (no launcher), by `mpirun -n 1` and by `mpirun -n 2`, one thread
 with the time and the peak memory of each rank; and one FFT pair of the surface on 1, 2
 and 4 ranks (4 oversubscribed on a 2-core machine) in FFTW-MPI's two layouts.
 
-    .venv/bin/python bench/mpi.py [--n 2048] [--repeats 1] [--pairs-only] [--executable PATH]
+    .venv/bin/python bench/mpi.py [--n 2048] [--repeats 1] [--pairs-only] [--executable PATH] [--before PATH]
 
 Scene: self-affine H = 0.8, shortest wavelength 8 points, rms gradient 0.1, seed 1, on an
 incompressible layer h/lambda = 0.05 (nu = 0.5), Coulomb friction mu_c = 0.5,
 p_m = 0.15 E* h/lambda, tol 1e-8, no surface stress and no fields written (the solve and
 the gathering of its fields to rank 0). "solve" is the summary's solver time (operator,
-coarse start, iterations; the best of --repeats), "run" the whole process, "peak RSS" each
-rank's largest resident set (/usr/bin/time's %M). Ratios are measured within this run.
+coarse start, iterations; the best of --repeats), "coarse" the coarse start's part of it
+(the result's `coarse_time`, rank 0's), "run" the whole process, "peak RSS" each rank's
+largest resident set (/usr/bin/time's %M). Ratios are measured within this run.
+`--before PATH`: another build's program (e.g. the one before a change) run alternately
+with this one in the same run, its rows marked "before".
 The FFT pairs come from bench/mpi_fft_pair.c, compiled here with mpicc.
 """
 
@@ -25,6 +28,8 @@ import sys
 import sysconfig
 import tempfile
 from pathlib import Path
+
+import h5py
 
 HERE = Path(__file__).resolve().parent
 
@@ -59,11 +64,12 @@ def scene(directory: Path, n: int) -> Path:
     return nml
 
 
-def run(ranks: int, nml: Path) -> tuple[float, float, list[float], str]:
-    """(solve s, run s, peak RSS MiB of each rank, solver) of one run; ranks 0: no launcher."""
+def run(ranks: int, nml: Path, program: str) -> tuple[float, float, list[float], str, float]:
+    """(solve s, run s, peak RSS MiB of each rank, solver, coarse start s) of one run of
+    `program`; ranks 0: no launcher."""
     # (each rank's /usr/bin/time report in a file of its own: rank.N)
     timed = ["sh", "-c", '/usr/bin/time -f "peak_rss_kib %M elapsed %e" -o "rank.${OMPI_COMM_WORLD_RANK:-0}" "$0" "$1"',
-             executable(), str(nml)]
+             program, str(nml)]
     command = timed if ranks == 0 else ["mpirun", "--oversubscribe", "-n", str(ranks), *timed]
     done = subprocess.run(command, cwd=nml.parent, capture_output=True, text=True, env=environment(ranks > 0))
     if done.returncode != 0:
@@ -73,7 +79,9 @@ def run(ranks: int, nml: Path) -> tuple[float, float, list[float], str]:
     reports = [(nml.parent / f"rank.{r}").read_text() for r in range(max(ranks, 1))]
     peaks = [int(re.search(r"peak_rss_kib (\d+)", text).group(1)) / 1024 for text in reports]
     elapsed = max(float(re.search(r"elapsed (\S+)", text).group(1)) for text in reports)
-    return solve, elapsed, peaks, solver
+    with h5py.File(nml.parent / "coupled.h5", "r") as f:
+        coarse = float(f["results"].attrs["coarse_time"])
+    return solve, elapsed, peaks, solver, coarse
 
 
 def pairs(n: int) -> None:
@@ -94,9 +102,14 @@ def main() -> None:
     parser.add_argument("--pairs-only", action="store_true")
     parser.add_argument("--no-pairs", action="store_true", help="the solves only")
     parser.add_argument("--executable", help="the layercontact program (default: the installed one)")
+    parser.add_argument("--before",
+                        help="another build's layercontact program, run alternately with this one")
     args = parser.parse_args()
     global EXECUTABLE
     EXECUTABLE = args.executable
+    programs = {"": executable()}
+    if args.before:
+        programs = {"before ": args.before, "": executable()}
     print(f"load average before: {os.getloadavg()[0]:.1f}")
     if not args.no_pairs:
         print(f"FFT pair of {args.n}² (median of 7, slowest rank):")
@@ -108,19 +121,21 @@ def main() -> None:
         rows = {}
         for _ in range(args.repeats):
             for ranks in (0, 1, 2):
-                solve, elapsed, peaks, solver = run(ranks, nml)
-                best = rows.get(ranks)
-                if best is None or solve < best[0]:
-                    rows[ranks] = (solve, elapsed, peaks, solver)
-        serial = rows[0]
+                for label, program in programs.items():
+                    measured = run(ranks, nml, program)
+                    best = rows.get((label, ranks))
+                    if best is None or measured[0] < best[0]:
+                        rows[(label, ranks)] = measured
         print(f"\n{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5), tol 1e-8, one thread per rank")
-        print(f"{'run':<14}{'solver':<8}{'solve (s)':>10}{'run (s)':>9}{'serial/this':>13}"
+        print(f"{'run':<21}{'solver':<8}{'solve (s)':>10}{'coarse (s)':>11}{'run (s)':>9}{'serial/this':>13}"
               f"{'peak RSS/rank (MiB)':>22}{'of serial':>11}")
-        for ranks, (solve, elapsed, peaks, solver) in rows.items():
-            name = "serial" if ranks == 0 else f"mpirun -n {ranks}"
+        for (label, ranks), (solve, elapsed, peaks, solver, coarse) in rows.items():
+            serial = rows[(label, 0)]
+            name = label + ("serial" if ranks == 0 else f"mpirun -n {ranks}")
             rss = "/".join(f"{p:.0f}" for p in peaks)
-            print(f"{name:<14}{solver:<8}{solve:>10.2f}{elapsed:>9.2f}{serial[0] / solve:>13.2f}{rss:>22}"
-                  f"{max(peaks) / max(serial[2]):>11.2f}")
+            print(f"{name:<21}{solver:<8}{solve:>10.2f}{coarse:>11.2f}{elapsed:>9.2f}"
+                  f"{serial[0] / solve:>13.2f}"
+                  f"{rss:>22}{max(peaks) / max(serial[2]):>11.2f}")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 
 

@@ -24,12 +24,20 @@ The model (model_* functions, which take every measured part as an argument):
   transposes (FFTW_MPI_TRANSPOSED_OUT/IN) move the half spectrum twice, in total
   2 x 16 B x nx/2 x ny x (P-1)/P, a rank's share 1/P of it, over the link's bandwidth,
   plus P-1 messages a transpose per rank at the latency; every iteration's MPI_Allreduce
-  calls cost latency x ceil(log2 P) each; the coarse start is gathered (N/4 doubles,
-  MPI_Allgatherv) and solved whole on every rank: its time does not shrink with P;
-- memory per rank: the serial doubles per point over P, or during the coarse start the
-  coarse grid's serial solve (N/4 points at the same doubles per point), whichever is
-  larger (the 2-rank peaks follow the larger, not the sum), plus on rank 0 the gathered
-  fields (pressure, gap, displacement, heights: 4 doubles per point of the whole grid).
+  calls cost latency x ceil(log2 P) each;
+- the coarse start: its levels (every second point, recursively, down to 512 points) share
+  the serial coarse time as their N log N. A level of at least 8 rows a rank
+  (distributed_coarse_rows of src/contact/solve.f90) is solved on its own slabs like the
+  fine grid (its time over P, its pairs' transposes, its iterations' reductions, and the
+  moves of its height and pressure into its slabs and of its solution back: 3 all-to-alls
+  of its N_l doubles); the first thinner level is gathered (the level above's height and
+  pressure, MPI_Allgatherv) and it and every level below are solved whole on every rank:
+  that tail does not shrink with P;
+- memory per rank: the serial doubles per point over P, or the gathered tail's serial
+  solve (its first level's points at the same doubles per point), whichever is larger
+  (the 2-rank peaks follow the larger, not the sum; a coarse level on the slabs holds
+  a quarter of the level above's slab), plus on rank 0 the gathered fields (pressure, gap,
+  displacement, heights: 4 doubles per point of the whole grid).
 Assumptions (flags): the iterations, pairs and split of the 2048² solve at every size
 (they grow with the size: docs/performance.md says by how much), one rank per core, no
 overlap of communication with computation, the padding copies around each transform
@@ -53,6 +61,10 @@ import time
 ALLREDUCES_PER_ITERATION = 11
 
 MIB = 2.0**20
+#: src/contact/solve.f90: a coarse level is solved on the slabs from this many rows a rank,
+#: and the coarse start stops before a grid of fewer than COARSEST_GRID points
+DISTRIBUTED_COARSE_ROWS = 8
+COARSEST_GRID = 512
 
 
 def transpose_bytes_total(nx: int, ny: int, ranks: int) -> float:
@@ -80,6 +92,51 @@ def allreduce_seconds(ranks: int, latency: float) -> float:
     return 0.0 if ranks == 1 else math.ceil(math.log2(ranks)) * latency
 
 
+def coarse_levels(n: int, ranks: int) -> list[dict]:
+    """The coarse start's levels of an n x n grid on P ranks: their points, rows, whether
+    each is solved on the slabs (at least DISTRIBUTED_COARSE_ROWS rows a rank, every level
+    above on the slabs too) and its share of the serial coarse time (N_l log N_l)."""
+    levels, side = [], n
+    while side % 2 == 0 and (side // 2) ** 2 >= COARSEST_GRID:
+        side //= 2
+        above = not levels or levels[-1]["on_slabs"]
+        on_slabs = ranks > 1 and above and math.ceil(side / ranks) >= DISTRIBUTED_COARSE_ROWS
+        levels.append({"points": side * side, "rows": side, "on_slabs": on_slabs,
+                       "weight": side * side * math.log2(side * side)})
+    total = sum(level["weight"] for level in levels) or 1.0
+    for level in levels:
+        level["share"] = level["weight"] / total
+    return levels
+
+
+def model_coarse(n: int, ranks: int, s: dict, bandwidth: float, latency: float, allreduces: int) -> float:
+    """The coarse start's time on P ranks (s): the levels on the slabs as the fine grid (a
+    level's pairs: the serial coarse pairs shared alike among the levels, each in its own
+    units), the gathered tail whole."""
+    levels = coarse_levels(n, ranks)
+    if ranks == 1 or not levels:
+        return s["coarse"]
+    own_pairs = s["coarse_pairs"] / sum(level["points"] / (n * n) for level in levels)
+    seconds, above = 0.0, n * n
+    for level in levels:
+        serial = s["coarse"] * level["share"]
+        if level["on_slabs"]:
+            side = level["rows"]
+            moves = 3 * (level["points"] * 8.0 * (ranks - 1) / ranks / ranks / bandwidth
+                         + (ranks - 1) * latency)
+            seconds += (serial / ranks + own_pairs * transpose_seconds(side, side, ranks, bandwidth, latency)
+                        + s["iterations"] * allreduces * allreduce_seconds(ranks, latency) + moves)
+        else:
+            if above is not None:
+                seconds += (2 * above * 8.0 * (ranks - 1) / ranks / bandwidth
+                            + allreduce_seconds(ranks, latency))
+            seconds += serial
+            above = None
+            continue
+        above = level["points"]
+    return seconds
+
+
 def model_serial(n: int, coefficient: float, ref: dict) -> dict:
     """The serial solve of n x n in parts (s), scaled from the reference solve ref (n,
     solve, pairs, split) with the fitted pair."""
@@ -90,21 +147,19 @@ def model_serial(n: int, coefficient: float, ref: dict) -> dict:
     fine_pairs = ref["pairs"] * fine0 / (fine0 + coarse0)
     passes0 = max(fine0 - fine_pairs * pair_seconds(n0, coefficient), 0.0)
     return {"setup": setup0 * fft_scale, "coarse": coarse0 * fft_scale, "fine_pairs": fine_pairs,
+            "coarse_pairs": ref["pairs"] - fine_pairs,
             "pair": pair_seconds(n, coefficient), "passes": passes0 * point_scale,
             "iterations": ref["iterations"]}
 
 
 def model_time(n: int, ranks: int, coefficient: float, ref: dict, bandwidth: float, latency: float,
                allreduces: int = ALLREDUCES_PER_ITERATION) -> dict:
-    """Solve time on P ranks (s) and its parts: set-up, coarse start (gather + serial
-    solve), fine iterations (local transforms, transposes, passes, reductions)."""
+    """Solve time on P ranks (s) and its parts: set-up, coarse start (model_coarse), fine
+    iterations (local transforms, transposes, passes, reductions)."""
     s = model_serial(n, coefficient, ref)
-    points = n * n
-    gather = 0.0 if ranks == 1 else (points / 4 * 8.0 * (ranks - 1) / ranks / bandwidth
-                                     + allreduce_seconds(ranks, latency))
     parts = {
         "setup": s["setup"] / ranks,
-        "coarse": s["coarse"] + gather,
+        "coarse": model_coarse(n, ranks, s, bandwidth, latency, allreduces),
         "fft": s["fine_pairs"] * s["pair"] / ranks,
         "transpose": s["fine_pairs"] * transpose_seconds(n, n, ranks, bandwidth, latency),
         "passes": s["passes"] / ranks,
@@ -119,7 +174,8 @@ def model_memory(n: int, ranks: int, doubles_per_point: float) -> dict:
     """Peak bytes per rank: rank 0 and the others."""
     points = n * n
     slab = doubles_per_point * points / ranks
-    coarse = 0.0 if ranks == 1 else doubles_per_point * points / 4
+    gathered = [level["points"] for level in coarse_levels(n, ranks) if not level["on_slabs"]]
+    coarse = 0.0 if ranks == 1 or not gathered else doubles_per_point * gathered[0]
     solve = 8.0 * max(slab, coarse)
     gathered = 0.0 if ranks == 1 else 8.0 * 4 * points
     return {"rank0": solve + gathered, "other": solve}
@@ -134,6 +190,17 @@ def coarse_dominates_from(n: int, coefficient: float, ref: dict, bandwidth: floa
             return ranks
         ranks *= 2
     return 0
+
+
+def best_speed_up(n: int, coefficient: float, ref: dict, bandwidth: float,
+                  latency: float) -> tuple[int, float]:
+    """The power-of-two P (up to 2^20) of the largest speed-up, and that speed-up."""
+    best = (1, 1.0)
+    for power in range(21):
+        t = model_time(n, 2**power, coefficient, ref, bandwidth, latency)
+        if t["serial"] / t["total"] > best[1]:
+            best = (2**power, t["serial"] / t["total"])
+    return best
 
 
 def measure_fft_coefficient(sizes=(512, 1024, 2048)) -> float:
@@ -235,7 +302,9 @@ def main() -> None:
         room = args.node_memory * 2**30 - m["rank0"]
         fit = ("rank 0 alone does not fit" if room < 0
                else f"{1 + int(room // m['other'])} ranks fit on rank 0's node")
-        print(f"{n}²: the coarse start takes over half the solve from P = {p}; at P = {max(args.ranks)} "
+        best, speed_up = best_speed_up(n, coefficient, ref, args.bandwidth, args.latency)
+        print(f"{n}²: the coarse start takes over half the solve from P = {p or 'none up to 2^20'}; "
+              f"the largest speed-up {speed_up:.0f}x at P = {best}; at P = {max(args.ranks)} "
               f"{fit} ({m['rank0'] / 2**30:.0f} GiB rank 0, {m['other'] / 2**30:.0f} GiB each other rank)")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 

@@ -18,6 +18,7 @@ unevenly (64 = 22 + 22 + 20, 128 = 43 + 43 + 42).
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -157,6 +158,123 @@ def test_distributed_runs_give_the_serial_answer(scene, tmp_path):
                 assert "distributed runs use gcr/cg" in f["results"].attrs["solver_reason"].decode()
         # one summary, from rank 0
         assert done.stdout.count("result file") == 1
+
+
+#: grids, their fine level and coarse levels, and the coarse levels each rank count solves
+#: on the slabs (the others: gathered; src/contact/solve.f90: distributed_coarse_rows = 8).
+#: 256 x 32: 128 x 16 on the slabs on 2 ranks (8 rows a rank), 64 x 8 (4 a rank) gathered
+#: below it; on 3 and 4 ranks (6 and 4 rows a rank) both gathered. 64 x 42: the fine slabs
+#: of 2 ranks start at rows 0 and 21 (odd: the second samples its rows 22, 24, ..), the 21
+#: coarse rows on the slabs (11 + 10), the last one's next row periodic (row 0); on 3 and
+#: 4 ranks (7 and 6 rows a rank) gathered.
+COARSE_CASES = {
+    "256 x 32": (["128 x 16", "64 x 8"], {1: [], 2: ["128 x 16"], 3: [], 4: []}),
+    "64 x 42": (["32 x 21"], {1: [], 2: ["32 x 21"], 3: [], 4: []}),
+}
+
+
+@needs_mpi
+@pytest.mark.parametrize("fine", sorted(COARSE_CASES))
+def test_coarse_levels_on_the_slabs_and_gathered_give_the_serial_answer(fine, tmp_path):
+    """The coarse start on its own slabs (the coarse rows moved between the two slab
+    layouts, interpolated with the next coarse row) and, below 8 rows a rank, gathered:
+    P = 1..4 give the serial answer, each level where COARSE_CASES says (`&solver verbose`
+    names a level solved on the slabs). 64^2 in the test above covers 32 coarse rows on 3
+    ranks (11 + 11 + 10, on the slabs).
+
+    The converged answer does not show a wrong start, so each level's own outcome is
+    compared with the serial run's too: a coarse level solves the same problem from the
+    same start to 1e-4, its iterations, its residual (4 digits) and contact fraction are
+    the serial ones unless a row of its heights or start is misplaced; the finest grid's
+    iterations are the serial ones unless the interpolated start is (rounding, ~1e-16 of
+    the fields, moves neither)."""
+    coarse_levels, on_slabs = COARSE_CASES[fine]
+    nx, ny = (int(size) for size in fine.split(" x "))
+
+    def scene(name: str, output: str) -> Path:
+        nml = write_scene(tmp_path, name, 32, SCENES["coupled"], output)
+        text = nml.read_text().replace("&scene geometry = 'areal', n = 32, ny = 32 /\n",
+                                       f"&scene geometry = 'areal', nx = {nx}, ny = {ny} /\n")
+        nml.write_text(text.replace("&solver tol = 1e-13 /", "&solver tol = 1e-13, verbose = .true. /"))
+        return nml
+
+    def levels(log: str) -> dict[str, tuple[str, ...]]:
+        found = re.findall(r"(\d+ x \d+)(?: on the slabs of \d ranks)?: gcr converged in (\d+) iterations, "
+                           r"residual (\S+), contact fraction (\S+)", log)
+        return {level: (iterations,) if level == fine else (iterations, residual, fraction)
+                for level, iterations, residual, fraction in found}
+
+    done = run_serial(scene("serial", "serial.h5"))
+    assert done.returncode == 0, done.stderr
+    serial_levels = levels(done.stderr)
+    assert set(serial_levels) == {fine, *coarse_levels}
+    for ranks in (1, 2, 3, 4):
+        out = f"ranks{ranks}.h5"
+        done = run_mpi(ranks, [executable(), str(scene(f"grid{ranks}", out))], tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert_same(tmp_path / "serial.h5", tmp_path / out)
+        for level in coarse_levels:
+            slabs = f"{level} on the slabs of {ranks} ranks: gcr converged"
+            whole = f"{level}: gcr converged"
+            assert (slabs in done.stderr) == (level in on_slabs[ranks]), (ranks, level)
+            assert (whole in done.stderr) == (level not in on_slabs[ranks]), (ranks, level)
+        if ranks > 1:
+            assert f"{fine} on the slabs of {ranks} ranks: gcr converged" in done.stderr
+        assert levels(done.stderr) == serial_levels
+
+
+@needs_mpi
+def test_anderson_on_the_slabs_gives_the_serial_answer(tmp_path):
+    """&solver method = 'anderson' on the coupled scene: its Gram matrix and projections
+    summed over the ranks, the same mixing on every rank; P = 1..4 give the serial answer
+    (both converged to tol 1e-13: SAME holds as for the other methods)."""
+    nml = write_scene(tmp_path, "serial", 64, SCENES["coupled"], "serial.h5")
+    anderson = "&solver method = 'anderson', tol = 1e-13 /"
+    nml.write_text(nml.read_text().replace("&solver tol = 1e-13 /", anderson))
+    assert "method = 'anderson', tol = 1e-13" in nml.read_text()
+    done = run_serial(nml)
+    assert done.returncode == 0, done.stderr
+    for ranks in (1, 2, 3, 4):
+        out = f"ranks{ranks}.h5"
+        nml_p = tmp_path / f"anderson{ranks}.nml"
+        nml_p.write_text(nml.read_text().replace("'serial.h5'", f"'{out}'"))
+        done = run_mpi(ranks, [executable(), str(nml_p)], tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert_same(tmp_path / "serial.h5", tmp_path / out)
+        with h5py.File(tmp_path / out, "r") as f:
+            assert f["results"].attrs["solver"].decode() == "anderson"
+            assert f["results"].attrs["converged"]
+            assert f["results"].attrs["outer_iterations"] > 1
+
+
+@pytest.fixture(scope="module")
+def redistribute_program() -> Path:
+    """tests/fortran/test_redistribute, built in build/unit (as tests/test_slab_io.py builds
+    its program) when needed."""
+    root = Path(__file__).resolve().parents[1]
+    build = root / "build" / "unit"
+    program = build / "tests" / "fortran" / "test_redistribute"
+    env = dict(os.environ, PATH=str(Path(sys.executable).parent) + os.pathsep + os.environ.get("PATH", ""))
+    if not (build / "build.ninja").exists():
+        subprocess.run(["meson", "setup", str(build), "-Dunit_tests=true", "--buildtype=debugoptimized"],
+                       cwd=root, env=env, check=True, capture_output=True)
+    built = subprocess.run(["ninja", "-C", str(build), "tests/fortran/test_redistribute"], env=env,
+                           capture_output=True, text=True)
+    assert built.returncode == 0 and program.exists(), built.stdout[-2000:]
+    return program
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [1, 2, 3, 4])
+def test_rows_move_between_slab_layouts(ranks, redistribute_program):
+    """lc_base_parallel's redistribute_rows under mpirun (tests/fortran/test_redistribute.f90:
+    every rank checks its rows against the closed form they were made from)."""
+    program = redistribute_program
+    done = subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(program)], capture_output=True,
+                          text=True, env=launcher_env(), timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("all redistribute_rows checks passed") == ranks
+    assert "FAIL" not in done.stdout
 
 
 @needs_mpi

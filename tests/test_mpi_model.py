@@ -60,14 +60,30 @@ def test_one_rank_reproduces_the_reference_solve_and_its_memory():
     assert memory["rank0"] == memory["other"] == pytest.approx(16.7 * 8 * 2048**2, rel=1e-14)
 
 
-def test_memory_per_rank_takes_the_larger_of_slab_and_coarse_grid_and_rank0_the_fields():
+def test_coarse_levels_on_the_slabs_down_to_eight_rows_a_rank():
+    # 2048² on 16 ranks: 1024, 512, 256 and 128 rows (64, 32, 16, 8 a rank) on the slabs;
+    # 64 rows (4 a rank) gathered, and 32 below it; 16² = 256 < 512 points is not a level
+    levels = model.coarse_levels(2048, 16)
+    assert [level["rows"] for level in levels] == [1024, 512, 256, 128, 64, 32]
+    assert [level["on_slabs"] for level in levels] == [True] * 4 + [False] * 2
+    assert sum(level["share"] for level in levels) == pytest.approx(1.0, rel=1e-14)
+    # one rank: nothing on slabs (the serial solve); 5 ranks do not divide the rows of 256²:
+    # ceil(128/5) = 26 and ceil(64/5) = 13 a rank on the slabs, ceil(32/5) = 7 gathered
+    assert not any(level["on_slabs"] for level in model.coarse_levels(2048, 1))
+    assert [level["on_slabs"] for level in model.coarse_levels(256, 5)] == [True, True, False]
+
+
+def test_memory_per_rank_takes_the_larger_of_slab_and_gathered_tail_and_rank0_the_fields():
     n, d = 4096, 20.0
-    # P = 2: the slab, d N / 2, is larger than the coarse grid's d N / 4
+    # P = 2: every coarse level on the slabs (down to 32² = 1024 points, 16 rows, 8 a rank):
+    # the fine slab d N / 2 is the peak
     m = model.model_memory(n, 2, d)
     assert m["other"] == pytest.approx(8 * d * n * n / 2, rel=1e-14)
     assert m["rank0"] - m["other"] == pytest.approx(8 * 4 * n * n, rel=1e-14)
-    # P = 64: the coarse grid, whole on every rank, is what is left
-    assert model.model_memory(n, 64, d)["other"] == pytest.approx(8 * d * n * n / 4, rel=1e-14)
+    # P = 64: 2048 .. 512 rows on the slabs, 256² gathered: the slab d N / 64 is larger
+    assert model.model_memory(n, 64, d)["other"] == pytest.approx(8 * d * n * n / 64, rel=1e-14)
+    # P = 1024: 2048 rows are 2 a rank: the first coarse grid gathered, whole on every rank
+    assert model.model_memory(n, 1024, d)["other"] == pytest.approx(8 * d * n * n / 4, rel=1e-14)
 
 
 def test_serial_time_scales_the_transforms_as_n_log_n_and_the_passes_as_n():
@@ -78,11 +94,24 @@ def test_serial_time_scales_the_transforms_as_n_log_n_and_the_passes_as_n():
     assert large["passes"] / small["passes"] == pytest.approx(4.0, rel=1e-14)
 
 
-def test_coarse_start_bounds_the_speed_up_as_amdahl():
-    # an ideal network: the time is coarse + rest / P; the coarse start takes over half from
-    # P > rest / coarse = 0.87 / 0.13 = 6.7, so from P = 8 among the powers of two; the
-    # speed-up tends to 1 / 0.13 of the reference size's split (N log N alike for both)
-    p = model.coarse_dominates_from(2048, COEFFICIENT, REF, bandwidth=math.inf, latency=0.0)
-    assert p == 8
+def test_coarse_start_on_the_slabs_shrinks_with_the_ranks_down_to_its_gathered_tail():
+    # an ideal network: a level on the slabs takes its serial share over P, the gathered
+    # tail its whole share; the shares are N_l log2 N_l of the levels 1024² .. 32² of 2048²
+    weights = [(2048 >> k) ** 2 * math.log2((2048 >> k) ** 2) for k in range(1, 7)]
+    serial = model.model_serial(2048, COEFFICIENT, REF)["coarse"]
+    t = model.model_time(2048, 16, COEFFICIENT, REF, bandwidth=math.inf, latency=0.0)
+    expected = serial * (sum(weights[:4]) / 16 + sum(weights[4:])) / sum(weights)
+    assert t["coarse"] == pytest.approx(expected, rel=1e-12)
+    # where no level has 8 rows a rank, the coarse start is gathered and solved whole, and
+    # bounds the speed-up as Amdahl: 1 / 0.13 of the split (0.87 / 2**20 left)
     t = model.model_time(2048, 2**20, COEFFICIENT, REF, bandwidth=math.inf, latency=0.0)
-    assert t["serial"] / t["total"] == pytest.approx(1 / 0.13, rel=1e-4)   # (0.87 / 2**20 left)
+    assert t["coarse"] == pytest.approx(serial, rel=1e-12)
+    assert t["serial"] / t["total"] == pytest.approx(1 / 0.13, rel=1e-4)
+    # below that, 2 ranks: every level on the slabs, the whole solve halves
+    t = model.model_time(2048, 2, COEFFICIENT, REF, bandwidth=math.inf, latency=0.0)
+    assert t["serial"] / t["total"] == pytest.approx(2.0, rel=1e-12)
+    # the coarse start takes over half the solve once its gathered tail outweighs the rest
+    # over P: at P = 128 the levels from 512 rows (4 a rank) on, about a quarter of the
+    # coarse time (0.13/4 = 0.033 of the serial solve against the rest's 0.87/128 = 0.007);
+    # at P = 64 the tail from 256 rows, about 1/16 (0.008 against 0.014)
+    assert model.coarse_dominates_from(2048, COEFFICIENT, REF, bandwidth=math.inf, latency=0.0) == 128

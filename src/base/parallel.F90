@@ -18,13 +18,13 @@ module lc_base_parallel
 #ifdef LC_MPI
    use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Allgatherv, &
       & MPI_Gatherv, MPI_Scatterv, MPI_Bcast, MPI_Abort, MPI_Initialized, MPI_IN_PLACE, MPI_SUM, MPI_MAX, MPI_MIN, &
-      & MPI_LOR, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_Barrier
+      & MPI_LOR, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_Barrier, MPI_Allgather, MPI_Alltoallv
 #endif
    implicit none (type, external)
    private
    public :: parallel_start, parallel_end, is_distributed, rank_count, this_rank, is_root, slab, slab_rows, check_rank_count
    public :: largest_rank_count, global_sum, global_max, sum_over_ranks, max_over_ranks, global_any
-   public :: gather_rows, allgather_rows, scatter_rows
+   public :: gather_rows, allgather_rows, scatter_rows, redistribute_rows
    public :: broadcast, abort_job, mpi_available, barrier
 #ifdef LC_MPI
    public :: communicator
@@ -303,6 +303,84 @@ contains
       call slab(ny, y_start, rows)
       local = full(nx*y_start + 1:nx*(y_start + rows))
    end subroutine scatter_rows
+
+   !> Rows of a field of `ny` rows of `row_length` values, moved between two layouts over the
+   !> ranks: this rank holds the rows `held_first` .. `held_first` + size(held)/row_length - 1
+   !> (0-based; the ranks' held rows are disjoint and cover the field, in any split) and
+   !> receives in `wanted` the rows `wanted_first` .. `wanted_first` + `wanted_rows` - 1,
+   !> counted modulo ny (periodic: a halo row past the last is row 0), from whichever ranks
+   !> hold them. The ranks' wanted rows may overlap. One message each way between each pair
+   !> of ranks (MPI_Alltoallv); one rank: a copy.
+   subroutine redistribute_rows(held, row_length, ny, held_first, wanted_first, wanted_rows, wanted)
+      real(wp), contiguous, intent(in) :: held(:)
+      integer, intent(in) :: row_length, ny, held_first, wanted_first, wanted_rows
+      real(wp), contiguous, intent(out) :: wanted(:)
+      integer :: k, row
+#ifdef LC_MPI
+      integer :: ranges(4, 0:ranks - 1), send_counts(0:ranks - 1), send_offsets(0:ranks - 1)
+      integer :: receive_counts(0:ranks - 1), receive_offsets(0:ranks - 1), filled(0:ranks - 1)
+      real(wp), allocatable :: outgoing(:), incoming(:)
+      integer :: q, owner, next
+      if (ranks > 1) then
+         ! (every rank's held and wanted rows: what each sends to each, and in which order)
+         call MPI_Allgather([held_first, size(held)/row_length, wanted_first, wanted_rows], 4, MPI_INTEGER, ranges, 4, &
+            & MPI_INTEGER, communicator)
+         send_counts = 0
+         do q = 0, ranks - 1
+            do k = 0, ranges(4, q) - 1
+               row = modulo(ranges(3, q) + k, ny)
+               if (row_owner(row, ranges) == rank) send_counts(q) = send_counts(q) + row_length
+            end do
+         end do
+         receive_counts = 0
+         do k = 0, wanted_rows - 1
+            owner = row_owner(modulo(wanted_first + k, ny), ranges)
+            receive_counts(owner) = receive_counts(owner) + row_length
+         end do
+         send_offsets(0) = 0
+         receive_offsets(0) = 0
+         do q = 1, ranks - 1
+            send_offsets(q) = send_offsets(q - 1) + send_counts(q - 1)
+            receive_offsets(q) = receive_offsets(q - 1) + receive_counts(q - 1)
+         end do
+         allocate (outgoing(max(sum(send_counts), 1)), incoming(max(sum(receive_counts), 1)))
+         ! each rank's wanted rows that this one holds, in the order that rank wants them
+         next = 1
+         do q = 0, ranks - 1
+            do k = 0, ranges(4, q) - 1
+               row = modulo(ranges(3, q) + k, ny)
+               if (row_owner(row, ranges) /= rank) cycle
+               outgoing(next:next + row_length - 1) = held((row - held_first)*row_length + 1:(row - held_first + 1)*row_length)
+               next = next + row_length
+            end do
+         end do
+         call MPI_Alltoallv(outgoing, send_counts, send_offsets, MPI_DOUBLE_PRECISION, incoming, receive_counts, &
+            & receive_offsets, MPI_DOUBLE_PRECISION, communicator)
+         filled = receive_offsets
+         do k = 0, wanted_rows - 1
+            owner = row_owner(modulo(wanted_first + k, ny), ranges)
+            wanted(k*row_length + 1:(k + 1)*row_length) = incoming(filled(owner) + 1:filled(owner) + row_length)
+            filled(owner) = filled(owner) + row_length
+         end do
+         return
+      end if
+#endif
+      do k = 0, wanted_rows - 1
+         row = modulo(wanted_first + k, ny) - held_first
+         wanted(k*row_length + 1:(k + 1)*row_length) = held(row*row_length + 1:(row + 1)*row_length)
+      end do
+   end subroutine redistribute_rows
+#ifdef LC_MPI
+
+   !> The rank whose held rows (ranges(1:2, r): first, count) include `row`.
+   pure integer function row_owner(row, ranges) result(owner)
+      integer, intent(in) :: row, ranges(:, 0:)
+      do owner = 0, size(ranges, 2) - 1
+         if (row >= ranges(1, owner) .and. row < ranges(1, owner) + ranges(2, owner)) return
+      end do
+      owner = -1
+   end function row_owner
+#endif
 
    !> Wait for every rank.
    subroutine barrier()

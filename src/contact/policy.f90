@@ -85,8 +85,8 @@ module lc_contact_policy
       !> multigrid method smooths it by rows where the GCR is slow
       logical :: rows_ahead = .false.
       !> a surface shared among the ranks of an MPI job (docs/decisions/023-mpi-slabs.md):
-      !> the constrained CG and GCR (and GCR keeping its history) solve it, the serial methods
-      !> (multigrid, Anderson, GFMD, dense Newton) do not
+      !> the constrained CG and GCR (GCR keeping its history, then Anderson's iteration) solve
+      !> it, the serial methods (multigrid, GFMD, dense Newton) do not
       logical :: distributed = .false.
    end type problem_indicators
 
@@ -163,9 +163,11 @@ contains
 
       first = trim(ind%method)
       why = ''
-      if (ind%distributed .and. all(trim(ind%method) /= [character(len=8) :: 'auto', 'cg', 'gcr', 'kept'])) then
+      if (ind%distributed .and. all(trim(ind%method) /= [character(len=8) :: 'auto', 'cg', 'gcr', 'kept', &
+         & 'anderson'])) then
          call fatal_error(error, "&solver: method = '" // trim(ind%method) // "' runs on one MPI rank; a surface " // &
-            & "shared among ranks is solved by 'auto', 'cg' or 'gcr' (" // distributed_refusal // ')', code_input)
+            & "shared among ranks is solved by 'auto', 'cg', 'gcr' or 'anderson' (" // distributed_refusal // ')', &
+            & code_input)
          return
       end if
       select case (trim(ind%method))
@@ -227,7 +229,7 @@ contains
       end if
       if (plan%stages(plan%count) == 'gcr' .and. (trim(ind%method) == 'auto' .or. first == 'multigrid')) then
          call add(plan, 'kept')
-         if (.not. ind%distributed) call add(plan, 'anderson')
+         call add(plan, 'anderson')
       end if
       if (trim(ind%method) == 'auto' .and. ind%points <= dense_points .and. ind%monotone .and. first /= 'newton' &
          & .and. .not. ind%distributed) call add(plan, 'newton')

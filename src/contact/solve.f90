@@ -32,7 +32,9 @@ module lc_contact_solve
    use lc_base_memory, only: check_memory
    use lc_base_pages, only: advise_huge_pages
    use lc_base_threads, only: solve_threads, use_threads, active_threads
-   use lc_base_parallel, only: is_distributed, slab, global_sum, global_max, allgather_rows, rank_count
+   use lc_base_parallel, only: is_distributed, slab, global_sum, global_max, allgather_rows, rank_count, &
+      & redistribute_rows
+   use lc_base_slab, only: empty_rank
    implicit none (type, external)
    private
    public :: solve_contact, scene_mean_pressure
@@ -40,6 +42,12 @@ module lc_contact_solve
    !> The coarse-start recursion stops before a grid of fewer than coarsest_grid points:
    !> below that a solve costs less than the set-up of another level.
    integer, parameter :: coarsest_grid = 512
+   !> A distributed surface's coarse grid is itself solved on the slabs where each rank gets
+   !> at least this many of its rows (ceiling((ny/2)/P) rows a rank); a thinner coarse grid
+   !> is gathered onto every rank and solved whole there, as its own coarse grids are: a
+   !> thin slab pays its transforms' 2(P - 1) messages a pair for little work, while the
+   !> grid it would share is small (docs/decisions/027-distributed-coarse-start.md).
+   integer, parameter :: distributed_coarse_rows = 8
    !> Tolerance of the coarse solves (or the scene's, if looser): a starting guess only
    !> needs to be closer than the discretisation difference between the two grids, which
    !> falls like the grid step (contact edges within a grid step): coarse_tol up to a fine
@@ -278,6 +286,8 @@ contains
          if (allocated(error)) return
       end if
       call progress%begin_level(grid%nx, grid%ny)
+      if (progress%enabled .and. across_ranks) &
+         & progress%level = progress%level // ' on the slabs of ' // to_string(rank_count()) // ' ranks'
       call progress%plan(plan%reason)
       uniform = 0.0_wp
       if (load_control) call op%drop_uniform_mode(uniform)
@@ -339,9 +349,11 @@ contains
    !> of a starting guess (coarse_tol); its FFT pairs are returned in units of pairs of
    !> this grid (2 or 4 times as long each, on a line or a surface), with its iterations
    !> and whether its plan took the multigrid method: what the policy reads of it.
-   !> Distributed (`across_ranks`: height and state%p are this rank's slab): the coarse
-   !> problem is gathered to every rank and solved there, serially and identically; each
-   !> rank then takes its slab of the interpolated start.
+   !> Distributed (`across_ranks`: height and state%p are this rank's slab): the coarse grid
+   !> is a distributed surface of its own (its slabs by the same contract, its own plans)
+   !> where it leaves each rank at least distributed_coarse_rows rows (coarse_on_slabs);
+   !> a thinner one is gathered to every rank and solved there, serially and identically,
+   !> each rank then taking its slab of the interpolated start.
    recursive subroutine coarse_solution(scene, grid, kernel, height, friction, load_control, pm, g_ref, state, &
          & pairs, iterations, took_multigrid, progress, error, across_ranks)
       type(scene_type), intent(in) :: scene
@@ -364,6 +376,7 @@ contains
       real(wp), allocatable, target :: hc(:)
       real(wp), allocatable :: whole(:)
       integer :: ratio, y_start, ny_local
+      logical :: on_slabs
 
       pairs = 0
       iterations = 0
@@ -372,8 +385,11 @@ contains
       coarse = scene
       coarse%solver%tol = max(scene%solver%tol, coarse_tol*min(1.0_wp, real(coarse_tol_size, wp)/grid%nx))
       if (trim(scene%solver%method) == 'multigrid') coarse%solver%tol = max(scene%solver%tol, multigrid_coarse_tol)
-      allocate (coarse_state%w(coarse_grid%points()), coarse_state%gap(coarse_grid%points()))
-      if (across_ranks) then
+      on_slabs = across_ranks .and. coarse_on_slabs(coarse_grid)
+      if (on_slabs) then
+         call restrict_to_slabs(grid, height, hc)
+         call restrict_to_slabs(grid, state%p, coarse_state%p)
+      else if (across_ranks) then
          call allgather_rows(height, grid%nx, grid%ny, whole)
          hc = restrict(grid, whole)
          call allgather_rows(state%p, grid%nx, grid%ny, whole)
@@ -382,11 +398,14 @@ contains
          hc = restrict(grid, height)
          coarse_state%p = restrict(grid, state%p)
       end if
+      allocate (coarse_state%w(size(hc)), coarse_state%gap(size(hc)))
       coarse_state%s = state%s
       call solve_on_grid(coarse, coarse_grid, kernel, hc, friction, load_control, pm, g_ref, coarse_op, coarse_state, &
-         & coarse_result, progress, error, coarse_plan)
+         & coarse_result, progress, error, coarse_plan, distributed=on_slabs)
       if (allocated(error)) return
-      if (across_ranks) then
+      if (on_slabs) then
+         call interpolate_from_slabs(grid, coarse_state%p, state%p)
+      else if (across_ranks) then
          call interpolate(grid, coarse_state%p, whole)
          call slab(grid%ny, y_start, ny_local)
          state%p = whole(grid%nx*y_start + 1:grid%nx*(y_start + ny_local))
@@ -399,6 +418,75 @@ contains
       iterations = coarse_result%iterations
       took_multigrid = coarse_plan%stages(1) == 'multigrid'
    end subroutine coarse_solution
+
+   !> Whether the coarse grid of a distributed surface is solved on the slabs: at least
+   !> distributed_coarse_rows rows a rank, and no rank left without rows or without columns
+   !> of the transposed half spectrum (nx/2 + 1 of them).
+   logical function coarse_on_slabs(coarse_grid)
+      type(grid_type), intent(in) :: coarse_grid
+      integer :: p
+      p = rank_count()
+      coarse_on_slabs = (coarse_grid%ny + p - 1)/p >= distributed_coarse_rows .and. &
+         & .not. empty_rank(coarse_grid%ny, p) .and. .not. empty_rank(coarse_grid%nx/2 + 1, p)
+   end function coarse_on_slabs
+
+   !> fc: this rank's slab (the contract of the grid of every second point) of f sampled at
+   !> every second point, from this rank's slab of f. Each rank samples the even rows of
+   !> its own slab; those rows are moved to the ranks whose coarse slabs hold them.
+   subroutine restrict_to_slabs(grid, f, fc)
+      type(grid_type), intent(in) :: grid
+      real(wp), intent(in) :: f(:)
+      real(wp), allocatable, intent(out) :: fc(:)
+      real(wp), allocatable :: sampled(:)
+      integer :: y_start, ny_local, first, last, yc_start, nyc_local, nxc, j, row
+      call slab(grid%ny, y_start, ny_local)
+      nxc = grid%nx/2
+      ! (the coarse rows j whose fine row 2j is in this slab)
+      first = (y_start + 1)/2
+      last = (y_start + ny_local - 1)/2
+      allocate (sampled(nxc*max(last - first + 1, 0)))
+      do j = first, last
+         row = 2*j - y_start
+         sampled((j - first)*nxc + 1:(j - first + 1)*nxc) = f(row*grid%nx + 1:(row + 1)*grid%nx:2)
+      end do
+      call slab(grid%ny/2, yc_start, nyc_local)
+      allocate (fc(nxc*nyc_local))
+      call redistribute_rows(sampled, nxc, grid%ny/2, first, yc_start, nyc_local, fc)
+   end subroutine restrict_to_slabs
+
+   !> f: this rank's slab of the bilinear interpolation (interpolate_surface, the same
+   !> operations in the same order) of fc, this rank's slab of the grid of every second
+   !> point. A fine row between two coarse rows needs both: the coarse rows that cover
+   !> this slab, and the next (periodic: past the last row, row 0), are brought here.
+   subroutine interpolate_from_slabs(grid, fc, f)
+      type(grid_type), intent(in) :: grid
+      real(wp), intent(in) :: fc(:)
+      real(wp), intent(out) :: f(:)
+      real(wp), allocatable :: near(:), along_x(:, :)
+      integer :: y_start, ny_local, yc_start, nyc_local, first, rows, nxc, i, y, k
+      call slab(grid%ny, y_start, ny_local)
+      call slab(grid%ny/2, yc_start, nyc_local)
+      nxc = grid%nx/2
+      first = y_start/2
+      rows = (y_start + ny_local - 1)/2 - first + 2
+      allocate (near(nxc*rows), along_x(grid%nx, rows))
+      call redistribute_rows(fc, nxc, grid%ny/2, yc_start, first, rows, near)
+      do k = 1, rows
+         associate (coarse_row => near((k - 1)*nxc + 1:k*nxc))
+            along_x(1:grid%nx:2, k) = coarse_row
+            along_x(2:grid%nx:2, k) = 0.5_wp*(coarse_row + cshift(coarse_row, 1))
+         end associate
+      end do
+      do i = 1, ny_local
+         y = y_start + i - 1
+         k = y/2 - first + 1
+         if (mod(y, 2) == 0) then
+            f((i - 1)*grid%nx + 1:i*grid%nx) = along_x(:, k)
+         else
+            f((i - 1)*grid%nx + 1:i*grid%nx) = 0.5_wp*(along_x(:, k) + along_x(:, k + 1))
+         end if
+      end do
+   end subroutine interpolate_from_slabs
 
    !> The values of f at every second point (along both axes of a surface).
    pure function restrict(grid, f) result(fc)

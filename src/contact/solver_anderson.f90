@@ -11,9 +11,15 @@
 !> Convergence is judged on the complementarity residual of the full coupled problem at
 !> T's output (which is always feasible: p >= 0 and the load is exact). A run that stops
 !> without converging returns its best iterate (the smallest residual).
+!>
+!> On an operator on a slab of a surface shared among the ranks (docs/decisions/023-mpi-slabs.md)
+!> the fields and the history are this rank's rows: the inner products, the Gram matrix's
+!> row and the projections are summed over the ranks (one message an iteration), so every
+!> rank solves the same small least-squares problem and mixes its rows with the same gamma.
 module lc_contact_solver_anderson
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_internal
+   use lc_base_parallel, only: global_sum, global_max, sum_over_ranks
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_cg, only: constrained_cg, cg_outcome
    use lc_contact_residual, only: complementarity_residual, rounding_floor
@@ -82,13 +88,17 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(progress_log), intent(inout), optional :: progress
       real(wp), allocatable :: x(:), f(:), x_old(:), f_old(:), tx(:), dx(:, :), df(:, :), b(:), nw(:), p_best(:)
-      real(wp), allocatable :: gamma(:), gram(:, :), projection(:)
+      real(wp), allocatable :: gamma(:), gram(:, :), projection(:), products(:)
       type(cg_outcome) :: inner
       real(wp) :: inner_tol, s_full, s_inner, best, best_residual
       integer :: n, k, columns, newest, j, last_progress, depth
-      logical :: preconditioned
+      logical :: preconditioned, across_ranks
+      real(wp) :: points
 
+      across_ranks = op%distributed
       n = size(p)
+      points = n
+      if (across_ranks) points = global_sum(points)
       allocate (x(n), f(n), x_old(n), f_old(n), tx(n), b(n), nw(n), dx(n, memory), df(n, memory), p_best(n))
       allocate (gamma(memory), gram(memory, memory), projection(memory))
       depth = memory   ! the history kept now (grows on stagnation)
@@ -123,7 +133,7 @@ contains
          history(k) = outcome%residual
          if (present(progress)) then
             if (progress%enabled) call progress%tick(outcome%cg_iterations, outcome%residual, &
-               & count(p > 0.0_wp)/real(n, wp))
+               & contact_count(p, across_ranks)/points)
          end if
          if (outcome%residual <= tol) then
             outcome%converged = .true.
@@ -178,6 +188,12 @@ contains
             x = tx
          else
             call history_products(df(:, 1:columns), newest, f, gram(1:columns, newest), projection(1:columns))
+            if (across_ranks) then
+               products = [gram(1:columns, newest), projection(1:columns)]
+               call sum_over_ranks(products)
+               gram(1:columns, newest) = products(1:columns)
+               projection(1:columns) = products(columns + 1:)
+            end if
             gram(newest, 1:columns) = gram(1:columns, newest)
             call least_squares(gram(1:columns, 1:columns), projection(1:columns), gamma(1:columns), error)
             if (allocated(error)) return
@@ -186,7 +202,7 @@ contains
             ! the previous output) and the mixing returns the x it was given; it would do so
             ! forever. Restart it from a plain step x = T(x), whose inner problem is the
             ! coupled one at the current p.
-            if (maxval(abs(x - x_old)) <= plateau_step*maxval(abs(x_old))) then
+            if (largest(abs(x - x_old), across_ranks) <= plateau_step*largest(abs(x_old), across_ranks)) then
                columns = 0
                newest = 0
                x = tx
@@ -208,19 +224,46 @@ contains
       real(wp), intent(in) :: r(:), mean_pressure, s, g_ref, p(:)
       logical, intent(in) :: load_control
       real(wp), intent(out) :: w(:), gap(:), s_full, residual
-      real(wp) :: p_ref
+      real(wp) :: p_ref, points
+      logical :: across_ranks
+      across_ranks = op%distributed
       call op%apply_full(p, w)
       gap = w - r
       if (load_control) then
-         s_full = sum(gap, mask=p > 0.0_wp)/max(count(p > 0.0_wp), 1)
+         s_full = total(sum(gap, mask=p > 0.0_wp), across_ranks)/max(contact_count(p, across_ranks), 1)
       else
          s_full = s
       end if
       gap = gap - s_full
-      p_ref = merge(mean_pressure, sum(p)/size(p), load_control)
-      residual = complementarity_residual(p, gap, p_ref, g_ref, &
-         & rounding_floor(maxval(abs(w)), maxval(abs(r)), maxval(p), op%largest))
+      points = total(real(size(p), wp), across_ranks)
+      p_ref = merge(mean_pressure, total(sum(p), across_ranks)/points, load_control)
+      residual = largest([complementarity_residual(p, gap, p_ref, g_ref, rounding_floor(largest(abs(w), across_ranks), &
+         & largest(abs(r), across_ranks), largest(p, across_ranks), op%largest))], across_ranks)
    end subroutine coupled_state
+
+   !> The contact points (p > 0) of p, over the ranks where `across_ranks`.
+   integer function contact_count(p, across_ranks) result(points)
+      real(wp), intent(in) :: p(:)
+      logical, intent(in) :: across_ranks
+      points = count(p > 0.0_wp)
+      if (across_ranks) points = global_sum(points)
+   end function contact_count
+
+   !> x summed over the ranks where `across_ranks`.
+   real(wp) function total(x, across_ranks)
+      real(wp), intent(in) :: x
+      logical, intent(in) :: across_ranks
+      total = x
+      if (across_ranks) total = global_sum(x)
+   end function total
+
+   !> The largest value of x, over the ranks where `across_ranks`.
+   real(wp) function largest(x, across_ranks)
+      real(wp), intent(in) :: x(:)
+      logical, intent(in) :: across_ranks
+      largest = maxval(x)
+      if (across_ranks) largest = global_max(largest)
+   end function largest
 
    !> Room for `depth` history columns (the contents are dropped: the mixing restarts).
    subroutine grow_history(dx, df, gram, gamma, projection, depth)

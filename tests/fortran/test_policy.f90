@@ -211,8 +211,9 @@ contains
       call report(name, error%code == code_input .and. index(error%message, message_has) > 0, error%message)
    end subroutine refused
 
-   !> A surface shared among MPI ranks: CG or GCR (and GCR keeping its history), never the
-   !> serial methods, however large or hard the grid; the serial methods refused by name.
+   !> A surface shared among MPI ranks: CG or GCR (GCR keeping its history, then Anderson's
+   !> iteration, as on one rank), never the serial methods, however large or hard the grid;
+   !> the serial methods refused by name.
    subroutine check_distributed()
       type(problem_indicators) :: ind
       ind = problem(2048**2, .false., .false.)
@@ -221,11 +222,14 @@ contains
       call expect('distributed symmetric 2048^2', ind, .true., 'cg', 'multigrid is serial')
       ind%coupled = .true.
       ind%start_iterations = 40
-      call expect('distributed coupled 2048^2, hard start', ind, .true., 'gcr+kept', 'distributed runs use gcr/cg')
+      call expect('distributed coupled 2048^2, hard start', ind, .true., 'gcr+kept+anderson', &
+         & 'distributed runs use gcr/cg')
       ind%points = 32**2
-      call expect('distributed coupled 32^2 (no dense Newton)', ind, .true., 'gcr+kept', 'the constrained GCR')
+      call expect('distributed coupled 32^2 (no dense Newton)', ind, .true., 'gcr+kept+anderson', 'the constrained GCR')
       ind%method = 'anderson'
-      call refused('distributed anderson', ind, 'runs on one MPI rank')
+      call expect('distributed anderson', ind, .true., 'anderson', "method 'anderson'")
+      ind%method = 'gfmd'
+      call refused('distributed gfmd', ind, 'runs on one MPI rank')
       ind%method = 'multigrid'
       call refused('distributed multigrid', ind, 'runs on one MPI rank')
       ind%method = 'gcr'
