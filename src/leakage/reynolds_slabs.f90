@@ -85,9 +85,10 @@ contains
             & code_internal)
          return
       end if
-      ! this rank's share: its slab's cells
+      ! this rank's share: its slab's cells (a failure on some ranks only ends the job: the
+      ! run's MPI_Abort, docs/clusters.md)
       call leakage_memory_check(size(g, kind=i8), 0, error)
-      if (failed_somewhere(error)) return
+      if (allocated(error)) return
       result%tol = tol
       result%solver = leakage_solver
       hx = lx/nx
@@ -140,15 +141,6 @@ contains
             & max_iter, prepared, flow, error)
       end subroutine solve_direction
    end subroutine reynolds_leakage_slab
-
-   !> True on every rank if `error` is set on some rank (there: its error; elsewhere: that
-   !> another rank failed), so that all leave together.
-   logical function failed_somewhere(error)
-      type(error_type), allocatable, intent(inout) :: error
-      failed_somewhere = global_any(allocated(error))
-      if (failed_somewhere .and. .not. allocated(error)) &
-         & call fatal_error(error, 'the leakage failed on another MPI rank', code_internal)
-   end function failed_somewhere
 
    !> The face conductances of this slab's cells to the east and north (face_weights on the
    !> slab and the row above it).
@@ -383,8 +375,6 @@ contains
       if (.not. prepared) then
          status = lc_hypre_setup_boomeramg_rows(int(communicator_handle(), c_int), int(first_row, c_int), &
             & int(n_free, c_int), row_start, column, value, amg_strength)
-         ! (every rank leaves if one failed: hypre's next step is collective)
-         status = nint(global_max(real(status, wp)))
          if (status == hypre_out_of_memory) then
             call out_of_memory(error, 'hypre''s BoomerAMG hierarchy', hypre_bytes_per_unknown*n_free)
             return
@@ -437,13 +427,12 @@ contains
 
    contains
 
-      !> z = one V-cycle of BoomerAMG on r (an error on every rank if hypre reports a failure
-      !> on one).
+      !> z = one V-cycle of BoomerAMG on r (an error if hypre reports a failure).
       subroutine precondition(r, z)
          real(wp), intent(in) :: r(:)
          real(wp), intent(out) :: z(:)
-         integer :: status
-         status = nint(global_max(real(lc_hypre_apply(r, z), wp)))
+         integer(c_int) :: status
+         status = lc_hypre_apply(r, z)
          if (status == hypre_out_of_memory) then
             z = 0.0_wp
             call out_of_memory(error, 'the work arrays of hypre''s V-cycle', hypre_bytes_per_unknown*size(r, kind=i8))
