@@ -27,9 +27,10 @@ contains
    !> Solve `scene` on the profile `height` (flat, x fastest) with Coulomb coefficient
    !> `friction` (the scene's, or 0 for the frictionless companion) and compute its
    !> observables (with &output conductance, the conductance and stiffness too). A surface
-   !> shared among MPI ranks (`height`: this rank's slab) is solved distributed; its fields
-   !> are then gathered to rank 0, which computes the observables from the whole maps
-   !> (the other ranks' results keep the scalars of the solve and no fields).
+   !> shared among MPI ranks (`height`: this rank's slab) is solved distributed; its patches
+   !> and leakage are computed on the slabs, then its fields are gathered to rank 0, which
+   !> computes the other observables from the whole maps (the other ranks' results keep the
+   !> scalars of the solve, the patches and the leakage, and no fields).
    subroutine solve_scene(scene, height, friction, result, error)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in), target :: height(:)
@@ -55,8 +56,8 @@ contains
    end subroutine solve_scene
 
    !> What a distributed solve computes on its slabs, every rank its own, before the fields
-   !> are gathered: the contact patches (on every rank) and, with &output leakage, the
-   !> Reynolds leakage (lc_observables_patches, lc_leakage_reynolds).
+   !> are gathered: the contact patches and, with &output leakage, the Reynolds leakage,
+   !> each rank holding the whole result (lc_observables_patches, lc_leakage_reynolds_slabs).
    subroutine observe_on_slabs(scene, grid, result, error)
       type(scene_type), intent(in) :: scene
       type(grid_type), intent(in) :: grid
