@@ -205,3 +205,30 @@ def test_the_leakage_on_the_slabs_is_the_serial_one(pressure, near, tmp_path):
         assert serial["percolating_x"] and serial["percolating_y"]
         assert serial["connected_fraction_x"] == serial["fluid_fraction"] > 0.9
     assert_same_leakage(results)
+
+
+@needs_mpi
+def test_a_rank_whose_slab_is_all_contact(tmp_path):
+    """A ridge along x closes rows 0-4 of 32: on 8 ranks (4 rows each) rank 0 holds no
+    fluid cell, so no row of hypre's matrix, and the flow along x passes through the other
+    slabs; across the ridge (y) nothing flows. The serial k_eff to LEAKAGE and counts."""
+    n = 32
+    x = np.arange(n) / n
+    xx, yy = np.meshgrid(x, x - 1.5 / n)
+    heights = (0.02 * np.cos(2 * np.pi * yy) + 0.004 * np.cos(6 * np.pi * xx + 1) * np.sin(2 * np.pi * yy) ** 2
+               + 0.003 * np.cos(2 * np.pi * (2 * xx + 3 * yy)))
+    np.save(tmp_path / "ridge.npy", heights.astype("<f8"))
+    results = {}
+    for ranks in (0, 8):
+        out = f"ridge{ranks}"
+        nml = write_scene(tmp_path, out, n, "kind = 'file', file = 'ridge.npy'", 1.0, f"{out}.h5", leakage=True)
+        done = run_serial(nml) if ranks == 0 else run_mpi(ranks, [executable(), str(nml)], tmp_path)
+        assert done.returncode == 0, done.stderr
+        results[ranks] = read(tmp_path / f"{out}.h5")
+    closed_rows = np.all(results[0]["pressure"] > 0, axis=1)
+    assert closed_rows[:4].all() and not closed_rows[5:-1].any()
+    serial, run = results[0]["leakage"], results[8]["leakage"]
+    assert serial["k_eff_x"] > 0 and serial["k_eff_y"] == 0 and serial["iterations_x"] > 0
+    assert run["k_eff_x"] == pytest.approx(serial["k_eff_x"], rel=LEAKAGE, abs=0) and run["k_eff_y"] == 0
+    assert run["unknowns_x"] == serial["unknowns_x"] and run["converged"]
+    assert np.array_equal(results[8]["area"], results[0]["area"])

@@ -9,7 +9,8 @@
  *
  * Debian's hypre is built with MPI. MPI is started here only when a preconditioner is
  * first needed (a singleton start: no mpirun), and finished at exit if it was started here,
- * so that runs that compute no leakage never touch MPI. Everything runs on MPI_COMM_SELF.
+ * so that runs that compute no leakage never touch MPI. A run of one process works on
+ * MPI_COMM_SELF; a distributed one on its job's communicator (below).
  *
  * Open MPI keeps a session directory (ompi.HOST.UID/ with the singleton's files) under
  * $TMPDIR and leaves it there after MPI_Finalize. MPI is therefore started with a directory
@@ -327,9 +328,10 @@ int lc_hypre_setup_boomeramg_rows(int comm, int first, int n, const int *row_sta
 /* y = A x on this process's rows of the matrix set up (n values each); 0, or 5 if none is. */
 int lc_hypre_matvec(const double *x, double *y) {
     if (!amg.live) return 5;
-    memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), x, sizeof(double) * (size_t)amg.n);
+    /* (a rank without rows takes part in the product's exchange all the same) */
+    if (amg.n > 0) memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), x, sizeof(double) * (size_t)amg.n);
     HYPRE_ParCSRMatrixMatvec(1.0, amg.par_a, amg.par_x, 0.0, amg.par_b);
-    memcpy(y, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), sizeof(double) * (size_t)amg.n);
+    if (amg.n > 0) memcpy(y, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), sizeof(double) * (size_t)amg.n);
     return 0;
 }
 
@@ -337,13 +339,13 @@ int lc_hypre_matvec(const double *x, double *y) {
 int lc_hypre_apply(const double *r, double *z) {
     sigjmp_buf target;
     if (!amg.live) return 5;
-    memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), r, sizeof(double) * (size_t)amg.n);
+    if (amg.n > 0) memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), r, sizeof(double) * (size_t)amg.n);
     HYPRE_ParVectorSetConstantValues(amg.par_x, 0.0);
     if (sigsetjmp(target, 0) != 0) return aborted();
     abort_return = &target;
     HYPRE_BoomerAMGSolve(amg.solver, amg.par_a, amg.par_b, amg.par_x);
     abort_return = NULL;
-    memcpy(z, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), sizeof(double) * (size_t)amg.n);
+    if (amg.n > 0) memcpy(z, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), sizeof(double) * (size_t)amg.n);
     HYPRE_ClearAllErrors(); /* "not converged" after one cycle is the intent */
     return 0;
 }
