@@ -279,8 +279,11 @@ def test_rows_move_between_slab_layouts(ranks, redistribute_program):
 
 @needs_mpi
 def test_observables_of_the_whole_map_on_rank_0(tmp_path):
-    """Surface stress, leakage, conductance and stiffness need the whole map: rank 0
-    computes them from the gathered fields, the serial run's values (stress fields too)."""
+    """Surface stress, conductance and stiffness need the whole map: rank 0 computes them
+    from the gathered fields, the serial run's values (stress fields too). The leakage is
+    computed on the slabs by hypre's distributed BoomerAMG, which takes other CG iterations:
+    its k_eff agrees to the leakage tolerance (tests/test_mpi_observables.py), its counts
+    exactly."""
     body = SCENES["coupled"].replace("coefficient = 0.5", "coefficient = 0.5, companion = .true.")
     for name, out in (("serial", "serial.h5"), ("ranks", "ranks2.h5")):
         nml = write_scene(tmp_path, name, 64, body, out)
@@ -296,7 +299,9 @@ def test_observables_of_the_whole_map_on_rank_0(tmp_path):
         for name, value in g["leakage"].attrs.items():
             # (its time, and its CG's residuals at the leakage tolerance, are not the answer)
             if np.asarray(value).dtype.kind == "f" and not name.startswith(("wall_time", "residual")):
-                assert np.all(np.abs(f["leakage"].attrs[name] - value) <= SAME * np.abs(value) + VANISHING), name
+                # (k_eff: each run within leakage_tol = 1e-6 of the exact value, above it)
+                close = 10 * g["leakage"].attrs["tol"] if name.startswith("k_eff") else SAME
+                assert np.all(np.abs(f["leakage"].attrs[name] - value) <= close * np.abs(value) + VANISHING), name
 
 
 @needs_mpi

@@ -22,8 +22,8 @@ module lc_application_run
    use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_application_accuracy, only: choose_resolution
    use lc_base_version, only: version_string, build_isa
-   use lc_base_parallel, only: parallel_start, parallel_end, is_distributed, is_root, rank_count, this_rank, check_rank_count, &
-      & barrier, abort_job, gather_rows, global_any
+   use lc_base_parallel, only: parallel_start, parallel_end, is_distributed, is_root, rank_count, this_rank, &
+      & check_rank_count, barrier, abort_job, gather_rows, global_any, slab
    implicit none (type, external)
    private
    public :: run_scene_file
@@ -85,6 +85,7 @@ contains
       real(wp), allocatable :: height(:), local_height(:)
       type(run_record) :: run
       integer(i8) :: start, finish, rate
+      integer :: y_start, rows
 
       converged = .false.
       call system_clock(start, rate)
@@ -135,9 +136,11 @@ contains
       if (allocated(error)) return
 
       ! the leakage runs after the solve, next to the solution's fields (and the companion's):
-      ! a grid whose leakage would not fit ends here, before the solve
+      ! a grid whose leakage would not fit ends here, before the solve (distributed: each
+      ! rank its slab's)
       if (scene%leakage) then
-         call leakage_memory_check(int(scene%n, i8)*max(scene%ny, 1), &
+         call slab(max(scene%ny, 1), y_start, rows)
+         call leakage_memory_check(int(scene%n, i8)*rows, &
             & merge(2, 1, scene%companion)*merge(10, 4, scene%stress), error)
          if (allocated(error)) return
       end if

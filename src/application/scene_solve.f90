@@ -11,10 +11,12 @@ module lc_application_scene_solve
    use lc_base_threads, only: active_threads
    use lc_base_grid, only: grid_type
    use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
+   use lc_leakage_reynolds_slabs, only: reynolds_leakage_slab
    use lc_result, only: contact_result
    use lc_contact_operator, only: compliance_operator, build_operator
    use lc_contact_solve, only: solve_contact
    use lc_observables, only: observe
+   use lc_observables_patches, only: contact_patches_slab
    use lc_observables_conductance, only: contact_conductance, contact_stiffness, masked_outcome
    implicit none (type, external)
    private
@@ -25,9 +27,10 @@ contains
    !> Solve `scene` on the profile `height` (flat, x fastest) with Coulomb coefficient
    !> `friction` (the scene's, or 0 for the frictionless companion) and compute its
    !> observables (with &output conductance, the conductance and stiffness too). A surface
-   !> shared among MPI ranks (`height`: this rank's slab) is solved distributed; its fields
-   !> are then gathered to rank 0, which computes the observables from the whole maps
-   !> (the other ranks' results keep the scalars of the solve and no fields).
+   !> shared among MPI ranks (`height`: this rank's slab) is solved distributed; its patches
+   !> and leakage are computed on the slabs, then its fields are gathered to rank 0, which
+   !> computes the other observables from the whole maps (the other ranks' results keep the
+   !> scalars of the solve, the patches and the leakage, and no fields).
    subroutine solve_scene(scene, height, friction, result, error)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in), target :: height(:)
@@ -43,12 +46,30 @@ contains
          ! (the slab's operator is freed before rank 0 holds the whole fields)
          grid = op%grid
          deallocate (op)
+         call observe_on_slabs(scene, grid, result, error)
+         if (allocated(error)) return
          call observe_gathered(scene, height, friction, grid, result, error)
          return
       end if
       call observe(scene, op, height, result)
       if (scene%conductance) call conductance_of(scene, op, result, error)
    end subroutine solve_scene
+
+   !> What a distributed solve computes on its slabs, every rank its own, before the fields
+   !> are gathered: the contact patches and, with &output leakage, the Reynolds leakage,
+   !> each rank holding the whole result (lc_observables_patches, lc_leakage_reynolds_slabs).
+   subroutine observe_on_slabs(scene, grid, result, error)
+      type(scene_type), intent(in) :: scene
+      type(grid_type), intent(in) :: grid
+      type(contact_result), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      call contact_patches_slab(grid, result%pressure, result%patch_area, result%patch_perimeter)
+      result%n_spots = size(result%patch_area)
+      if (.not. scene%leakage) return
+      allocate (result%leakage)
+      call reynolds_leakage_slab(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
+         & scene%leakage_tol, leakage_max_iter, result%leakage, error)
+   end subroutine observe_on_slabs
 
    !> The fields of a distributed solve gathered to rank 0, and there the observables (and
    !> the conductance) on the whole grid, with a serial operator of the scene.
@@ -112,15 +133,15 @@ contains
       type(error_type), allocatable, intent(out) :: error
       call solve_scene(scene, height, scene%friction, result, error)
       if (allocated(error)) return
-      ! (a distributed solve's fields are on rank 0: the leakage runs there)
-      if (scene%leakage .and. (is_root() .or. .not. is_distributed())) then
+      ! (a distributed solve has computed it on its slabs: observe_on_slabs)
+      if (scene%leakage .and. .not. is_distributed()) then
          call leakage_of(scene, result, error)
          if (allocated(error)) return
       end if
       if (.not. scene%companion) return
       call solve_scene(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
       if (allocated(error)) return
-      if (scene%leakage .and. (is_root() .or. .not. is_distributed())) call leakage_of(scene, companion, error)
+      if (scene%leakage .and. .not. is_distributed()) call leakage_of(scene, companion, error)
    end subroutine solve_runs
 
    !> The Reynolds leakage of the solved gap along x and y; contact is where p > 0 (and gaps

@@ -2,9 +2,15 @@
  * set up on the symmetric matrix of the free cells (IJ interface), applied as one V-cycle per
  * call from the conjugate gradients of the Fortran core, then freed. One at a time.
  *
+ * On a surface shared among the ranks of an MPI job (lc_leakage_reynolds_slabs) each rank
+ * gives the rows of its slab's free cells, numbered across the ranks, on the job's
+ * communicator: hypre's ParCSR matrix is then distributed as the slabs are, and its product
+ * with a vector (lc_hypre_matvec) exchanges the neighbouring rows' values.
+ *
  * Debian's hypre is built with MPI. MPI is started here only when a preconditioner is
  * first needed (a singleton start: no mpirun), and finished at exit if it was started here,
- * so that runs that compute no leakage never touch MPI. Everything runs on MPI_COMM_SELF.
+ * so that runs that compute no leakage never touch MPI. A run of one process works on
+ * MPI_COMM_SELF; a distributed one on its job's communicator (below).
  *
  * Open MPI keeps a session directory (ompi.HOST.UID/ with the singleton's files) under
  * $TMPDIR and leaves it there after MPI_Finalize. MPI is therefore started with a directory
@@ -208,9 +214,10 @@ static int room_for(size_t bytes) {
     return 1;
 }
 
-/* An IJ vector of n rows and its ParCSR object; 0 on success, else hypre's error flag. */
-static int ij_vector(int n, HYPRE_IJVector *v, HYPRE_ParVector *par) {
-    int status = HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, n - 1, v);
+/* An IJ vector of the n rows from `first` and its ParCSR object; 0 on success, else hypre's
+ * error flag. */
+static int ij_vector(MPI_Comm comm, int first, int n, HYPRE_IJVector *v, HYPRE_ParVector *par) {
+    int status = HYPRE_IJVectorCreate(comm, first, first + n - 1, v);
     if (status == 0) status = HYPRE_IJVectorSetObjectType(*v, HYPRE_PARCSR);
     if (status == 0) status = HYPRE_IJVectorInitialize(*v);
     if (status == 0) status = HYPRE_IJVectorAssemble(*v);
@@ -218,20 +225,20 @@ static int ij_vector(int n, HYPRE_IJVector *v, HYPRE_ParVector *par) {
     return status;
 }
 
-/* hypre's matrix of n rows (`sizes` entries each, rows numbered in `rows`), its vectors and
- * BoomerAMG set up on it, into `amg`; 0 or hypre's error flag (the objects made so far are
- * then in `amg` for lc_hypre_free). */
-static int build(int n, const int *sizes, const int *rows, const int *column, const double *value,
-                 double strength) {
-    int status = HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, n - 1, 0, n - 1, &amg.ij_a);
+/* hypre's matrix of the n rows from `first` of this process (`sizes` entries each, rows
+ * numbered in `rows`) on `comm`, its vectors and BoomerAMG set up on it, into `amg`; 0 or
+ * hypre's error flag (the objects made so far are then in `amg` for lc_hypre_free). */
+static int build(MPI_Comm comm, int first, int n, const int *sizes, const int *rows, const int *column,
+                 const double *value, double strength) {
+    int status = HYPRE_IJMatrixCreate(comm, first, first + n - 1, first, first + n - 1, &amg.ij_a);
     if (status == 0) status = HYPRE_IJMatrixSetObjectType(amg.ij_a, HYPRE_PARCSR);
     if (status == 0) status = HYPRE_IJMatrixSetRowSizes(amg.ij_a, sizes);
     if (status == 0) status = HYPRE_IJMatrixInitialize(amg.ij_a);
     if (status == 0) status = HYPRE_IJMatrixSetValues(amg.ij_a, n, (int *)sizes, rows, column, value);
     if (status == 0) status = HYPRE_IJMatrixAssemble(amg.ij_a);
     if (status == 0) status = HYPRE_IJMatrixGetObject(amg.ij_a, (void **)&amg.par_a);
-    if (status == 0) status = ij_vector(n, &amg.ij_b, &amg.par_b);
-    if (status == 0) status = ij_vector(n, &amg.ij_x, &amg.par_x);
+    if (status == 0) status = ij_vector(comm, first, n, &amg.ij_b, &amg.par_b);
+    if (status == 0) status = ij_vector(comm, first, n, &amg.ij_x, &amg.par_x);
     if (status == 0) status = HYPRE_BoomerAMGCreate(&amg.solver);
     if (status != 0) return status;
     HYPRE_BoomerAMGSetPrintLevel(amg.solver, 0);
@@ -256,19 +263,21 @@ static int build(int n, const int *sizes, const int *rows, const int *column, co
     return HYPRE_BoomerAMGSetup(amg.solver, amg.par_a, amg.par_b, amg.par_x);
 }
 
-/* BoomerAMG of the symmetric matrix of n > 0 rows in CSR form (zero-based). 0 on success;
- * 1 or 2: MPI or hypre did not start; 3: not enough memory; 4: hypre failed otherwise.
- * On a failure nothing of this matrix is kept. */
-int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, const double *value,
-                             double strength) {
+/* BoomerAMG on `comm` of the symmetric matrix whose rows first .. first + n - 1 (n >= 0)
+ * this process holds, in CSR form (zero-based row starts, global columns). 0 on success; 1
+ * or 2: MPI or hypre did not start; 3: not enough memory; 4: hypre failed otherwise. On a
+ * failure nothing of this matrix is kept. */
+static int setup_on(MPI_Comm comm, int first, int n, const int *row_start, const int *column,
+                    const double *value, double strength) {
     int i, status;
     int *sizes, *rows;
     sigjmp_buf target;
     if ((status = start()) != 0) return status;
     lc_hypre_free();
     if (!room_for((size_t)LC_HYPRE_BYTES_PER_UNKNOWN * (size_t)n)) return OUT_OF_MEMORY;
-    sizes = malloc(sizeof(int) * (size_t)n);
-    rows = malloc(sizeof(int) * (size_t)n);
+    /* (one more: a rank whose slab holds no free cell gives no rows) */
+    sizes = malloc(sizeof(int) * ((size_t)n + 1));
+    rows = malloc(sizeof(int) * ((size_t)n + 1));
     if (!sizes || !rows) {
         free(sizes);
         free(rows);
@@ -276,7 +285,7 @@ int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, con
     }
     for (i = 0; i < n; i++) {
         sizes[i] = row_start[i + 1] - row_start[i];
-        rows[i] = i;
+        rows[i] = first + i;
     }
     HYPRE_ClearAllErrors();
     memset(&amg, 0, sizeof amg);
@@ -288,7 +297,7 @@ int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, con
         return aborted();
     }
     abort_return = &target;
-    status = build(n, sizes, rows, column, value, strength);
+    status = build(comm, first, n, sizes, rows, column, value, strength);
     abort_return = NULL;
     free(sizes);
     free(rows);
@@ -299,17 +308,44 @@ int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, con
     return 0;
 }
 
+/* BoomerAMG of the symmetric matrix of n > 0 rows in CSR form (zero-based), on this process
+ * alone (setup_on). */
+int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, const double *value,
+                             double strength) {
+    return setup_on(MPI_COMM_SELF, 0, n, row_start, column, value, strength);
+}
+
+/* The same on the communicator whose Fortran handle is `comm` (a negative handle: this
+ * process alone), this process holding the n rows from `first` (setup_on). */
+int lc_hypre_setup_boomeramg_rows(int comm, int first, int n, const int *row_start, const int *column,
+                                  const double *value, double strength) {
+    int status = start();
+    if (status != 0) return status;
+    return setup_on(comm < 0 ? MPI_COMM_SELF : MPI_Comm_f2c((MPI_Fint)comm), first, n, row_start, column, value,
+                    strength);
+}
+
+/* y = A x on this process's rows of the matrix set up (n values each); 0, or 5 if none is. */
+int lc_hypre_matvec(const double *x, double *y) {
+    if (!amg.live) return 5;
+    /* (a rank without rows takes part in the product's exchange all the same) */
+    if (amg.n > 0) memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), x, sizeof(double) * (size_t)amg.n);
+    HYPRE_ParCSRMatrixMatvec(1.0, amg.par_a, amg.par_x, 0.0, amg.par_b);
+    if (amg.n > 0) memcpy(y, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), sizeof(double) * (size_t)amg.n);
+    return 0;
+}
+
 /* z = M^-1 r: one V-cycle from a zero guess (n values, as set up). */
 int lc_hypre_apply(const double *r, double *z) {
     sigjmp_buf target;
     if (!amg.live) return 5;
-    memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), r, sizeof(double) * (size_t)amg.n);
+    if (amg.n > 0) memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), r, sizeof(double) * (size_t)amg.n);
     HYPRE_ParVectorSetConstantValues(amg.par_x, 0.0);
     if (sigsetjmp(target, 0) != 0) return aborted();
     abort_return = &target;
     HYPRE_BoomerAMGSolve(amg.solver, amg.par_a, amg.par_b, amg.par_x);
     abort_return = NULL;
-    memcpy(z, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), sizeof(double) * (size_t)amg.n);
+    if (amg.n > 0) memcpy(z, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), sizeof(double) * (size_t)amg.n);
     HYPRE_ClearAllErrors(); /* "not converged" after one cycle is the intent */
     return 0;
 }

@@ -29,6 +29,9 @@ module lc_leakage_reynolds
    private
    public :: leakage_flow, leakage_result, reynolds_leakage, leakage_tol_allowed, leakage_tol_range, &
       & leakage_max_iter, leakage_solver, leakage_memory_check, smallest_leakage_tol, largest_leakage_tol
+   ! (shared with the leakage on the slabs of a distributed surface, lc_leakage_reynolds_slabs)
+   public :: contact_threshold_relative, smallest_gap, cg_delay, amg_strength, hypre_out_of_memory, &
+      & hypre_bytes_per_unknown, face_weights, flow_clusters, out_of_memory
    !> The tolerances allowed for &output leakage_tol (the relative accuracy of k_eff).
    real(wp), parameter :: smallest_leakage_tol = 1.0e-14_wp, largest_leakage_tol = 1.0e-2_wp
    character(len=*), parameter :: leakage_tol_range = '1e-14 <= leakage_tol <= 1e-2'
@@ -147,7 +150,7 @@ contains
          call out_of_memory(error, 'its face conductances', 24*size(g, kind=i8))
          return
       end if
-      call flow_clusters(fluid, nx, ny, cluster, winds_x, winds_y, stat)
+      call flow_clusters(fluid, nx, ny, .true., cluster, winds_x, winds_y, stat)
       if (stat /= 0) then
          call out_of_memory(error, 'its fluid clusters', 17*size(g, kind=i8))
          return
@@ -247,14 +250,17 @@ contains
    !> cell's unwrapped coordinates: an edge that reaches a labelled cell at other unwrapped
    !> coordinates closes a loop around the cell, along x when the x coordinates differ. Every
    !> loop is a sum of the loops the edges outside the search tree close, so the cluster winds
-   !> along x exactly when one of its edges says so.
-   pure subroutine flow_clusters(fluid, nx, ny, cluster, winds_x, winds_y, stat)
-      logical, intent(in) :: fluid(:)
+   !> along x exactly when one of its edges says so. On a slab of rows (periodic_y false:
+   !> no edge between the last row and the first) the clusters are those of the slab.
+   pure subroutine flow_clusters(fluid, nx, ny, periodic_y, cluster, winds_x, winds_y, stat, unwrapped_x)
+      logical, intent(in) :: fluid(:), periodic_y
       integer, intent(in) :: nx, ny
       integer, allocatable, intent(out) :: cluster(:)
       logical, allocatable, intent(out) :: winds_x(:), winds_y(:)
       !> nonzero: an allocation failed
       integer, intent(out) :: stat
+      !> each cell's unwrapped x coordinate (0-based) along its cluster's search
+      integer, allocatable, intent(out), optional :: unwrapped_x(:)
       integer, allocatable :: queue(:), ux(:), uy(:)
       logical, allocatable :: winds(:, :)
       integer, parameter :: step_x(4) = [1, -1, 0, 0], step_y(4) = [0, 0, 1, -1]
@@ -281,6 +287,7 @@ contains
             i = modulo(k - 1, nx)
             j = (k - 1)/nx
             do m = 1, 4
+               if (.not. periodic_y .and. (j + step_y(m) < 0 .or. j + step_y(m) >= ny)) cycle
                ni = modulo(i + step_x(m), nx)
                nj = modulo(j + step_y(m), ny)
                next = ni + nj*nx + 1
@@ -302,6 +309,7 @@ contains
       if (stat /= 0) return
       winds_x = winds(1, :max(n_labels, 1))
       winds_y = winds(2, :max(n_labels, 1))
+      if (present(unwrapped_x)) call move_alloc(ux, unwrapped_x)
    end subroutine flow_clusters
 
    !> Solve for phi along `direction` (1: x, 2: y) on the `active` cells and set k_eff.

@@ -102,7 +102,9 @@ contains
 
       associate (p => result%pressure, grid => op%grid)
          nx = grid%nx
-         call contact_patches(grid, p, result%patch_area, result%patch_perimeter, label)
+         ! (a distributed solve has measured them on its slabs: lc_application_scene_solve)
+         if (.not. allocated(result%patch_area)) &
+            & call contact_patches(grid, p, result%patch_area, result%patch_perimeter, label)
          result%n_spots = size(result%patch_area)
          if (.not. scene%stress) return
          allocate (result%displacement_x(size(p)), result%displacement_y(size(p)), result%stress_xx(size(p)), &

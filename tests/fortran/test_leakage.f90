@@ -10,6 +10,7 @@ program test_leakage
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
    use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
+   use lc_leakage_reynolds_slabs, only: reynolds_leakage_slab
    use lc_test_checks, only: check, finish
    implicit none (type, external)
 
@@ -20,6 +21,7 @@ program test_leakage
    call check_stripes()
    call check_blocked()
    call check_diagonal_channel()
+   call check_one_slab()
    call finish('leakage')
 
 contains
@@ -90,4 +92,51 @@ contains
          & 'diagonal channel: percolates along x and y')
       call check(abs(res%x%k_eff/res%y%k_eff - 1) < tol_solve, 'diagonal channel: symmetric, k_eff_x = k_eff_y')
    end subroutine check_diagonal_channel
+
+   !> The leakage on the slabs (lc_leakage_reynolds_slabs) with one rank: its slab is the
+   !> whole surface, its clusters are joined across the periodic edge y by the join of the
+   !> slabs, its matrix and V-cycle are hypre's on this process. On a contact map with
+   !> clusters that wind along y only through that edge, along x only, both, and pools that
+   !> carry no flow: the serial counts exactly, k_eff to tol_solve (both CG stopped at 1e-12
+   !> on one preconditioner; they differ by the order of the sums).
+   subroutine check_one_slab()
+      integer, parameter :: nx = 48, ny = 40
+      real(wp), parameter :: pi = acos(-1.0_wp)
+      real(wp) :: g(nx*ny), x, y
+      type(leakage_result) :: serial, slab
+      type(error_type), allocatable :: error
+      integer :: i, j
+      logical :: closed(nx*ny)
+      ! a smooth gap closed on half the cells, connected along x and y through necks
+      do j = 1, ny
+         do i = 1, nx
+            x = 2*pi*(i - 1)/nx
+            y = 2*pi*(j - 1)/ny
+            g(i + (j - 1)*nx) = max(0.0_wp, 0.03_wp + sin(3*x + 1.3_wp)*cos(2*y) + 0.5_wp*sin(5*x + 7*y + 0.4_wp) &
+               & + 0.3_wp*cos(x - 4*y))
+         end do
+      end do
+      ! two rings of contact around pools, one across the periodic edge y (rows ny-2 .. 2)
+      closed = .false.
+      do j = -2, 2
+         do i = -2, 2
+            if (max(abs(i), abs(j)) /= 2) cycle
+            closed(11 + i + (10 + j)*nx) = .true.
+            closed(21 + i + modulo(j, ny)*nx) = .true.
+         end do
+      end do
+      call reynolds_leakage(g, closed, nx, ny, 1.0_wp, 1.2_wp, 1.0e-12_wp, 500, serial, error)
+      if (allocated(error)) call check(.false., 'leakage: ' // error%message)
+      call reynolds_leakage_slab(g, closed, nx, ny, 1.0_wp, 1.2_wp, 1.0e-12_wp, 500, slab, error)
+      if (allocated(error)) call check(.false., 'leakage on one slab: ' // error%message)
+      call check(serial%fluid_fraction < 0.8_wp .and. serial%x%connected_fraction < serial%fluid_fraction, &
+         & 'one slab: the map has pools that carry no flow')
+      call check(slab%fluid_fraction == serial%fluid_fraction .and. &
+         & (slab%x%connected_fraction == serial%x%connected_fraction) .and. &
+         & (slab%y%connected_fraction == serial%y%connected_fraction) .and. slab%x%unknowns == serial%x%unknowns &
+         & .and. slab%y%unknowns == serial%y%unknowns .and. (slab%x%percolating .eqv. serial%x%percolating) .and. &
+         & (slab%y%percolating .eqv. serial%y%percolating), 'one slab: the serial clusters and unknowns')
+      call check(abs(slab%x%k_eff/serial%x%k_eff - 1) < tol_solve .and. abs(slab%y%k_eff/serial%y%k_eff - 1) &
+         & < tol_solve .and. serial%x%k_eff > 0 .and. serial%y%k_eff > 0, 'one slab: the serial k_eff along x and y')
+   end subroutine check_one_slab
 end program test_leakage
