@@ -212,7 +212,8 @@ contains
    end subroutine refused
 
    !> A surface shared among MPI ranks: CG or GCR (and GCR keeping its history), never the
-   !> serial methods, however large or hard the grid; the serial methods refused by name.
+   !> serial methods, however large or hard the grid; GFMD as asked; the serial methods
+   !> refused by name.
    subroutine check_distributed()
       type(problem_indicators) :: ind
       ind = problem(2048**2, .false., .false.)
@@ -230,6 +231,8 @@ contains
       call refused('distributed multigrid', ind, 'runs on one MPI rank')
       ind%method = 'gcr'
       call expect('distributed gcr', ind, .true., 'gcr', '')
+      ind%method = 'gfmd'
+      call expect('distributed gfmd', ind, .true., 'gfmd', "method 'gfmd'")
    end subroutine check_distributed
 
    !> What the memory check provides for: every grid where some start could send the
