@@ -2,12 +2,14 @@
 frictionless and coupled scenes, to the bound the two tolerances allow, among them the
 paper's Fig. 3 family (thin incompressible layers, mu_c up to 1, from ~1 % to full contact);
 scenes whose friction ratio is beyond what the update of the friction traction was measured
-to relax are refused before any step (docs/decisions/001-gfmd-masses.md)."""
+to relax are refused before any step (docs/decisions/001-gfmd-masses.md). Under `mpirun -n P`
+GFMD runs on the slabs and gives the serial run's answer (the helpers of test_mpi.py)."""
 
 import numpy as np
 import pytest
 
 import layercontact as lc
+from test_mpi import assert_same, executable, needs_mpi, read, run_mpi, run_serial
 
 TOL = 1e-9
 P_M = 0.02
@@ -190,8 +192,6 @@ def test_gfmd_refuses_a_lossy_sliding_layer():
         lc.solve_areal(surface(n=32), thickness=0.5, poisson=0.3, friction=0.3, material=SLS, speed=1.0,
                        mean_pressure=P_M, method="gfmd")
 
-
-from test_mpi import assert_same, needs_mpi, read, run_mpi, run_serial, executable  # noqa: E402
 
 #: the distributed scenes: a thin incompressible layer (h/lambda = 0.05) at ~6 % contact,
 #: frictionless and with mu_c = 0.5 (friction ratio 2.3: the traction update runs)
