@@ -85,8 +85,8 @@ module lc_contact_policy
       !> multigrid method smooths it by rows where the GCR is slow
       logical :: rows_ahead = .false.
       !> a surface shared among the ranks of an MPI job (docs/decisions/023-mpi-slabs.md):
-      !> the constrained CG and GCR (GCR keeping its history, then Anderson's iteration) solve
-      !> it, the serial methods (multigrid, GFMD, dense Newton) do not
+      !> the constrained CG and GCR (GCR keeping its history, then Anderson's iteration) and
+      !> GFMD solve it, the serial methods (multigrid, dense Newton) do not
       logical :: distributed = .false.
    end type problem_indicators
 
@@ -116,14 +116,15 @@ contains
       ind%viscoelastic = op%kernel%viscoelastic
       ind%monotone = op%monotone
       ind%gfmd_refusal = ''
+      ! (GFMD's measure is a largest ratio over the modes: taken over the ranks on a slab)
+      if (trim(method) == 'gfmd') ind%gfmd_refusal = gfmd_refusal(op)
       if (op%distributed) then
-         ! (the multigrid's and GFMD's measures read a whole spectrum: not taken on a slab)
+         ! (the multigrid's measures read a whole spectrum: not taken on a slab)
          ind%distributed = .true.
          ind%refusal = distributed_refusal
          return
       end if
       ind%refusal = multigrid_refusal(op)
-      if (trim(method) == 'gfmd') ind%gfmd_refusal = gfmd_refusal(op)
       if (op%coupled .or. (len(ind%refusal) > 0 .and. .not. op%kernel%viscoelastic)) then
          ind%refusal = coupled_refusal(op, load_control)
          ind%rising = .not. op%coupled .and. len(ind%refusal) == 0
@@ -164,9 +165,10 @@ contains
       first = trim(ind%method)
       why = ''
       if (ind%distributed .and. all(trim(ind%method) /= [character(len=8) :: 'auto', 'cg', 'gcr', 'kept', &
-         & 'anderson'])) then
+         & 'anderson', 'gfmd'])) then
          call fatal_error(error, "&solver: method = '" // trim(ind%method) // "' runs on one MPI rank; a surface " // &
-            & "shared among ranks is solved by 'auto', 'cg', 'gcr' or 'anderson' (" // distributed_refusal // ')', &
+            & "shared among ranks is solved by 'auto', 'cg', 'gcr', 'anderson' or 'gfmd' (" // distributed_refusal // &
+            & ')', &
             & code_input)
          return
       end if

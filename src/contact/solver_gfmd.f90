@@ -36,6 +36,12 @@
 !> pressure the wall carries (p = lambda, w = G_eff lambda, gap = w - b - s), not on an
 !> energy. A step costs one transform pair, a check one more.
 !>
+!> On a surface shared among the ranks of an MPI job (an operator on a slab,
+!> docs/decisions/023-mpi-slabs.md) every step is the same: the points' work on the slab,
+!> the distributed transforms, and the sums and maxima over the ranks (FIRE's power and
+!> norms in one message, the residual's, the update's test, the Gram matrix of the
+!> Anderson mixing); every rank takes the same decisions from the same global numbers.
+!>
 !> The loss of a sliding viscoelastic layer gives G_n itself a phase, which no traction
 !> update removes: gfmd_refusal measures |Im G_n|/Re G_n on the operator before any step
 !> and refuses the scenes beyond max_stiffness_phase, and the friction ratio
@@ -45,6 +51,7 @@ module lc_contact_solver_gfmd
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
    use lc_base_strings, only: formatted
+   use lc_base_parallel, only: global_sum, global_max, global_any, sum_over_ranks, max_over_ranks
    use lc_contact_operator, only: compliance_operator
    use lc_contact_residual, only: complementarity_residual, rounding_floor
    use lc_contact_progress, only: progress_log
@@ -128,14 +135,17 @@ contains
       real(wp), allocatable :: gram(:, :), gamma(:), projection(:)
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: dt, alpha, power, v_norm, a_norm, s_best, uniform, b_max, mass, residual, friction
-      real(wp) :: imbalance, mismatch, mismatch_floor, contact_fraction
+      real(wp) :: imbalance, mismatch, mismatch_floor, contact_fraction, points, sums(3), maxima(2)
       integer :: step, since_negative, checks, n, j, since_update, columns, newest
-      logical :: with_traction
+      logical :: with_traction, across_ranks
 
       n = size(p)
+      across_ranks = op%distributed
+      points = real(op%grid%points(), wp)
       friction = op%friction
       call split_multiplier(op, normal, tangential)
       with_traction = friction > 0.0_wp .and. any(tangential /= (0.0_wp, 0.0_wp))
+      if (across_ranks) with_traction = global_any(with_traction)
       allocate (stiffness(size(normal)), coupling(size(normal)))
       where (normal /= (0.0_wp, 0.0_wp))
          stiffness = 1.0_wp/normal
@@ -147,9 +157,11 @@ contains
       deallocate (normal, tangential)   ! (the solve's memory: stiffness and coupling suffice)
       buffer => op%buffer()
       allocate (u(n), v(n), a(n), lambda(n), tau(n), offset(n))
-      b_max = maxval(abs(b))
+      maxima = [maxval(abs(b)), maxval(abs(stiffness))]
+      if (across_ranks) call max_over_ranks(maxima)
+      b_max = maxima(1)
+      mass = maxima(2)
       uniform = merge(mean_pressure, 0.0_wp, load_control)
-      mass = maxval(abs(stiffness))
       ! start from the displacement of the guess (its friction traction held); under load
       ! control the wall is placed where it touches the highest point of the gap, and the
       ! load moves the surface
@@ -168,7 +180,10 @@ contains
          allocate (gram(update_memory, update_memory), gamma(update_memory), projection(update_memory))
          allocate (update_preconditioner(size(stiffness)))
       end if
-      if (load_control) s = minval(u - b)
+      if (load_control) then
+         s = minval(u - b)
+         if (across_ranks) s = -global_max(-s)
+      end if
       u = max(u, b + s)
       v = 0.0_wp
       dt = dt_start
@@ -181,7 +196,9 @@ contains
       p_best = p
       s_best = s
       ! below this mismatch the traction is left as it is (the residual's rounding level)
-      mismatch_floor = 0.01_wp*tol*max(mean_pressure, maxval(p), tiny(1.0_wp))*friction
+      mismatch_floor = maxval(p)
+      if (across_ranks) mismatch_floor = global_max(mismatch_floor)
+      mismatch_floor = 0.01_wp*tol*max(mean_pressure, mismatch_floor, tiny(1.0_wp))*friction
 
       do step = 1, max_iter
          ! the layer's reaction p = K_n u - K_n G_x tau (+ p_m), what the wall carries and
@@ -197,10 +214,13 @@ contains
          end do
          ! FIRE: mix the velocity towards the force, grow the step while the power is
          ! positive, stop and shrink it when it turns negative
-         power = dot_product(v, a)
+         ! (the power and the two norms in one sum over the ranks)
+         sums = [dot_product(v, a), dot_product(v, v), dot_product(a, a)]
+         if (across_ranks) call sum_over_ranks(sums)
+         power = sums(1)
          if (power > 0.0_wp) then
-            v_norm = norm2(v)
-            a_norm = norm2(a)
+            v_norm = sqrt(sums(2))
+            a_norm = sqrt(sums(3))
             if (a_norm > 0.0_wp) v = (1.0_wp - alpha)*v + (alpha*v_norm/a_norm)*a
             since_negative = since_negative + 1
             if (since_negative > fire_min_steps) then
@@ -232,7 +252,7 @@ contains
                if (checks <= size(history)) history(checks) = residual
             end if
             if (present(progress)) then
-               if (progress%enabled) call progress%tick(step, residual, count(lambda > 0.0_wp)/real(n, wp))
+               if (progress%enabled) call progress%tick(step, residual, contacts(lambda)/points)
             end if
             if (residual < outcome%residual) then
                outcome%residual = residual
@@ -247,8 +267,10 @@ contains
             ! the dynamics has relaxed the problem of the current traction well enough
             ! against what the traction itself is off by: update it
             since_update = since_update + 1
-            imbalance = mass*maxval(abs(a))   ! max |rho|
-            mismatch = maxval(abs(friction*lambda - tau))
+            maxima = [mass*maxval(abs(a)), maxval(abs(friction*lambda - tau))]   ! max |rho|, the mismatch
+            if (across_ranks) call max_over_ranks(maxima)
+            imbalance = maxima(1)
+            mismatch = maxima(2)
             if (mismatch > mismatch_floor .and. &
                & (imbalance <= update_ratio*mismatch .or. since_update >= update_max_steps)) then
                call update_traction()
@@ -263,32 +285,47 @@ contains
       s = s_best
       call op%apply_full(p, w)
       outcome%fft_pairs = outcome%fft_pairs + 1
-      if (load_control) call contact_shift(p, w, b, s)
+      if (load_control) call contact_shift(p, w, b, s, across_ranks)
       gap = w - b - s
    contains
       !> The residual of the pressure the wall carries: w = G_eff lambda, s of the contact set.
       subroutine check(pressure, res)
          real(wp), intent(in) :: pressure(:)
          real(wp), intent(out) :: res
-         real(wp) :: shift, p_ref
+         real(wp) :: shift, p_ref, mean, largest(2)
          call op%apply_full(pressure, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
          shift = s
-         if (load_control) call contact_shift(pressure, w, b, shift)
+         if (load_control) call contact_shift(pressure, w, b, shift, across_ranks)
          gap = w - b - shift
-         p_ref = merge(mean_pressure, sum(pressure)/n, load_control)
+         mean = sum(pressure)
+         largest = [maxval(abs(w)), maxval(pressure)]
+         if (across_ranks) then
+            mean = global_sum(mean)
+            call max_over_ranks(largest)
+         end if
+         mean = mean/points
+         p_ref = merge(mean_pressure, mean, load_control)
          res = complementarity_residual(pressure, gap, p_ref, g_ref, &
-            & rounding_floor(maxval(abs(w)), b_max, maxval(pressure), op%largest))
+            & rounding_floor(largest(1), b_max, largest(2), op%largest))
+         if (across_ranks) res = global_max(res)
          ! the load the wall carries must be the given one
-         if (load_control) res = max(res, abs(sum(pressure)/n - mean_pressure)/mean_pressure)
+         if (load_control) res = max(res, abs(mean - mean_pressure)/mean_pressure)
       end subroutine check
+
+      !> The contact points (lambda > 0) of the whole surface.
+      real(wp) function contacts(pressure)
+         real(wp), intent(in) :: pressure(:)
+         contacts = real(count(pressure > 0.0_wp), wp)
+         if (across_ranks) contacts = global_sum(contacts)
+      end function contacts
 
       !> tau <- the Anderson mixing of the preconditioned updates tau + P_a^-1 (mu_c lambda - tau),
       !> P_a = 1 + a mu_c G_x/G_n (a: the contact fraction), and the offset K_n G_x tau of the
       !> new traction (two transform pairs).
       subroutine update_traction()
          outcome%updates = outcome%updates + 1
-         contact_fraction = count(lambda > 0.0_wp)/real(n, wp)
+         contact_fraction = contacts(lambda)/points
          update_preconditioner = 1.0_wp/(1.0_wp + (contact_fraction*friction)*coupling)
          !$omp simd
          do j = 1, n
@@ -313,6 +350,7 @@ contains
          else
             call history_products(df(:, 1:columns), newest, step_tau, gram(1:columns, newest), &
                & projection(1:columns))
+            if (across_ranks) call add_products_over_ranks(gram(1:columns, newest), projection(1:columns))
             gram(newest, 1:columns) = gram(1:columns, newest)
             call least_squares(gram(1:columns, 1:columns), projection(1:columns), gamma(1:columns), error)
             if (allocated(error)) return
@@ -324,6 +362,18 @@ contains
          outcome%fft_pairs = outcome%fft_pairs + 2
       end subroutine update_traction
    end subroutine gfmd
+
+   !> The Gram column and the projection of the mixing summed over the ranks (one message).
+   subroutine add_products_over_ranks(gram_column, projection)
+      real(wp), intent(inout) :: gram_column(:), projection(:)
+      real(wp) :: products(2*size(gram_column))
+      integer :: m
+      m = size(gram_column)
+      products = [gram_column, projection]
+      call sum_over_ranks(products)
+      gram_column = products(1:m)
+      projection = products(m + 1:)
+   end subroutine add_products_over_ranks
 
    !> The operator's multiplier split into the normal response to the pressure, G_n, and
    !> to the friction traction, G_x: G_eff = G_n + mu_c G_x (the operator's modes; G_x = 0
@@ -337,7 +387,7 @@ contains
       complex(wp), allocatable, intent(out) :: normal(:), tangential(:)
       complex(wp) :: one_minus_a, one_minus_b, c, t, compliance, reduced
       real(wp) :: qx, qy, q
-      integer :: i, mx
+      integer :: i, mx, my
       logical :: real_factors
       allocate (normal(op%nk), tangential(op%nk))
       tangential = (0.0_wp, 0.0_wp)
@@ -346,8 +396,13 @@ contains
          return
       end if
       real_factors = .not. (op%kernel%layered .and. op%kernel%viscoelastic)
-      normal(1) = op%full(1)
-      do i = 2, op%nk
+      do i = 1, op%nk
+         call op%fft%mode_indices(i, mx, my)
+         if (mx == 0 .and. my == 0) then
+            ! (the uniform mode: the first of the rank that holds it)
+            normal(i) = op%full(i)
+            cycle
+         end if
          call op%column_mode(i, qx, qy, mx)
          compliance = op%compliance(mx + 1)
          if (real_factors .and. 2*mx /= op%grid%nx .and. compliance /= (0.0_wp, 0.0_wp)) then
@@ -370,6 +425,7 @@ contains
    !> Why the damped dynamics cannot relax the scene of `op` ('' if it can): the ratio
    !> |Im G_n|/Re G_n of some mode exceeds max_stiffness_phase (the loss of a sliding
    !> viscoelastic layer), or the friction ratio mu_c |G_x|/|G_n| exceeds max_friction_ratio.
+   !> (On a slab, the largest over the ranks' modes: every rank gives the same answer.)
    function gfmd_refusal(op) result(refusal)
       type(compliance_operator), intent(in) :: op
       character(len=:), allocatable :: refusal
@@ -379,6 +435,7 @@ contains
       if (.not. op%coupled) return
       call split_multiplier(op, normal, tangential)
       ratio = stiffness_phase(normal)
+      if (op%distributed) ratio = global_max(ratio)
       if (ratio > max_stiffness_phase) then
          if (ratio < huge(1.0_wp)) then
             refusal = "its stiffness 1/G_n (the layer's normal response without friction) is far from symmetric, " // &
@@ -392,6 +449,7 @@ contains
          return
       end if
       ratio = op%friction*friction_ratio(normal, tangential)
+      if (op%distributed) ratio = global_max(ratio)
       if (ratio > max_friction_ratio) then
          refusal = 'its friction ratio mu_c |G_x|/|G_n| (the normal response to the friction traction against ' // &
             & 'that to the pressure) reaches ' // formatted(ratio, '(g0.3)') // &
@@ -426,13 +484,15 @@ contains
    end function friction_ratio
 
    !> s = the mean of w - b over the contact set (p > 0): the wall position the contact
-   !> points agree on (unchanged without contact).
-   pure subroutine contact_shift(p, w, b, s)
+   !> points agree on (unchanged without contact); `across_ranks`: over the job's slabs.
+   subroutine contact_shift(p, w, b, s, across_ranks)
       real(wp), intent(in) :: p(:), w(:), b(:)
       real(wp), intent(inout) :: s
-      integer :: contact
-      contact = count(p > 0.0_wp)
-      if (contact > 0) s = sum(w - b, mask=p > 0.0_wp)/contact
+      logical, intent(in) :: across_ranks
+      real(wp) :: sums(2)
+      sums = [real(count(p > 0.0_wp), wp), sum(w - b, mask=p > 0.0_wp)]
+      if (across_ranks) call sum_over_ranks(sums)
+      if (sums(1) > 0.0_wp) s = sums(2)/sums(1)
    end subroutine contact_shift
 
    subroutine solve_by_gfmd(self, problem, state, budget, outcome, progress, error)

@@ -213,7 +213,7 @@ contains
 
    !> A surface shared among MPI ranks: CG or GCR (GCR keeping its history, then Anderson's
    !> iteration, as on one rank), never the serial methods, however large or hard the grid;
-   !> the serial methods refused by name.
+   !> GFMD as asked; the serial methods refused by name.
    subroutine check_distributed()
       type(problem_indicators) :: ind
       ind = problem(2048**2, .false., .false.)
@@ -228,12 +228,12 @@ contains
       call expect('distributed coupled 32^2 (no dense Newton)', ind, .true., 'gcr+kept+anderson', 'the constrained GCR')
       ind%method = 'anderson'
       call expect('distributed anderson', ind, .true., 'anderson', "method 'anderson'")
-      ind%method = 'gfmd'
-      call refused('distributed gfmd', ind, 'runs on one MPI rank')
       ind%method = 'multigrid'
       call refused('distributed multigrid', ind, 'runs on one MPI rank')
       ind%method = 'gcr'
       call expect('distributed gcr', ind, .true., 'gcr', '')
+      ind%method = 'gfmd'
+      call expect('distributed gfmd', ind, .true., 'gfmd', "method 'gfmd'")
    end subroutine check_distributed
 
    !> What the memory check provides for: every grid where some start could send the
