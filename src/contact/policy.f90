@@ -28,7 +28,7 @@ module lc_contact_policy
    use lc_contact_solver_newton, only: dense_points
    use lc_contact_solver_gfmd, only: gfmd_refusal
    use lc_contact_solver_multigrid, only: multigrid_refusal, metric_refusal, coupled_refusal, rows_ahead_of_gcr, &
-      & loss_among_short_waves, short_loss_limit
+      & loss_among_short_waves, short_loss_limit, whole_operator
    implicit none (type, external)
    private
    public :: problem_indicators, solve_plan, measure_problem, measure_start, plan_solve, max_stages
@@ -85,13 +85,14 @@ module lc_contact_policy
       !> multigrid method smooths it by rows where the GCR is slow
       logical :: rows_ahead = .false.
       !> a surface shared among the ranks of an MPI job (docs/decisions/023-mpi-slabs.md):
-      !> the constrained CG and GCR (and GCR keeping its history) solve it, the serial methods
-      !> (multigrid, Anderson, GFMD, dense Newton) do not
+      !> the constrained CG and GCR (and GCR keeping its history) and the multigrid method
+      !> (docs/decisions/028-distributed-multigrid.md) solve it, the serial methods
+      !> (Anderson, GFMD, dense Newton) do not
       logical :: distributed = .false.
    end type problem_indicators
 
-   !> Why a distributed surface takes no multigrid method.
-   character(len=*), parameter :: distributed_refusal = 'multigrid is serial; distributed runs use gcr/cg'
+   !> The methods a distributed surface may ask for by name.
+   character(len=*), parameter :: distributed_methods = "'auto', 'cg', 'gcr' or 'multigrid'"
 
    !> The methods to run, in turn, the coarse start before them, and why.
    type :: solve_plan
@@ -116,20 +117,50 @@ contains
       ind%viscoelastic = op%kernel%viscoelastic
       ind%monotone = op%monotone
       ind%gfmd_refusal = ''
+      ind%refusal = ''
       if (op%distributed) then
-         ! (the multigrid's and GFMD's measures read a whole spectrum: not taken on a slab)
+         ! (the multigrid's measures read a whole spectrum: taken on an operator of the whole
+         ! grid, where the multigrid method may solve the scene)
          ind%distributed = .true.
-         ind%refusal = distributed_refusal
+         if (.not. measured_whole(ind)) return
+         block
+            type(compliance_operator) :: whole
+            type(error_type), allocatable :: error
+            call whole_operator(op, whole, error)
+            if (allocated(error)) then
+               ind%refusal = 'the operator of the whole grid could not be made: ' // error%message
+               return
+            end if
+            call measure_multigrid(ind, whole, load_control)
+         end block
          return
       end if
-      ind%refusal = multigrid_refusal(op)
       if (trim(method) == 'gfmd') ind%gfmd_refusal = gfmd_refusal(op)
+      call measure_multigrid(ind, op, load_control)
+   end function measure_problem
+
+   !> Whether the multigrid method can solve the scene of `op` (its refusals), and in which form.
+   subroutine measure_multigrid(ind, op, load_control)
+      type(problem_indicators), intent(inout) :: ind
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
+      ind%refusal = multigrid_refusal(op)
       if (op%coupled .or. (len(ind%refusal) > 0 .and. .not. op%kernel%viscoelastic)) then
          ind%refusal = coupled_refusal(op, load_control)
          ind%rising = .not. op%coupled .and. len(ind%refusal) == 0
       end if
       if (len(ind%refusal) == 0 .and. (ind%coupled .or. ind%rising)) ind%metric_admitted = len(metric_refusal(op)) == 0
-   end function measure_problem
+   end subroutine measure_multigrid
+
+   !> Whether a distributed surface's multigrid measures are taken (on an operator of the
+   !> whole grid, made for them on every rank): where the multigrid method may solve it
+   !> whatever its start (may_take_multigrid), or, coupled, may smooth it by rows
+   !> (rows_multigrid_surface_points). Elsewhere no rule could pick the multigrid method.
+   logical function measured_whole(ind)
+      type(problem_indicators), intent(in) :: ind
+      measured_whole = may_take_multigrid(ind%method, ind%points, ind%line, ind%coupled, ind%viscoelastic) .or. &
+         & (trim(ind%method) == 'auto' .and. ind%coupled .and. ind%points >= rows_multigrid_surface_points)
+   end function measured_whole
 
    !> Add what the start tells (the coarse start's iterations, 0 where none ran, whether it
    !> took the multigrid method, the contact points of the start `p`) and what the rules
@@ -146,10 +177,29 @@ contains
       ind%start_contacts = count(p > 0.0_wp)
       if (ind%distributed) ind%start_contacts = global_sum(ind%start_contacts)
       if (trim(ind%method) /= 'auto' .or. len(ind%refusal) > 0) return
+      if (ind%distributed) then
+         if (.not. measured_whole(ind)) return
+         block
+            type(compliance_operator) :: whole
+            type(error_type), allocatable :: error
+            call whole_operator(op, whole, error)
+            if (allocated(error)) return
+            call measure_hard_start(ind, whole, load_control)
+         end block
+      else
+         call measure_hard_start(ind, op, load_control)
+      end if
+   end subroutine measure_start
+
+   !> What the rules 3a and 3b read of the operator once the start is known.
+   subroutine measure_hard_start(ind, op, load_control)
+      type(problem_indicators), intent(inout) :: ind
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
       if (ind%viscoelastic .and. ind%points >= lossy_points(ind%line)) ind%short_wave_loss = loss_among_short_waves(op)
       if (ind%coupled .and. .not. ind%line .and. hard(ind) .and. ind%points >= rows_multigrid_surface_points .and. &
          & ind%points < coupled_points(ind%line)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
-   end subroutine measure_start
+   end subroutine measure_hard_start
 
    !> The plan for a problem with indicators `ind` (before the coarse start: the first
    !> method, and whether the start runs; after it: the final plan). Errors for a method
@@ -163,9 +213,10 @@ contains
 
       first = trim(ind%method)
       why = ''
-      if (ind%distributed .and. all(trim(ind%method) /= [character(len=8) :: 'auto', 'cg', 'gcr', 'kept'])) then
+      if (ind%distributed .and. all(trim(ind%method) /= [character(len=9) :: 'auto', 'cg', 'gcr', 'kept', &
+         & 'multigrid'])) then
          call fatal_error(error, "&solver: method = '" // trim(ind%method) // "' runs on one MPI rank; a surface " // &
-            & "shared among ranks is solved by 'auto', 'cg' or 'gcr' (" // distributed_refusal // ')', code_input)
+            & 'shared among ranks is solved by ' // distributed_methods, code_input)
          return
       end if
       select case (trim(ind%method))
@@ -265,7 +316,6 @@ contains
       if (ind%coupled) then
          first = 'gcr'
          why = 'a coupled operator (friction, or a sliding viscoelastic layer): the constrained GCR'
-         if (ind%distributed) why = why // ' (no multigrid method: ' // ind%refusal // ')'
       end if
       if (len(ind%refusal) > 0) return
 

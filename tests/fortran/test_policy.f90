@@ -211,23 +211,32 @@ contains
       call report(name, error%code == code_input .and. index(error%message, message_has) > 0, error%message)
    end subroutine refused
 
-   !> A surface shared among MPI ranks: CG or GCR (and GCR keeping its history), never the
-   !> serial methods, however large or hard the grid; the serial methods refused by name.
+   !> A surface shared among MPI ranks: the plans of the serial surface (the multigrid method
+   !> where its rules take it, docs/decisions/028-distributed-multigrid.md), without the
+   !> serial methods (Anderson, dense Newton), which are refused by name.
    subroutine check_distributed()
       type(problem_indicators) :: ind
       ind = problem(2048**2, .false., .false.)
       ind%distributed = .true.
-      ind%refusal = 'multigrid is serial; distributed runs use gcr/cg'
-      call expect('distributed symmetric 2048^2', ind, .true., 'cg', 'multigrid is serial')
+      call expect('distributed symmetric 2048^2: multigrid', ind, .false., 'multigrid+cg', 'the multigrid method')
+      ind%points = 512**2
+      call expect('distributed symmetric 512^2: CG', ind, .true., 'cg', 'the constrained CG')
+      ind%points = 2048**2
       ind%coupled = .true.
       ind%start_iterations = 40
-      call expect('distributed coupled 2048^2, hard start', ind, .true., 'gcr+kept', 'distributed runs use gcr/cg')
+      call expect('distributed coupled 2048^2, hard start: multigrid, no Anderson', ind, .true., 'multigrid+gcr+kept', &
+         & 'coarse start was hard')
+      ind%start_iterations = 4
+      call expect('distributed coupled 2048^2, easy start: GCR, no Anderson', ind, .true., 'gcr+kept', &
+         & 'the constrained GCR')
       ind%points = 32**2
       call expect('distributed coupled 32^2 (no dense Newton)', ind, .true., 'gcr+kept', 'the constrained GCR')
       ind%method = 'anderson'
       call refused('distributed anderson', ind, 'runs on one MPI rank')
+      ind%method = 'newton'
+      call refused('distributed dense Newton', ind, 'runs on one MPI rank')
       ind%method = 'multigrid'
-      call refused('distributed multigrid', ind, 'runs on one MPI rank')
+      call expect('distributed multigrid by name', ind, .true., 'multigrid+gcr+kept', "method 'multigrid'")
       ind%method = 'gcr'
       call expect('distributed gcr', ind, .true., 'gcr', '')
    end subroutine check_distributed
