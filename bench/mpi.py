@@ -4,6 +4,14 @@ with the time and the peak memory of each rank; and one FFT pair of the surface 
 and 4 ranks (4 oversubscribed on a 2-core machine) in FFTW-MPI's two layouts.
 
     .venv/bin/python bench/mpi.py [--n 2048] [--repeats 1] [--pairs-only] [--executable PATH]
+    .venv/bin/python bench/mpi.py --scene sliding --n 1024 --no-pairs
+
+With --scene sliding (docs/decisions/028-distributed-multigrid.md): a standard linear solid
+(E_inf/E0 = 10, V tau/lambda = 0.1) sliding on a layer h/lambda = 0.16, nu = 0.5, with
+mu_c = 0.5 and p_m = 0.02 E0, which 'auto' sends to the multigrid method (serially from
+512^2), solved serially, by `mpirun -n 2` (the multigrid gathered onto both ranks) and by
+`mpirun -n 2` with method 'gcr' (what two ranks ran before they took the multigrid method),
+with their iterations and transform pairs.
 
 Scene: self-affine H = 0.8, shortest wavelength 8 points, rms gradient 0.1, seed 1, on an
 incompressible layer h/lambda = 0.05 (nu = 0.5), Coulomb friction mu_c = 0.5,
@@ -48,19 +56,26 @@ def environment(launched: bool) -> dict[str, str]:
     return env
 
 
-def scene(directory: Path, n: int) -> Path:
-    nml = directory / "coupled.nml"
+def scene(directory: Path, n: int, kind: str = "coupled", method: str = "auto") -> Path:
+    nml = directory / f"{kind}_{method}.nml"
+    if kind == "coupled":
+        body = ("&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
+                "&loading control = 'load', normalised_pressure = 0.15 /\n")
+    else:
+        body = ("&layer thickness = 0.16, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
+                "&material model = 'sls', e0 = 1.0, e_inf = 10.0, tau = 1.0, speed = 0.1 /\n"
+                "&loading control = 'load', mean_pressure = 0.02 /\n")
     nml.write_text(
-        f"&scene geometry = 'areal', n = {n}, ny = {n} /\n"
-        "&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
+        f"&scene geometry = 'areal', n = {n}, ny = {n} /\n" + body +
         f"&profile kind = 'self_affine', hurst = 0.8, seed = 1, short_wavelength = {8 / n}, rms_gradient = 0.1 /\n"
-        "&loading control = 'load', normalised_pressure = 0.15 /\n&solver tol = 1e-8 /\n"
-        "&output file = 'coupled.h5', overwrite = .true., stress = .false., fields = .false. /\n")
+        f"&solver tol = 1e-8, method = '{method}' /\n"
+        f"&output file = '{kind}.h5', overwrite = .true., stress = .false., fields = .false. /\n")
     return nml
 
 
-def run(ranks: int, nml: Path) -> tuple[float, float, list[float], str]:
-    """(solve s, run s, peak RSS MiB of each rank, solver) of one run; ranks 0: no launcher."""
+def run(ranks: int, nml: Path) -> tuple[float, float, list[float], str, int]:
+    """(solve s, run s, peak RSS MiB of each rank, solver, iterations) of one run; ranks 0: no
+    launcher."""
     # (each rank's /usr/bin/time report in a file of its own: rank.N)
     timed = ["sh", "-c", '/usr/bin/time -f "peak_rss_kib %M elapsed %e" -o "rank.${OMPI_COMM_WORLD_RANK:-0}" "$0" "$1"',
              executable(), str(nml)]
@@ -70,10 +85,11 @@ def run(ranks: int, nml: Path) -> tuple[float, float, list[float], str]:
         sys.exit(f"bench/mpi.py: {' '.join(command)} failed ({done.returncode}):\n{done.stderr}")
     solve = float(re.search(r"solver time\s+(\S+)", done.stdout).group(1))
     solver = re.search(r"solver\s+(\S+)", done.stdout).group(1)
+    iterations = int(re.search(r"iterations\s+(\d+)", done.stdout).group(1))
     reports = [(nml.parent / f"rank.{r}").read_text() for r in range(max(ranks, 1))]
     peaks = [int(re.search(r"peak_rss_kib (\d+)", text).group(1)) / 1024 for text in reports]
     elapsed = max(float(re.search(r"elapsed (\S+)", text).group(1)) for text in reports)
-    return solve, elapsed, peaks, solver
+    return solve, elapsed, peaks, solver, iterations
 
 
 def pairs(n: int) -> None:
@@ -94,6 +110,7 @@ def main() -> None:
     parser.add_argument("--pairs-only", action="store_true")
     parser.add_argument("--no-pairs", action="store_true", help="the solves only")
     parser.add_argument("--executable", help="the layercontact program (default: the installed one)")
+    parser.add_argument("--scene", choices=("coupled", "sliding"), default="coupled")
     args = parser.parse_args()
     global EXECUTABLE
     EXECUTABLE = args.executable
@@ -103,24 +120,32 @@ def main() -> None:
         pairs(args.n)
     if args.pairs_only:
         return
+    # (runs: ranks, method; ranks 0 is the serial run without a launcher)
+    runs = [(0, "auto"), (1, "auto"), (2, "auto")]
+    title = f"{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5), tol 1e-8, one thread per rank"
+    if args.scene == "sliding":
+        runs = [(0, "auto"), (2, "auto"), (2, "gcr")]
+        title = (f"{args.n}² sliding SLS (E_inf/E0 10, V tau/lambda 0.1, h/lambda 0.16, nu 0.5, mu_c 0.5), tol 1e-8, "
+                 "one thread per rank")
     with tempfile.TemporaryDirectory() as tmp:
-        nml = scene(Path(tmp), args.n)
         rows = {}
         for _ in range(args.repeats):
-            for ranks in (0, 1, 2):
-                solve, elapsed, peaks, solver = run(ranks, nml)
-                best = rows.get(ranks)
+            for ranks, method in runs:
+                solve, elapsed, peaks, solver, iterations = run(ranks, scene(Path(tmp), args.n, args.scene, method))
+                best = rows.get((ranks, method))
                 if best is None or solve < best[0]:
-                    rows[ranks] = (solve, elapsed, peaks, solver)
-        serial = rows[0]
-        print(f"\n{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5), tol 1e-8, one thread per rank")
-        print(f"{'run':<14}{'solver':<8}{'solve (s)':>10}{'run (s)':>9}{'serial/this':>13}"
+                    rows[(ranks, method)] = (solve, elapsed, peaks, solver, iterations)
+        serial = rows[(0, "auto")]
+        print(f"\n{title}")
+        print(f"{'run':<22}{'solver':<16}{'iterations':>11}{'solve (s)':>10}{'run (s)':>9}{'serial/this':>13}"
               f"{'peak RSS/rank (MiB)':>22}{'of serial':>11}")
-        for ranks, (solve, elapsed, peaks, solver) in rows.items():
+        for (ranks, method), (solve, elapsed, peaks, solver, iterations) in rows.items():
             name = "serial" if ranks == 0 else f"mpirun -n {ranks}"
+            if method != "auto":
+                name += f" ({method})"
             rss = "/".join(f"{p:.0f}" for p in peaks)
-            print(f"{name:<14}{solver:<8}{solve:>10.2f}{elapsed:>9.2f}{serial[0] / solve:>13.2f}{rss:>22}"
-                  f"{max(peaks) / max(serial[2]):>11.2f}")
+            print(f"{name:<22}{solver:<16}{iterations:>11}{solve:>10.2f}{elapsed:>9.2f}{serial[0] / solve:>13.2f}"
+                  f"{rss:>22}{max(peaks) / max(serial[2]):>11.2f}")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 
 

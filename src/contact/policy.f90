@@ -177,8 +177,8 @@ contains
       ind%start_contacts = count(p > 0.0_wp)
       if (ind%distributed) ind%start_contacts = global_sum(ind%start_contacts)
       if (trim(ind%method) /= 'auto' .or. len(ind%refusal) > 0) return
+      if (.not. (loss_needed(ind) .or. rows_needed(ind))) return
       if (ind%distributed) then
-         if (.not. measured_whole(ind)) return
          block
             type(compliance_operator) :: whole
             type(error_type), allocatable :: error
@@ -196,9 +196,8 @@ contains
       type(problem_indicators), intent(inout) :: ind
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
-      if (ind%viscoelastic .and. ind%points >= lossy_points(ind%line)) ind%short_wave_loss = loss_among_short_waves(op)
-      if (ind%coupled .and. .not. ind%line .and. hard(ind) .and. ind%points >= rows_multigrid_surface_points .and. &
-         & ind%points < coupled_points(ind%line)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
+      if (loss_needed(ind)) ind%short_wave_loss = loss_among_short_waves(op)
+      if (rows_needed(ind)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
    end subroutine measure_hard_start
 
    !> The plan for a problem with indicators `ind` (before the coarse start: the first
@@ -364,6 +363,20 @@ contains
          may = points >= min(symmetric_points(line), coupled_points(line))
       end if
    end function may_take_multigrid
+
+   !> Rule 3a reads the loss among the short waves ...
+   pure logical function loss_needed(ind)
+      type(problem_indicators), intent(in) :: ind
+      loss_needed = ind%viscoelastic .and. ind%points >= lossy_points(ind%line)
+   end function loss_needed
+
+   !> ... and 3b on a surface between rows_multigrid_surface_points and coupled_points
+   !> whether rows smooth it.
+   pure logical function rows_needed(ind)
+      type(problem_indicators), intent(in) :: ind
+      rows_needed = ind%coupled .and. .not. ind%line .and. hard(ind) .and. &
+         & ind%points >= rows_multigrid_surface_points .and. ind%points < coupled_points(ind%line)
+   end function rows_needed
 
    pure logical function hard(ind)
       type(problem_indicators), intent(in) :: ind
