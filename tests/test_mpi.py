@@ -80,7 +80,7 @@ SCENES = {
     "frictionless": "&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.0 /\n",
     # friction couples the fields (h/lambda 0.05, mu_c 0.5, nu 0.5): the constrained GCR
     "coupled": "&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n",
-    # a sliding standard linear solid (serially the multigrid method may take it; distributed, GCR)
+    # a sliding standard linear solid (the methods the serial policy plans, distributed as well)
     "viscoelastic": "&layer thickness = 0.05, poisson = 0.5 /\n"
                     "&material model = 'sls', e0 = 1.0, e_inf = 10.0, tau = 1.0, speed = 0.5 /\n"
                     "&friction coefficient = 0.0 /\n",
@@ -154,8 +154,6 @@ def test_distributed_runs_give_the_serial_answer(scene, tmp_path):
         with h5py.File(tmp_path / out, "r") as f:
             assert int(f.attrs["mpi_ranks"]) == ranks
             assert int(f["results"].attrs["mpi_ranks"]) == ranks
-            if ranks > 1:
-                assert "distributed runs use gcr/cg" in f["results"].attrs["solver_reason"].decode()
         # one summary, from rank 0
         assert done.stdout.count("result file") == 1
 

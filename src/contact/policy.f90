@@ -28,7 +28,7 @@ module lc_contact_policy
    use lc_contact_solver_newton, only: dense_points
    use lc_contact_solver_gfmd, only: gfmd_refusal
    use lc_contact_solver_multigrid, only: multigrid_refusal, metric_refusal, coupled_refusal, rows_ahead_of_gcr, &
-      & loss_among_short_waves, short_loss_limit
+      & loss_among_short_waves, short_loss_limit, whole_operator
    implicit none (type, external)
    private
    public :: problem_indicators, solve_plan, measure_problem, measure_start, plan_solve, max_stages
@@ -86,12 +86,17 @@ module lc_contact_policy
       logical :: rows_ahead = .false.
       !> a surface shared among the ranks of an MPI job (docs/decisions/023-mpi-slabs.md):
       !> the constrained CG and GCR (GCR keeping its history, then Anderson's iteration) and
-      !> GFMD solve it, the serial methods (multigrid, dense Newton) do not
+      !> GFMD solve it on the slabs; the multigrid method solves the whole grid on every rank
+      !> (docs/decisions/028-distributed-multigrid.md), asked by name only; dense Newton not
       logical :: distributed = .false.
    end type problem_indicators
 
-   !> Why a distributed surface takes no multigrid method.
-   character(len=*), parameter :: distributed_refusal = 'multigrid is serial; distributed runs use gcr/cg'
+   !> The methods a distributed surface may ask for by name, and why 'auto' takes no
+   !> multigrid method there: it would hold the whole grid on every rank.
+   character(len=*), parameter :: distributed_methods = "'auto', 'cg', 'gcr', 'anderson', 'gfmd' or " // &
+      & "'multigrid' (the whole grid on every rank)"
+   character(len=*), parameter :: distributed_refusal = 'the multigrid method solves the whole grid on ' // &
+      & "every rank (asked by name only); distributed runs use gcr/cg"
 
    !> The methods to run, in turn, the coarse start before them, and why.
    type :: solve_plan
@@ -116,21 +121,45 @@ contains
       ind%viscoelastic = op%kernel%viscoelastic
       ind%monotone = op%monotone
       ind%gfmd_refusal = ''
+      ind%refusal = ''
       ! (GFMD's measure is a largest ratio over the modes: taken over the ranks on a slab)
       if (trim(method) == 'gfmd') ind%gfmd_refusal = gfmd_refusal(op)
       if (op%distributed) then
-         ! (the multigrid's measures read a whole spectrum: not taken on a slab)
          ind%distributed = .true.
-         ind%refusal = distributed_refusal
+         ! 'auto' keeps a shared surface on the methods that run on the slabs
+         if (trim(method) /= 'multigrid') then
+            ind%refusal = distributed_refusal
+            return
+         end if
+         ! (the multigrid's measures read a whole spectrum: taken on an operator of the whole
+         ! grid, which the method solves on every rank)
+         block
+            type(compliance_operator) :: whole
+            type(error_type), allocatable :: error
+            call whole_operator(op, whole, error)
+            if (allocated(error)) then
+               ind%refusal = 'the operator of the whole grid could not be made: ' // error%message
+               return
+            end if
+            call measure_multigrid(ind, whole, load_control)
+         end block
          return
       end if
+      call measure_multigrid(ind, op, load_control)
+   end function measure_problem
+
+   !> Whether the multigrid method can solve the scene of `op` (its refusals), and in which form.
+   subroutine measure_multigrid(ind, op, load_control)
+      type(problem_indicators), intent(inout) :: ind
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
       ind%refusal = multigrid_refusal(op)
       if (op%coupled .or. (len(ind%refusal) > 0 .and. .not. op%kernel%viscoelastic)) then
          ind%refusal = coupled_refusal(op, load_control)
          ind%rising = .not. op%coupled .and. len(ind%refusal) == 0
       end if
       if (len(ind%refusal) == 0 .and. (ind%coupled .or. ind%rising)) ind%metric_admitted = len(metric_refusal(op)) == 0
-   end function measure_problem
+   end subroutine measure_multigrid
 
    !> Add what the start tells (the coarse start's iterations, 0 where none ran, whether it
    !> took the multigrid method, the contact points of the start `p`) and what the rules
@@ -147,9 +176,9 @@ contains
       ind%start_contacts = count(p > 0.0_wp)
       if (ind%distributed) ind%start_contacts = global_sum(ind%start_contacts)
       if (trim(ind%method) /= 'auto' .or. len(ind%refusal) > 0) return
-      if (ind%viscoelastic .and. ind%points >= lossy_points(ind%line)) ind%short_wave_loss = loss_among_short_waves(op)
-      if (ind%coupled .and. .not. ind%line .and. hard(ind) .and. ind%points >= rows_multigrid_surface_points .and. &
-         & ind%points < coupled_points(ind%line)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
+      ! (a shared surface under 'auto' has its refusal: returned above)
+      if (loss_needed(ind)) ind%short_wave_loss = loss_among_short_waves(op)
+      if (rows_needed(ind)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
    end subroutine measure_start
 
    !> The plan for a problem with indicators `ind` (before the coarse start: the first
@@ -164,12 +193,10 @@ contains
 
       first = trim(ind%method)
       why = ''
-      if (ind%distributed .and. all(trim(ind%method) /= [character(len=8) :: 'auto', 'cg', 'gcr', 'kept', &
-         & 'anderson', 'gfmd'])) then
+      if (ind%distributed .and. all(trim(ind%method) /= [character(len=9) :: 'auto', 'cg', 'gcr', 'kept', &
+         & 'anderson', 'gfmd', 'multigrid'])) then
          call fatal_error(error, "&solver: method = '" // trim(ind%method) // "' runs on one MPI rank; a surface " // &
-            & "shared among ranks is solved by 'auto', 'cg', 'gcr', 'anderson' or 'gfmd' (" // distributed_refusal // &
-            & ')', &
-            & code_input)
+            & 'shared among ranks is solved by ' // distributed_methods, code_input)
          return
       end if
       select case (trim(ind%method))
@@ -318,6 +345,20 @@ contains
          may = points >= min(symmetric_points(line), coupled_points(line))
       end if
    end function may_take_multigrid
+
+   !> Rule 3a reads the loss among the short waves ...
+   pure logical function loss_needed(ind)
+      type(problem_indicators), intent(in) :: ind
+      loss_needed = ind%viscoelastic .and. ind%points >= lossy_points(ind%line)
+   end function loss_needed
+
+   !> ... and 3b on a surface between rows_multigrid_surface_points and coupled_points
+   !> whether rows smooth it.
+   pure logical function rows_needed(ind)
+      type(problem_indicators), intent(in) :: ind
+      rows_needed = ind%coupled .and. .not. ind%line .and. hard(ind) .and. &
+         & ind%points >= rows_multigrid_surface_points .and. ind%points < coupled_points(ind%line)
+   end function rows_needed
 
    pure logical function hard(ind)
       type(problem_indicators), intent(in) :: ind

@@ -142,7 +142,11 @@ contains
       coupled_memory = kernel%coupled(friction)
       if (.not. coupled_memory .and. may_multigrid .and. grid%is_line()) &
          & coupled_memory = kernel%compliance_rise(2*pi/grid%lx, pi*grid%nx/grid%lx) > allowed_rise
-      call check_memory(n_local, coupled_memory, scene%solver%memory, scene%stress .and. grid%ny > 1, &
+      ! (a shared surface takes the multigrid method by name only, and it then solves the
+      ! whole grid on every rank: decision 028)
+      if (distributed) may_multigrid = trim(scene%solver%method) == 'multigrid'
+      call check_memory(merge(n, n_local, distributed .and. may_multigrid), coupled_memory, scene%solver%memory, &
+         & scene%stress .and. grid%ny > 1, &
          & may_multigrid, grid%is_line(), trim(scene%solver%method) == 'gfmd', error)
       if (allocated(error)) return
       lambda_max = maxval(height)

@@ -46,7 +46,9 @@ module lc_contact_solver_multigrid
    use lc_base_errors, only: error_type
    use lc_base_memory, only: available_bytes
    use lc_base_strings, only: to_string, formatted
-   use lc_contact_operator, only: compliance_operator
+   use lc_contact_operator, only: compliance_operator, build_operator
+   use lc_base_parallel, only: allgather_rows, slab
+   use lc_base_threads, only: active_threads
    use lc_contact_multigrid_hierarchy, only: hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, &
       & build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, precondition, worst_smoothing, &
       & apply_stiffness, worst_row_smoothing, accepted_smoothing
@@ -58,7 +60,7 @@ module lc_contact_solver_multigrid
    implicit none (type, external)
    private
    public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
-   public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit
+   public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, whole_operator
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -1236,7 +1238,9 @@ contains
       type(multigrid_outcome) :: nested
       real(wp), allocatable :: history(:)
       allocate (history(budget))
-      if (problem%op%coupled .or. len(multigrid_refusal(problem%op)) > 0) then
+      if (problem%op%distributed) then
+         call solve_gathered(problem, state, budget, nested, history, progress, error)
+      else if (problem%op%coupled .or. len(multigrid_refusal(problem%op)) > 0) then
          call coupled_tnnmg(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
             & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
       else
@@ -1248,6 +1252,58 @@ contains
          & fft_pairs=nested%fft_pairs, residual=nested%residual, &
          & history=history(1:min(nested%iterations, size(history))))
    end subroutine solve_by_multigrid
+
+   !> The multigrid solve of a surface shared among the ranks (problem%op on this rank's
+   !> slab; docs/decisions/028-distributed-multigrid.md): the profile and the start gathered
+   !> onto every rank (MPI_Allgatherv), the serial iteration run on an operator of the whole
+   !> grid, alike on every rank (same data, same plans: the same iterates), and each rank
+   !> keeping its slab of p, w and gap. s is the whole surface's on every rank.
+   subroutine solve_gathered(problem, state, budget, nested, history, progress, error)
+      type(contact_problem), intent(in) :: problem
+      type(contact_state), intent(inout) :: state
+      integer, intent(in) :: budget
+      type(multigrid_outcome), intent(out) :: nested
+      real(wp), contiguous, intent(inout) :: history(:)
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(compliance_operator), target :: whole
+      real(wp), allocatable :: b(:), p(:), w(:), gap(:)
+      integer :: nx, ny, y_start, ny_local, first, last
+      nx = problem%op%grid%nx
+      ny = problem%op%grid%ny
+      call whole_operator(problem%op, whole, error)
+      if (allocated(error)) return
+      call allgather_rows(problem%b, nx, ny, b)
+      call allgather_rows(state%p, nx, ny, p)
+      allocate (w(nx*ny), gap(nx*ny))
+      if (whole%coupled .or. len(multigrid_refusal(whole)) > 0) then
+         call coupled_tnnmg(whole, b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
+            & problem%tol, budget, p, w, gap, nested, history, progress, error)
+      else
+         call multigrid(whole, b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, problem%tol, &
+            & budget, p, w, gap, nested, history, progress, error)
+      end if
+      if (allocated(error)) return
+      call slab(ny, y_start, ny_local)
+      first = nx*y_start + 1
+      last = nx*(y_start + ny_local)
+      state%p = p(first:last)
+      state%w = w(first:last)
+      state%gap = gap(first:last)
+   end subroutine solve_gathered
+
+   !> The operator of the whole grid of `op` (a slab's, distributed) on this rank alone: the
+   !> same grid, layer and friction, and its uniform mode left out where op's is
+   !> (drop_uniform_mode). What the multigrid method and its measures read: whole spectra.
+   subroutine whole_operator(op, whole, error)
+      type(compliance_operator), intent(in) :: op
+      type(compliance_operator), intent(out) :: whole
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: uniform
+      call build_operator(whole, op%grid, op%kernel, op%friction, active_threads(), error, distributed=.false.)
+      if (allocated(error)) return
+      if (op%dropped_uniform /= 0.0_wp) call whole%drop_uniform_mode(uniform)
+   end subroutine whole_operator
 
    pure function multigrid_name(self) result(name)
       class(multigrid_solver), intent(in) :: self

@@ -211,15 +211,17 @@ contains
       call report(name, error%code == code_input .and. index(error%message, message_has) > 0, error%message)
    end subroutine refused
 
-   !> A surface shared among MPI ranks: CG or GCR (GCR keeping its history, then Anderson's
-   !> iteration, as on one rank), never the serial methods, however large or hard the grid;
-   !> GFMD as asked; the serial methods refused by name.
+   !> A surface shared among MPI ranks: 'auto' plans CG or GCR (GCR keeping its history, then
+   !> Anderson's iteration, as on one rank), never the multigrid method, which would hold the
+   !> whole grid on every rank, however large or hard the grid; the multigrid method,
+   !> Anderson and GFMD as asked; dense Newton refused by name.
    subroutine check_distributed()
       type(problem_indicators) :: ind
       ind = problem(2048**2, .false., .false.)
       ind%distributed = .true.
-      ind%refusal = 'multigrid is serial; distributed runs use gcr/cg'
-      call expect('distributed symmetric 2048^2', ind, .true., 'cg', 'multigrid is serial')
+      ind%refusal = 'the multigrid method solves the whole grid on every rank (asked by name only); ' // &
+         & 'distributed runs use gcr/cg'
+      call expect('distributed symmetric 2048^2', ind, .true., 'cg', 'distributed runs use gcr/cg')
       ind%coupled = .true.
       ind%start_iterations = 40
       call expect('distributed coupled 2048^2, hard start', ind, .true., 'gcr+kept+anderson', &
@@ -228,12 +230,17 @@ contains
       call expect('distributed coupled 32^2 (no dense Newton)', ind, .true., 'gcr+kept+anderson', 'the constrained GCR')
       ind%method = 'anderson'
       call expect('distributed anderson', ind, .true., 'anderson', "method 'anderson'")
-      ind%method = 'multigrid'
-      call refused('distributed multigrid', ind, 'runs on one MPI rank')
+      ind%method = 'newton'
+      call refused('distributed dense Newton', ind, 'runs on one MPI rank')
       ind%method = 'gcr'
       call expect('distributed gcr', ind, .true., 'gcr', '')
       ind%method = 'gfmd'
       call expect('distributed gfmd', ind, .true., 'gfmd', "method 'gfmd'")
+      ! (asked by name, the multigrid's measures are taken on the whole grid's operator)
+      ind%method = 'multigrid'
+      ind%refusal = ''
+      ind%points = 2048**2
+      call expect('distributed multigrid by name', ind, .true., 'multigrid+gcr+kept+anderson', "method 'multigrid'")
    end subroutine check_distributed
 
    !> What the memory check provides for: every grid where some start could send the

@@ -1,0 +1,114 @@
+"""The multigrid method on a surface shared among the ranks of an MPI job
+(docs/decisions/028-distributed-multigrid.md): `mpirun -n P layercontact scene.nml` takes it
+by name and gives the serial run's answer; 'auto' keeps a shared surface on the methods
+that run on the slabs.
+
+The oracle is the serial run of the same scene (no launcher). The distributed run gathers the
+profile and the start onto every rank and runs the serial iteration on the whole grid; what
+differs from the serial run is the rounding of the profile (made on the slabs by FFTW-MPI's
+c2r) and of the coarse start's and the Krylov stages' sums over the ranks. Both solves run
+to tol = 1e-12 (the complementarity residual relative to p_m and the relief); two solutions
+that close to the unique one agree to about that, so SAME = 1e-10 relative (test_mpi.py) is
+met with two decades to spare and fails on a slab taken from the wrong rows of the gathered
+solution (percents), a state not gathered (the multigrid would start from a slab), or an
+operator of the slab's grid in place of the whole one's (the wrong modes).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import pytest
+
+from test_mpi import assert_same, executable, needs_mpi, run_mpi, run_serial
+
+#: a standard linear solid sliding on a thin incompressible layer with friction whose loss
+#: among the waves short along x exceeds 3 (E_inf/E0 = 100 at V tau/lambda = 0.1, h/lambda =
+#: 0.16): serially 'auto' takes the multigrid method from 128^2 (test_multigrid.py,
+#: "lossy among its short waves")
+SLIDING = ("&layer thickness = 0.16, poisson = 0.5 /\n"
+           "&material model = 'sls', e0 = 1.0, e_inf = 100.0, tau = 1.0, speed = 0.1 /\n"
+           "&friction coefficient = 0.5 /\n"
+           "&loading control = 'load', mean_pressure = 0.02 /\n")
+#: a compressible layer, frictionless (the symmetric multigrid) and with friction (the
+#: coupled form), both under &solver method = 'multigrid'
+ELASTIC = "&layer thickness = 0.16, poisson = 0.3 /\n&loading control = 'load', normalised_pressure = 0.15 /\n"
+SCENES = {
+    "sliding": (128, SLIDING + "&solver method = 'multigrid', tol = 1e-12 /\n"),
+    "frictionless": (64, ELASTIC + "&friction coefficient = 0.0 /\n&solver method = 'multigrid', tol = 1e-12 /\n"),
+    "coupled": (64, ELASTIC + "&friction coefficient = 0.5 /\n&solver method = 'multigrid', tol = 1e-12 /\n"),
+}
+
+
+def write_scene(directory: Path, name: str, n: int, body: str, output: str) -> Path:
+    nml = directory / f"{name}.nml"
+    nml.write_text(
+        f"&scene geometry = 'areal', n = {n}, ny = {n} /\n" + body +
+        f"&profile kind = 'self_affine', hurst = 0.8, seed = 1, short_wavelength = {8 / n}, rms_gradient = 0.1 /\n"
+        f"&output file = '{output}', overwrite = .true., stress = .false. /\n")
+    return nml
+
+
+def counts(path: Path) -> tuple[str, int, int]:
+    with h5py.File(path, "r") as f:
+        attrs = f["results"].attrs
+        solver = attrs["solver"]
+        return (solver.decode() if isinstance(solver, bytes) else str(solver)), int(attrs["iterations"]), \
+            int(attrs["fft_pairs"])
+
+
+@needs_mpi
+@pytest.mark.parametrize("scene", sorted(SCENES))
+def test_the_distributed_multigrid_gives_the_serial_answer(scene, tmp_path):
+    """P = 1..4 ranks (3 splits the rows unevenly): every field and scalar of the serial run,
+    the same methods in turn (the `solver` path, compared as a string), the multigrid first;
+    and the serial run's iteration count: every rank iterates the serial method on the
+    whole grid, so only a profile or start rounded differently could move it."""
+    n, body = SCENES[scene]
+    done = run_serial(write_scene(tmp_path, scene, n, body, "serial.h5"))
+    assert done.returncode == 0, done.stderr
+    serial = counts(tmp_path / "serial.h5")
+    assert serial[0].startswith("multigrid"), serial
+    for ranks in (1, 2, 3, 4):
+        out = f"ranks{ranks}.h5"
+        done = run_mpi(ranks, [executable(), str(write_scene(tmp_path, f"{scene}{ranks}", n, body, out))], tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert_same(tmp_path / "serial.h5", tmp_path / out)
+        distributed = counts(tmp_path / out)
+        print(scene, ranks, "serial", serial, "distributed", distributed)
+        assert distributed[:2] == serial[:2], (serial, distributed)
+        with h5py.File(tmp_path / out, "r") as f:
+            assert int(f["results"].attrs["mpi_ranks"]) == ranks
+
+
+@needs_mpi
+def test_auto_keeps_a_shared_surface_on_the_slabs(tmp_path):
+    """The sliding scene that 'auto' sends to the multigrid method on one process: on two
+    ranks 'auto' plans the GCR, which stays on the slabs (the multigrid would hold the whole
+    grid on every rank), says why, and reaches the serial answer by another method."""
+    n, body = SCENES["sliding"]
+    body = body.replace("method = 'multigrid', ", "")
+    assert run_serial(write_scene(tmp_path, "serial", n, body, "serial.h5")).returncode == 0
+    assert counts(tmp_path / "serial.h5")[0].startswith("multigrid")
+    done = run_mpi(2, [executable(), str(write_scene(tmp_path, "ranks", n, body, "ranks.h5"))], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert counts(tmp_path / "ranks.h5")[0].startswith("gcr")
+    with h5py.File(tmp_path / "ranks.h5", "r") as f:
+        assert "asked by name only" in f["results"].attrs["solver_reason"].decode()
+    assert_same(tmp_path / "serial.h5", tmp_path / "ranks.h5")
+
+
+@needs_mpi
+@pytest.mark.parametrize("method", ["newton"])
+def test_serial_methods_are_refused_by_name_on_several_ranks(method, tmp_path):
+    """The method that runs on one rank only (dense Newton): exit 2 with a message naming
+    the method and the methods a distributed surface takes, the multigrid among them; no
+    result file."""
+    n, body = SCENES["frictionless"]
+    body = body.replace("method = 'multigrid'", f"method = '{method}'")
+    done = run_mpi(2, [executable(), str(write_scene(tmp_path, method, n, body, "refused.h5"))], tmp_path)
+    assert done.returncode == 2, done.stderr
+    message = done.stderr + done.stdout
+    assert f"method = '{method}' runs on one MPI rank" in message and "'multigrid'" in message, message
+    assert not (tmp_path / "refused.h5").exists()
