@@ -21,7 +21,15 @@ from pathlib import Path
 import h5py
 import pytest
 
-from test_mpi import assert_same, executable, needs_mpi, run_mpi, run_serial
+import numpy as np
+
+from test_mpi import assert_same, executable, needs_mpi, read, run_mpi, run_serial
+
+#: two methods (the serial multigrid, the distributed GCR) each stopped at tol = 1e-12 on
+#: the gap's residual: the stiffest modes of this lossy layer (E_inf/E0 = 100) magnify the
+#: residual's 1e-12 about a hundredfold in the pressure, and the two stop on different
+#: sides of the solution (measured: 1.9e-10 of the largest pressure); 1e-8 leaves room
+DIFFERENT_METHODS = 1e-8
 
 #: a standard linear solid sliding on a thin incompressible layer with friction whose loss
 #: among the waves short along x exceeds 3 (E_inf/E0 = 100 at V tau/lambda = 0.1, h/lambda =
@@ -96,7 +104,12 @@ def test_auto_keeps_a_shared_surface_on_the_slabs(tmp_path):
     assert counts(tmp_path / "ranks.h5")[0].startswith("gcr")
     with h5py.File(tmp_path / "ranks.h5", "r") as f:
         assert "asked by name only" in f["results"].attrs["solver_reason"].decode()
-    assert_same(tmp_path / "serial.h5", tmp_path / "ranks.h5")
+    (serial_fields, serial_scalars, _), (fields, scalars, _) = read(tmp_path / "serial.h5"), read(tmp_path / "ranks.h5")
+    for name, field in serial_fields.items():
+        assert np.max(np.abs(fields[name] - field)) <= DIFFERENT_METHODS * np.max(np.abs(field)), name
+    assert scalars["contact_fraction"] == serial_scalars["contact_fraction"]
+    for name in ("mean_pressure", "penetration", "dissipated_power"):
+        assert abs(scalars[name] - serial_scalars[name]) <= DIFFERENT_METHODS * abs(serial_scalars[name]), name
 
 
 @needs_mpi
