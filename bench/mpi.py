@@ -4,13 +4,17 @@ with the time and the peak memory of each rank; and one FFT pair of the surface 
 and 4 ranks (4 oversubscribed on a 2-core machine) in FFTW-MPI's two layouts.
 
     .venv/bin/python bench/mpi.py [--n 2048] [--repeats 1] [--pairs-only] [--executable PATH]
+                                  [--runs serial,1,2] [--fields]
 
 Scene: self-affine H = 0.8, shortest wavelength 8 points, rms gradient 0.1, seed 1, on an
 incompressible layer h/lambda = 0.05 (nu = 0.5), Coulomb friction mu_c = 0.5,
-p_m = 0.15 E* h/lambda, tol 1e-8, no surface stress and no fields written (the solve and
-the gathering of its fields to rank 0). "solve" is the summary's solver time (operator,
-coarse start, iterations; the best of --repeats), "run" the whole process, "peak RSS" each
-rank's largest resident set (/usr/bin/time's %M). Ratios are measured within this run.
+p_m = 0.15 E* h/lambda, tol 1e-8, no surface stress and no fields written (--fields: the
+pressure, gap and displacement maps and the heights written, by slabs on several ranks).
+"solve" is the summary's solver time (operator, coarse start, iterations; the best of
+--repeats), "run" the whole process, "peak RSS" each rank's largest resident set
+(/usr/bin/time's %M), "of serial" each rank's peak over the serial run's, and "doubles/pt"
+each rank's peak over 8 bytes a point of the whole grid, and their sum. Ratios are
+measured within this run. --runs chooses the runs (serial: no launcher; P: mpirun -n P).
 The FFT pairs come from bench/mpi_fft_pair.c, compiled here with mpicc.
 """
 
@@ -48,14 +52,14 @@ def environment(launched: bool) -> dict[str, str]:
     return env
 
 
-def scene(directory: Path, n: int) -> Path:
+def scene(directory: Path, n: int, fields: bool = False) -> Path:
     nml = directory / "coupled.nml"
     nml.write_text(
         f"&scene geometry = 'areal', n = {n}, ny = {n} /\n"
         "&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
         f"&profile kind = 'self_affine', hurst = 0.8, seed = 1, short_wavelength = {8 / n}, rms_gradient = 0.1 /\n"
         "&loading control = 'load', normalised_pressure = 0.15 /\n&solver tol = 1e-8 /\n"
-        "&output file = 'coupled.h5', overwrite = .true., stress = .false., fields = .false. /\n")
+        f"&output file = 'coupled.h5', overwrite = .true., stress = .false., fields = {'.true.' if fields else '.false.'} /\n")
     return nml
 
 
@@ -94,6 +98,8 @@ def main() -> None:
     parser.add_argument("--pairs-only", action="store_true")
     parser.add_argument("--no-pairs", action="store_true", help="the solves only")
     parser.add_argument("--executable", help="the layercontact program (default: the installed one)")
+    parser.add_argument("--runs", default="serial,1,2", help="runs: serial (no launcher) and rank counts")
+    parser.add_argument("--fields", action="store_true", help="write the maps (the result file by slabs)")
     args = parser.parse_args()
     global EXECUTABLE
     EXECUTABLE = args.executable
@@ -104,23 +110,29 @@ def main() -> None:
     if args.pairs_only:
         return
     with tempfile.TemporaryDirectory() as tmp:
-        nml = scene(Path(tmp), args.n)
+        nml = scene(Path(tmp), args.n, args.fields)
         rows = {}
+        runs = [0 if run_name == "serial" else int(run_name) for run_name in args.runs.split(",")]
         for _ in range(args.repeats):
-            for ranks in (0, 1, 2):
+            for ranks in runs:
                 solve, elapsed, peaks, solver = run(ranks, nml)
                 best = rows.get(ranks)
                 if best is None or solve < best[0]:
                     rows[ranks] = (solve, elapsed, peaks, solver)
-        serial = rows[0]
-        print(f"\n{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5), tol 1e-8, one thread per rank")
+        serial = rows.get(0)
+        print(f"\n{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5), tol 1e-8, one thread per rank"
+              + (", fields written" if args.fields else ""))
         print(f"{'run':<14}{'solver':<8}{'solve (s)':>10}{'run (s)':>9}{'serial/this':>13}"
-              f"{'peak RSS/rank (MiB)':>22}{'of serial':>11}")
+              f"{'peak RSS/rank (MiB)':>22}{'of serial':>14}{'doubles/pt':>18}")
+        points = args.n**2
         for ranks, (solve, elapsed, peaks, solver) in rows.items():
             name = "serial" if ranks == 0 else f"mpirun -n {ranks}"
             rss = "/".join(f"{p:.0f}" for p in peaks)
-            print(f"{name:<14}{solver:<8}{solve:>10.2f}{elapsed:>9.2f}{serial[0] / solve:>13.2f}{rss:>22}"
-                  f"{max(peaks) / max(serial[2]):>11.2f}")
+            speed = f"{serial[0] / solve:.2f}" if serial else "-"
+            share = "/".join(f"{p / max(serial[2]):.2f}" for p in peaks) if serial else "-"
+            doubles = [p * 2**20 / 8 / points for p in peaks]
+            per_point = "/".join(f"{d:.1f}" for d in doubles) + (f" ({sum(doubles):.1f})" if len(doubles) > 1 else "")
+            print(f"{name:<14}{solver:<8}{solve:>10.2f}{elapsed:>9.2f}{speed:>13}{rss:>22}{share:>14}{per_point:>18}")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 
 
