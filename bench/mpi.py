@@ -59,7 +59,8 @@ def scene(directory: Path, n: int, fields: bool = False) -> Path:
         "&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
         f"&profile kind = 'self_affine', hurst = 0.8, seed = 1, short_wavelength = {8 / n}, rms_gradient = 0.1 /\n"
         "&loading control = 'load', normalised_pressure = 0.15 /\n&solver tol = 1e-8 /\n"
-        f"&output file = 'coupled.h5', overwrite = .true., stress = .false., fields = {'.true.' if fields else '.false.'} /\n")
+        "&output file = 'coupled.h5', overwrite = .true., stress = .false., "
+        f"fields = {'.true.' if fields else '.false.'} /\n")
     return nml
 
 
@@ -131,8 +132,11 @@ def main() -> None:
             speed = f"{serial[0] / solve:.2f}" if serial else "-"
             share = "/".join(f"{p / max(serial[2]):.2f}" for p in peaks) if serial else "-"
             doubles = [p * 2**20 / 8 / points for p in peaks]
-            per_point = "/".join(f"{d:.1f}" for d in doubles) + (f" ({sum(doubles):.1f})" if len(doubles) > 1 else "")
-            print(f"{name:<14}{solver:<8}{solve:>10.2f}{elapsed:>9.2f}{speed:>13}{rss:>22}{share:>14}{per_point:>18}")
+            per_point = "/".join(f"{d:.1f}" for d in doubles)
+            if len(doubles) > 1:
+                per_point += f" ({sum(doubles):.1f})"
+            print(f"{name:<14}{solver:<8}{solve:>10.2f}{elapsed:>9.2f}{speed:>13}{rss:>22}{share:>14}"
+                  f"{per_point:>18}")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 
 
