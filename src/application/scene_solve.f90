@@ -5,10 +5,9 @@
 !> executable's run, the Python driver and the resolution pilot all solve through it.
 module lc_application_scene_solve
    use lc_base_kinds, only: wp
-   use lc_base_errors, only: error_type
+   use lc_base_errors, only: error_type, fatal_error
    use lc_scene, only: scene_type, grid_of, companion_of
    use lc_base_parallel, only: is_distributed, is_root, gather_rows, broadcast_from
-   use lc_base_errors, only: fatal_error
    use lc_base_grid, only: grid_type
    use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter, leakage_flow
    use lc_result, only: contact_result
