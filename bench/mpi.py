@@ -3,17 +3,27 @@ solved serially (no launcher), by `mpirun -n 1` and by `mpirun -n 2`, one thread
 with the time and the peak memory of each rank; and one FFT pair of the surface on 1, 2
 and 4 ranks (4 oversubscribed on a 2-core machine) in FFTW-MPI's two layouts.
 
-    .venv/bin/python bench/mpi.py [--n 2048] [--repeats 1] [--pairs-only] [--executable PATH] [--before PATH]
+    .venv/bin/python bench/mpi.py [--n 2048] [--repeats 1] [--pairs-only] [--executable PATH]
+                                  [--runs serial,1,2] [--fields] [--before PATH]
+    .venv/bin/python bench/mpi.py --scene sliding --n 1024 --no-pairs
+
+With --scene sliding (docs/decisions/028-distributed-multigrid.md): a standard linear solid
+(E_inf/E0 = 10, V tau/lambda = 0.1) sliding on a layer h/lambda = 0.16, nu = 0.5, with
+mu_c = 0.5 and p_m = 0.02 E0, which 'auto' sends to the multigrid method serially (from
+512^2), solved serially, by `mpirun -n 2` under method 'multigrid' (the stage gathered onto
+both ranks) and by `mpirun -n 2` under 'auto' (the GCR on the slabs), with their iterations.
+With --before PATH another build's program runs each case alternately with this one.
 
 Scene: self-affine H = 0.8, shortest wavelength 8 points, rms gradient 0.1, seed 1, on an
 incompressible layer h/lambda = 0.05 (nu = 0.5), Coulomb friction mu_c = 0.5,
-p_m = 0.15 E* h/lambda, tol 1e-8, no surface stress and no fields written (the solve and
-the gathering of its fields to rank 0). "solve" is the summary's solver time (operator,
-coarse start, iterations; the best of --repeats), "coarse" the coarse start's part of it
-(the result's `coarse_time`, rank 0's), "run" the whole process, "peak RSS" each rank's
-largest resident set (/usr/bin/time's %M). Ratios are measured within this run.
-`--before PATH`: another build's program (e.g. the one before a change) run alternately
-with this one in the same run, its rows marked "before".
+p_m = 0.15 E* h/lambda, tol 1e-8, no surface stress and no fields written (--fields: the
+pressure, gap and displacement maps and the heights written, by slabs on several ranks).
+"solve" is the summary's solver time (operator, coarse start, iterations; the best of
+--repeats), "run" the whole process, "peak RSS" each rank's largest resident set
+(/usr/bin/time's %M), "of serial" each rank's peak over the serial run's, and "doubles/pt"
+each rank's peak over 8 bytes a point of the whole grid, and their sum. Ratios are
+measured within this run. --runs chooses the runs (serial: no launcher; P: mpirun -n P);
+"coarse" is the coarse start's time (the result's coarse_time).
 The FFT pairs come from bench/mpi_fft_pair.c, compiled here with mpicc.
 """
 
@@ -53,20 +63,27 @@ def environment(launched: bool) -> dict[str, str]:
     return env
 
 
-def scene(directory: Path, n: int) -> Path:
-    nml = directory / "coupled.nml"
+def scene(directory: Path, n: int, kind: str = "coupled", method: str = "auto", fields: bool = False) -> Path:
+    nml = directory / f"{kind}_{method}.nml"
+    if kind == "coupled":
+        body = ("&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
+                "&loading control = 'load', normalised_pressure = 0.15 /\n")
+    else:
+        body = ("&layer thickness = 0.16, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
+                "&material model = 'sls', e0 = 1.0, e_inf = 10.0, tau = 1.0, speed = 0.1 /\n"
+                "&loading control = 'load', mean_pressure = 0.02 /\n")
     nml.write_text(
-        f"&scene geometry = 'areal', n = {n}, ny = {n} /\n"
-        "&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
+        f"&scene geometry = 'areal', n = {n}, ny = {n} /\n" + body +
         f"&profile kind = 'self_affine', hurst = 0.8, seed = 1, short_wavelength = {8 / n}, rms_gradient = 0.1 /\n"
-        "&loading control = 'load', normalised_pressure = 0.15 /\n&solver tol = 1e-8 /\n"
-        "&output file = 'coupled.h5', overwrite = .true., stress = .false., fields = .false. /\n")
+        f"&solver tol = 1e-8, method = '{method}' /\n"
+        f"&output file = '{kind}.h5', overwrite = .true., stress = .false., "
+        f"fields = {'.true.' if fields else '.false.'} /\n")
     return nml
 
 
-def run(ranks: int, nml: Path, program: str) -> tuple[float, float, list[float], str, float]:
-    """(solve s, run s, peak RSS MiB of each rank, solver, coarse start s) of one run of
-    `program`; ranks 0: no launcher."""
+def run(ranks: int, nml: Path, program: str) -> tuple[float, float, list[float], str, int, float]:
+    """(solve s, run s, peak RSS MiB of each rank, solver, iterations, coarse start s) of one
+    run of `program`; ranks 0: no launcher."""
     # (each rank's /usr/bin/time report in a file of its own: rank.N)
     timed = ["sh", "-c", '/usr/bin/time -f "peak_rss_kib %M elapsed %e" -o "rank.${OMPI_COMM_WORLD_RANK:-0}" "$0" "$1"',
              program, str(nml)]
@@ -76,12 +93,13 @@ def run(ranks: int, nml: Path, program: str) -> tuple[float, float, list[float],
         sys.exit(f"bench/mpi.py: {' '.join(command)} failed ({done.returncode}):\n{done.stderr}")
     solve = float(re.search(r"solver time\s+(\S+)", done.stdout).group(1))
     solver = re.search(r"solver\s+(\S+)", done.stdout).group(1)
+    iterations = int(re.search(r"iterations\s+(\d+)", done.stdout).group(1))
     reports = [(nml.parent / f"rank.{r}").read_text() for r in range(max(ranks, 1))]
     peaks = [int(re.search(r"peak_rss_kib (\d+)", text).group(1)) / 1024 for text in reports]
     elapsed = max(float(re.search(r"elapsed (\S+)", text).group(1)) for text in reports)
-    with h5py.File(nml.parent / "coupled.h5", "r") as f:
+    with h5py.File(nml.parent / f"{nml.stem.split('_')[0]}.h5", "r") as f:
         coarse = float(f["results"].attrs["coarse_time"])
-    return solve, elapsed, peaks, solver, coarse
+    return solve, elapsed, peaks, solver, iterations, coarse
 
 
 def pairs(n: int) -> None:
@@ -102,8 +120,10 @@ def main() -> None:
     parser.add_argument("--pairs-only", action="store_true")
     parser.add_argument("--no-pairs", action="store_true", help="the solves only")
     parser.add_argument("--executable", help="the layercontact program (default: the installed one)")
-    parser.add_argument("--before",
-                        help="another build's layercontact program, run alternately with this one")
+    parser.add_argument("--runs", default="serial,1,2", help="runs: serial (no launcher) and rank counts")
+    parser.add_argument("--fields", action="store_true", help="write the maps (the result file by slabs)")
+    parser.add_argument("--scene", choices=("coupled", "sliding"), default="coupled")
+    parser.add_argument("--before", help="another build's layercontact program, run alternately with this one")
     args = parser.parse_args()
     global EXECUTABLE
     EXECUTABLE = args.executable
@@ -116,26 +136,40 @@ def main() -> None:
         pairs(args.n)
     if args.pairs_only:
         return
+    if args.scene == "coupled":
+        cases = [(0 if name == "serial" else int(name), "auto") for name in args.runs.split(",")]
+        title = f"{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5)"
+    else:
+        cases = [(0, "auto"), (2, "multigrid"), (2, "auto")]
+        title = f"{args.n}² sliding SLS (E_inf/E0 10, V tau/lambda 0.1, h/lambda 0.16, mu_c 0.5)"
     with tempfile.TemporaryDirectory() as tmp:
-        nml = scene(Path(tmp), args.n)
         rows = {}
         for _ in range(args.repeats):
-            for ranks in (0, 1, 2):
+            for ranks, method in cases:
+                nml = scene(Path(tmp), args.n, args.scene, method, args.fields)
                 for label, program in programs.items():
                     measured = run(ranks, nml, program)
-                    best = rows.get((label, ranks))
+                    best = rows.get((label, ranks, method))
                     if best is None or measured[0] < best[0]:
-                        rows[(label, ranks)] = measured
-        print(f"\n{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5), tol 1e-8, one thread per rank")
-        print(f"{'run':<21}{'solver':<8}{'solve (s)':>10}{'coarse (s)':>11}{'run (s)':>9}{'serial/this':>13}"
-              f"{'peak RSS/rank (MiB)':>22}{'of serial':>11}")
-        for (label, ranks), (solve, elapsed, peaks, solver, coarse) in rows.items():
-            serial = rows[(label, 0)]
+                        rows[(label, ranks, method)] = measured
+        print(f"\n{title}, tol 1e-8, one thread per rank" + (", fields written" if args.fields else ""))
+        print(f"{'run':<30}{'solver':<16}{'iterations':>11}{'solve (s)':>10}{'coarse (s)':>11}{'run (s)':>9}"
+              f"{'serial/this':>13}{'peak RSS/rank (MiB)':>22}{'of serial':>14}{'doubles/pt':>18}")
+        points = args.n**2
+        for (label, ranks, method), (solve, elapsed, peaks, solver, iterations, coarse) in rows.items():
+            serial = rows.get((label, 0, "auto"))
             name = label + ("serial" if ranks == 0 else f"mpirun -n {ranks}")
+            if method != "auto":
+                name += f" ({method})"
             rss = "/".join(f"{p:.0f}" for p in peaks)
-            print(f"{name:<21}{solver:<8}{solve:>10.2f}{coarse:>11.2f}{elapsed:>9.2f}"
-                  f"{serial[0] / solve:>13.2f}"
-                  f"{rss:>22}{max(peaks) / max(serial[2]):>11.2f}")
+            speed = f"{serial[0] / solve:.2f}" if serial else "-"
+            share = "/".join(f"{p / max(serial[2]):.2f}" for p in peaks) if serial else "-"
+            doubles = [p * 2**20 / 8 / points for p in peaks]
+            per_point = "/".join(f"{d:.1f}" for d in doubles)
+            if len(doubles) > 1:
+                per_point += f" ({sum(doubles):.1f})"
+            print(f"{name:<30}{solver:<16}{iterations:>11}{solve:>10.2f}{coarse:>11.2f}{elapsed:>9.2f}{speed:>13}"
+                  f"{rss:>22}{share:>14}{per_point:>18}")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 
 

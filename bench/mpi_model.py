@@ -171,14 +171,14 @@ def model_time(n: int, ranks: int, coefficient: float, ref: dict, bandwidth: flo
 
 
 def model_memory(n: int, ranks: int, doubles_per_point: float) -> dict:
-    """Peak bytes per rank: rank 0 and the others."""
+    """Peak bytes per rank: rank 0 and the others (alike: the observables run on the slabs
+    and the file is written by them, decisions 025 and 026; no field is gathered)."""
     points = n * n
     slab = doubles_per_point * points / ranks
     gathered = [level["points"] for level in coarse_levels(n, ranks) if not level["on_slabs"]]
     coarse = 0.0 if ranks == 1 or not gathered else doubles_per_point * gathered[0]
     solve = 8.0 * max(slab, coarse)
-    gathered = 0.0 if ranks == 1 else 8.0 * 4 * points
-    return {"rank0": solve + gathered, "other": solve}
+    return {"rank0": solve, "other": solve}
 
 
 def coarse_dominates_from(n: int, coefficient: float, ref: dict, bandwidth: float, latency: float) -> int:

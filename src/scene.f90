@@ -22,6 +22,7 @@ module lc_scene
    private
    public :: scene_type, profile_spec, solver_settings, check_scene, is_halfspace, not_set, material_of, &
       & static_contact_modulus, grid_of, kernel_of, is_areal, pressure_scale, companion_of, foundation
+   public :: relief_pressure_scale
    public :: max_string, default_rms_gradient
 
    !> Sentinel for "not given" in optional positive quantities: a value nobody types, so
@@ -287,14 +288,20 @@ contains
    real(wp) function pressure_scale(scene, height)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: height(:)
-      real(wp) :: lambda0
-      if (is_areal(scene) .and. .not. is_halfspace(scene)) then
-         pressure_scale = static_contact_modulus(scene)*scene%thickness/scene%period
-      else
-         lambda0 = maxval(height) - sum(height)/size(height)
-         pressure_scale = static_contact_modulus(scene)*lambda0/scene%period
-      end if
+      pressure_scale = relief_pressure_scale(scene, maxval(height) - sum(height)/size(height))
    end function pressure_scale
+
+   !> pressure_scale from the relief Lambda0 = max r - mean r (L) of the whole profile (a
+   !> surface shared among MPI ranks has it from the extremes and sums over the ranks).
+   real(wp) function relief_pressure_scale(scene, lambda0)
+      type(scene_type), intent(in) :: scene
+      real(wp), intent(in) :: lambda0
+      if (is_areal(scene) .and. .not. is_halfspace(scene)) then
+         relief_pressure_scale = static_contact_modulus(scene)*scene%thickness/scene%period
+      else
+         relief_pressure_scale = static_contact_modulus(scene)*lambda0/scene%period
+      end if
+   end function relief_pressure_scale
 
    !> The frictionless companion of a scene: a/a0 compares contact areas at the same load,
    !> the scene's own under load control and otherwise the `mean_pressure` its solve found.

@@ -13,6 +13,11 @@ value, a scalar's size) is met with three decades to spare yet fails on any slab
 misplaced, any sum taken on one rank only, or a mode's wavevector taken from the local
 index (each of those moves the answer by percents). The run with 3 ranks splits the rows
 unevenly (64 = 22 + 22 + 20, 128 = 43 + 43 + 42).
+
+A distributed run computes its observables on the slabs and every rank writes its rows of
+the result file, which must be the serial run's file: every dataset (dtype, shape, chunks,
+filters, values) and every attribute, but for what records the run rather than the answer
+(times, counts of iterations, the rank count, the host and the clock).
 """
 
 from __future__ import annotations
@@ -37,6 +42,12 @@ VANISHING = 1e-14
 #: the counts and the time of a solve differ between runs by design: not compared
 NOT_COMPARED = {"wall_time", "setup_time", "coarse_time", "residual", "iterations", "fft_pairs", "outer_iterations", "mpi_ranks",
                 "solver_reason", "omp_threads"}
+#: what else in a file records the run, not the answer: its clock, and the counts and
+#: residuals of the iterations that stop at a tolerance (conductance, stiffness, leakage)
+RUN_RECORD = NOT_COMPARED | {"created", "started", "run_wall_time", "input_file", "conductance_iterations",
+                             "stiffness_iterations"}
+#: datasets recording the run: the solver's residual history (its length is its iterations)
+RUN_DATASETS = {"convergence/residual", "companion/convergence/residual"}
 
 
 def executable() -> str:
@@ -88,14 +99,17 @@ SCENES = {
 SIZES = {"frictionless": 64, "coupled": 64, "viscoelastic": 128}
 
 
-def write_scene(directory: Path, name: str, n: int, body: str, output: str) -> Path:
+def write_scene(directory: Path, name: str, n: int, body: str, output: str,
+                observables: str = "stress = .false.", profile: str = "") -> Path:
+    directory.mkdir(parents=True, exist_ok=True)
     nml = directory / f"{name}.nml"
+    profile = profile or (f"&profile kind = 'self_affine', hurst = 0.8, seed = 3, "
+                          f"short_wavelength = {8 / n} /\n")
     nml.write_text(
-        f"&scene geometry = 'areal', n = {n}, ny = {n} /\n" + body +
-        f"&profile kind = 'self_affine', hurst = 0.8, seed = 3, short_wavelength = {8 / n} /\n"
+        f"&scene geometry = 'areal', n = {n}, ny = {n} /\n" + body + profile +
         "&loading control = 'load', normalised_pressure = 0.15 /\n"
         "&solver tol = 1e-13 /\n"
-        f"&output file = '{output}', overwrite = .true., stress = .false. /\n")
+        f"&output file = '{output}', overwrite = .true., {observables} /\n")
     return nml
 
 
@@ -138,22 +152,83 @@ def assert_same(serial: Path, distributed: Path) -> None:
         assert np.all(np.abs(a - b) <= SAME * np.abs(a) + VANISHING), name
 
 
+def contents(path: Path) -> tuple[dict[str, h5py.Dataset], dict[str, object]]:
+    """Every dataset's description and values, and every attribute, by path, of a file."""
+    datasets, attributes = {}, {}
+    with h5py.File(path, "r") as f:
+        def visit(name, item):
+            for key, value in item.attrs.items():
+                attributes[f"{name}@{key}"] = value
+            if isinstance(item, h5py.Dataset):
+                datasets[name] = (item.dtype, item.shape, item.chunks, item.compression,
+                                  item.compression_opts, item.shuffle, np.asarray(item[()]))
+        for key, value in f.attrs.items():
+            attributes[f"@{key}"] = value
+        f.visititems(visit)
+    return datasets, attributes
+
+
+def assert_same_file(serial: Path, distributed: Path) -> None:
+    """The distributed run's file is the serial run's: the same datasets with the same dtype,
+    shape, chunks and filters, their values to SAME, and the same attributes (texts equal,
+    numbers to SAME), but for what records the run (RUN_RECORD, RUN_DATASETS)."""
+    datasets_1, attributes_1 = contents(serial)
+    datasets_p, attributes_p = contents(distributed)
+    assert set(datasets_1) == set(datasets_p)
+    assert set(attributes_1) == set(attributes_p)
+    for name, (dtype, shape, chunks, compression, options, shuffle, values) in datasets_1.items():
+        other = datasets_p[name]
+        assert other[0] == dtype, name
+        if name in RUN_DATASETS:
+            continue
+        assert other[1:6] == (shape, chunks, compression, options, shuffle), name
+        if values.dtype.kind in "fc":
+            scale = max(np.max(np.abs(values), initial=0.0), np.finfo(float).tiny)
+            assert np.max(np.abs(other[6] - values), initial=0.0) <= SAME * scale, name
+        else:
+            assert np.array_equal(other[6], values), name
+    for name, value in attributes_1.items():
+        key = name.rsplit("@", 1)[1]
+        if key in RUN_RECORD or key.startswith(("wall_time", "residual", "iterations")):
+            continue
+        other = attributes_p[name]
+        if isinstance(value, (bytes, str)):
+            assert other == value, name
+            continue
+        a, b = np.asarray(value, float), np.asarray(other, float)
+        close = SAME
+        if key.startswith("k_eff"):
+            # (the leakage's CG with hypre's distributed BoomerAMG: each run stops within
+            # leakage_tol of the exact k_eff, above it; tests/test_mpi_observables.py)
+            close = 10 * float(attributes_1[name.rsplit("@", 1)[0] + "@tol"])
+        assert np.all(np.abs(a - b) <= close * np.abs(a) + VANISHING), name
+
+
+#: the observables on the slabs: surface stress, conductance and stiffness, gap histogram
+OBSERVABLES = "stress = .true., conductance = .true., gap_bins = 24"
+
+
 @needs_mpi
 @pytest.mark.parametrize("scene", sorted(SCENES))
-def test_distributed_runs_give_the_serial_answer(scene, tmp_path):
-    """P = 1..4 ranks: every field and scalar of the serial run, and @mpi_ranks = P."""
-    nml = write_scene(tmp_path, scene, SIZES[scene], SCENES[scene], "serial.h5")
+def test_distributed_files_are_the_serial_file(scene, tmp_path):
+    """P = 1..4 ranks, the observables on (stress, conductance, stiffness, gap histogram):
+    the whole result file is the serial run's, and @mpi_ranks = P."""
+    nml = write_scene(tmp_path / "serial", "scene", SIZES[scene], SCENES[scene], "result.h5", OBSERVABLES)
     done = run_serial(nml)
     assert done.returncode == 0, done.stderr
     for ranks in (1, 2, 3, 4):
-        out = f"ranks{ranks}.h5"
-        nml_p = write_scene(tmp_path, f"{scene}{ranks}", SIZES[scene], SCENES[scene], out)
-        done = run_mpi(ranks, [executable(), str(nml_p)], tmp_path)
+        directory = tmp_path / f"ranks{ranks}"
+        write_scene(directory, "scene", SIZES[scene], SCENES[scene], "result.h5", OBSERVABLES)
+        done = run_mpi(ranks, [executable(), "scene.nml"], directory)
         assert done.returncode == 0, done.stderr
-        assert_same(tmp_path / "serial.h5", tmp_path / out)
-        with h5py.File(tmp_path / out, "r") as f:
+        assert_same_file(nml.parent / "result.h5", directory / "result.h5")
+        with h5py.File(directory / "result.h5", "r") as f:
             assert int(f.attrs["mpi_ranks"]) == ranks
             assert int(f["results"].attrs["mpi_ranks"]) == ranks
+            assert f["results"].attrs["conductance"] > 0 and f["results"].attrs["contact_stiffness"] > 0
+            assert "stress_xy" in f["fields"] and "counts" in f["gap_histogram"]
+            if ranks > 1:
+                assert "distributed runs use gcr/cg" in f["results"].attrs["solver_reason"].decode()
         # one summary, from rank 0
         assert done.stdout.count("result file") == 1
 
@@ -276,30 +351,27 @@ def test_rows_move_between_slab_layouts(ranks, redistribute_program):
 
 
 @needs_mpi
-def test_observables_of_the_whole_map_on_rank_0(tmp_path):
-    """Surface stress, conductance and stiffness need the whole map: rank 0 computes them
-    from the gathered fields, the serial run's values (stress fields too). The leakage is
-    computed on the slabs by hypre's distributed BoomerAMG, which takes other CG iterations:
-    its k_eff agrees to the leakage tolerance (tests/test_mpi_observables.py), its counts
-    exactly."""
+def test_companion_patches_and_leakage(tmp_path):
+    """The frictionless companion, the contact patches and the leakage (both on the slabs:
+    tests/test_mpi_observables.py): the serial run's file, on 2 and 3 ranks."""
     body = SCENES["coupled"].replace("coefficient = 0.5", "coefficient = 0.5, companion = .true.")
-    for name, out in (("serial", "serial.h5"), ("ranks", "ranks2.h5")):
-        nml = write_scene(tmp_path, name, 64, body, out)
-        nml.write_text(nml.read_text().replace("stress = .false.", "stress = .true., leakage = .true., "
-                                                "conductance = .true."))
-    assert run_serial(tmp_path / "serial.nml").returncode == 0
-    done = run_mpi(2, [executable(), str(tmp_path / "ranks.nml")], tmp_path)
-    assert done.returncode == 0, done.stderr
-    assert_same(tmp_path / "serial.h5", tmp_path / "ranks2.h5")
-    with h5py.File(tmp_path / "ranks2.h5", "r") as f, h5py.File(tmp_path / "serial.h5", "r") as g:
-        assert f["results"].attrs["conductance"] > 0 and f["results"].attrs["contact_stiffness"] > 0
-        assert any("stress" in name for name in f["fields"])
-        for name, value in g["leakage"].attrs.items():
-            # (its time, and its CG's residuals at the leakage tolerance, are not the answer)
-            if np.asarray(value).dtype.kind == "f" and not name.startswith(("wall_time", "residual")):
-                # (k_eff: each run within leakage_tol = 1e-6 of the exact value, above it)
-                close = 10 * g["leakage"].attrs["tol"] if name.startswith("k_eff") else SAME
-                assert np.all(np.abs(f["leakage"].attrs[name] - value) <= close * np.abs(value) + VANISHING), name
+    observables = OBSERVABLES + ", leakage = .true."
+    nml = write_scene(tmp_path / "serial", "scene", 64, body, "result.h5", observables)
+    assert run_serial(nml).returncode == 0
+    for ranks in (2, 3):
+        directory = tmp_path / f"ranks{ranks}"
+        write_scene(directory, "scene", 64, body, "result.h5", observables)
+        done = run_mpi(ranks, [executable(), "scene.nml"], directory)
+        assert done.returncode == 0, done.stderr
+        assert_same_file(nml.parent / "result.h5", directory / "result.h5")
+    with h5py.File(tmp_path / "ranks3" / "result.h5", "r") as f:
+        for group in ("", "companion/"):
+            # the patches cover the contact: their areas add up to the contact fraction of the
+            # cell (period 1 x 1; each node dx dy, exact but for the sum's rounding)
+            area = f[group + "patches/area"]
+            assert area.size == f[group + "results"].attrs["n_spots"] >= 1
+            assert abs(np.sum(area) - f[group + "results"].attrs["contact_fraction"]) <= 1e-12
+            assert f[group + "leakage"].attrs["fluid_fraction"] > 0
 
 
 @needs_mpi
@@ -365,3 +437,49 @@ def test_a_failure_on_one_rank_ends_the_job_with_its_code(tmp_path):
     assert done.returncode == 5, done.stderr
     assert "error on MPI rank 1 of 2" in done.stderr
     assert (tmp_path / "big.h5").read_bytes() == before
+
+
+@needs_mpi
+def test_height_files_by_slabs(tmp_path):
+    """A height file that is one period of the grid is read by slabs (each rank its rows of
+    the HDF5 dataset, or of a .npy file that rank 0 reads and scatters) and detrended on the
+    slabs: a self-affine surface plus a tilt, detrend = 'plane', gives the serial run's file
+    on 2 and 3 ranks. Kept tilted (detrend = 'none') it is not periodic: the warning that
+    says so, computed over the slabs (the tilt is along y: its edges are the first and last
+    rows, on the first and last ranks), is printed once, with the serial run's jump and
+    kink."""
+    source = write_scene(tmp_path / "source", "scene", 64, SCENES["coupled"], "result.h5")
+    assert run_serial(source).returncode == 0
+    with h5py.File(source.parent / "result.h5", "r") as f:
+        surface = np.asarray(f["profile/height"]).reshape(64, 64)
+    # a rise of 4 rms heights over the cell along y: the tilted surface's heights jump by 2.6
+    # of its rms heights across the edges (the warning's limit: 2)
+    tilted = surface + 4 * surface.std() * np.arange(64)[:, None] / 64
+    for name in ("heights.h5", "heights.npy"):
+        for detrend in ("plane", "none"):
+            profile = f"&profile kind = 'file', file = '../{name}', dataset = 'h', detrend = '{detrend}' /\n"
+            runs = {"serial": 1, "ranks2": 2, "ranks3": 3}
+            for directory, ranks in runs.items():
+                nml = write_scene(tmp_path / detrend / name / directory, "scene", 64, SCENES["coupled"],
+                                  "result.h5", profile=profile)
+                target = nml.parent.parent / name
+                if name.endswith(".h5"):
+                    with h5py.File(target, "w") as f:
+                        f["h"] = tilted
+                else:
+                    np.save(target, tilted)
+                if ranks == 1:
+                    done = run_serial(nml)
+                else:
+                    done = run_mpi(ranks, [executable(), "scene.nml"], nml.parent)
+                assert done.returncode == 0, done.stderr
+                # (detrended by the plane the surface is periodic again: no warning)
+                warnings = [line for line in done.stderr.splitlines() if "is taken as one period" in line]
+                assert len(warnings) == (1 if detrend == "none" else 0), done.stderr
+                # (the same jump and kink, as printed: 2 decimals and 3 digits)
+                if ranks == 1:
+                    serial_warnings = warnings
+                assert warnings == serial_warnings
+            for directory in ("ranks2", "ranks3"):
+                assert_same_file(tmp_path / detrend / name / "serial" / "result.h5",
+                                 tmp_path / detrend / name / directory / "result.h5")

@@ -15,15 +15,18 @@ module lc_application_run
    use lc_leakage_reynolds, only: leakage_memory_check
    use lc_result, only: contact_result
    use lc_io_namelist, only: read_scene
-   use lc_io_hdf5, only: check_output, write_results, run_record, utc_now
+   use lc_io_hdf5, only: check_output, run_record, utc_now
+   use lc_application_result_file, only: write_result_file
    use lc_profiles_profile, only: make_profile, make_profile_slab
-   use lc_profiles_measured, only: measured_grid, periodicity_mismatch, edge_jump_limit, edge_kink_limit
+   use lc_profiles_measured, only: measured_grid, periodicity_mismatch, edge_jump_limit, edge_kink_limit, &
+      & slab_periodicity_mismatch
    use lc_application_scene_solve, only: solve_runs
+   use lc_profiles_measured_slab, only: reads_by_slab, measured_slab_grid
    use lc_greens_viscoelastic, only: is_viscoelastic
    use lc_application_accuracy, only: choose_resolution
    use lc_base_version, only: version_string, build_isa
    use lc_base_parallel, only: parallel_start, parallel_end, is_distributed, is_root, rank_count, this_rank, &
-      & check_rank_count, barrier, abort_job, gather_rows, global_any, slab
+      & check_rank_count, barrier, abort_job, global_any, global_max, slab
    implicit none (type, external)
    private
    public :: run_scene_file
@@ -35,12 +38,14 @@ contains
    !>
    !> Under an MPI launcher with several ranks (docs/clusters.md, "One surface on several
    !> ranks") an areal scene is solved distributed: each rank reads the namelist and makes
-   !> the profile, keeps its slab of rows, and rank 0 writes the result file and the
-   !> summary from the gathered fields. `communicator`: the Fortran handle of the ranks to
-   !> share the scene among (a Python caller's mpi4py communicator), else the launcher's
-   !> job. Input refused on every rank returns its error there; a failure on some rank only
-   !> (memory, I/O) ends the whole job (MPI_Abort) with its exit code, since the other ranks
-   !> would wait for it. `root`: this process is the one that reports (rank 0 of the ranks).
+   !> its slab of the profile, solves and computes the observables on the slabs, all write
+   !> the result file together (each its rows), and rank 0 prints the summary.
+   !> `communicator`: the Fortran handle of the ranks to share the scene among (a Python
+   !> caller's mpi4py communicator), else the launcher's job. Input refused on every rank,
+   !> and a failure of the file's writing (which every rank learns), return their error
+   !> there; a failure on some rank only (memory) ends the whole job (MPI_Abort) with its
+   !> exit code, since the other ranks would wait for it. `root`: this process is the one
+   !> that reports (rank 0 of the ranks).
    subroutine run_scene_file(input, unit, output_file, converged, error, communicator, root)
       character(len=*), intent(in) :: input
       integer, intent(in) :: unit
@@ -49,6 +54,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: communicator
       logical, intent(out), optional :: root
+      logical :: agreed
       converged = .false.
       call parallel_start(error, communicator)
       if (present(root)) root = is_root()
@@ -56,38 +62,41 @@ contains
          call parallel_end()
          return
       end if
-      call run_scene(input, merge(unit, -1, is_root()), output_file, converged, error)
+      call run_scene(input, merge(unit, -1, is_root()), output_file, converged, agreed, error)
       if (is_distributed()) then
          if (allocated(error)) then
-            if (error%code /= code_input) then
+            if (error%code /= code_input .and. .not. agreed) then
                write (error_unit, '(a)') 'layercontact: error on MPI rank ' // to_string(this_rank()) // ' of ' // &
                   & to_string(rank_count()) // ': ' // error%message
                call abort_job(error%code)
             end if
          else
-            ! (every rank returns once rank 0 wrote the result file)
+            ! (every rank returns once the result file is in place)
             call barrier()
          end if
       end if
       call parallel_end()
    end subroutine run_scene_file
 
-   !> run_scene_file on this rank.
-   subroutine run_scene(input, unit, output_file, converged, error)
+   !> run_scene_file on this rank; `agreed`: the error is every rank's alike (the result
+   !> file's writing).
+   subroutine run_scene(input, unit, output_file, converged, agreed, error)
       character(len=*), intent(in) :: input
       integer, intent(in) :: unit
       character(len=:), allocatable, intent(out) :: output_file
-      logical, intent(out) :: converged
+      logical, intent(out) :: converged, agreed
       type(error_type), allocatable, intent(out) :: error
       type(scene_type) :: scene
       type(contact_result) :: result, companion
       character(len=:), allocatable :: text
-      real(wp), allocatable :: height(:), local_height(:)
+      real(wp), allocatable :: height(:)
       type(run_record) :: run
       integer(i8) :: start, finish, rate
       integer :: y_start, rows
+      real(wp) :: slope
 
       converged = .false.
+      agreed = .false.
       call system_clock(start, rate)
       run%input_file = input
       run%started = utc_now()
@@ -98,8 +107,14 @@ contains
       output_file = trim(scene%output_file)
       ! without &scene n (nx, ny) a profile file sets the grid: its own size
       if (trim(scene%profile%kind) == 'file' .and. .not. scene%grid_given) then
-         call measured_grid(trim(scene%profile%file), trim(scene%profile%dataset), is_areal(scene), &
-            & scene%profile%boundary, scene%n, scene%ny, error)
+         if (is_distributed() .and. is_areal(scene) .and. reads_by_slab(scene%profile%boundary, &
+            & scene%profile%resample)) then
+            ! (by slabs: no rank reads the whole file)
+            call measured_slab_grid(trim(scene%profile%file), trim(scene%profile%dataset), scene%n, scene%ny, error)
+         else
+            call measured_grid(trim(scene%profile%file), trim(scene%profile%dataset), is_areal(scene), &
+               & scene%profile%boundary, scene%n, scene%ny, error)
+         end if
          if (allocated(error)) return
          call check_scene(scene, error)
          if (allocated(error)) then
@@ -121,16 +136,15 @@ contains
       end if
       if (is_distributed()) then
          ! each rank makes its slab (a self-affine surface by the distributed c2r: its
-         ! phases are seeded by mode); rank 0 gathers the whole one for the result file
-         call make_profile_slab(scene, local_height, error)
+         ! phases are seeded by mode; a height file read by slabs)
+         call make_profile_slab(scene, height, error)
          if (global_failure(error)) return
-         call gather_rows(local_height, scene%n, scene%ny, height)
       else
          allocate (height(scene%n*scene%ny))
          call make_profile(scene, height, error)
          if (allocated(error)) return
       end if
-      if (unit >= 0) call warn_if_not_periodic(scene, height)
+      call warn_if_not_periodic(scene, height, unit >= 0)
       ! bad input in the profile (a file's content) is found before anything is created
       call check_output(output_file, scene%overwrite, error)
       if (allocated(error)) return
@@ -144,28 +158,27 @@ contains
             & merge(2, 1, scene%companion)*merge(10, 4, scene%stress), error)
          if (allocated(error)) return
       end if
-      if (is_distributed()) then
-         call solve_runs(scene, local_height, result, companion, error)
-      else
-         call solve_runs(scene, height, result, companion, error)
-      end if
+      call solve_runs(scene, height, result, companion, error)
       if (allocated(error)) return
       converged = result%converged
       if (scene%companion) converged = converged .and. companion%converged
-      if (.not. is_root()) return
       call system_clock(finish)
       run%seconds = real(finish - start, wp)/real(rate, wp)
       if (scene%companion) then
-         call write_results(output_file, scene, text, height, result, companion, version_string, error, run)
+         call write_result_file(output_file, scene, text, height, result, version_string, run, error, companion)
       else
-         call write_results(output_file, scene, text, height, result, version=version_string, error=error, run=run)
+         call write_result_file(output_file, scene, text, height, result, version_string, run, error)
       end if
+      agreed = allocated(error)
       if (allocated(error)) return
+      ! (x-differences lie inside a row: each rank its rows, the largest over the ranks)
+      slope = largest_slope(result%displacement_z, scene)
+      if (is_distributed()) slope = global_max(slope)
       if (unit >= 0) then
          if (scene%companion) then
-            call print_summary(unit, input, output_file, scene, result, companion)
+            call print_summary(unit, input, output_file, scene, result, slope, companion)
          else
-            call print_summary(unit, input, output_file, scene, result)
+            call print_summary(unit, input, output_file, scene, result, slope)
          end if
       end if
    end subroutine run_scene
@@ -196,14 +209,22 @@ contains
    !> A height file taken as one period (&profile boundary = 'periodic') whose heights jump
    !> or kink across the cell's edges is most likely a tilted or non-periodic measurement,
    !> which the solve would take as a periodic surface with a step (or kink) at each edge:
-   !> a warning on standard error says so and what to set (limits: docs/decisions/019).
-   subroutine warn_if_not_periodic(scene, height)
+   !> a warning on standard error says so and what to set (limits: docs/decisions/019), if
+   !> `speak`. A surface shared among MPI ranks (`height`: this rank's slab) is measured by
+   !> all of them together.
+   subroutine warn_if_not_periodic(scene, height, speak)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in) :: height(:)
+      logical, intent(in) :: speak
       real(wp) :: jump, kink
       if (trim(scene%profile%kind) /= 'file' .or. trim(scene%profile%boundary) /= 'periodic') return
-      call periodicity_mismatch(reshape(height, [scene%n, max(scene%ny, 1)]), jump, kink)
-      if (jump <= edge_jump_limit .and. kink <= edge_kink_limit) return
+      if (is_distributed() .and. is_areal(scene)) then
+         call slab_periodicity_mismatch(height, scene%n, scene%ny, jump, kink)
+      else
+         if (.not. speak) return
+         call periodicity_mismatch(reshape(height, [scene%n, max(scene%ny, 1)]), jump, kink)
+      end if
+      if (.not. speak .or. (jump <= edge_jump_limit .and. kink <= edge_kink_limit)) return
       write (error_unit, '(a, f0.2, a, es9.2, a)') "layercontact: warning: &profile: file = '" // &
          & trim(scene%profile%file) // "' is taken as one period (boundary = 'periodic'), but its heights jump by ", &
          & jump, ' rms heights across the edges of the cell and their slopes differ there by ', kink, &
@@ -224,25 +245,28 @@ contains
          & '; allowed: a regular file', code_input)
    end subroutine check_input_file
 
-   !> The largest |dw/dx| of the surface displacement along the sliding direction.
+   !> The largest |dw/dx| of the surface displacement along the sliding direction (of the
+   !> rows `w` holds: all of them, or a rank's slab).
    pure real(wp) function largest_slope(w, scene) result(slope)
       real(wp), intent(in) :: w(:)
       type(scene_type), intent(in) :: scene
       integer :: nx, ny
       nx = scene%n
-      ny = max(scene%ny, 1)
+      ny = size(w)/max(nx, 1)
       slope = 0.0_wp
-      if (nx < 2 .or. size(w) /= nx*ny) return
+      if (nx < 2 .or. ny < 1 .or. size(w) /= nx*ny) return
       associate (rows => reshape(w, [nx, ny]))
          slope = maxval(abs(rows(2:, :) - rows(:nx - 1, :)))*nx/scene%period
       end associate
    end function largest_slope
 
-   subroutine print_summary(unit, input, output_file, scene, result, companion)
+   !> The summary of the run; `slope`: the largest |dw/dx| of the whole surface (largest_slope).
+   subroutine print_summary(unit, input, output_file, scene, result, slope, companion)
       integer, intent(in) :: unit
       character(len=*), intent(in) :: input, output_file
       type(scene_type), intent(in) :: scene
       type(contact_result), intent(in) :: result
+      real(wp), intent(in) :: slope
       type(contact_result), intent(in), optional :: companion
       character(len=*), parameter :: real_fmt = '(2x, a, t34, es14.6, 1x, a)'
       character(len=*), parameter :: int_fmt = '(2x, a, t34, i14, 1x, a)'
@@ -287,7 +311,7 @@ contains
          & ': the pressure''s variation is lost in the rounding of p_m (not converged)'
       ! Delta mu = <p w'>/p_m carries the rounding of w' (a frictionless elastic scene's is
       ! zero exactly): below that it is printed as zero (the result file keeps the value)
-      resolution = 64*epsilon(1.0_wp)*largest_slope(result%displacement_z, scene)
+      resolution = 64*epsilon(1.0_wp)*slope
       if (abs(result%delta_mu) > resolution) then
          write (unit, real_fmt) 'interlocking friction Delta mu', result%delta_mu
          write (unit, real_fmt) 'total friction mu_c + Delta mu', result%friction + result%delta_mu

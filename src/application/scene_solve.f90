@@ -5,18 +5,16 @@
 !> executable's run, the Python driver and the resolution pilot all solve through it.
 module lc_application_scene_solve
    use lc_base_kinds, only: wp
-   use lc_base_errors, only: error_type
-   use lc_scene, only: scene_type, grid_of, companion_of, kernel_of
-   use lc_base_parallel, only: is_distributed, is_root, gather_rows
-   use lc_base_threads, only: active_threads
+   use lc_base_errors, only: error_type, fatal_error
+   use lc_scene, only: scene_type, grid_of, companion_of
+   use lc_base_parallel, only: is_distributed
    use lc_base_grid, only: grid_type
    use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
    use lc_leakage_reynolds_slabs, only: reynolds_leakage_slab
    use lc_result, only: contact_result
-   use lc_contact_operator, only: compliance_operator, build_operator
+   use lc_contact_operator, only: compliance_operator
    use lc_contact_solve, only: solve_contact
    use lc_observables, only: observe
-   use lc_observables_patches, only: contact_patches_slab
    use lc_observables_conductance, only: contact_conductance, contact_stiffness, masked_outcome
    implicit none (type, external)
    private
@@ -27,10 +25,9 @@ contains
    !> Solve `scene` on the profile `height` (flat, x fastest) with Coulomb coefficient
    !> `friction` (the scene's, or 0 for the frictionless companion) and compute its
    !> observables (with &output conductance, the conductance and stiffness too). A surface
-   !> shared among MPI ranks (`height`: this rank's slab) is solved distributed; its patches
-   !> and leakage are computed on the slabs, then its fields are gathered to rank 0, which
-   !> computes the other observables from the whole maps (the other ranks' results keep the
-   !> scalars of the solve, the patches and the leakage, and no fields).
+   !> shared among MPI ranks (`height`: this rank's slab) is solved distributed and its
+   !> observables computed on the slabs (lc_observables): every rank's result holds its rows
+   !> of the fields and the scalars of the whole grid.
    subroutine solve_scene(scene, height, friction, result, error)
       type(scene_type), intent(in) :: scene
       real(wp), intent(in), target :: height(:)
@@ -38,66 +35,12 @@ contains
       type(contact_result), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       type(compliance_operator), allocatable, target :: op
-      type(grid_type) :: grid
       allocate (op)
       call solve_contact(scene, height, friction, result, op, error)
       if (allocated(error)) return
-      if (op%distributed) then
-         ! (the slab's operator is freed before rank 0 holds the whole fields)
-         grid = op%grid
-         deallocate (op)
-         call observe_on_slabs(scene, grid, result, error)
-         if (allocated(error)) return
-         call observe_gathered(scene, height, friction, grid, result, error)
-         return
-      end if
       call observe(scene, op, height, result)
       if (scene%conductance) call conductance_of(scene, op, result, error)
    end subroutine solve_scene
-
-   !> What a distributed solve computes on its slabs, every rank its own, before the fields
-   !> are gathered: the contact patches and, with &output leakage, the Reynolds leakage,
-   !> each rank holding the whole result (lc_observables_patches, lc_leakage_reynolds_slabs).
-   subroutine observe_on_slabs(scene, grid, result, error)
-      type(scene_type), intent(in) :: scene
-      type(grid_type), intent(in) :: grid
-      type(contact_result), intent(inout) :: result
-      type(error_type), allocatable, intent(out) :: error
-      call contact_patches_slab(grid, result%pressure, result%patch_area, result%patch_perimeter)
-      result%n_spots = size(result%patch_area)
-      if (.not. scene%leakage) return
-      allocate (result%leakage)
-      call reynolds_leakage_slab(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
-         & scene%leakage_tol, leakage_max_iter, result%leakage, error)
-   end subroutine observe_on_slabs
-
-   !> The fields of a distributed solve gathered to rank 0, and there the observables (and
-   !> the conductance) on the whole grid, with a serial operator of the scene.
-   subroutine observe_gathered(scene, height, friction, grid, result, error)
-      type(scene_type), intent(in) :: scene
-      real(wp), intent(in) :: height(:), friction
-      type(grid_type), intent(in) :: grid
-      type(contact_result), intent(inout) :: result
-      type(error_type), allocatable, intent(out) :: error
-      type(compliance_operator), target :: whole
-      real(wp), allocatable, target :: whole_height(:)
-      real(wp), allocatable :: field(:)
-      real(wp) :: uniform
-      call gather_rows(result%pressure, grid%nx, grid%ny, field)
-      call move_alloc(field, result%pressure)
-      call gather_rows(result%gap, grid%nx, grid%ny, field)
-      call move_alloc(field, result%gap)
-      call gather_rows(result%displacement_z, grid%nx, grid%ny, field)
-      call move_alloc(field, result%displacement_z)
-      call gather_rows(height, grid%nx, grid%ny, whole_height)
-      if (.not. is_root()) return
-      call build_operator(whole, grid, kernel_of(scene), friction, active_threads(), error)
-      if (allocated(error)) return
-      ! (the operator the observables see, as the serial solve leaves it)
-      if (trim(scene%control) == 'load') call whole%drop_uniform_mode(uniform)
-      call observe(scene, whole, whole_height, result)
-      if (scene%conductance) call conductance_of(scene, whole, result, error)
-   end subroutine observe_gathered
 
    !> The conductance and the normal interfacial stiffness at the solved contact set (p > 0),
    !> each to the scene's tolerance and within its budget of iterations.
@@ -111,7 +54,7 @@ contains
       real(wp) :: per_conductivity
       contact = result%pressure > 0.0_wp
       call contact_conductance(op%grid, contact, scene%thickness, scene%solver%tol, scene%solver%max_iter, &
-         & scene%solver%threads, per_conductivity, conduction, error)
+         & scene%solver%threads, per_conductivity, conduction, error, op%distributed)
       if (allocated(error)) return
       result%conductance = scene%conductivity*per_conductivity
       call contact_stiffness(op, contact, scene%solver%tol, scene%solver%max_iter, result%contact_stiffness, stiffness)
@@ -133,15 +76,14 @@ contains
       type(error_type), allocatable, intent(out) :: error
       call solve_scene(scene, height, scene%friction, result, error)
       if (allocated(error)) return
-      ! (a distributed solve has computed it on its slabs: observe_on_slabs)
-      if (scene%leakage .and. .not. is_distributed()) then
+      if (scene%leakage) then
          call leakage_of(scene, result, error)
          if (allocated(error)) return
       end if
       if (.not. scene%companion) return
       call solve_scene(companion_of(scene, result%mean_pressure), height, 0.0_wp, companion, error)
       if (allocated(error)) return
-      if (scene%leakage .and. .not. is_distributed()) call leakage_of(scene, companion, error)
+      if (scene%leakage) call leakage_of(scene, companion, error)
    end subroutine solve_runs
 
    !> The Reynolds leakage of the solved gap along x and y; contact is where p > 0 (and gaps
@@ -153,6 +95,12 @@ contains
       type(grid_type) :: grid
       grid = grid_of(scene)
       allocate (result%leakage)
+      if (is_distributed() .and. .not. grid%is_line()) then
+         ! (on the slabs, every rank getting the whole answer: lc_leakage_reynolds_slabs)
+         call reynolds_leakage_slab(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
+            & scene%leakage_tol, leakage_max_iter, result%leakage, error)
+         return
+      end if
       call reynolds_leakage(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
          & scene%leakage_tol, leakage_max_iter, result%leakage, error)
    end subroutine leakage_of

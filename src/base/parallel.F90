@@ -26,6 +26,7 @@ module lc_base_parallel
    public :: largest_rank_count, global_sum, global_max, sum_over_ranks, max_over_ranks, global_any
    public :: gather_rows, allgather_rows, scatter_rows, redistribute_rows
    public :: broadcast, abort_job, mpi_available, barrier
+   public :: broadcast_from, sum_counts_over_ranks, global_maxloc, shifted_rows
 #ifdef LC_MPI
    public :: communicator
 #endif
@@ -34,6 +35,10 @@ module lc_base_parallel
 #ifdef LC_MPI
    type(MPI_Comm) :: communicator
 #endif
+
+   interface broadcast_from
+      module procedure broadcast_scalar_from, broadcast_array_from
+   end interface broadcast_from
 
    interface global_sum
       module procedure global_sum_scalar, global_sum_integer
@@ -233,6 +238,122 @@ contains
       if (.false.) x = x
 #endif
    end subroutine broadcast
+
+   !> x from rank `owner` on every rank.
+   subroutine broadcast_scalar_from(x, owner)
+      real(wp), intent(inout) :: x
+      integer, intent(in) :: owner
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Bcast(x, 1, MPI_DOUBLE_PRECISION, owner, communicator)
+#else
+      if (.false. .and. owner > 0) x = x
+#endif
+   end subroutine broadcast_scalar_from
+
+   !> x(:) from rank `owner` on every rank (every rank's x of the same size).
+   subroutine broadcast_array_from(x, owner)
+      real(wp), contiguous, intent(inout) :: x(:)
+      integer, intent(in) :: owner
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Bcast(x, size(x), MPI_DOUBLE_PRECISION, owner, communicator)
+#else
+      if (.false. .and. owner > 0) x = x
+#endif
+   end subroutine broadcast_array_from
+
+   !> counts <- their sum over the ranks, element by element.
+   subroutine sum_counts_over_ranks(counts)
+      integer, contiguous, intent(inout) :: counts(:)
+#ifdef LC_MPI
+      if (ranks > 1) call MPI_Allreduce(MPI_IN_PLACE, counts, size(counts), MPI_INTEGER, MPI_SUM, communicator)
+#else
+      if (.false.) counts = counts
+#endif
+   end subroutine sum_counts_over_ranks
+
+   !> The largest of the slabs' values over the ranks, the rank holding it and its index in
+   !> that rank's slab (ties: the first in the whole field's order, as maxloc takes it on one
+   !> process; the slabs follow each other in rank order).
+   subroutine global_maxloc(values, largest, owner, position)
+      real(wp), intent(in) :: values(:)
+      real(wp), intent(out) :: largest
+      integer, intent(out) :: owner, position
+      real(wp) :: first_owner
+      position = maxloc(values, dim=1)
+      largest = values(position)
+      owner = rank
+      if (ranks == 1) return
+      largest = global_max(largest)
+      ! (the lowest rank holding the largest value: the first of them in the field's order)
+      first_owner = -real(ranks, wp)
+      if (values(position) == largest) first_owner = -real(rank, wp)
+      owner = nint(-global_max(first_owner))
+   end subroutine global_maxloc
+
+   !> The field (nx x ny) shifted periodically by `shift` rows, this rank's slab of it:
+   !> shifted's row j is the field's row j + shift (mod ny), `local` this rank's slab. Each
+   !> rank sends every other the rows of its slab that the other's shifted slab holds (one
+   !> MPI_Alltoallv; a slab needs rows of at most two ranks when |shift| is below a block).
+   subroutine shifted_rows(local, nx, ny, shift, shifted)
+      real(wp), contiguous, intent(in) :: local(:)
+      integer, intent(in) :: nx, ny, shift
+      real(wp), allocatable, intent(out) :: shifted(:)
+      integer :: y_start, rows, row
+#ifdef LC_MPI
+      integer :: send_counts(0:ranks - 1), send_offsets(0:ranks - 1), receive_counts(0:ranks - 1), &
+         & receive_offsets(0:ranks - 1), r, first, count_rows
+      if (ranks > 1) then
+         call slab(ny, y_start, rows)
+         allocate (shifted(nx*rows))
+         ! what rank r's shifted slab takes from mine, and what mine takes from rank r
+         do r = 0, ranks - 1
+            call overlap(r, rank, first, count_rows)
+            send_counts(r) = nx*count_rows
+            send_offsets(r) = nx*first
+            call overlap(rank, r, first, count_rows)
+            receive_counts(r) = nx*count_rows
+            receive_offsets(r) = nx*modulo(first + (r*block_of(ny) - y_start) - shift, ny)
+         end do
+         call MPI_Alltoallv(local, send_counts, send_offsets, MPI_DOUBLE_PRECISION, shifted, receive_counts, &
+            & receive_offsets, MPI_DOUBLE_PRECISION, communicator)
+         return
+      end if
+#endif
+      call slab(ny, y_start, rows)
+      allocate (shifted(nx*rows))
+      do row = 0, rows - 1
+         shifted(row*nx + 1:(row + 1)*nx) = local(modulo(row + shift, ny)*nx + 1:(modulo(row + shift, ny) + 1)*nx)
+      end do
+#ifdef LC_MPI
+
+   contains
+
+      !> The rows of `source`'s slab that `target`'s shifted slab holds: the first (0-based,
+      !> in the source's slab) and how many (one run: the ranks' rows are one period).
+      subroutine overlap(target, source, first, count_rows)
+         integer, intent(in) :: target, source
+         integer, intent(out) :: first, count_rows
+         integer :: target_start, target_rows, source_start, source_rows, k, g
+         call slab_rows(ny, ranks, target, target_start, target_rows)
+         call slab_rows(ny, ranks, source, source_start, source_rows)
+         first = -1
+         count_rows = 0
+         do k = 0, target_rows - 1
+            g = modulo(target_start + k + shift, ny)
+            if (g < source_start .or. g >= source_start + source_rows) cycle
+            if (first < 0) first = g - source_start
+            count_rows = count_rows + 1
+         end do
+         first = max(first, 0)
+      end subroutine overlap
+#endif
+   end subroutine shifted_rows
+
+   !> The rows of a block of ny rows among the job's ranks (lc_base_slab).
+   pure integer function block_of(ny)
+      integer, intent(in) :: ny
+      block_of = (ny + ranks - 1)/ranks
+   end function block_of
 
    !> The counts and offsets (in values) of every rank's slab of a field of nx x ny.
    subroutine slab_counts(nx, ny, counts, offsets)

@@ -20,6 +20,11 @@
 !>
 !> On a half-space G = (2/E*)/q and G_c = (1/sigma)/q: C = (2 sigma/E*) K (Barber's analogy,
 !> J. R. Barber, "Bounds on the electrical resistance between contacting elastic rough bodies").
+!>
+!> On a surface shared among MPI ranks (a distributed operator, or `distributed` for the
+!> conductance) the contact set is this rank's slab: the transforms are the distributed
+!> plans', the multipliers on this rank's columns of the spectrum, and every dot product,
+!> norm and mean a sum over the ranks, as in the contact solver's conjugate gradients.
 module lc_observables_conductance
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_positive_inf, ieee_is_finite
    use lc_base_kinds, only: wp
@@ -27,6 +32,7 @@ module lc_observables_conductance
    use lc_base_strings, only: to_string
    use lc_base_grid, only: grid_type
    use lc_fft_plans, only: fft_plan
+   use lc_base_parallel, only: global_sum, global_any, slab
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private
@@ -48,10 +54,15 @@ module lc_observables_conductance
    !> z = P_A B r, on the values at the points of A only (a field vanishing off A; the vector
    !> operations then cost a pass over A, not over the grid).
    type, abstract :: masked_system
-      integer, allocatable :: contact(:)   !< the points of A (flat indices of the grid)
-      integer :: n = 0                     !< grid points
+      integer, allocatable :: contact(:)   !< the points of A (flat indices of the grid, or of this rank's slab)
+      integer :: n = 0                     !< grid points (of the whole grid)
       integer :: fft_pairs = 0
+      !> the points are this rank's of a surface shared among MPI ranks: sums over the ranks
+      logical :: distributed = .false.
    contains
+      procedure :: dot => masked_dot
+      procedure :: norm => masked_norm
+      procedure :: total => masked_total
       procedure(masked_map), deferred :: apply
       procedure(masked_map), deferred :: precondition
    end type masked_system
@@ -92,28 +103,56 @@ contains
       type(grid_type), intent(in) :: grid
       real(wp), intent(in) :: thickness
       real(wp), allocatable :: multiplier(:)
-      real(wp) :: qx, qy, q
       integer :: i
       allocate (multiplier(grid%modes()))
-      multiplier(1) = 0.0_wp
-      if (ieee_is_finite(thickness)) multiplier(1) = thickness
-      do i = 2, size(multiplier)
-         call grid%wavevector(i, qx, qy)
-         q = hypot(qx, qy)
-         if (ieee_is_finite(thickness)) then
-            multiplier(i) = tanh(q*thickness)/q
-         else
-            multiplier(i) = 1.0_wp/q
-         end if
+      do i = 1, size(multiplier)
+         multiplier(i) = conduction_of_mode(grid, i, thickness)
       end do
    end function conduction_multiplier
+
+   !> conduction_multiplier on the modes of the plan `fft` (a distributed plan: this rank's
+   !> columns of the spectrum).
+   function plan_multiplier(fft, grid, thickness) result(multiplier)
+      type(fft_plan), intent(in) :: fft
+      type(grid_type), intent(in) :: grid
+      real(wp), intent(in) :: thickness
+      real(wp), allocatable :: multiplier(:)
+      integer :: i, mx, my
+      allocate (multiplier(fft%nk))
+      do i = 1, fft%nk
+         call fft%mode_indices(i, mx, my)
+         multiplier(i) = conduction_of_mode(grid, my*grid%nkx() + mx + 1, thickness)
+      end do
+   end function plan_multiplier
+
+   !> sigma G_c (L) of the mode `index` of the half spectrum of `grid` (1: the uniform mode).
+   real(wp) function conduction_of_mode(grid, index, thickness) result(multiplier)
+      type(grid_type), intent(in) :: grid
+      integer, intent(in) :: index
+      real(wp), intent(in) :: thickness
+      real(wp) :: qx, qy, q
+      if (index == 1) then
+         multiplier = 0.0_wp
+         if (ieee_is_finite(thickness)) multiplier = thickness
+         return
+      end if
+      call grid%wavevector(index, qx, qy)
+      q = hypot(qx, qy)
+      if (ieee_is_finite(thickness)) then
+         multiplier = tanh(q*thickness)/q
+      else
+         multiplier = 1.0_wp/q
+      end if
+   end function conduction_of_mode
 
    !> The conductance per unit nominal area and per unit conductivity (1/L) of the contact
    !> set `contact` (flat, x fastest) on `grid`, for a layer of `thickness` on a perfectly
    !> conducting base (+Inf: a half-space, constriction convention): C/sigma = mean(J) with
    !> sigma G_c J = 1 on the contact set, to a relative tol (masked_cg), within max_iter
-   !> iterations.
-   subroutine contact_conductance(grid, contact, thickness, tol, max_iter, threads, conductance, outcome, error)
+   !> iterations. `distributed`: the surface is shared among the job's MPI ranks (if there
+   !> are several) and `contact` is this rank's slab of rows.
+   subroutine contact_conductance(grid, contact, thickness, tol, max_iter, threads, conductance, outcome, error, &
+         & distributed)
       type(grid_type), intent(in) :: grid
       logical, intent(in) :: contact(:)
       real(wp), intent(in) :: thickness, tol
@@ -121,13 +160,22 @@ contains
       real(wp), intent(out) :: conductance
       type(masked_outcome), intent(out) :: outcome
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: distributed
       type(conduction_system) :: system
       real(wp), allocatable :: solution(:)
+      integer :: points, y_start, rows
 
       conductance = 0.0_wp
-      if (size(contact) /= grid%points()) then
+      system%distributed = .false.
+      if (present(distributed)) system%distributed = distributed .and. .not. grid%is_line()
+      points = grid%points()
+      if (system%distributed) then
+         call slab(grid%ny, y_start, rows)
+         points = grid%nx*rows
+      end if
+      if (size(contact) /= points) then
          call fatal_error(error, 'conductance: the contact map has ' // to_string(size(contact)) // &
-            & ' points; allowed: the grid''s ' // to_string(grid%points()), code_input)
+            & ' points; allowed: the grid''s ' // to_string(points), code_input)
          return
       end if
       if (.not. thickness > 0.0_wp) then
@@ -135,11 +183,13 @@ contains
             & ' is not allowed; allowed: > 0, or Inf for a half-space', code_input)
          return
       end if
-      if (trivial(contact, ieee_is_finite(thickness), thickness, conductance, outcome)) return
-      call system%fft%init(grid%nx, grid%ny, threads, error)
+      if (trivial(contact, system%distributed, ieee_is_finite(thickness), thickness, conductance, outcome)) return
+      call system%fft%init(grid%nx, grid%ny, threads, error, system%distributed)
       if (allocated(error)) return
-      call restrict(system, contact)
-      system%multiplier = conduction_multiplier(grid, thickness)/grid%points()
+      ! (a one-rank job has no distributed plan: its system is the serial one)
+      system%distributed = system%fft%distributed
+      call restrict(system, contact, grid%points())
+      system%multiplier = plan_multiplier(system%fft, grid, thickness)/grid%points()
       allocate (system%inverse(size(system%multiplier)))
       where (system%multiplier > 0.0_wp)
          system%inverse = 1.0_wp/(system%multiplier*real(grid%points(), wp)**2)
@@ -147,7 +197,7 @@ contains
          system%inverse = 0.0_wp
       end where
       call masked_cg(system, tol, max_iter, solution, outcome)
-      conductance = sum(solution)/system%n
+      conductance = system%total(solution)/system%n
       call system%fft%destroy()
    end subroutine contact_conductance
 
@@ -166,32 +216,40 @@ contains
       type(stiffness_system) :: system
       real(wp), allocatable :: solution(:)
       logical :: bounded
+      real(wp) :: uniform
 
       ! a uniform mode in the operator: full contact has the finite stiffness 1/G(0)
-      bounded = op%metric(1) + op%dropped_uniform > 0.0_wp
-      if (trivial(contact, bounded, op%metric(1) + op%dropped_uniform, stiffness, outcome)) return
+      ! (distributed: the rank holding the uniform mode has its multiplier)
+      uniform = 0.0_wp
+      if (op%holds_uniform .and. op%nk > 0) uniform = op%metric(1)
+      if (op%distributed) uniform = global_sum(uniform)
+      uniform = uniform + op%dropped_uniform
+      bounded = uniform > 0.0_wp
+      if (trivial(contact, op%distributed, bounded, uniform, stiffness, outcome)) return
       system%op => op
-      call restrict(system, contact)
+      system%distributed = op%distributed
+      call restrict(system, contact, op%grid%points())
       if (op%coupled) then
          call masked_bicgstab(system, tol, max_iter, solution, outcome)
       else
          call masked_cg(system, tol, max_iter, solution, outcome)
       end if
-      stiffness = sum(solution)/system%n
+      stiffness = system%total(solution)/system%n
    end subroutine contact_stiffness
 
    !> The answers without an iteration: no contact gives 0, full contact 1/uniform (or +Inf
    !> where the operator has no uniform mode). True if one of them applies.
-   logical function trivial(contact, bounded, uniform, value, outcome)
-      logical, intent(in) :: contact(:), bounded
+   !> (`distributed`: `contact` is this rank's part of the contact set.)
+   logical function trivial(contact, distributed, bounded, uniform, value, outcome)
+      logical, intent(in) :: contact(:), distributed, bounded
       real(wp), intent(in) :: uniform
       real(wp), intent(out) :: value
       type(masked_outcome), intent(inout) :: outcome
       trivial = .true.
       outcome%converged = .true.
       value = 0.0_wp
-      if (.not. any(contact)) return
-      if (all(contact)) then
+      if (.not. anywhere(any(contact))) return
+      if (.not. anywhere(.not. all(contact))) then
          if (bounded) then
             value = 1.0_wp/uniform
          else
@@ -201,6 +259,14 @@ contains
       end if
       trivial = .false.
       outcome%converged = .false.
+
+   contains
+
+      logical function anywhere(here)
+         logical, intent(in) :: here
+         anywhere = here
+         if (distributed) anywhere = global_any(here)
+      end function anywhere
    end function trivial
 
    !> Preconditioned conjugate gradients for the symmetric positive definite P_A A P_A x =
@@ -223,26 +289,26 @@ contains
       allocate (x(n), z(n), ad(n), r(n))
       x = 0.0_wp
       r = 1.0_wp
-      b_norm = norm2(r)
+      b_norm = system%norm(r)
       r_norm = b_norm
       call system%precondition(r, z)
       d = z
-      rz = dot_product(r, z)
+      rz = system%dot(r, z)
       energy = 0.0_wp
       recent = huge(1.0_wp)/error_delay   ! (no estimate before error_delay steps)
       do while (outcome%iterations < max_iter)
          call system%apply(d, ad)
-         alpha = rz/dot_product(d, ad)
+         alpha = rz/system%dot(d, ad)
          x = x + alpha*d
          r = r - alpha*ad
          outcome%iterations = outcome%iterations + 1
          energy = energy + alpha*rz
          recent(mod(outcome%iterations, error_delay)) = alpha*rz
-         r_norm = norm2(r)
+         r_norm = system%norm(r)
          outcome%converged = r_norm <= tol*b_norm .or. sum(recent) <= tol*energy
          if (outcome%converged) exit
          call system%precondition(r, z)
-         rz_next = dot_product(r, z)
+         rz_next = system%dot(r, z)
          d = z + (rz_next/rz)*d
          rz = rz_next
       end do
@@ -268,7 +334,7 @@ contains
       x = 0.0_wp
       r = 1.0_wp
       shadow = r
-      b_norm = norm2(r)
+      b_norm = system%norm(r)
       r_norm = b_norm
       allocate (p(n), v(n), s(n))
       p = 0.0_wp
@@ -277,7 +343,7 @@ contains
       alpha = 1.0_wp
       omega = 1.0_wp
       do while (outcome%iterations < max_iter)
-         rho_next = dot_product(shadow, r)
+         rho_next = system%dot(shadow, r)
          ! a breakdown (rho or omega at rounding): restart from the current iterate
          if (abs(rho_next) <= epsilon(1.0_wp)*b_norm*r_norm .or. omega == 0.0_wp) then
             call system%apply(x, v)
@@ -288,27 +354,27 @@ contains
             rho = 1.0_wp
             alpha = 1.0_wp
             omega = 1.0_wp
-            rho_next = dot_product(shadow, r)
+            rho_next = system%dot(shadow, r)
          end if
          p = r + (rho_next/rho)*(alpha/omega)*(p - omega*v)
          rho = rho_next
          call system%precondition(p, p_hat)
          call system%apply(p_hat, v)
-         alpha = rho/dot_product(shadow, v)
+         alpha = rho/system%dot(shadow, v)
          s = r - alpha*v
          outcome%iterations = outcome%iterations + 1
-         if (norm2(s) <= tol*b_norm) then
+         if (system%norm(s) <= tol*b_norm) then
             x = x + alpha*p_hat
             r = s
-            r_norm = norm2(r)
+            r_norm = system%norm(r)
             exit
          end if
          call system%precondition(s, s_hat)
          call system%apply(s_hat, t)
-         omega = dot_product(t, s)/dot_product(t, t)
+         omega = system%dot(t, s)/system%dot(t, t)
          x = x + alpha*p_hat + omega*s_hat
          r = s - omega*t
-         r_norm = norm2(r)
+         r_norm = system%norm(r)
          if (r_norm <= tol*b_norm) exit
       end do
       outcome%residual = r_norm/b_norm
@@ -358,7 +424,7 @@ contains
       field = 0.0_wp
       field(self%contact) = x
       call self%op%full_in_buffer()
-      y = field(self%contact) + self%op%dropped_uniform*sum(x)/self%n
+      y = field(self%contact) + self%op%dropped_uniform*self%total(x)/self%n
       self%fft_pairs = self%fft_pairs + 1
    end subroutine stiffness_apply
 
@@ -377,12 +443,41 @@ contains
       self%fft_pairs = self%fft_pairs + 1
    end subroutine stiffness_precondition
 
+   !> a.b over the contact set (over every rank's part of it, distributed).
+   real(wp) function masked_dot(self, a, b) result(dot)
+      class(masked_system), intent(in) :: self
+      real(wp), intent(in) :: a(:), b(:)
+      dot = dot_product(a, b)
+      if (self%distributed) dot = global_sum(dot)
+   end function masked_dot
+
+   !> |a| over the contact set.
+   real(wp) function masked_norm(self, a) result(norm)
+      class(masked_system), intent(in) :: self
+      real(wp), intent(in) :: a(:)
+      if (self%distributed) then
+         norm = sqrt(global_sum(dot_product(a, a)))
+      else
+         norm = norm2(a)
+      end if
+   end function masked_norm
+
+   !> The sum of a over the contact set.
+   real(wp) function masked_total(self, a) result(total)
+      class(masked_system), intent(in) :: self
+      real(wp), intent(in) :: a(:)
+      total = sum(a)
+      if (self%distributed) total = global_sum(total)
+   end function masked_total
+
    !> The points of the contact set `contact` (flat, x fastest) as the system's unknowns.
-   subroutine restrict(system, contact)
+   subroutine restrict(system, contact, points)
       class(masked_system), intent(inout) :: system
       logical, intent(in) :: contact(:)
+      !> the whole grid's points
+      integer, intent(in) :: points
       integer :: i
-      system%n = size(contact)
+      system%n = points
       system%contact = pack([(i, i = 1, size(contact))], contact)
    end subroutine restrict
 

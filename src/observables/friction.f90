@@ -11,9 +11,12 @@
 !>                    is refined (the spectral slope of w - r is not zero at contact nodes
 !>                    next to an edge), which makes it a per-run accuracy indicator.
 !> Comparing them checks the solver and the sign conventions (docs/theory.md).
-!> On a surface (lc_base_grid) the derivatives are along the sliding direction x.
+!> On a surface (lc_base_grid) the derivatives are along the sliding direction x. On a
+!> surface shared among MPI ranks (the operator's slab and its columns of the spectrum) each
+!> rank sums its modes and the sums are added over the ranks.
 module lc_observables_friction
    use lc_base_kinds, only: wp
+   use lc_base_parallel, only: global_sum, sum_over_ranks
    use lc_contact_operator, only: compliance_operator
    implicit none (type, external)
    private
@@ -37,9 +40,11 @@ contains
       complex(wp), allocatable :: ph(:), rh(:), wh(:)
       real(wp) :: pm, qx, qy, q, cx, cy, im_g, power, mu
       complex(wp) :: uxh, compliance, anti, one_minus_a, one_minus_b, c, t
+      real(wp) :: sums(5)
       integer :: i, mx
 
       pm = sum(p)/op%n
+      if (op%distributed) pm = global_sum(sum(p))/op%grid%points()
       mu = op%friction
       allocate (ph(op%nk), rh(op%nk), wh(op%nk))
       call spectrum_of(op, p, ph)
@@ -52,8 +57,9 @@ contains
       by_energy = 0.0_wp
       dissipation = 0.0_wp
       ! Parseval on the half spectrum: <f g_x> = sum 2 Re[conj(f^) i q_x g^] over the modes
-      ! with 0 < mx < nx/2 (mx = 0 has no x-derivative, nor has the Nyquist column).
-      do i = 2, op%nk
+      ! with 0 < mx < nx/2 (mx = 0 has no x-derivative, nor has the Nyquist column); a
+      ! distributed spectrum holds each of them on one rank.
+      do i = 1, op%nk
          call op%column_mode(i, qx, qy, mx)
          if (mx == 0 .or. 2*mx == op%grid%nx) cycle
          q = hypot(qx, qy)
@@ -75,6 +81,15 @@ contains
          dissipation = dissipation + 2*qx*power*(2*aimag(compliance*(one_minus_a + mu**2*one_minus_b*cx**2))/q &
             & + mu**2*cy**2*aimag(anti))
       end do
+      if (op%distributed) then
+         sums = [by_displacement, by_profile, by_spectrum, by_energy, dissipation]
+         call sum_over_ranks(sums)
+         by_displacement = sums(1)
+         by_profile = sums(2)
+         by_spectrum = sums(3)
+         by_energy = sums(4)
+         dissipation = sums(5)
+      end if
       by_displacement = by_displacement/pm
       by_profile = by_profile/pm
       by_spectrum = by_spectrum/pm

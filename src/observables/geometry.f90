@@ -260,16 +260,23 @@ contains
 
    !> Histogram of the gap over the whole period: `counts(i)` nodes with
    !> edges(i) <= g < edges(i+1), uniform bins from 0 to the largest gap (contact nodes,
-   !> g = 0, fall in the first bin).
-   pure subroutine gap_histogram(gap, edges, counts)
+   !> g = 0, fall in the first bin). `largest`: the largest gap of the whole map, where `gap`
+   !> is a part of it (a slab of a surface shared among MPI ranks), whose counts are then
+   !> added to the other parts'.
+   pure subroutine gap_histogram(gap, edges, counts, largest)
       real(wp), intent(in) :: gap(:)
       real(wp), intent(out) :: edges(:)
       integer, intent(out) :: counts(:)
+      real(wp), intent(in), optional :: largest
       real(wp) :: top, width
       integer :: j, bin, bins
 
       bins = size(counts)
-      top = max(maxval(gap), tiny(1.0_wp))
+      if (present(largest)) then
+         top = max(largest, tiny(1.0_wp))
+      else
+         top = max(maxval(gap), tiny(1.0_wp))
+      end if
       width = top/bins
       edges = [(width*j, j = 0, bins)]
       counts = 0

@@ -18,6 +18,8 @@
 !> A mode of the Nyquist column (even nx) is its own mirror image: its multiplier M is the
 !> mirror average (M(q_x, q_y) + conj M(q_x, -q_y))/2; a mode of the Nyquist row (even ny)
 !> stands for q_y = +-pi/dy: (M(q_x, q_y) + M(q_x, -q_y))/2.
+!> On a surface shared among MPI ranks the multipliers act on each rank's columns of the
+!> distributed spectrum and the operator's distributed plans give each rank its rows.
 module lc_observables_stress
    use lc_base_kinds, only: wp
    use lc_contact_operator, only: compliance_operator
@@ -38,31 +40,20 @@ contains
       real(wp), intent(out) :: displacement_x(:), displacement_y(:), stress_xx(:), stress_yy(:), stress_xy(:)
       complex(wp), allocatable :: ph(:), fh(:, :)
       complex(wp) :: m(n_fields)
-      real(wp) :: qx, qy, pm, contraction, c0
+      real(wp) :: qx, qy
       integer :: i, mx, my, field
 
-      associate (fft => op%fft, poisson => op%kernel%poisson)
-      contraction = poisson/(1.0_wp - poisson)
+      associate (fft => op%fft)
       fft%real_buffer = p
       call fft%forward()
       ph = fft%spectrum
-      pm = real(ph(1), wp)
       allocate (fh(op%nk, n_fields))
-      c0 = real(op%compliance(1), wp)
-      if (op%kernel%halfspace) then
-         fh(1, :) = [complex(wp) :: 0.0_wp, 0.0_wp, -pm, -2.0_wp*poisson*pm, 0.0_wp]
-      else if (op%kernel%unbounded()) then
-         ! a stack on a half-space: the limit of its modes along x (as the half-space's row
-         ! above), u undefined (zero)
-         fh(1, :) = real(mode_multipliers(op, 1.0e-9_wp/sum(op%kernel%stack%thickness), 0.0_wp, 0), wp)*pm
-         fh(1, 1:2) = 0.0_wp
-      else
-         fh(1, :) = [complex(wp) :: op%friction*pm*op%kernel%shear_uniform(c0), 0.0_wp, -contraction*pm, &
-            & -contraction*pm, 0.0_wp]
-      end if
-      do i = 2, op%nk
+      ! (a distributed spectrum: this rank's columns, the uniform mode on the rank holding it)
+      if (op%holds_uniform .and. op%nk > 0) fh(1, :) = uniform_fields(op, real(ph(1), wp))
+      do i = 1, op%nk
          call op%column_mode(i, qx, qy, mx)
-         my = (i - 1)/op%grid%nkx()
+         call op%fft%mode_indices(i, mx, my)
+         if (mx == 0 .and. my == 0) cycle
          m = mode_multipliers(op, qx, qy, mx)
          if (2*mx == op%grid%nx) m = 0.5_wp*(m + conjg(mode_multipliers(op, qx, -qy, mx)))
          if (2*my == op%grid%ny) m = 0.5_wp*(m + mode_multipliers(op, qx, -qy, mx))
@@ -86,6 +77,29 @@ contains
       end do
       end associate
    end subroutine surface_stress
+
+   !> (u_x, u_y, sigma_xx, sigma_yy, sigma_xy) of the uniform mode for the mean pressure pm.
+   function uniform_fields(op, pm) result(fields)
+      type(compliance_operator), intent(in) :: op
+      real(wp), intent(in) :: pm
+      complex(wp) :: fields(n_fields)
+      real(wp) :: contraction, c0
+      associate (poisson => op%kernel%poisson)
+      contraction = poisson/(1.0_wp - poisson)
+      c0 = real(op%compliance(1), wp)
+      if (op%kernel%halfspace) then
+         fields = [complex(wp) :: 0.0_wp, 0.0_wp, -pm, -2.0_wp*poisson*pm, 0.0_wp]
+      else if (op%kernel%unbounded()) then
+         ! a stack on a half-space: the limit of its modes along x (as the half-space's row
+         ! above), u undefined (zero)
+         fields = real(mode_multipliers(op, 1.0e-9_wp/sum(op%kernel%stack%thickness), 0.0_wp, 0), wp)*pm
+         fields(1:2) = 0.0_wp
+      else
+         fields = [complex(wp) :: op%friction*pm*op%kernel%shear_uniform(c0), 0.0_wp, -contraction*pm, &
+            & -contraction*pm, 0.0_wp]
+      end if
+      end associate
+   end function uniform_fields
 
    !> (u_x, u_y, sigma_xx, sigma_yy, sigma_xy) per unit p^ of the mode (qx, qy), |q| > 0,
    !> with tau_x = mu_c p; mx is the column (for the contact compliance C(q_x V)).

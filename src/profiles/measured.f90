@@ -28,12 +28,14 @@ module lc_profiles_measured
    use lc_base_errors, only: error_type, fatal_error, input_error, code_input
    use lc_base_strings, only: to_string
    use lc_fft_plans, only: fft_plan
+   use lc_base_parallel, only: global_sum, slab, shifted_rows, sum_over_ranks
    use lc_profiles_height_file, only: read_height_file, named, shape_text
    implicit none (type, external)
    private
    public :: measured_heights, measured_grid, prepare_heights, detrend_heights, mirror_heights, resample_heights
    public :: detrend_modes, boundary_modes, resample_modes, check_treatments
-   public :: periodicity_mismatch, edge_jump_limit, edge_kink_limit
+   public :: periodicity_mismatch, edge_jump_limit, edge_kink_limit, slab_periodicity_mismatch, &
+      & detrend_slab, c_shape
 
    !> Allowed values of &profile detrend, boundary and resample, for checks and messages.
    character(len=*), parameter :: detrend_modes = "'auto', 'none', 'mean', 'plane' or 'curvature'"
@@ -232,6 +234,52 @@ contains
       end do
    end subroutine detrend_heights
 
+   !> detrend_heights on a surface shared among MPI ranks: `height` holds the rows
+   !> y_start+1 .. of the ny rows; the least-squares sums are added over the ranks.
+   subroutine detrend_slab(height, y_start, ny, mode)
+      real(wp), intent(inout) :: height(:, :)
+      integer, intent(in) :: y_start, ny
+      character(len=*), intent(in) :: mode
+      real(wp) :: normal(6, 6), rhs(6), basis(6), coefficients(6), sums(42), u, v
+      integer :: terms, ix, iy, mx
+
+      mx = size(height, 1)
+      select case (mode)
+      case ('mean')
+         terms = 1
+      case ('plane')
+         terms = 3
+      case ('curvature')
+         terms = 6
+      case default
+         return
+      end select
+      normal = 0.0_wp
+      rhs = 0.0_wp
+      do iy = 1, size(height, 2)
+         v = centred(y_start + iy, ny)
+         do ix = 1, mx
+            u = centred(ix, mx)
+            basis = terms_at(u, v, .false.)
+            call add_outer(normal, basis, terms)
+            rhs(1:terms) = rhs(1:terms) + basis(1:terms)*height(ix, iy)
+         end do
+      end do
+      sums = [reshape(normal, [36]), rhs]
+      call sum_over_ranks(sums)
+      normal = reshape(sums(1:36), [6, 6])
+      rhs = sums(37:42)
+      call solve_small(normal(1:terms, 1:terms), rhs(1:terms), coefficients(1:terms))
+      do iy = 1, size(height, 2)
+         v = centred(y_start + iy, ny)
+         do ix = 1, mx
+            u = centred(ix, mx)
+            basis = terms_at(u, v, .false.)
+            height(ix, iy) = height(ix, iy) - dot_product(coefficients(1:terms), basis(1:terms))
+         end do
+      end do
+   end subroutine detrend_slab
+
    !> Index i of 1..m mapped onto [-1, 1] (0 for m = 1).
    pure real(wp) function centred(i, m)
       integer, intent(in) :: i, m
@@ -371,6 +419,81 @@ contains
          kink = max(kink, axis_kink)
       end if
    end subroutine periodicity_mismatch
+
+   !> periodicity_mismatch of a surface (nx, ny) shared among MPI ranks, from this rank's slab
+   !> of rows `height` (flat, x fastest); every rank calls it and gets the same values. Along
+   !> x the edges and second differences lie inside each row: each rank sums over its rows.
+   !> Along y they join rows of other ranks: the slab of the surface shifted by -1, m and -m
+   !> rows (lc_base_parallel's shifted_rows) gives each row its partners.
+   subroutine slab_periodicity_mismatch(height, nx, ny, jump, kink)
+      real(wp), intent(in) :: height(:)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(out) :: jump, kink
+      real(wp), allocatable :: rows(:, :), before(:, :), ahead(:, :), behind(:, :), flat(:)
+      real(wp) :: rms, mean, sums(4)
+      integer :: y_start, ny_local, m, j, g
+      call slab(ny, y_start, ny_local)
+      rows = reshape(height, [nx, ny_local])
+      mean = global_sum(sum(rows))/(real(nx, wp)*ny)
+      rms = sqrt(global_sum(sum((rows - mean)**2))/(real(nx, wp)*ny))
+      jump = 0.0_wp
+      kink = 0.0_wp
+      if (.not. rms > 0.0_wp) return
+      if (nx >= 16) then
+         ! (sums over this rank's rows: jump^2, edge, inside, and the inside's count)
+         m = max(2, nx/16)
+         sums = 0.0_wp
+         sums(1) = sum((rows(1, :) - rows(nx, :))**2)
+         sums(2) = sum((rows(1 + m, :) - 2*rows(1, :) + rows(nx + 1 - m, :))**2)
+         do j = 2*m + 1, nx - 2*m
+            sums(3) = sums(3) + sum((rows(j + m, :) - 2*rows(j, :) + rows(j - m, :))**2)
+         end do
+         sums(4) = real(max(nx - 4*m, 0), wp)*ny
+         call add_axis(sums, ny)
+      end if
+      if (ny >= 16) then
+         m = max(2, ny/16)
+         call shifted_rows(height, nx, ny, -1, flat)
+         before = reshape(flat, [nx, ny_local])
+         call shifted_rows(height, nx, ny, m, flat)
+         ahead = reshape(flat, [nx, ny_local])
+         call shifted_rows(height, nx, ny, -m, flat)
+         behind = reshape(flat, [nx, ny_local])
+         sums = 0.0_wp
+         do j = 1, ny_local
+            g = y_start + j - 1
+            if (g == 0) then
+               sums(1) = sum((rows(:, j) - before(:, j))**2)
+               sums(2) = sum((ahead(:, j) - 2*rows(:, j) + behind(:, j))**2)
+            end if
+            if (g >= 2*m .and. g <= ny - 2*m - 1) sums(3) = sums(3) + sum((ahead(:, j) - 2*rows(:, j) + behind(:, j))**2)
+         end do
+         sums(4) = real(max(ny - 4*m, 0), wp)*nx
+         call add_axis(sums, nx)
+      end if
+
+   contains
+
+      !> jump and kink of one axis from the sums over the ranks (`lines`: the lines across it).
+      subroutine add_axis(sums, lines)
+         real(wp), intent(inout) :: sums(4)
+         integer, intent(in) :: lines
+         real(wp) :: edge, inside, axis_kink
+         sums(1:3) = [global_sum(sums(1)), global_sum(sums(2)), global_sum(sums(3))]
+         jump = max(jump, sqrt(sums(1)/lines)/rms)
+         edge = sums(2)/lines
+         inside = 0.0_wp
+         if (sums(4) > 0.0_wp) inside = sums(3)/sums(4)
+         if (inside > 0.0_wp) then
+            axis_kink = sqrt(edge/inside)
+         else if (edge > 0.0_wp) then
+            axis_kink = huge(1.0_wp)
+         else
+            axis_kink = 0.0_wp
+         end if
+         kink = max(kink, axis_kink)
+      end subroutine add_axis
+   end subroutine slab_periodicity_mismatch
 
    !> periodicity_mismatch along the first axis of `rows` (n, rows).
    pure subroutine edge_mismatch(rows, rms, jump, kink)

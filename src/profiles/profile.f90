@@ -22,6 +22,7 @@ module lc_profiles_profile
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
    use lc_profiles_surface, only: self_affine_surface, sinusoid_surface, spherical_cap
    use lc_profiles_measured, only: measured_heights
+   use lc_profiles_measured_slab, only: reads_by_slab, measured_slab
    use lc_base_parallel, only: slab
    implicit none (type, external)
    private
@@ -72,8 +73,9 @@ contains
    !> sphere's radius are checked here too, as the surface routines cannot fail.
    !> This rank's slab of rows of an areal scene's profile (a surface shared among MPI
    !> ranks, lc_base_parallel): a self-affine surface is made on the slabs by the distributed
-   !> c2r (the same heights as on one process, to rounding); the other kinds (cheap, or a
-   !> file every rank reads) are made whole and cut.
+   !> c2r (the same heights as on one process, to rounding); a height file that is one period
+   !> of the grid is read by slabs (lc_profiles_measured_slab); the other kinds (cheap, or a
+   !> mirrored or resampled file, which every rank reads) are made whole and cut.
    subroutine make_profile_slab(scene, height, error)
       type(scene_type), intent(in) :: scene
       real(wp), allocatable, intent(out) :: height(:)
@@ -82,6 +84,13 @@ contains
       real(wp) :: period_y
       integer :: y_start, rows
       call slab(scene%ny, y_start, rows)
+      associate (p => scene%profile)
+         if (is_areal(scene) .and. trim(p%kind) == 'file' .and. reads_by_slab(p%boundary, p%resample)) then
+            call measured_slab(trim(p%file), trim(p%dataset), p%detrend, p%boundary, p%resample, scene%n, scene%ny, &
+               & height, error)
+            return
+         end if
+      end associate
       if (.not. (is_areal(scene) .and. trim(scene%profile%kind) == 'self_affine')) then
          allocate (whole(scene%n*scene%ny))
          call make_profile(scene, whole, error)
