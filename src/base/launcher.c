@@ -67,6 +67,33 @@ int lc_mpi_start(void) {
     atexit(finish_at_exit);
     return 0;
 }
+
+/* A process that leaves while its ranks share a scene (a runtime error in the middle of a
+ * solve, an allocation the compiler's runtime could not make) must not call MPI_Finalize:
+ * that waits for the other ranks, which wait in their next reduction for this one, and the
+ * job hangs. While a run is in flight the exit ends the whole job instead, with code 5 (an
+ * internal failure, the executable's code for memory), whoever started MPI (this file, the
+ * leakage's hypre glue or a caller's mpi4py: this handler, registered last, runs first). */
+static int in_flight = 0;
+
+static void abort_if_in_flight(void) {
+    int initialized = 0, finalized = 0;
+    if (!in_flight) return;
+    MPI_Initialized(&initialized);
+    MPI_Finalized(&finalized);
+    if (initialized && !finalized) MPI_Abort(MPI_COMM_WORLD, 5);
+}
+
+void lc_mpi_run_begins(void) {
+    static int registered = 0;
+    if (!registered) atexit(abort_if_in_flight);
+    registered = 1;
+    in_flight = 1;
+}
+
+void lc_mpi_run_ends(void) { in_flight = 0; }
 #else
 int lc_mpi_start(void) { return 0; }
+void lc_mpi_run_begins(void) {}
+void lc_mpi_run_ends(void) {}
 #endif

@@ -57,6 +57,10 @@ module lc_base_parallel
          import :: c_int
          integer(c_int) :: rank
       end function lc_launch_rank
+      subroutine lc_mpi_run_begins() bind(c, name='lc_mpi_run_begins')
+      end subroutine lc_mpi_run_begins
+      subroutine lc_mpi_run_ends() bind(c, name='lc_mpi_run_ends')
+      end subroutine lc_mpi_run_ends
    end interface
 
 contains
@@ -97,6 +101,8 @@ contains
       ranks = value
       call MPI_Comm_rank(communicator, value)
       rank = value
+      ! (a rank leaving before parallel_end ends the job: src/base/launcher.c)
+      if (ranks > 1) call lc_mpi_run_begins()
 #else
       ranks = 1
       rank = 0
@@ -113,6 +119,7 @@ contains
    !> Back to one rank (MPI itself stays started: it is finished at exit): what runs after
    !> a distributed run in the same process (a Python session's in-memory solves) is serial.
    subroutine parallel_end()
+      call lc_mpi_run_ends()
       ranks = 1
       rank = 0
    end subroutine parallel_end
