@@ -3,7 +3,7 @@ frictionless and coupled scenes, to the bound the two tolerances allow, among th
 paper's Fig. 3 family (thin incompressible layers, mu_c up to 1, from ~1 % to full contact);
 scenes whose friction ratio is beyond what the update of the friction traction was measured
 to relax are refused before any step (docs/decisions/001-gfmd-masses.md). Under `mpirun -n P`
-GFMD runs on the slabs and gives the serial run's answer (the helpers of test_mpi.py)."""
+GFMD runs on the slabs and gives the serial run's answer (with the functions of test_mpi.py)."""
 
 import numpy as np
 import pytest

@@ -117,7 +117,7 @@ contains
    end subroutine parallel_start
 
    !> Back to one rank (MPI itself stays started: it is finished at exit): what runs after
-   !> a distributed run in the same process (a Python session's in-memory solves) is serial.
+   !> a distributed run in the same process (a Python program's in-memory solves) is serial.
    subroutine parallel_end()
       call lc_mpi_run_ends()
       ranks = 1
