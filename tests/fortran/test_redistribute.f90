@@ -14,7 +14,7 @@
 program test_redistribute
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
-   use lc_base_parallel, only: parallel_start, rank_count, this_rank, slab_rows, redistribute_rows
+   use lc_base_parallel, only: parallel_start, parallel_end, rank_count, this_rank, slab_rows, redistribute_rows
    use lc_test_checks, only: check, finish
    implicit none (type, external)
 
@@ -31,6 +31,8 @@ program test_redistribute
       call check_coarse_layouts(coarse_rows(k))
       call check_whole_field(coarse_rows(k))
    end do
+   ! (the ranks leave together: a rank leaving before parallel_end would end the job)
+   call parallel_end()
    call finish('redistribute_rows')
 
 contains
