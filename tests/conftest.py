@@ -27,6 +27,22 @@ from reference_operator import apply, g_eff  # noqa: F401 (shared with the tests
 ROOT = Path(__file__).resolve().parents[1]
 
 
+UNIT_BUILD = ROOT / "build" / "unit"
+
+
+def build_unit_program(name: str) -> tuple[subprocess.CompletedProcess, Path]:
+    """Build the Fortran unit-test program tests/fortran/`name` in build/unit (as `make
+    unit-tests` does; meson set up there when needed) with this Python's environment's
+    meson and ninja; returns ninja's outcome and the program's path."""
+    import sys
+    env = dict(os.environ, PATH=str(Path(sys.executable).parent) + os.pathsep + os.environ.get("PATH", ""))
+    if not (UNIT_BUILD / "build.ninja").exists():
+        subprocess.run(["meson", "setup", str(UNIT_BUILD), "-Dunit_tests=true", "--buildtype=debugoptimized"],
+                       cwd=ROOT, env=env, check=True, capture_output=True)
+    built = subprocess.run(["ninja", "-C", str(UNIT_BUILD), f"tests/fortran/{name}"], env=env,
+                           capture_output=True, text=True)
+    return built, UNIT_BUILD / "tests" / "fortran" / name
+
 def first_method(res) -> str:
     """The method a solve started with (the policy's choice): the path's first name. Which
     methods went on after it where it stalled may differ with rounding from one processor

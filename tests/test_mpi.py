@@ -34,6 +34,8 @@ import h5py
 import numpy as np
 import pytest
 
+from conftest import build_unit_program
+
 #: relative agreement of the distributed and the serial run (see the module docstring)
 SAME = 1e-10
 #: scalars that vanish physically (the interlocking friction of a frictionless elastic scene,
@@ -322,17 +324,8 @@ def test_anderson_on_the_slabs_gives_the_serial_answer(tmp_path):
 
 @pytest.fixture(scope="module")
 def redistribute_program() -> Path:
-    """tests/fortran/test_redistribute, built in build/unit (as tests/test_slab_io.py builds
-    its program) when needed."""
-    root = Path(__file__).resolve().parents[1]
-    build = root / "build" / "unit"
-    program = build / "tests" / "fortran" / "test_redistribute"
-    env = dict(os.environ, PATH=str(Path(sys.executable).parent) + os.pathsep + os.environ.get("PATH", ""))
-    if not (build / "build.ninja").exists():
-        subprocess.run(["meson", "setup", str(build), "-Dunit_tests=true", "--buildtype=debugoptimized"],
-                       cwd=root, env=env, check=True, capture_output=True)
-    built = subprocess.run(["ninja", "-C", str(build), "tests/fortran/test_redistribute"], env=env,
-                           capture_output=True, text=True)
+    """tests/fortran/test_redistribute, built in build/unit when needed."""
+    built, program = build_unit_program("test_redistribute")
     assert built.returncode == 0 and program.exists(), built.stdout[-2000:]
     return program
 

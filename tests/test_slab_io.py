@@ -16,12 +16,13 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
+
+from conftest import build_unit_program
 
 ROOT = Path(__file__).resolve().parents[1]
 BUILD = ROOT / "build" / "unit"
@@ -42,12 +43,7 @@ def program() -> Path:
     """The test program, built in build/unit (as `make unit-tests` builds it) when needed."""
     if shutil.which("mpirun") is None:
         _unavailable("mpirun not found")
-    env = dict(os.environ, PATH=str(Path(sys.executable).parent) + os.pathsep + os.environ.get("PATH", ""))
-    if not (BUILD / "build.ninja").exists():
-        subprocess.run(["meson", "setup", str(BUILD), "-Dunit_tests=true", "--buildtype=debugoptimized"],
-                       cwd=ROOT, env=env, check=True, capture_output=True)
-    built = subprocess.run(["ninja", "-C", str(BUILD), "tests/fortran/test_slab_io"], env=env,
-                           capture_output=True, text=True)
+    built, _ = build_unit_program("test_slab_io")
     if built.returncode != 0 or not PROGRAM.exists():
         _unavailable("this build has no MPI Fortran bindings (no test_slab_io): " + built.stdout[-500:])
     if "-DLC_PARALLEL_HDF5" not in (BUILD / "build.ninja").read_text():

@@ -12,11 +12,11 @@
  * so that runs that compute no leakage never touch MPI. A run of one process works on
  * MPI_COMM_SELF; a distributed one on its job's communicator (below).
  *
- * Open MPI keeps a session directory (ompi.HOST.UID/ with the singleton's files) under
+ * Open MPI keeps a directory of temporary files (ompi.HOST.UID/ with the singleton's) under
  * $TMPDIR and leaves it there after MPI_Finalize. MPI is therefore started with a directory
  * of its own as that base, made for this process in $TMPDIR (or in the base the caller set
  * with OMPI_MCA_orte_tmpdir_base), and that directory is removed, whole, at exit: the run
- * leaves $TMPDIR as it found it and touches no other process's session.
+ * leaves $TMPDIR as it found it and touches no other process's files.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -37,8 +37,8 @@ enum { OUT_OF_MEMORY = 3 };
 
 static int mpi_started_here = 0;
 static int hypre_started = 0;
-/* the session base made for this process's MPI ("" if none) */
-static char session_base[4096] = "";
+/* the temporary-file base made for this process's MPI ("" if none) */
+static char scratch_base[4096] = "";
 
 /* Loading Debian's hypre loads SuperLU_DIST, whose initialisation turns off glibc's mmap for
  * large blocks and the trimming of the heap (mallopt M_MMAP_MAX 0, M_TRIM_THRESHOLD -1): every
@@ -71,21 +71,21 @@ static void finish_at_exit(void) {
     MPI_Finalized(&finalized);
     if (mpi_started_here && !finalized) MPI_Finalize();
     /* children first (FTW_DEPTH), symbolic links not followed (FTW_PHYS) */
-    if (session_base[0] != '\0') nftw(session_base, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+    if (scratch_base[0] != '\0') nftw(scratch_base, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
 }
 
-/* Make this process's session base (see the top) and point Open MPI at it; without a
+/* Make this process's temporary-file base (see the top) and point Open MPI at it; without a
  * writable $TMPDIR Open MPI keeps its default. */
-static void make_session_base(void) {
+static void make_scratch_base(void) {
     const char *base = getenv("OMPI_MCA_orte_tmpdir_base");
     if (base == NULL || base[0] == '\0') base = getenv("TMPDIR");
     if (base == NULL || base[0] == '\0') base = "/tmp";
-    if (snprintf(session_base, sizeof session_base, "%s/layercontact-mpi.XXXXXX", base) >= (int)sizeof session_base ||
-        mkdtemp(session_base) == NULL) {
-        session_base[0] = '\0';
+    if (snprintf(scratch_base, sizeof scratch_base, "%s/layercontact-mpi.XXXXXX", base) >= (int)sizeof scratch_base ||
+        mkdtemp(scratch_base) == NULL) {
+        scratch_base[0] = '\0';
         return;
     }
-    setenv("OMPI_MCA_orte_tmpdir_base", session_base, 1);
+    setenv("OMPI_MCA_orte_tmpdir_base", scratch_base, 1);
 }
 
 /* 1 if MPI runs in this process (started by a first preconditioner, or by the caller). */
@@ -104,7 +104,7 @@ static int start(void) {
         const char *given = getenv("OMPI_MCA_orte_tmpdir_base");
         char *caller_base = given ? strdup(given) : NULL;
         int status;
-        make_session_base();
+        make_scratch_base();
         status = MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided);
         /* the environment as the caller left it (Open MPI has read it) */
         if (caller_base) {
@@ -114,8 +114,8 @@ static int start(void) {
             unsetenv("OMPI_MCA_orte_tmpdir_base");
         }
         if (status != MPI_SUCCESS) {
-            if (session_base[0] != '\0') nftw(session_base, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
-            session_base[0] = '\0';
+            if (scratch_base[0] != '\0') nftw(scratch_base, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+            scratch_base[0] = '\0';
             return 1;
         }
         mpi_started_here = 1;
