@@ -11,7 +11,10 @@ mu_c = 0.5), as bench/threads.py. For each size the bare r2c + c2r pair of the g
 timed first (py_grid_fft_pair_seconds: the plan a solve's operator makes, best of 3 rounds),
 then each scene is solved --repeats times (the best kept). Printed: the solve's
 ``wall_time``, its transform pairs (the coarse grids' counted in pairs of the finest grid),
-one pair's time, the ratio solve / (pairs x pair), and the split of ``wall_time`` from the
+one pair's time, the ratio solve / (pairs x pair), the ratio of the solve to its own time
+inside the transforms (``transform_time``, timed around each transform during the solve:
+the same moments of the machine, so on a shared machine, whose speed drifts by tens of per
+cent from one second to the next, the steadier of the two), and the split of ``wall_time`` from the
 result's own timers: ``setup_time`` (checks, the finest grid's operator: plans and
 multipliers), ``coarse_time`` (the coarse start: the coarser grids' solves) and the rest,
 the finest grid's iterations. The surface's observables (contact fraction, patches) are
@@ -69,16 +72,18 @@ def main() -> None:
             rows.append((n, name, pair, best, after))
     print(f"load average after: {load()}\n")
     print("| grid | scene | solver | it. | pairs | pair (ms) | solve (s) | solve / (pairs x pair) "
-          "| set-up | coarse start | fine it. | after (s) |")
-    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "| transforms (s) | solve / transforms | set-up | coarse start | fine it. | after (s) |")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for n, name, pair, r, after in rows:
         # (a build before the timers, PYTHONPATH=an earlier --target install: the ratio alone)
         setup, coarse = getattr(r, "setup_time", float("nan")), getattr(r, "coarse_time", float("nan"))
         fine = r.wall_time - setup - coarse
+        transforms = getattr(r, "transform_time", float("nan"))
         share = {key: f"{value:.2f} s ({100 * value / r.wall_time:.0f} %)"
                  for key, value in (("setup", setup), ("coarse", coarse), ("fine", fine))}
         print(f"| {n}² | {name} | {r.solver} | {r.iterations} | {r.fft_pairs} | {pair * 1e3:.1f} "
-              f"| {r.wall_time:.2f} | {r.wall_time / (r.fft_pairs * pair):.2f} | {share['setup']} "
+              f"| {r.wall_time:.2f} | {r.wall_time / (r.fft_pairs * pair):.2f} | {transforms:.2f} "
+              f"| {r.wall_time / transforms:.2f} | {share['setup']} "
               f"| {share['coarse']} | {share['fine']} | {after:.2f} |")
 
 if __name__ == "__main__":

@@ -102,6 +102,9 @@ module lc_result
       !> is the finest grid's iterations (s)
       real(wp) :: setup_time = 0.0_wp
       real(wp) :: coarse_time = 0.0_wp
+      !> of wall_time: the time in the grids' transforms (every r2c and c2r of the solve, the
+      !> coarse grids' included; a distributed run's transposes included, rank 0's) (s)
+      real(wp) :: transform_time = 0.0_wp
       !> threads the solve ran on (&solver threads, or what the job was given: lc_base_threads)
       integer :: omp_threads = 1
       integer :: mpi_ranks = 1                !< processes sharing the grid (1: this build has no MPI)
@@ -155,6 +158,7 @@ contains
          & real_scalar('wall_time', res%wall_time, 's'), &
          & real_scalar('setup_time', res%setup_time, 's'), &
          & real_scalar('coarse_time', res%coarse_time, 's'), &
+         & real_scalar('transform_time', res%transform_time, 's'), &
          & integer_scalar('omp_threads', res%omp_threads), &
          & integer_scalar('mpi_ranks', res%mpi_ranks), &
          & real_scalar('friction', res%friction), &

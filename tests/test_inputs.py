@@ -523,7 +523,7 @@ def test_every_result_attribute_has_its_unit(default_result):
     assert units.endswith("dimensionless (fractions, friction coefficients, residuals, normalised values) or counts")
     dimensional = {"mean_pressure", "penetration", "contact_length", "mean_gap", "leak_rate", "pressure_shift",
                    "summit_shift", "max_tension", "max_tension_grid", "max_tension_x", "max_tension_offset",
-                   "dissipated_power", "wall_time", "setup_time", "coarse_time"}
+                   "dissipated_power", "wall_time", "setup_time", "coarse_time", "transform_time"}
     assert dimensional <= named and dimensional <= set(attrs)
 
 

@@ -42,7 +42,7 @@ SAME = 1e-10
 #: zero but for the rounding of w', ~1e-18 here) are compared to this absolute floor
 VANISHING = 1e-14
 #: the counts and the time of a solve differ between runs by design: not compared
-NOT_COMPARED = {"wall_time", "setup_time", "coarse_time", "residual", "iterations", "fft_pairs", "outer_iterations", "mpi_ranks",
+NOT_COMPARED = {"wall_time", "setup_time", "coarse_time", "transform_time", "residual", "iterations", "fft_pairs", "outer_iterations", "mpi_ranks",
                 "solver_reason", "omp_threads"}
 #: what else in a file records the run, not the answer: its clock, and the counts and
 #: residuals of the iterations that stop at a tolerance (conductance, stiffness, leakage)

@@ -491,8 +491,9 @@ def test_timers_split_the_solve_time():
     """setup_time and coarse_time are parts of wall_time, which is part of the call's time
     measured around it here; without the coarse start there is nothing to time there (0
     exactly), with it the coarser grids' solves take a positive time (on 128², grids of
-    64² .. 32²). The three clocks are the same monotonic clock, so the inequalities hold to
-    its resolution (1e-9 s)."""
+    64² .. 32²). transform_time, the solve's time inside its transforms, is a part of
+    wall_time too, and positive (the solve makes fft_pairs > 0 pairs). The clocks are the
+    same monotonic clock, so the inequalities hold to its resolution (1e-9 s)."""
     import time
 
     h = lc.self_affine_surface(128, 0.8, seed=3, short_wavelength=8 / 128)
@@ -505,3 +506,4 @@ def test_timers_split_the_solve_time():
         assert 0 < r.setup_time and 0 <= r.coarse_time
         assert r.setup_time + r.coarse_time <= r.wall_time + 1e-9 <= call + 2e-9
         assert (r.coarse_time > 0) == coarse_start
+        assert r.fft_pairs > 0 and 0 < r.transform_time <= r.wall_time + 1e-9

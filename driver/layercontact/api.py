@@ -125,6 +125,8 @@ class LineResult:
     #: iterations
     setup_time: float = 0.0
     coarse_time: float = 0.0
+    #: of ``wall_time`` (s): the time in the grids' transforms, every grid's
+    transform_time: float = 0.0
     n_spots: int = 0
     spots: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
     mean_gap: float = float("nan")
@@ -432,6 +434,8 @@ class ArealResult:
     #: iterations
     setup_time: float = 0.0
     coarse_time: float = 0.0
+    #: of ``wall_time`` (s): the time in the grids' transforms, every grid's
+    transform_time: float = 0.0
     dissipated_power: float = 0.0
     monotone: bool = True
     normalised_pressure: float = float("nan")

@@ -51,5 +51,6 @@ contains
       call broadcast(result%wall_time)
       call broadcast(result%setup_time)
       call broadcast(result%coarse_time)
+      call broadcast(result%transform_time)
    end subroutine agree_on_times
 end module lc_application_result_file

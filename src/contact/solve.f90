@@ -31,6 +31,7 @@ module lc_contact_solve
    use lc_contact_progress, only: progress_log
    use lc_base_memory, only: check_memory
    use lc_base_pages, only: advise_huge_pages
+   use lc_fft_plans, only: transform_seconds
    use lc_base_threads, only: solve_threads, use_threads, active_threads
    use lc_base_parallel, only: is_distributed, slab, global_sum, global_max, allgather_rows, rank_count, &
       & redistribute_rows
@@ -98,8 +99,10 @@ contains
       real(wp), parameter :: pi = acos(-1.0_wp)
       integer :: n, n_local, y_start, ny_local
       logical :: distributed
+      real(wp) :: transforms_before
 
       call system_clock(start, rate)
+      transforms_before = transform_seconds()
       call solve_threads(scene%solver%threads, result%omp_threads, error)
       if (allocated(error)) return
       call progress%begin(scene%solver%verbose)
@@ -203,6 +206,7 @@ contains
       result%monotone = op%monotone
       call system_clock(finish)
       result%wall_time = real(finish - start, wp)/real(rate, wp)
+      result%transform_time = transform_seconds() - transforms_before
    end subroutine solve_contact
 
    !> The count over the ranks (distributed) or this one's.

@@ -37,7 +37,7 @@ module lc_fft_plans
 #endif
    implicit none (type, external)
    private
-   public :: fft_plan
+   public :: fft_plan, transform_seconds
 
    !> Surfaces of at least this many points are transformed in two passes: the rows (r2c),
    !> then the columns of the half spectrum in blocks of `column_block` adjacent columns.
@@ -49,6 +49,9 @@ module lc_fft_plans
    integer, parameter :: column_block = 8
    !> FFTW-MPI's own set-up is done (once per process)
    logical :: fftw_mpi_ready = .false.
+   !> clock ticks this process spent in the grid transforms (forward_unscaled and backward,
+   !> the distributed ones' transposes included): a solve's own FFT time (transform_seconds)
+   integer(i8) :: transform_ticks = 0
 
    !> An r2c/c2r plan pair with its buffers: copy data into `real_buffer`, call
    !> `forward`, work on `spectrum`, call `backward`, read `real_buffer`. Planning with
@@ -352,30 +355,48 @@ contains
    !> the 1/n into their multipliers and so save a pass over the spectrum.
    subroutine forward_unscaled(self)
       class(fft_plan), intent(inout) :: self
-#ifdef LC_MPI
+      integer(i8) :: start, finish
+      call system_clock(start)
       if (self%distributed) then
+#ifdef LC_MPI
          call pad_rows(self)
          call fftw_mpi_execute_dft_r2c(self%r2c, self%padded, self%spectrum)
-         return
-      end if
 #endif
-      call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
-      if (self%split) call transform_columns(self, self%columns_forward, self%last_forward)
+      else
+         call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
+         if (self%split) call transform_columns(self, self%columns_forward, self%last_forward)
+      end if
+      call system_clock(finish)
+      !$omp atomic
+      transform_ticks = transform_ticks + (finish - start)
    end subroutine forward_unscaled
 
    !> real_buffer <- sum_q spectrum(q) exp(i q.x). The spectrum is destroyed.
    subroutine backward(self)
       class(fft_plan), intent(inout) :: self
-#ifdef LC_MPI
+      integer(i8) :: start, finish
+      call system_clock(start)
       if (self%distributed) then
+#ifdef LC_MPI
          call fftw_mpi_execute_dft_c2r(self%c2r, self%spectrum, self%padded)
          call unpad_rows(self)
-         return
-      end if
 #endif
-      if (self%split) call transform_columns(self, self%columns_backward, self%last_backward)
-      call fftw_execute_dft_c2r(self%c2r, self%spectrum, self%real_buffer)
+      else
+         if (self%split) call transform_columns(self, self%columns_backward, self%last_backward)
+         call fftw_execute_dft_c2r(self%c2r, self%spectrum, self%real_buffer)
+      end if
+      call system_clock(finish)
+      !$omp atomic
+      transform_ticks = transform_ticks + (finish - start)
    end subroutine backward
+
+   !> Seconds this process has spent in the grid transforms so far (a solve takes the
+   !> difference over its run: contact_result%transform_time).
+   real(wp) function transform_seconds()
+      integer(i8) :: rate
+      call system_clock(count_rate=rate)
+      transform_seconds = real(transform_ticks, wp)/real(rate, wp)
+   end function transform_seconds
 
    !> The column pass of a two-pass surface: each block of adjacent columns in place.
    subroutine transform_columns(self, block_plan, last_plan)
