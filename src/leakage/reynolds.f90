@@ -110,11 +110,6 @@ module lc_leakage_reynolds
          real(c_double), intent(in) :: value(*)
          real(c_double), value :: strength
       end function lc_hypre_setup_boomeramg_rows
-      integer(c_int) function lc_hypre_matvec(x, y) bind(C)
-         import :: c_int, c_double
-         real(c_double), intent(in) :: x(*)
-         real(c_double), intent(out) :: y(*)
-      end function lc_hypre_matvec
       integer(c_int) function lc_hypre_apply(r, z) bind(C)
          import :: c_int, c_double
          real(c_double), intent(in) :: r(*)
@@ -469,6 +464,7 @@ contains
       type(leakage_flow), intent(inout) :: flow
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: we(:), wn(:), b(:), phi(:), r(:), z(:), p(:), q(:), decreases(:), phi_grid(:)
+      real(wp), allocatable :: extended(:)
       logical, allocatable :: free(:)
       integer, allocatable :: number(:), free_cells(:), counts(:)
       integer(c_int), allocatable :: row_start(:), column(:)
@@ -521,12 +517,12 @@ contains
          return
       end if
       allocate (row_start(n_free + 1), column(5*n_free), value(5*n_free), r(n_free), z(n_free), p(n_free), &
-         & q(n_free), decreases(max_iter), stat=stat)
+         & q(n_free), extended(n_free + 2*nx), decreases(max_iter), stat=stat)
       if (stat /= 0) then
-         call out_of_memory(error, 'its matrix and iteration vectors', 96*int(n_free, i8))
+         call out_of_memory(error, 'its matrix and iteration vectors', 104*int(n_free, i8))
          return
       end if
-      call assemble()
+      call assemble(.true.)
       if (.not. prepared) then
          status = lc_hypre_setup_boomeramg_rows(int(communicator_handle(), c_int), int(first_row, c_int), &
             & int(n_free, c_int), row_start, column, value, amg_strength)
@@ -540,6 +536,9 @@ contains
          end if
          prepared = .true.
       end if
+      ! (hypre holds its copy: the columns from here on index this rank's values and the
+      ! neighbouring rows', for the product in Fortran)
+      call assemble(.false.)
 
       r = b
       call precondition(r, z)
@@ -597,11 +596,30 @@ contains
          end if
       end subroutine precondition
 
-      !> q = A v on this rank's free cells (hypre's distributed product).
+      !> q = A v on this rank's free cells: v and the values of the free cells of the rows
+      !> next to the slab (exchanged; one rank: its own edge rows) in `extended`, each row
+      !> summed in the order of its entries (the diagonal, east, west, north, south).
       subroutine apply_matrix(v, q)
          real(wp), intent(in) :: v(:)
          real(wp), intent(out) :: q(:)
-         if (lc_hypre_matvec(v, q) /= 0) q = 0.0_wp
+         real(wp) :: below(nx), above(nx)
+         integer :: i, m, e
+         do i = 1, nx
+            edge_rows(i) = 0.0_wp
+            edge_rows(nx + i) = 0.0_wp
+            if (free(i)) edge_rows(i) = v(number(i) - first_row + 1)
+            if (free(n_cells - nx + i)) edge_rows(nx + i) = v(number(n_cells - nx + i) - first_row + 1)
+         end do
+         call halo_rows(edge_rows, nx, below, above)
+         extended(:n_free) = v
+         extended(n_free + 1:n_free + nx) = below
+         extended(n_free + nx + 1:) = above
+         do m = 1, n_free
+            q(m) = 0.0_wp
+            do e = row_start(m) + 1, row_start(m + 1)
+               q(m) = q(m) + value(e)*extended(column(e))
+            end do
+         end do
       end subroutine apply_matrix
 
       !> The north face weight of the cell below cell k (column i, row j of the slab).
@@ -627,10 +645,13 @@ contains
          end do
       end subroutine rhs_on_free_cells
 
-      !> This rank's rows of the matrix on the free cells in CSR form (zero-based, global
-      !> columns): the diagonal and the open faces to free neighbours, in the serial order.
-      subroutine assemble()
-         integer :: i, j, k, m, f, nnz, neighbours(4)
+      !> This rank's rows of the matrix on the free cells in CSR form (zero-based row
+      !> starts): the diagonal and the open faces to free neighbours, in the serial order.
+      !> Columns: global and zero-based (hypre's), or (global false) one-based in `extended`,
+      !> this rank's free cells then the rows below and above the slab by their x.
+      subroutine assemble(global)
+         logical, intent(in) :: global
+         integer :: i, j, k, m, f, nnz, neighbours(4), columns(4), diagonal
          real(wp) :: weights(4)
          nnz = 0
          do m = 1, n_free
@@ -640,25 +661,36 @@ contains
             ! global numbers of the east, west, north and south neighbours (-1: not free)
             neighbours(1) = number(modulo(i, nx) + 1 + (j - 1)*nx)
             neighbours(2) = number(modulo(i - 2, nx) + 1 + (j - 1)*nx)
+            columns(1:2) = neighbours(1:2) - first_row + 1
             if (j < rows) then
                neighbours(3) = number(k + nx)
+               columns(3) = neighbours(3) - first_row + 1
             else
                neighbours(3) = nint(number_above(i))
+               columns(3) = n_free + nx + i
             end if
             if (j > 1) then
                neighbours(4) = number(k - nx)
+               columns(4) = neighbours(4) - first_row + 1
             else
                neighbours(4) = nint(number_below(i))
+               columns(4) = n_free + i
+            end if
+            if (global) then
+               columns = neighbours
+               diagonal = first_row + m - 1
+            else
+               diagonal = m
             end if
             weights = [we(k), we(modulo(i - 2, nx) + 1 + (j - 1)*nx), wn(k), south_weight(k, i, j)]
             row_start(m) = nnz
             nnz = nnz + 1
-            column(nnz) = first_row + m - 1
+            column(nnz) = diagonal
             value(nnz) = sum(weights)
             do f = 1, 4
                if (weights(f) /= 0.0_wp .and. neighbours(f) >= 0) then
                   nnz = nnz + 1
-                  column(nnz) = neighbours(f)
+                  column(nnz) = columns(f)
                   value(nnz) = -weights(f)
                end if
             end do
