@@ -530,6 +530,44 @@ def test_mirrored_height_files_by_slabs(name, tmp_path):
 
 
 @needs_mpi
+@pytest.mark.parametrize("boundary", ["periodic", "mirror"])
+def test_resampled_height_files_by_slabs(boundary, tmp_path):
+    """A file resampled to the grid (resample = 'fourier') is read and resampled on the
+    slabs: each row along x, then each column along y on blocks of columns. A 20 x 24 file
+    (ny x nx; mirrored: a 40 x 48 surface) onto a 50 x 32 grid gives the serial run's file on
+    2-4 ranks (to 1e-10: the same map, its transforms in another order). The file is a
+    band-limited periodic surface, two oblique waves below both grids' Nyquist modes: the
+    serial heights are its values on the grid (to 1e-12: FFT rounding on heights of order
+    0.05), an independent check of what the runs are compared against."""
+    ny_file, nx_file = 20, 24
+    y, x = np.meshgrid(np.arange(ny_file) / ny_file, np.arange(nx_file) / nx_file, indexing="ij")
+
+    def waves(x, y):
+        return 0.03 * np.cos(2 * np.pi * (2 * x + 3 * y)) + 0.02 * np.sin(2 * np.pi * (5 * x - 4 * y) + 0.3)
+
+    for ranks in (1, 2, 3, 4):
+        directory = tmp_path / f"ranks{ranks}"
+        directory.mkdir()
+        with h5py.File(directory / "heights.h5", "w") as f:
+            f["h"] = waves(x, y)
+        (directory / "scene.nml").write_text(
+            "&scene geometry = 'areal', n = 32, ny = 50 /\n" + SCENES["coupled"] +
+            f"&profile kind = 'file', file = 'heights.h5', dataset = 'h', boundary = '{boundary}', "
+            "detrend = 'none', resample = 'fourier' /\n"
+            "&loading control = 'load', normalised_pressure = 0.15 /\n&solver tol = 1e-13 /\n"
+            "&output file = 'result.h5', overwrite = .true., stress = .false. /\n")
+        done = run_serial(directory / "scene.nml") if ranks == 1 else run_mpi(ranks, [executable(), "scene.nml"],
+                                                                             directory)
+        assert done.returncode == 0, done.stderr
+    if boundary == "periodic":
+        with h5py.File(tmp_path / "ranks1" / "result.h5", "r") as f:
+            height = np.asarray(f["profile/height"]).reshape(50, 32)
+        y, x = np.meshgrid(np.arange(50) / 50, np.arange(32) / 32, indexing="ij")
+        assert np.abs(height - waves(x, y)).max() < 1e-12
+    for ranks in (2, 3, 4):
+        assert_same_file(tmp_path / "ranks1" / "result.h5", tmp_path / f"ranks{ranks}" / "result.h5")
+
+@needs_mpi
 @pytest.mark.parametrize("profile", ["&profile kind = 'sinusoid', amplitude = 0.05, mode = 2, mode_y = -3 /\n",
                                      "&profile kind = 'sphere', radius = 2.0 /\n"])
 def test_sinusoid_and_sphere_by_slabs(profile, tmp_path):

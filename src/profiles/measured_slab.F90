@@ -16,8 +16,11 @@ module lc_profiles_measured_slab
    use lc_profiles_measured, only: detrend_slab, check_treatments
    use lc_profiles_height_file, only: named, shape_text
 #ifdef LC_MPI
-   use lc_base_parallel, only: communicator, slab, redistribute_rows
-   use lc_base_slab, only: row_slab
+   use mpi_f08, only: MPI_Alltoallv, MPI_DOUBLE_PRECISION
+   use lc_base_parallel, only: communicator, slab, redistribute_rows, rank_count, this_rank
+   use lc_base_slab, only: row_slab, slab_of
+   use lc_fft_plans, only: fft_plan
+   use lc_io_mpi_agree, only: agree_error
    use lc_profiles_height_slabs, only: read_height_slab
 #endif
    implicit none (type, external)
@@ -30,7 +33,8 @@ contains
    pure logical function reads_by_slab(boundary, resample)
       character(len=*), intent(in) :: boundary, resample
 #ifdef LC_MPI
-      reads_by_slab = (trim(boundary) == 'periodic' .or. trim(boundary) == 'mirror') .and. trim(resample) == 'none'
+      reads_by_slab = (trim(boundary) == 'periodic' .or. trim(boundary) == 'mirror') .and. &
+         & (trim(resample) == 'none' .or. trim(resample) == 'fourier')
 #else
       reads_by_slab = .false. .and. len(boundary) + len(resample) > 0
 #endif
@@ -64,10 +68,10 @@ contains
       real(wp), allocatable, intent(out) :: height(:)
       type(error_type), allocatable, intent(out) :: error
 #ifdef LC_MPI
-      real(wp), allocatable :: rows(:, :)
+      real(wp), allocatable :: rows(:, :), mirrored_rows(:)
       type(row_slab) :: file_slab
       character(len=:), allocatable :: mode
-      integer :: least, factor, mx, my
+      integer :: least, factor, mx, my, y_start, count
       logical :: mirrored
 
       call check_treatments(detrend, boundary, resample, error)
@@ -89,7 +93,7 @@ contains
             & "'", code_input)
          return
       end if
-      if (factor*mx /= nx .or. factor*my /= ny) then
+      if ((factor*mx /= nx .or. factor*my /= ny) .and. trim(resample) /= 'fourier') then
          call fatal_error(error, named(filename) // ' holds shape ' // &
             & shape_text([int(factor*my, i8), int(factor*mx, i8)]) // trim(merge(' (mirrored)', '           ', &
             & mirrored)) // '; allowed: the grid, (ny, nx) = (' // to_string(ny) // ', ' // to_string(nx) // &
@@ -98,9 +102,16 @@ contains
       end if
       call detrend_slab(rows, file_slab%y_start, my, mode)
       if (mirrored) then
-         call mirror_slab(rows, file_slab%y_start, mx, my, height)
-      else
+         call mirror_slab(rows, file_slab%y_start, mx, my, mirrored_rows)
+         mx = 2*mx
+         my = 2*my
+         call slab(my, y_start, count)
+         rows = reshape(mirrored_rows, [mx, count])
+      end if
+      if (mx == nx .and. my == ny) then
          height = reshape(rows, [size(rows)])
+      else
+         call resample_slab(rows, mx, my, nx, ny, height, error)
       end if
 #else
       allocate (height(0))
@@ -142,5 +153,167 @@ contains
          height(2*mx*j:2*mx*(j - 1) + mx + 1:-1) = patch(:, j)
       end do
    end subroutine mirror_slab
+
+   !> The heights of an mx x my surface whose slab of rows this rank holds (`rows`, mx x its
+   !> rows, lc_base_slab) mapped onto the nx x ny grid by their Fourier series, as
+   !> lc_profiles_measured's resample_heights maps the whole surface: this rank's slab of the
+   !> grid's rows (flat, x fastest). The map keeps a rectangle of modes, so it is the map of
+   !> each row along x followed by that of each column along y (each the 1D map of the same
+   !> rule: a kept size is left as it is, a changed one keeps the modes both sizes hold
+   !> below their Nyquist modes). Along y a column needs every row: the rows are moved to
+   !> blocks of columns (each rank ceiling(nx/P) columns, all my rows; MPI_Alltoallv),
+   !> mapped, and moved to the grid's slabs. No rank holds more than its share of either
+   !> surface; the heights are the serial ones to rounding (the transforms' order).
+   subroutine resample_slab(rows, mx, my, nx, ny, height, error)
+      real(wp), intent(in) :: rows(:, :)
+      integer, intent(in) :: mx, my, nx, ny
+      real(wp), allocatable, intent(out) :: height(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: wide(:, :), outgoing(:), incoming(:), columns(:, :), resampled(:, :)
+      integer, allocatable :: send_counts(:), send_offsets(:), receive_counts(:), receive_offsets(:)
+      integer :: ranks, rank, q, block, first, count, own_first, own_count, rows_here, j, c, next
+      type(row_slab) :: target, other_source, other_target
+
+      ranks = rank_count()
+      rank = this_rank()
+      target = slab_of(nx, ny, ranks, rank)
+      rows_here = size(rows, 2)
+      ! along x: each row on its own
+      if (mx /= nx) then
+         call resample_lines(rows, nx, wide, error)
+         call agree_error(error, communicator)
+         if (allocated(error)) return
+      else
+         wide = rows
+      end if
+      if (my == ny) then
+         height = reshape(wide, [size(wide)])
+         return
+      end if
+      ! the columns of the grid in blocks, rank q's from q*block (some ranks may hold none)
+      block = (nx + ranks - 1)/ranks
+      own_first = min(rank*block, nx)
+      own_count = max(0, min(nx, own_first + block) - own_first)
+      allocate (send_counts(0:ranks - 1), send_offsets(0:ranks - 1), receive_counts(0:ranks - 1), &
+         & receive_offsets(0:ranks - 1))
+      ! rows -> columns: to rank q this rank's rows of q's columns, row by row
+      do q = 0, ranks - 1
+         first = min(q*block, nx)
+         count = max(0, min(nx, first + block) - first)
+         other_source = slab_of(mx, my, ranks, q)
+         send_counts(q) = count*rows_here
+         receive_counts(q) = own_count*other_source%ny_local
+      end do
+      call offsets_of(send_counts, send_offsets)
+      call offsets_of(receive_counts, receive_offsets)
+      allocate (outgoing(max(sum(send_counts), 1)), incoming(max(sum(receive_counts), 1)))
+      next = 0
+      do q = 0, ranks - 1
+         first = min(q*block, nx)
+         count = max(0, min(nx, first + block) - first)
+         do j = 1, rows_here
+            outgoing(next + 1:next + count) = wide(first + 1:first + count, j)
+            next = next + count
+         end do
+      end do
+      deallocate (wide)
+      call MPI_Alltoallv(outgoing, send_counts, send_offsets, MPI_DOUBLE_PRECISION, incoming, receive_counts, &
+         & receive_offsets, MPI_DOUBLE_PRECISION, communicator)
+      ! columns(:, c): all my rows of this rank's column own_first + c
+      allocate (columns(my, own_count))
+      do q = 0, ranks - 1
+         other_source = slab_of(mx, my, ranks, q)
+         do j = 1, other_source%ny_local
+            do c = 1, own_count
+               columns(other_source%y_start + j, c) = incoming(receive_offsets(q) + (j - 1)*own_count + c)
+            end do
+         end do
+      end do
+      deallocate (outgoing, incoming)
+      ! along y: each column on its own
+      if (own_count > 0) then
+         call resample_lines(columns, ny, resampled, error)
+      else
+         allocate (resampled(ny, 0))
+      end if
+      call agree_error(error, communicator)
+      if (allocated(error)) return
+      deallocate (columns)
+      ! columns -> rows: to rank q its rows of this rank's columns, row by row
+      do q = 0, ranks - 1
+         first = min(q*block, nx)
+         count = max(0, min(nx, first + block) - first)
+         other_target = slab_of(nx, ny, ranks, q)
+         send_counts(q) = own_count*other_target%ny_local
+         receive_counts(q) = count*target%ny_local
+      end do
+      call offsets_of(send_counts, send_offsets)
+      call offsets_of(receive_counts, receive_offsets)
+      allocate (outgoing(max(sum(send_counts), 1)), incoming(max(sum(receive_counts), 1)))
+      next = 0
+      do q = 0, ranks - 1
+         other_target = slab_of(nx, ny, ranks, q)
+         do j = 1, other_target%ny_local
+            outgoing(next + 1:next + own_count) = resampled(other_target%y_start + j, :)
+            next = next + own_count
+         end do
+      end do
+      deallocate (resampled)
+      call MPI_Alltoallv(outgoing, send_counts, send_offsets, MPI_DOUBLE_PRECISION, incoming, receive_counts, &
+         & receive_offsets, MPI_DOUBLE_PRECISION, communicator)
+      allocate (height(nx*target%ny_local))
+      do q = 0, ranks - 1
+         first = min(q*block, nx)
+         count = max(0, min(nx, first + block) - first)
+         do j = 1, target%ny_local
+            height(nx*(j - 1) + first + 1:nx*(j - 1) + first + count) = &
+               & incoming(receive_offsets(q) + (j - 1)*count + 1:receive_offsets(q) + j*count)
+         end do
+      end do
+   end subroutine resample_slab
+
+   !> Each line (column) of `lines` (m values each) mapped by its Fourier series onto n
+   !> points (n /= m): the modes below both Nyquist modes kept, as resample_heights keeps
+   !> them along an axis whose size changes. out(n, size(lines, 2)).
+   subroutine resample_lines(lines, n, out, error)
+      real(wp), intent(in) :: lines(:, :)
+      integer, intent(in) :: n
+      real(wp), allocatable, intent(out) :: out(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(fft_plan) :: from, to
+      integer :: m, count, k_max, j
+      m = size(lines, 1)
+      count = size(lines, 2)
+      allocate (out(n, count))
+      call from%init(m, count, 1, error)
+      if (allocated(error)) return
+      call from%plan_rows(error)
+      if (allocated(error)) return
+      call to%init(n, count, 1, error)
+      if (allocated(error)) return
+      call to%plan_rows(error)
+      if (allocated(error)) return
+      from%real_buffer = reshape(lines, [m*count])
+      call from%rows_forward_unscaled()
+      k_max = min((m - 1)/2, (n - 1)/2)
+      to%spectrum = (0.0_wp, 0.0_wp)
+      do j = 0, count - 1
+         to%spectrum(j*(n/2 + 1) + 1:j*(n/2 + 1) + k_max + 1) = &
+            & from%spectrum(j*(m/2 + 1) + 1:j*(m/2 + 1) + k_max + 1)*(1.0_wp/m)
+      end do
+      call to%rows_backward()
+      out = reshape(to%real_buffer, [n, count])
+   end subroutine resample_lines
+
+   !> The offsets of consecutive blocks of `counts` values (from 0).
+   pure subroutine offsets_of(counts, offsets)
+      integer, intent(in) :: counts(0:)
+      integer, intent(out) :: offsets(0:)
+      integer :: q
+      offsets(0) = 0
+      do q = 1, size(counts) - 1
+         offsets(q) = offsets(q - 1) + counts(q - 1)
+      end do
+   end subroutine offsets_of
 #endif
 end module lc_profiles_measured_slab
