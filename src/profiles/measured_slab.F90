@@ -1,14 +1,14 @@
 !> A height file's surface shared among the MPI ranks of a job (&profile kind = 'file'),
-!> each rank reading a slab of rows of the file (lc_profiles_height_slabs) where no
-!> resampling is asked (resample = 'none': the file is one period of the grid, or with
-!> boundary = 'mirror' the patch that its mirror images make the grid of). The detrending's
-!> least-squares sums are added over the ranks (lc_profiles_measured's detrend_slab), so no
-!> rank holds the whole surface. A mirrored patch is detrended on the file's slabs, then
-!> each rank receives the file rows its slab of the grid holds (row j of the grid is file
-!> row j, or 2 my - 1 - j in the mirror image along y) and mirrors them along x. A file
-!> resampled to another grid (resample = 'fourier', where every height depends on the whole
-!> file) is read whole by every rank (lc_profiles_measured), which keeps its rows. A build
-!> without MPI has no slabs: `reads_by_slab` is false there.
+!> each rank reading a slab of rows of the file (lc_profiles_height_slabs), so that no rank
+!> holds the whole surface (but rank 0 reading a .npy or text file). The detrending's
+!> least-squares sums are added over the ranks (lc_profiles_measured's detrend_slab). A
+!> mirrored patch (boundary = 'mirror') is detrended on the file's slabs, then each rank
+!> receives the file rows its slab of the mirrored surface holds (row j is file row j, or
+!> 2 my - 1 - j in the mirror image along y) and mirrors them along x. A surface resampled
+!> to the grid (resample = 'fourier') is mapped row by row along x, then on blocks of
+!> columns along y (resample_slab). The steps are those of lc_profiles_measured's
+!> prepare_heights, in its order. A build without MPI has no slabs: `reads_by_slab` is
+!> false there.
 module lc_profiles_measured_slab
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_input, code_internal

@@ -72,10 +72,9 @@ contains
    !> This rank's slab of rows of an areal scene's profile (a surface shared among MPI
    !> ranks, lc_base_parallel), no rank making the whole surface: a self-affine surface is
    !> made on the slabs by the distributed c2r (the same heights as on one process, to
-   !> rounding); a sinusoid or a sphere row by row (the same values); a height file on the
-   !> grid, periodic or mirrored, is read by slabs (lc_profiles_measured_slab). A file
-   !> resampled to the grid (resample = 'fourier': every height depends on the whole file)
-   !> and a line are made whole and cut.
+   !> rounding); a sinusoid or a sphere row by row (the same values); a height file is read,
+   !> mirrored and resampled by slabs (lc_profiles_measured_slab). A line is made whole and
+   !> cut.
    subroutine make_profile_slab(scene, height, error)
       type(scene_type), intent(in) :: scene
       real(wp), allocatable, intent(out) :: height(:)
