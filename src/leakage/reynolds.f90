@@ -36,8 +36,11 @@
 !>   cells, so the cell pinned is the first of its whole cluster whatever the rank count.
 !> - The linear system: each rank owns the rows of its free cells, numbered across the
 !>   ranks in grid order, in hypre's ParCSR matrix on the job's communicator (MPI_COMM_SELF
-!>   on one rank); inner products summed over the ranks. BoomerAMG's coarsening differs on
-!>   several ranks, so the iterations may too; k_eff meets the same tolerance.
+!>   on one rank) for the V-cycle; the matrix product is done here, row by row, with the
+!>   neighbouring rows' values exchanged (on one rank the serial order of the sums, so its
+!>   results are those of the whole-gap solver it replaced, to the bit); inner products
+!>   summed over the ranks. BoomerAMG's coarsening differs on several ranks, so the
+!>   iterations may too; k_eff meets the same tolerance.
 module lc_leakage_reynolds
    use, intrinsic :: iso_c_binding, only: c_int, c_double
    use lc_base_kinds, only: wp, i8
@@ -205,8 +208,8 @@ contains
          flow%percolating = global_any(any(active))
          flow%connected_fraction = global_sum(count(active))/cells
          if (.not. flow%percolating) return
-         call flow_solve(direction, active, active .and. pinned, east, north, nx, cells, hx, hy, tol, &
-            & max_iter, prepared, flow, error)
+         call flow_solve(direction, active, pinned, east, north, nx, cells, hx, hy, tol, max_iter, prepared, &
+            & flow, error)
       end subroutine solve_direction
    end subroutine reynolds_leakage
 
@@ -452,8 +455,8 @@ contains
       end subroutine find_offset
    end subroutine join_clusters
 
-   !> Solve for phi along `direction` (1: x, 2: y) on the `active` cells of this slab (the
-   !> `pinned` ones held at phi = 0) and set k_eff; `cells` on the whole surface.
+   !> Solve for phi along `direction` (1: x, 2: y) on the `active` cells of this slab (those
+   !> `pinned` held at phi = 0) and set k_eff; `cells` on the whole surface.
    subroutine flow_solve(direction, active, pinned, east, north, nx, cells, hx, hy, tol, max_iter, &
          & prepared, flow, error)
       integer, intent(in) :: direction, nx, max_iter
@@ -464,7 +467,6 @@ contains
       type(leakage_flow), intent(inout) :: flow
       type(error_type), allocatable, intent(out) :: error
       real(wp), allocatable :: we(:), wn(:), b(:), phi(:), r(:), z(:), p(:), q(:), decreases(:), phi_grid(:)
-      real(wp), allocatable :: extended(:)
       logical, allocatable :: free(:)
       integer, allocatable :: number(:), free_cells(:), counts(:)
       integer(c_int), allocatable :: row_start(:), column(:)
@@ -517,9 +519,9 @@ contains
          return
       end if
       allocate (row_start(n_free + 1), column(5*n_free), value(5*n_free), r(n_free), z(n_free), p(n_free), &
-         & q(n_free), extended(n_free + 2*nx), decreases(max_iter), stat=stat)
+         & q(n_free), decreases(max_iter), stat=stat)
       if (stat /= 0) then
-         call out_of_memory(error, 'its matrix and iteration vectors', 104*int(n_free, i8))
+         call out_of_memory(error, 'its matrix and iteration vectors', 96*int(n_free, i8))
          return
       end if
       call assemble(.true.)
@@ -536,7 +538,7 @@ contains
          end if
          prepared = .true.
       end if
-      ! (hypre holds its copy: the columns from here on index this rank's values and the
+      ! (hypre holds its copy: the columns from here on index this rank's values, then the
       ! neighbouring rows', for the product in Fortran)
       call assemble(.false.)
 
@@ -596,28 +598,31 @@ contains
          end if
       end subroutine precondition
 
-      !> q = A v on this rank's free cells: v and the values of the free cells of the rows
-      !> next to the slab (exchanged; one rank: its own edge rows) in `extended`, each row
-      !> summed in the order of its entries (the diagonal, east, west, north, south).
+      !> q = A v on this rank's free cells, with the values of the free cells of the rows next
+      !> to the slab (exchanged; one rank: its own edge rows), each row summed in the order of
+      !> its entries (the diagonal, east, west, north, south).
       subroutine apply_matrix(v, q)
          real(wp), intent(in) :: v(:)
          real(wp), intent(out) :: q(:)
-         real(wp) :: below(nx), above(nx)
-         integer :: i, m, e
+         real(wp) :: halo(2*nx)
+         integer :: i, m, e, c
          do i = 1, nx
             edge_rows(i) = 0.0_wp
             edge_rows(nx + i) = 0.0_wp
             if (free(i)) edge_rows(i) = v(number(i) - first_row + 1)
             if (free(n_cells - nx + i)) edge_rows(nx + i) = v(number(n_cells - nx + i) - first_row + 1)
          end do
-         call halo_rows(edge_rows, nx, below, above)
-         extended(:n_free) = v
-         extended(n_free + 1:n_free + nx) = below
-         extended(n_free + nx + 1:) = above
+         ! halo: the row below, then the row above
+         call halo_rows(edge_rows, nx, halo(:nx), halo(nx + 1:))
          do m = 1, n_free
             q(m) = 0.0_wp
             do e = row_start(m) + 1, row_start(m + 1)
-               q(m) = q(m) + value(e)*extended(column(e))
+               c = column(e)
+               if (c <= n_free) then
+                  q(m) = q(m) + value(e)*v(c)
+               else
+                  q(m) = q(m) + value(e)*halo(c - n_free)
+               end if
             end do
          end do
       end subroutine apply_matrix
@@ -647,8 +652,8 @@ contains
 
       !> This rank's rows of the matrix on the free cells in CSR form (zero-based row
       !> starts): the diagonal and the open faces to free neighbours, in the serial order.
-      !> Columns: global and zero-based (hypre's), or (global false) one-based in `extended`,
-      !> this rank's free cells then the rows below and above the slab by their x.
+      !> Columns: global and zero-based (hypre's), or (global false) one-based: this rank's
+      !> free cells, then n_free + x for the row below the slab and n_free + nx + x above.
       subroutine assemble(global)
          logical, intent(in) :: global
          integer :: i, j, k, m, f, nnz, neighbours(4), columns(4), diagonal
