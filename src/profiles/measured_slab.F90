@@ -192,25 +192,20 @@ contains
       end if
       ! the columns of the grid in blocks, rank q's from q*block (some ranks may hold none)
       block = (nx + ranks - 1)/ranks
-      own_first = min(rank*block, nx)
-      own_count = max(0, min(nx, own_first + block) - own_first)
+      call columns_of(rank, own_first, own_count)
       allocate (send_counts(0:ranks - 1), send_offsets(0:ranks - 1), receive_counts(0:ranks - 1), &
          & receive_offsets(0:ranks - 1))
       ! rows -> columns: to rank q this rank's rows of q's columns, row by row
       do q = 0, ranks - 1
-         first = min(q*block, nx)
-         count = max(0, min(nx, first + block) - first)
+         call columns_of(q, first, count)
          other_source = slab_of(mx, my, ranks, q)
          send_counts(q) = count*rows_here
          receive_counts(q) = own_count*other_source%ny_local
       end do
-      call offsets_of(send_counts, send_offsets)
-      call offsets_of(receive_counts, receive_offsets)
-      allocate (outgoing(max(sum(send_counts), 1)), incoming(max(sum(receive_counts), 1)))
+      call buffers_of(send_counts, receive_counts, send_offsets, receive_offsets, outgoing, incoming)
       next = 0
       do q = 0, ranks - 1
-         first = min(q*block, nx)
-         count = max(0, min(nx, first + block) - first)
+         call columns_of(q, first, count)
          do j = 1, rows_here
             outgoing(next + 1:next + count) = wide(first + 1:first + count, j)
             next = next + count
@@ -241,15 +236,12 @@ contains
       deallocate (columns)
       ! columns -> rows: to rank q its rows of this rank's columns, row by row
       do q = 0, ranks - 1
-         first = min(q*block, nx)
-         count = max(0, min(nx, first + block) - first)
+         call columns_of(q, first, count)
          other_target = slab_of(nx, ny, ranks, q)
          send_counts(q) = own_count*other_target%ny_local
          receive_counts(q) = count*target%ny_local
       end do
-      call offsets_of(send_counts, send_offsets)
-      call offsets_of(receive_counts, receive_offsets)
-      allocate (outgoing(max(sum(send_counts), 1)), incoming(max(sum(receive_counts), 1)))
+      call buffers_of(send_counts, receive_counts, send_offsets, receive_offsets, outgoing, incoming)
       next = 0
       do q = 0, ranks - 1
          other_target = slab_of(nx, ny, ranks, q)
@@ -263,13 +255,22 @@ contains
          & receive_offsets, MPI_DOUBLE_PRECISION, communicator)
       allocate (height(nx*target%ny_local))
       do q = 0, ranks - 1
-         first = min(q*block, nx)
-         count = max(0, min(nx, first + block) - first)
+         call columns_of(q, first, count)
          do j = 1, target%ny_local
             height(nx*(j - 1) + first + 1:nx*(j - 1) + first + count) = &
                & incoming(receive_offsets(q) + (j - 1)*count + 1:receive_offsets(q) + j*count)
          end do
       end do
+
+   contains
+
+      !> The grid's columns first+1 .. first+count in rank q's block (none past nx).
+      pure subroutine columns_of(q, first, count)
+         integer, intent(in) :: q
+         integer, intent(out) :: first, count
+         first = min(q*block, nx)
+         count = max(0, min(nx, first + block) - first)
+      end subroutine columns_of
    end subroutine resample_slab
 
    !> Each line (column) of `lines` (m values each) mapped by its Fourier series onto n
@@ -305,15 +306,22 @@ contains
       out = reshape(to%real_buffer, [n, count])
    end subroutine resample_lines
 
-   !> The offsets of consecutive blocks of `counts` values (from 0).
-   pure subroutine offsets_of(counts, offsets)
-      integer, intent(in) :: counts(0:)
-      integer, intent(out) :: offsets(0:)
+   !> The offsets (from 0) of consecutive blocks of the send and receive counts of an
+   !> MPI_Alltoallv, and its buffers.
+   pure subroutine buffers_of(send_counts, receive_counts, send_offsets, receive_offsets, outgoing, incoming)
+      integer, intent(in) :: send_counts(0:), receive_counts(0:)
+      integer, intent(out) :: send_offsets(0:), receive_offsets(0:)
+      real(wp), allocatable, intent(inout) :: outgoing(:), incoming(:)
       integer :: q
-      offsets(0) = 0
-      do q = 1, size(counts) - 1
-         offsets(q) = offsets(q - 1) + counts(q - 1)
+      send_offsets(0) = 0
+      receive_offsets(0) = 0
+      do q = 1, size(send_counts) - 1
+         send_offsets(q) = send_offsets(q - 1) + send_counts(q - 1)
+         receive_offsets(q) = receive_offsets(q - 1) + receive_counts(q - 1)
       end do
-   end subroutine offsets_of
+      if (allocated(outgoing)) deallocate (outgoing)
+      if (allocated(incoming)) deallocate (incoming)
+      allocate (outgoing(max(sum(send_counts), 1)), incoming(max(sum(receive_counts), 1)))
+   end subroutine buffers_of
 #endif
 end module lc_profiles_measured_slab
