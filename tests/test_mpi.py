@@ -483,3 +483,101 @@ def test_height_files_by_slabs(tmp_path):
             for directory in ("ranks2", "ranks3"):
                 assert_same_file(tmp_path / detrend / name / "serial" / "result.h5",
                                  tmp_path / detrend / name / directory / "result.h5")
+
+
+@needs_mpi
+@pytest.mark.parametrize("name", ["patch.h5", "patch.npy"])
+def test_mirrored_height_files_by_slabs(name, tmp_path):
+    """A patch mirrored to the grid (boundary = 'mirror') is read by slabs too: detrended on
+    the file's slabs by its plane (detrend = 'auto'), then each rank takes the file rows its
+    slab of the mirrored grid holds, in the mirror image along y where it lies past the
+    patch. A 25 x 16 patch (ny x nx: a 50 x 32 grid, its rows split unevenly on 3 and 4
+    ranks, where a slab straddles the patch's edge) of a random surface with a tilt along y gives the serial run's file on 2 to 4 ranks; without &scene n the grid is the
+    mirrored patch's on every rank count."""
+    rng = np.random.default_rng(5)
+    ky, kx = np.meshgrid(np.fft.fftfreq(25) * 25, np.fft.fftfreq(16) * 16, indexing="ij")
+    spectrum = (rng.standard_normal((25, 16)) + 1j * rng.standard_normal((25, 16))) / (1 + kx**2 + ky**2)
+    patch = np.fft.ifft2(spectrum).real
+    patch = 0.05 * patch / patch.std() + 0.02 * np.arange(25)[:, None] / 25
+    for grid in ("given", "from the file"):
+        scene = "&scene geometry = 'areal', n = 32, ny = 50 /\n" if grid == "given" else "&scene geometry = 'areal' /\n"
+        for ranks in (1, 2, 3, 4):
+            directory = tmp_path / grid.replace(" ", "_") / f"ranks{ranks}"
+            directory.mkdir(parents=True)
+            if name.endswith(".h5"):
+                with h5py.File(directory / name, "w") as f:
+                    f["h"] = patch
+            else:
+                np.save(directory / name, patch)
+            (directory / "scene.nml").write_text(
+                scene + SCENES["coupled"] +
+                f"&profile kind = 'file', file = '{name}', dataset = 'h', boundary = 'mirror' /\n"
+                "&loading control = 'load', normalised_pressure = 0.15 /\n&solver tol = 1e-13 /\n"
+                "&output file = 'result.h5', overwrite = .true., stress = .false. /\n")
+            if ranks == 1:
+                done = run_serial(directory / "scene.nml")
+            else:
+                done = run_mpi(ranks, [executable(), "scene.nml"], directory)
+            assert done.returncode == 0, done.stderr
+        with h5py.File(tmp_path / grid.replace(" ", "_") / "ranks1" / "result.h5", "r") as f:
+            height = np.asarray(f["profile/height"]).reshape(50, 32)
+        # (the serial heights are the mirror images of the detrended patch: an independent
+        # check that the file compared against is the mirrored surface)
+        assert np.array_equal(height[:25, :16], height[:25, :15:-1]) and np.array_equal(height[:25], height[:24:-1])
+        for ranks in (2, 3, 4):
+            assert_same_file(tmp_path / grid.replace(" ", "_") / "ranks1" / "result.h5",
+                             tmp_path / grid.replace(" ", "_") / f"ranks{ranks}" / "result.h5")
+
+
+@needs_mpi
+@pytest.mark.parametrize("boundary", ["periodic", "mirror"])
+def test_resampled_height_files_by_slabs(boundary, tmp_path):
+    """A file resampled to the grid (resample = 'fourier') is read and resampled on the
+    slabs: each row along x, then each column along y on blocks of columns. A 20 x 24 file
+    (ny x nx; mirrored: a 40 x 48 surface) onto a 50 x 32 grid gives the serial run's file on
+    2-4 ranks (to 1e-10: the same map, its transforms in another order). The file is a
+    band-limited periodic surface, two oblique waves below both grids' Nyquist modes: the
+    serial heights are its values on the grid (to 1e-12: FFT rounding on heights of order
+    0.05), an independent check of what the runs are compared against."""
+    ny_file, nx_file = 20, 24
+    y, x = np.meshgrid(np.arange(ny_file) / ny_file, np.arange(nx_file) / nx_file, indexing="ij")
+
+    def waves(x, y):
+        return 0.03 * np.cos(2 * np.pi * (2 * x + 3 * y)) + 0.02 * np.sin(2 * np.pi * (5 * x - 4 * y) + 0.3)
+
+    for ranks in (1, 2, 3, 4):
+        directory = tmp_path / f"ranks{ranks}"
+        directory.mkdir()
+        with h5py.File(directory / "heights.h5", "w") as f:
+            f["h"] = waves(x, y)
+        (directory / "scene.nml").write_text(
+            "&scene geometry = 'areal', n = 32, ny = 50 /\n" + SCENES["coupled"] +
+            f"&profile kind = 'file', file = 'heights.h5', dataset = 'h', boundary = '{boundary}', "
+            "detrend = 'none', resample = 'fourier' /\n"
+            "&loading control = 'load', normalised_pressure = 0.15 /\n&solver tol = 1e-13 /\n"
+            "&output file = 'result.h5', overwrite = .true., stress = .false. /\n")
+        done = run_serial(directory / "scene.nml") if ranks == 1 else run_mpi(ranks, [executable(), "scene.nml"],
+                                                                             directory)
+        assert done.returncode == 0, done.stderr
+    if boundary == "periodic":
+        with h5py.File(tmp_path / "ranks1" / "result.h5", "r") as f:
+            height = np.asarray(f["profile/height"]).reshape(50, 32)
+        y, x = np.meshgrid(np.arange(50) / 50, np.arange(32) / 32, indexing="ij")
+        assert np.abs(height - waves(x, y)).max() < 1e-12
+    for ranks in (2, 3, 4):
+        assert_same_file(tmp_path / "ranks1" / "result.h5", tmp_path / f"ranks{ranks}" / "result.h5")
+
+@needs_mpi
+@pytest.mark.parametrize("profile", ["&profile kind = 'sinusoid', amplitude = 0.05, mode = 2, mode_y = -3 /\n",
+                                     "&profile kind = 'sphere', radius = 2.0 /\n"])
+def test_sinusoid_and_sphere_by_slabs(profile, tmp_path):
+    """An oblique sinusoid and a spherical cap are made row by row on each rank's slab (no
+    rank makes the whole surface): the serial run's file on 2, 3 and 4 ranks (50 rows: 3
+    and 4 ranks split them unevenly)."""
+    for ranks in (1, 2, 3, 4):
+        nml = write_scene(tmp_path / f"ranks{ranks}", "scene", 50, SCENES["frictionless"], "result.h5",
+                          profile=profile)
+        done = run_serial(nml) if ranks == 1 else run_mpi(ranks, [executable(), "scene.nml"], nml.parent)
+        assert done.returncode == 0, done.stderr
+    for ranks in (2, 3, 4):
+        assert_same_file(tmp_path / "ranks1" / "result.h5", tmp_path / f"ranks{ranks}" / "result.h5")

@@ -110,7 +110,8 @@ contains
          if (is_distributed() .and. is_areal(scene) .and. reads_by_slab(scene%profile%boundary, &
             & scene%profile%resample)) then
             ! (by slabs: no rank reads the whole file)
-            call measured_slab_grid(trim(scene%profile%file), trim(scene%profile%dataset), scene%n, scene%ny, error)
+            call measured_slab_grid(trim(scene%profile%file), trim(scene%profile%dataset), scene%profile%boundary, &
+               & scene%n, scene%ny, error)
          else
             call measured_grid(trim(scene%profile%file), trim(scene%profile%dataset), is_areal(scene), &
                & scene%profile%boundary, scene%n, scene%ny, error)

@@ -7,10 +7,8 @@ module lc_application_scene_solve
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error
    use lc_scene, only: scene_type, grid_of, companion_of
-   use lc_base_parallel, only: is_distributed
    use lc_base_grid, only: grid_type
    use lc_leakage_reynolds, only: reynolds_leakage, leakage_max_iter
-   use lc_leakage_reynolds_slabs, only: reynolds_leakage_slab
    use lc_result, only: contact_result
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solve, only: solve_contact
@@ -95,12 +93,7 @@ contains
       type(grid_type) :: grid
       grid = grid_of(scene)
       allocate (result%leakage)
-      if (is_distributed() .and. .not. grid%is_line()) then
-         ! (on the slabs, every rank getting the whole answer: lc_leakage_reynolds_slabs)
-         call reynolds_leakage_slab(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
-            & scene%leakage_tol, leakage_max_iter, result%leakage, error)
-         return
-      end if
+      ! (distributed: on the slabs, every rank getting the whole answer)
       call reynolds_leakage(result%gap, result%pressure > 0.0_wp, grid%nx, grid%ny, grid%lx, grid%ly, &
          & scene%leakage_tol, leakage_max_iter, result%leakage, error)
    end subroutine leakage_of

@@ -2,10 +2,9 @@
  * set up on the symmetric matrix of the free cells (IJ interface), applied as one V-cycle per
  * call from the conjugate gradients of the Fortran core, then freed. One at a time.
  *
- * On a surface shared among the ranks of an MPI job (lc_leakage_reynolds_slabs) each rank
- * gives the rows of its slab's free cells, numbered across the ranks, on the job's
- * communicator: hypre's ParCSR matrix is then distributed as the slabs are, and its product
- * with a vector (lc_hypre_matvec) exchanges the neighbouring rows' values.
+ * Each rank gives the rows of its slab's free cells, numbered across the ranks, on the job's
+ * communicator (one process: all rows, on MPI_COMM_SELF): hypre's ParCSR matrix and its
+ * V-cycle are then distributed as the slabs are.
  *
  * Debian's hypre is built with MPI. MPI is started here only when a preconditioner is
  * first needed (a singleton start: no mpirun), and finished at exit if it was started here,
@@ -32,7 +31,7 @@
 #include <HYPRE_parcsr_ls.h>
 #include <_hypre_parcsr_mv.h>
 
-/* The status of lc_hypre_setup_boomeramg when memory ran out (lc_leakage_reynolds). */
+/* The status of lc_hypre_setup_boomeramg_rows when memory ran out (lc_leakage_reynolds). */
 enum { OUT_OF_MEMORY = 3 };
 
 static int mpi_started_here = 0;
@@ -308,31 +307,14 @@ static int setup_on(MPI_Comm comm, int first, int n, const int *row_start, const
     return 0;
 }
 
-/* BoomerAMG of the symmetric matrix of n > 0 rows in CSR form (zero-based), on this process
- * alone (setup_on). */
-int lc_hypre_setup_boomeramg(int n, const int *row_start, const int *column, const double *value,
-                             double strength) {
-    return setup_on(MPI_COMM_SELF, 0, n, row_start, column, value, strength);
-}
-
-/* The same on the communicator whose Fortran handle is `comm` (a negative handle: this
- * process alone), this process holding the n rows from `first` (setup_on). */
+/* BoomerAMG (setup_on) on the communicator whose Fortran handle is `comm` (a negative handle:
+ * this process alone, MPI_COMM_SELF), this process holding the n rows from `first`. */
 int lc_hypre_setup_boomeramg_rows(int comm, int first, int n, const int *row_start, const int *column,
                                   const double *value, double strength) {
     int status = start();
     if (status != 0) return status;
     return setup_on(comm < 0 ? MPI_COMM_SELF : MPI_Comm_f2c((MPI_Fint)comm), first, n, row_start, column, value,
                     strength);
-}
-
-/* y = A x on this process's rows of the matrix set up (n values each); 0, or 5 if none is. */
-int lc_hypre_matvec(const double *x, double *y) {
-    if (!amg.live) return 5;
-    /* (a rank without rows takes part in the product's exchange all the same) */
-    if (amg.n > 0) memcpy(hypre_VectorData(hypre_ParVectorLocalVector(amg.par_x)), x, sizeof(double) * (size_t)amg.n);
-    HYPRE_ParCSRMatrixMatvec(1.0, amg.par_a, amg.par_x, 0.0, amg.par_b);
-    if (amg.n > 0) memcpy(y, hypre_VectorData(hypre_ParVectorLocalVector(amg.par_b)), sizeof(double) * (size_t)amg.n);
-    return 0;
 }
 
 /* z = M^-1 r: one V-cycle from a zero guess (n values, as set up). */

@@ -20,7 +20,7 @@ module lc_profiles_profile
    use lc_scene, only: scene_type, not_set, default_rms_gradient, is_areal
    use lc_fft_plans, only: fft_plan
    use lc_profiles_self_affine, only: self_affine_profile, sinusoid_profile
-   use lc_profiles_surface, only: self_affine_surface, sinusoid_surface, spherical_cap
+   use lc_profiles_surface, only: self_affine_surface, sinusoid_surface, spherical_cap, sinusoid_rows, spherical_cap_rows
    use lc_profiles_measured, only: measured_heights
    use lc_profiles_measured_slab, only: reads_by_slab, measured_slab
    use lc_base_parallel, only: slab
@@ -69,26 +69,43 @@ contains
       end associate
    end subroutine make_profile
 
-   !> Heights of an areal scene's surface on its n x ny grid. The sinusoid's modes and the
-   !> sphere's radius are checked here too, as the surface routines cannot fail.
    !> This rank's slab of rows of an areal scene's profile (a surface shared among MPI
-   !> ranks, lc_base_parallel): a self-affine surface is made on the slabs by the distributed
-   !> c2r (the same heights as on one process, to rounding); a height file that is one period
-   !> of the grid is read by slabs (lc_profiles_measured_slab); the other kinds (cheap, or a
-   !> mirrored or resampled file, which every rank reads) are made whole and cut.
+   !> ranks, lc_base_parallel), no rank making the whole surface: a self-affine surface is
+   !> made on the slabs by the distributed c2r (the same heights as on one process, to
+   !> rounding); a sinusoid or a sphere row by row (the same values); a height file is read,
+   !> mirrored and resampled by slabs (lc_profiles_measured_slab). A line is made whole and
+   !> cut.
    subroutine make_profile_slab(scene, height, error)
       type(scene_type), intent(in) :: scene
       real(wp), allocatable, intent(out) :: height(:)
       type(error_type), allocatable, intent(out) :: error
-      real(wp), allocatable :: whole(:)
+      real(wp), allocatable :: whole(:), slab_rows(:, :)
       real(wp) :: period_y
       integer :: y_start, rows
       call slab(scene%ny, y_start, rows)
-      associate (p => scene%profile)
-         if (is_areal(scene) .and. trim(p%kind) == 'file' .and. reads_by_slab(p%boundary, p%resample)) then
-            call measured_slab(trim(p%file), trim(p%dataset), p%detrend, p%boundary, p%resample, scene%n, scene%ny, &
-               & height, error)
-            return
+      period_y = scene%period
+      if (scene%period_y /= not_set) period_y = scene%period_y
+      associate (p => scene%profile, nx => scene%n, ny => scene%ny, lx => scene%period)
+         if (is_areal(scene)) then
+            select case (trim(p%kind))
+            case ('file')
+               if (reads_by_slab(p%boundary, p%resample)) then
+                  call measured_slab(trim(p%file), trim(p%dataset), p%detrend, p%boundary, p%resample, nx, ny, &
+                     & height, error)
+                  return
+               end if
+            case ('sinusoid', 'sphere')
+               call check_analytic(scene, error)
+               if (allocated(error)) return
+               allocate (slab_rows(nx, rows))
+               if (trim(p%kind) == 'sinusoid') then
+                  call sinusoid_rows(nx, ny, lx, period_y, p%amplitude, p%mode, p%mode_y, y_start, slab_rows)
+               else
+                  call spherical_cap_rows(nx, ny, lx, period_y, p%radius, y_start, slab_rows)
+               end if
+               height = reshape(slab_rows, [nx*rows])
+               return
+            end select
          end if
       end associate
       if (.not. (is_areal(scene) .and. trim(scene%profile%kind) == 'self_affine')) then
@@ -100,8 +117,6 @@ contains
       end if
       allocate (height(scene%n*rows))
       height = 0.0_wp
-      period_y = scene%period
-      if (scene%period_y /= not_set) period_y = scene%period_y
       associate (p => scene%profile)
          if (p%rms_gradient == not_set .and. p%rms_height == not_set) then
             call self_affine_surface(scene%n, scene%ny, scene%period, period_y, p%hurst, p%seed, &
@@ -133,6 +148,30 @@ contains
                   & p%short_wavelength, p%rms_gradient, p%rms_height, height, error)
             end if
          case ('sinusoid')
+            call check_analytic(scene, error)
+            if (.not. allocated(error)) &
+               & call sinusoid_surface(nx, ny, lx, period_y, p%amplitude, p%mode, p%mode_y, height)
+         case ('sphere')
+            call check_analytic(scene, error)
+            if (.not. allocated(error)) call spherical_cap(nx, ny, lx, period_y, p%radius, height)
+         case ('file')
+            call measured_heights(trim(p%file), trim(p%dataset), .true., p%detrend, p%boundary, p%resample, &
+               & nx, ny, height, error)
+         case default
+            call fatal_error(error, "&profile: kind = '" // trim(p%kind) // "' is not allowed; allowed: " // &
+               & "'self_affine', 'sinusoid', 'sphere' or 'file'", code_input)
+         end select
+      end associate
+   end subroutine make_surface
+
+   !> The areal sinusoid's amplitude and modes and the sphere's radius (the surface routines
+   !> cannot fail).
+   subroutine check_analytic(scene, error)
+      type(scene_type), intent(in) :: scene
+      type(error_type), allocatable, intent(out) :: error
+      associate (p => scene%profile, nx => scene%n, ny => scene%ny)
+         select case (trim(p%kind))
+         case ('sinusoid')
             if (.not. positive_finite(p%amplitude)) then
                call input_error(error, 'profile', 'amplitude', to_string(p%amplitude), '> 0 and finite')
             else if (p%mode < 0 .or. p%mode > (nx - 1)/2) then
@@ -143,24 +182,13 @@ contains
                   & '|mode_y| <= (ny-1)/2 = ' // to_string((ny - 1)/2))
             else if (p%mode == 0 .and. p%mode_y == 0) then
                call input_error(error, 'profile', 'mode/mode_y', '0/0', 'not both zero (a flat surface)')
-            else
-               call sinusoid_surface(nx, ny, lx, period_y, p%amplitude, p%mode, p%mode_y, height)
             end if
          case ('sphere')
-            if (.not. positive_finite(p%radius)) then
-               call input_error(error, 'profile', 'radius', to_string(p%radius), '> 0 and finite')
-            else
-               call spherical_cap(nx, ny, lx, period_y, p%radius, height)
-            end if
-         case ('file')
-            call measured_heights(trim(p%file), trim(p%dataset), .true., p%detrend, p%boundary, p%resample, &
-               & nx, ny, height, error)
-         case default
-            call fatal_error(error, "&profile: kind = '" // trim(p%kind) // "' is not allowed; allowed: " // &
-               & "'self_affine', 'sinusoid', 'sphere' or 'file'", code_input)
+            if (.not. positive_finite(p%radius)) &
+               & call input_error(error, 'profile', 'radius', to_string(p%radius), '> 0 and finite')
          end select
       end associate
-   end subroutine make_surface
+   end subroutine check_analytic
 
    !> Rms height, rms gradient and maximum height above the mean line (definitions in the
    !> module header). A plain subroutine: the gradient needs an FFT plan.

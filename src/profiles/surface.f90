@@ -52,7 +52,7 @@ module lc_profiles_surface
    use lc_profiles_self_affine, only: check_roughness_scale
    implicit none (type, external)
    private
-   public :: self_affine_surface, sinusoid_surface, spherical_cap, surface_mode_index
+   public :: self_affine_surface, sinusoid_surface, spherical_cap, sinusoid_rows, spherical_cap_rows, surface_mode_index
 
    real(wp), parameter :: pi = acos(-1.0_wp)
    !> Default shortest wavelength as a fraction of the shorter period.
@@ -205,17 +205,29 @@ contains
       integer, intent(in) :: mode, mode_y
       !> Heights (L)
       real(wp), intent(out) :: height(nx, ny)
+      call sinusoid_rows(nx, ny, lx, ly, amplitude, mode, mode_y, 0, height)
+   end subroutine sinusoid_surface
+
+   !> The rows y_start+1 .. y_start+size(height, 2) of sinusoid_surface (a slab of rows of
+   !> a surface shared among MPI ranks, lc_base_slab): the same values point by point.
+   pure subroutine sinusoid_rows(nx, ny, lx, ly, amplitude, mode, mode_y, y_start, height)
+      integer, intent(in) :: nx, ny, mode, mode_y
+      real(wp), intent(in) :: lx, ly, amplitude
+      !> rows before the first one here (0-based)
+      integer, intent(in) :: y_start
+      !> Heights of the rows (L), (nx, rows)
+      real(wp), intent(out) :: height(:, :)
       real(wp) :: x, y
       integer :: ix, iy
 
-      do iy = 0, ny - 1
+      do iy = y_start, y_start + size(height, 2) - 1
          y = iy*ly/ny
          do ix = 0, nx - 1
             x = ix*lx/nx
-            height(ix + 1, iy + 1) = amplitude*cos(2*pi*(mode*x/lx + mode_y*y/ly))
+            height(ix + 1, iy - y_start + 1) = amplitude*cos(2*pi*(mode*x/lx + mode_y*y/ly))
          end do
       end do
-   end subroutine sinusoid_surface
+   end subroutine sinusoid_rows
 
    !> Spherical cap of radius R with its apex at the grid point (ix, iy) = (nx/2, ny/2)
    !> (0-based; the cell's centre (lx/2, ly/2) for even sizes): r = sqrt(R^2 - rho^2) - R
@@ -231,10 +243,22 @@ contains
       real(wp), intent(in) :: radius
       !> Heights (L)
       real(wp), intent(out) :: height(nx, ny)
+      call spherical_cap_rows(nx, ny, lx, ly, radius, 0, height)
+   end subroutine spherical_cap
+
+   !> The rows y_start+1 .. y_start+size(height, 2) of spherical_cap (a slab of rows): the
+   !> same values point by point.
+   pure subroutine spherical_cap_rows(nx, ny, lx, ly, radius, y_start, height)
+      integer, intent(in) :: nx, ny
+      real(wp), intent(in) :: lx, ly, radius
+      !> rows before the first one here (0-based)
+      integer, intent(in) :: y_start
+      !> Heights of the rows (L), (nx, rows)
+      real(wp), intent(out) :: height(:, :)
       real(wp) :: dx, dy, rho2
       integer :: ix, iy
 
-      do iy = 0, ny - 1
+      do iy = y_start, y_start + size(height, 2) - 1
          dy = iy*ly/ny - (ny/2)*ly/ny
          do ix = 0, nx - 1
             dx = ix*lx/nx - (nx/2)*lx/nx
@@ -242,11 +266,11 @@ contains
             if (rho2 < radius**2) then
                ! sqrt(R^2 - rho^2) - R written without its cancellation near the apex (and
                ! as 0 - ..., so that the apex is +0, not -0)
-               height(ix + 1, iy + 1) = 0.0_wp - rho2/(radius + sqrt(radius**2 - rho2))
+               height(ix + 1, iy - y_start + 1) = 0.0_wp - rho2/(radius + sqrt(radius**2 - rho2))
             else
-               height(ix + 1, iy + 1) = -radius
+               height(ix + 1, iy - y_start + 1) = -radius
             end if
          end do
       end do
-   end subroutine spherical_cap
+   end subroutine spherical_cap_rows
 end module lc_profiles_surface

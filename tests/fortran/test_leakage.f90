@@ -10,7 +10,6 @@ program test_leakage
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
    use lc_leakage_reynolds, only: leakage_result, reynolds_leakage
-   use lc_leakage_reynolds_slabs, only: reynolds_leakage_slab
    use lc_test_checks, only: check, finish
    implicit none (type, external)
 
@@ -21,7 +20,7 @@ program test_leakage
    call check_stripes()
    call check_blocked()
    call check_diagonal_channel()
-   call check_one_slab()
+   call check_periodic_edge()
    call finish('leakage')
 
 contains
@@ -93,20 +92,22 @@ contains
       call check(abs(res%x%k_eff/res%y%k_eff - 1) < tol_solve, 'diagonal channel: symmetric, k_eff_x = k_eff_y')
    end subroutine check_diagonal_channel
 
-   !> The leakage on the slabs (lc_leakage_reynolds_slabs) with one rank: its slab is the
-   !> whole surface, its clusters are joined across the periodic edge y by the join of the
-   !> slabs, its matrix and V-cycle are hypre's on this process. On a contact map with
-   !> clusters that wind along y only through that edge, along x only, both, and pools that
-   !> carry no flow: the serial counts exactly, k_eff to tol_solve (both CG stopped at 1e-12
-   !> on one preconditioner; they differ by the order of the sums).
-   subroutine check_one_slab()
-      integer, parameter :: nx = 48, ny = 40
+   !> The clusters joined across the periodic edge along y. On one rank the slab is the whole
+   !> surface and the clusters that wind along y only through its periodic edge are joined by
+   !> the pairs across that edge (the join of the slabs); the same map shifted by half the
+   !> rows (and some columns) has them inside the slab and others across the edge. The flow
+   !> is invariant under the shift: the counts exactly, k_eff to tol_solve (both CG stopped
+   !> at 1e-12; they differ by the order of the sums and the preconditioner's coarsening).
+   !> A contact map with clusters that wind along y only through that edge, along x only,
+   !> both, and pools that carry no flow.
+   subroutine check_periodic_edge()
+      integer, parameter :: nx = 48, ny = 40, shift_x = 7, shift_y = ny/2
       real(wp), parameter :: pi = acos(-1.0_wp)
-      real(wp) :: g(nx*ny), x, y
-      type(leakage_result) :: serial, slab
+      real(wp) :: g(nx*ny), g_shifted(nx*ny), x, y
+      type(leakage_result) :: res, shifted
       type(error_type), allocatable :: error
-      integer :: i, j
-      logical :: closed(nx*ny)
+      integer :: i, j, k
+      logical :: closed(nx*ny), closed_shifted(nx*ny)
       ! a smooth gap closed on half the cells, connected along x and y through necks
       do j = 1, ny
          do i = 1, nx
@@ -125,18 +126,25 @@ contains
             closed(21 + i + modulo(j, ny)*nx) = .true.
          end do
       end do
-      call reynolds_leakage(g, closed, nx, ny, 1.0_wp, 1.2_wp, 1.0e-12_wp, 500, serial, error)
+      do j = 1, ny
+         do i = 1, nx
+            k = modulo(i - 1 + shift_x, nx) + 1 + modulo(j - 1 + shift_y, ny)*nx
+            g_shifted(i + (j - 1)*nx) = g(k)
+            closed_shifted(i + (j - 1)*nx) = closed(k)
+         end do
+      end do
+      call reynolds_leakage(g, closed, nx, ny, 1.0_wp, 1.2_wp, 1.0e-12_wp, 500, res, error)
       if (allocated(error)) call check(.false., 'leakage: ' // error%message)
-      call reynolds_leakage_slab(g, closed, nx, ny, 1.0_wp, 1.2_wp, 1.0e-12_wp, 500, slab, error)
-      if (allocated(error)) call check(.false., 'leakage on one slab: ' // error%message)
-      call check(serial%fluid_fraction < 0.8_wp .and. serial%x%connected_fraction < serial%fluid_fraction, &
-         & 'one slab: the map has pools that carry no flow')
-      call check(slab%fluid_fraction == serial%fluid_fraction .and. &
-         & (slab%x%connected_fraction == serial%x%connected_fraction) .and. &
-         & (slab%y%connected_fraction == serial%y%connected_fraction) .and. slab%x%unknowns == serial%x%unknowns &
-         & .and. slab%y%unknowns == serial%y%unknowns .and. (slab%x%percolating .eqv. serial%x%percolating) .and. &
-         & (slab%y%percolating .eqv. serial%y%percolating), 'one slab: the serial clusters and unknowns')
-      call check(abs(slab%x%k_eff/serial%x%k_eff - 1) < tol_solve .and. abs(slab%y%k_eff/serial%y%k_eff - 1) &
-         & < tol_solve .and. serial%x%k_eff > 0 .and. serial%y%k_eff > 0, 'one slab: the serial k_eff along x and y')
-   end subroutine check_one_slab
+      call reynolds_leakage(g_shifted, closed_shifted, nx, ny, 1.0_wp, 1.2_wp, 1.0e-12_wp, 500, shifted, error)
+      if (allocated(error)) call check(.false., 'leakage of the shifted gap: ' // error%message)
+      call check(res%fluid_fraction < 0.8_wp .and. res%x%connected_fraction < res%fluid_fraction, &
+         & 'periodic edge: the map has pools that carry no flow')
+      call check(shifted%fluid_fraction == res%fluid_fraction .and. &
+         & (shifted%x%connected_fraction == res%x%connected_fraction) .and. &
+         & (shifted%y%connected_fraction == res%y%connected_fraction) .and. shifted%x%unknowns == res%x%unknowns &
+         & .and. shifted%y%unknowns == res%y%unknowns .and. (shifted%x%percolating .eqv. res%x%percolating) .and. &
+         & (shifted%y%percolating .eqv. res%y%percolating), 'periodic edge: the same clusters and unknowns shifted')
+      call check(abs(shifted%x%k_eff/res%x%k_eff - 1) < tol_solve .and. abs(shifted%y%k_eff/res%y%k_eff - 1) &
+         & < tol_solve .and. res%x%k_eff > 0 .and. res%y%k_eff > 0, 'periodic edge: k_eff along x and y shifted')
+   end subroutine check_periodic_edge
 end program test_leakage
