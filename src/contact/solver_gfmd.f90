@@ -327,7 +327,6 @@ contains
          if (across_ranks) contacts = global_sum(contacts)
       end function contacts
 
-
       !> The Newton step of the traction on the current contact set C (lambda > 0), and the
       !> surface moved with it. On C the wall's pressure answers a change d of the traction
       !> by y = -S G_x d (S the inverse of G_n on C, the load held), so tau + d = mu_c
