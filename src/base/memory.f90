@@ -61,9 +61,10 @@ contains
       ! GCR's directions where a finishing phase stagnates, only where they fit in half the
       ! memory then left: not counted here)
       if (coupled .and. multigrid) doubles = max(doubles, merge(62, 66, line))
-      ! (GFMD's positions, velocities, forces and reaction, and with friction the traction's
-      ! update and its Anderson history of 10: peak resident 18.1 doubles per point
-      ! frictionless at 1024², 34.5-37.6 with friction at 1024² and 512², over the surface's)
+      ! (GFMD's positions, velocities, forces and reaction, and with friction the traction,
+      ! G_x, 1/G_eff and the 11 fields of its Newton step's GMRES: peak resident 18.1 doubles
+      ! per point frictionless at 1024², 34.5-37.6 with friction at 1024² and 512² with the
+      ! Anderson history of 10 fields that the GMRES replaced, an upper bound now)
       if (gfmd) doubles = merge(38, 19, coupled)
       if (stress) doubles = doubles + 6
       bytes = 8_i8*doubles*points

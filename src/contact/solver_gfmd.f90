@@ -24,13 +24,15 @@
 !> traction is updated towards its fixed point tau = mu_c lambda whenever the dynamics has
 !> relaxed the current problem to a fraction update_ratio of the update's own mismatch
 !> max|mu_c lambda - tau| (an inexact inner relaxation; the velocities are kept). On a
-!> fixed contact set the plain update tau <- mu_c lambda has the eigenvalues +-i beta
-!> (beta = mu_c |G_x|/G_n up to 4.7 on the paper's thin layers), so the update is
-!> preconditioned per mode by the full-contact Jacobian 1 + a mu_c G_x/G_n, a the contact
-!> fraction of the moment (1 at full contact, where it is exact; ~identity at sparse
-!> contact, where the contact set decouples the modes), and accelerated by Anderson mixing
-!> (Walker and Ni) over the last update_memory updates. An update costs two transform
-!> pairs (docs/decisions/001-gfmd-masses.md, docs/numerics.md).
+!> fixed contact set C the fixed point is linear in tau, and its Jacobian I + mu_c S G_x
+!> (S the inverse of G_n on C) has the eigenvalues 1 + i[-beta, beta] (beta = mu_c
+!> |G_x|/G_n up to 4.7 on the paper's thin layers): the update is its Newton step, the
+!> change of the wall's pressure solved on C with G_eff by GMRES (right-preconditioned by
+!> the masked 1/G_eff, exact at full contact) to a fraction update_forcing of its right
+!> side (an inexact Newton step), and the surface off C moves with it to the new
+!> traction's equilibrium on C. The dynamics finds the contact set; on a fixed set one
+!> update settles the traction, so the updates follow the set's changes: 1-13 on the
+!> Fig. 3 family (docs/decisions/001-gfmd-masses.md, docs/numerics.md).
 !>
 !> Convergence is judged, as for the other solvers, on the complementarity residual of the
 !> pressure the wall carries (p = lambda, w = G_eff lambda, gap = w - b - s), not on an
@@ -57,7 +59,6 @@ module lc_contact_solver_gfmd
    use lc_contact_progress, only: progress_log
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
-   use lc_contact_solver_anderson, only: least_squares, history_products, mix
    implicit none (type, external)
    private
    public :: gfmd, gfmd_outcome, gfmd_solver, gfmd_refusal
@@ -81,13 +82,17 @@ module lc_contact_solver_gfmd
    !> (docs/decisions/001-gfmd-masses.md).
    real(wp), parameter :: max_friction_ratio = 6.0_wp
    !> The traction is updated once the largest unbalanced pressure is below this fraction
-   !> of the update's mismatch max|mu_c lambda - tau| (measured: 0.3 against 0.1 and 0.03
-   !> at h/lambda = 0.05, mu_c = 1: 1085 against 1206 and 1419 steps at 2 % contact, 539
-   !> against 799 and 1190 at 32 %), or after update_max_steps steps at the latest.
-   real(wp), parameter :: update_ratio = 0.3_wp
+   !> of the update's mismatch max|mu_c lambda - tau| (measured, the Fig. 3 surface at 64²,
+   !> h/lambda = 0.05, mu_c = 1, 0.7 / 2 / 32 / 100 % contact: 451 / 344 / 338 / 62
+   !> transform pairs at 0.01, 512 / 404 / 334 / 54 at 0.03, 688 / 482 / 293 / 52 at 0.1,
+   !> 434 / 359 / 358 / 67 at 0.003), or after update_max_steps steps at the latest.
+   real(wp), parameter :: update_ratio = 0.01_wp
    integer, parameter :: update_max_steps = 500
-   !> Updates the Anderson mixing of the traction remembers.
-   integer, parameter :: update_memory = 10
+   !> Most GMRES steps of a Newton step of the traction, and the fraction of its right
+   !> side's norm it stops at (measured as above: 0.3 takes 451 / 410 / 532 / 66 pairs,
+   !> the steps of the dynamics growing where the traction is solved less well).
+   integer, parameter :: update_krylov = 10
+   real(wp), parameter :: update_forcing = 0.1_wp
 
    !> What one GFMD solve did.
    type :: gfmd_outcome
@@ -129,14 +134,14 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
-      complex(wp), allocatable :: normal(:), tangential(:), stiffness(:), coupling(:), update_preconditioner(:)
+      complex(wp), allocatable :: normal(:), tangential(:), stiffness(:), coupling(:), inverse_full(:)
       real(wp), allocatable :: u(:), v(:), a(:), lambda(:), p_best(:)
-      real(wp), allocatable :: tau(:), offset(:), step_tau(:), tau_old(:), step_old(:), tx(:), dx(:, :), df(:, :)
-      real(wp), allocatable :: gram(:, :), gamma(:), projection(:)
+      real(wp), allocatable :: tau(:), offset(:), basis(:, :), change(:), response(:)
+      logical, allocatable :: inside(:)
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: dt, alpha, power, v_norm, a_norm, s_best, uniform, b_max, mass, residual, friction
-      real(wp) :: imbalance, mismatch, mismatch_floor, contact_fraction, points, sums(3), maxima(2)
-      integer :: step, since_negative, checks, n, j, since_update, columns, newest
+      real(wp) :: imbalance, mismatch, mismatch_floor, contact_points, points, sums(3), maxima(2)
+      integer :: step, since_negative, checks, n, j, since_update
       logical :: with_traction, across_ranks
 
       n = size(p)
@@ -154,7 +159,14 @@ contains
          stiffness = (0.0_wp, 0.0_wp)
          coupling = (0.0_wp, 0.0_wp)
       end where
-      deallocate (normal, tangential)   ! (the solve's memory: stiffness and coupling suffice)
+      deallocate (normal)   ! (the solve's memory: stiffness, coupling and, with friction, G_x)
+      if (with_traction) then
+         ! 1/G_eff = K_n/(1 + mu_c G_x/G_n), the Newton step's preconditioner (0 where K_n = 0)
+         allocate (inverse_full(size(stiffness)))
+         inverse_full = stiffness/(1.0_wp + friction*coupling)
+      else
+         deallocate (tangential)
+      end if
       buffer => op%buffer()
       allocate (u(n), v(n), a(n), lambda(n), tau(n), offset(n))
       maxima = [maxval(abs(b)), maxval(abs(stiffness))]
@@ -176,9 +188,7 @@ contains
          call op%multiply_complex_in_buffer(coupling)
          offset = buffer
          outcome%fft_pairs = outcome%fft_pairs + 1
-         allocate (step_tau(n), tau_old(n), step_old(n), tx(n), dx(n, update_memory), df(n, update_memory))
-         allocate (gram(update_memory, update_memory), gamma(update_memory), projection(update_memory))
-         allocate (update_preconditioner(size(stiffness)))
+         allocate (basis(n, update_krylov + 1), change(n), response(n), inside(n))
       end if
       if (load_control) then
          s = minval(u - b)
@@ -190,8 +200,6 @@ contains
       alpha = fire_alpha0
       since_negative = 0
       since_update = 0
-      columns = 0
-      newest = 0
       checks = 0
       p_best = p
       s_best = s
@@ -274,7 +282,6 @@ contains
             if (mismatch > mismatch_floor .and. &
                & (imbalance <= update_ratio*mismatch .or. since_update >= update_max_steps)) then
                call update_traction()
-               if (allocated(error)) return
                since_update = 0
             end if
          end if
@@ -320,60 +327,141 @@ contains
          if (across_ranks) contacts = global_sum(contacts)
       end function contacts
 
-      !> tau <- the Anderson mixing of the preconditioned updates tau + P_a^-1 (mu_c lambda - tau),
-      !> P_a = 1 + a mu_c G_x/G_n (a: the contact fraction), and the offset K_n G_x tau of the
-      !> new traction (two transform pairs).
+      !> The Newton step of the traction on the current contact set C (lambda > 0), and the
+      !> surface moved with it. On C the wall's pressure answers a change d of the traction
+      !> by y = -S G_x d (S the inverse of G_n on C, the load held), so tau + d = mu_c
+      !> (lambda + y) asks for
+      !>    G_eff y + c = -G_x r on C,  sum(y) = 0 under load control (c = 0 otherwise),
+      !> r = mu_c lambda - tau, solved by GMRES on C to update_forcing of its right side;
+      !> then tau <- mu_c (lambda + y) on C (0 off it), and the surface off C moves by the
+      !> displacement of the two changes, du = G_eff y + G_x r - c, so that the dynamics
+      !> continues from the new traction's equilibrium on C. Transform pairs: one for G_x r,
+      !> two a GMRES step and one more for its solution, one for du, one for the offset.
       subroutine update_traction()
+         real(wp) :: shift
+         integer :: pairs
          outcome%updates = outcome%updates + 1
-         contact_fraction = contacts(lambda)/points
-         update_preconditioner = 1.0_wp/(1.0_wp + (contact_fraction*friction)*coupling)
+         inside = lambda > 0.0_wp
+         contact_points = real(count(inside), wp)
+         if (across_ranks) contact_points = global_sum(contact_points)
+         if (contact_points == 0.0_wp) return
          !$omp simd
          do j = 1, n
             buffer(j) = friction*lambda(j) - tau(j)
          end do
-         call op%multiply_complex_in_buffer(update_preconditioner)
-         step_tau = buffer
-         if (outcome%updates > 1) then
-            newest = mod(newest, update_memory) + 1
-            columns = min(columns + 1, update_memory)
-            !$omp simd
-            do j = 1, n
-               dx(j, newest) = tau(j) - tau_old(j)
-               df(j, newest) = step_tau(j) - step_old(j)
-            end do
+         call op%multiply_complex_in_buffer(tangential)
+         response = buffer   ! G_x r
+         change = merge(-response, 0.0_wp, inside)
+         call remove_contact_mean(change)
+         call gmres_on_contact(change, pairs)
+         buffer = change
+         call op%full_in_buffer()
+         response = response + buffer   ! du + c = G_eff y + G_x r, = c on C
+         shift = 0.0_wp
+         if (load_control) then
+            shift = sum(response, mask=inside)
+            if (across_ranks) shift = global_sum(shift)
+            shift = shift/contact_points
          end if
-         tau_old = tau
-         step_old = step_tau
-         tx = tau + step_tau
-         if (columns == 0) then
-            tau = tx
-         else
-            call history_products(df(:, 1:columns), newest, step_tau, gram(1:columns, newest), &
-               & projection(1:columns))
-            if (across_ranks) call add_products_over_ranks(gram(1:columns, newest), projection(1:columns))
-            gram(newest, 1:columns) = gram(1:columns, newest)
-            call least_squares(gram(1:columns, 1:columns), projection(1:columns), gamma(1:columns), error)
-            if (allocated(error)) return
-            call mix(tx, dx(:, 1:columns), df(:, 1:columns), gamma(1:columns), tau)
-         end if
+         !$omp simd
+         do j = 1, n
+            if (.not. inside(j)) u(j) = max(u(j) + response(j) - shift, b(j) + s)
+            tau(j) = merge(friction*(lambda(j) + change(j)), 0.0_wp, inside(j))
+         end do
          buffer = tau
          call op%multiply_complex_in_buffer(coupling)
          offset = buffer
-         outcome%fft_pairs = outcome%fft_pairs + 2
+         outcome%fft_pairs = outcome%fft_pairs + pairs + 3
       end subroutine update_traction
-   end subroutine gfmd
 
-   !> The Gram column and the projection of the mixing summed over the ranks (one message).
-   subroutine add_products_over_ranks(gram_column, projection)
-      real(wp), intent(inout) :: gram_column(:), projection(:)
-      real(wp) :: products(2*size(gram_column))
-      integer :: m
-      m = size(gram_column)
-      products = [gram_column, projection]
-      call sum_over_ranks(products)
-      gram_column = products(1:m)
-      projection = products(m + 1:)
-   end subroutine add_products_over_ranks
+      !> x <- x less its mean over C under load control (the load held: the constant c).
+      subroutine remove_contact_mean(x)
+         real(wp), intent(inout) :: x(:)
+         real(wp) :: total
+         if (.not. load_control) return
+         total = sum(x, mask=inside)
+         if (across_ranks) total = global_sum(total)
+         where (inside) x = x - total/contact_points
+      end subroutine remove_contact_mean
+
+      !> x <- the solution of Pi G_eff x = x on C (Pi: onto C, less the mean under load
+      !> control) by GMRES right-preconditioned by Pi G_eff^-1 (exact at full contact), at
+      !> most update_krylov steps, to update_forcing of the right side's norm; pairs: the
+      !> transform pairs it took.
+      subroutine gmres_on_contact(x, pairs)
+         real(wp), intent(inout) :: x(:)
+         integer, intent(out) :: pairs
+         real(wp) :: h(update_krylov + 1, update_krylov), g(update_krylov + 1), z(update_krylov + 1)
+         real(wp) :: cs(update_krylov), sn(update_krylov), column(update_krylov + 1)
+         real(wp) :: norm0, rotated, subdiagonal
+         integer :: k, i
+         pairs = 0
+         norm0 = norm(x)
+         if (norm0 == 0.0_wp) return
+         basis(:, 1) = x/norm0
+         g = 0.0_wp
+         g(1) = norm0
+         h = 0.0_wp
+         do k = 1, update_krylov
+            buffer = basis(:, k)
+            call precondition()
+            call op%full_in_buffer()
+            pairs = pairs + 2
+            x = merge(buffer, 0.0_wp, inside)
+            call remove_contact_mean(x)
+            ! classical Gram-Schmidt, twice (one sum over the ranks each)
+            column = 0.0_wp
+            do i = 1, 2
+               z(1:k) = matmul(x, basis(:, 1:k))
+               if (across_ranks) call sum_over_ranks(z(1:k))
+               x = x - matmul(basis(:, 1:k), z(1:k))
+               column(1:k) = column(1:k) + z(1:k)
+            end do
+            subdiagonal = norm(x)
+            column(k + 1) = subdiagonal
+            ! the Givens rotations of the earlier columns, and this column's
+            do i = 1, k - 1
+               rotated = cs(i)*column(i) + sn(i)*column(i + 1)
+               column(i + 1) = -sn(i)*column(i) + cs(i)*column(i + 1)
+               column(i) = rotated
+            end do
+            rotated = hypot(column(k), column(k + 1))
+            cs(k) = column(k)/rotated
+            sn(k) = column(k + 1)/rotated
+            column(k) = rotated
+            g(k + 1) = -sn(k)*g(k)
+            g(k) = cs(k)*g(k)
+            h(1:k, k) = column(1:k)
+            if (abs(g(k + 1)) <= update_forcing*norm0 .or. k == update_krylov) exit
+            basis(:, k + 1) = x/subdiagonal
+         end do
+         do i = k, 1, -1
+            z(i) = (g(i) - dot_product(h(i, i + 1:k), z(i + 1:k)))/h(i, i)
+         end do
+         buffer = matmul(basis(:, 1:k), z(1:k))
+         call precondition()
+         pairs = pairs + 1
+         x = buffer
+      end subroutine gmres_on_contact
+
+      !> buffer <- Pi G_eff^-1 buffer.
+      subroutine precondition()
+         call op%multiply_complex_in_buffer(inverse_full)
+         !$omp simd
+         do j = 1, n
+            if (.not. inside(j)) buffer(j) = 0.0_wp
+         end do
+         call remove_contact_mean(buffer)
+      end subroutine precondition
+
+      !> The Euclidean norm of x over the whole surface.
+      real(wp) function norm(x)
+         real(wp), intent(in) :: x(:)
+         norm = dot_product(x, x)
+         if (across_ranks) norm = global_sum(norm)
+         norm = sqrt(norm)
+      end function norm
+   end subroutine gfmd
 
    !> The operator's multiplier split into the normal response to the pressure, G_n, and
    !> to the friction traction, G_x: G_eff = G_n + mu_c G_x (the operator's modes; G_x = 0
