@@ -42,11 +42,16 @@ module lc_fft_plans
    !> Surfaces of at least this many points are transformed in two passes: the rows (r2c),
    !> then the columns of the half spectrum in blocks of `column_block` adjacent columns.
    !> FFTW_ESTIMATE's plan for the 2D transform walks the columns one at a time with a
-   !> stride of nx/2 + 1 complex numbers, a cache line per element; blocks of 8 share the
-   !> lines. The gain is steady from about 1000^2 on (docs/performance.md, 'Cost': 'Large surfaces:
-   !> a two-pass transform'; bench/fft_plans.c).
+   !> stride of nx/2 + 1 complex numbers, a cache line per element; blocks of adjacent
+   !> columns share the lines. The gain is steady from about 1000^2 on (docs/performance.md,
+   !> 'Cost': 'Large surfaces: a two-pass transform'; bench/fft_plans.c). Blocks of 16 (four
+   !> cache lines a row) rather than 8: the column pass, FFTW's buffered copies in and out of
+   !> each block, is the larger part of a pair, and takes 0.85-0.9 of its time with 8
+   !> (docs/decisions/024-fft-floor.md, 'Measured'); a column's transform is the same
+   !> arithmetic in a block of 8 or 16, so the same bits where the last, narrower block is
+   !> (nx/2 + 1 = 1 modulo 16: nx a multiple of 32).
    integer, parameter :: split_points = 800000
-   integer, parameter :: column_block = 8
+   integer, parameter :: column_block = 16
    !> FFTW-MPI's own set-up is done (once per process)
    logical :: fftw_mpi_ready = .false.
 
