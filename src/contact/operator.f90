@@ -168,6 +168,9 @@ contains
       do i = 1, op%nk
          call op%fft%mode_indices(i, mx, my)
          if (mx == 0 .and. my == 0) cycle
+         ! (a whole surface's row my > ny/2 has the q_y of row ny - my negated, and the
+         ! multipliers depend on |q| and q_x alone: mirror_rows copies it, the same bits)
+         if (.not. op%distributed .and. 2*my > grid%ny) cycle
          call grid%wavevector(my*nkx + mx + 1, qx, qy)
          q = hypot(qx, qy)
          q_min = min(q_min, q)
@@ -180,6 +183,7 @@ contains
          op%metric(i) = abs(g)
          if (op%coupled) op%full(i) = g
       end do
+      if (.not. op%distributed) call mirror_rows(op, nkx)
       allocate (op%preconditioner(op%nk))
       call advise_huge_pages(op%preconditioner)
       where (op%metric > 0.0_wp)
@@ -210,6 +214,21 @@ contains
       if (op%metric_falls) op%metric_falls = kernel%compliance_falls(q_min, q_max)
       call derive(op)
    end subroutine build_operator
+
+   !> The multipliers of the rows my > ny/2 of a whole surface's half spectrum from the rows
+   !> ny - my (q_y negated: |q| and q_x are the same), which build_operator left out: half
+   !> the kernel's evaluations on a surface.
+   subroutine mirror_rows(op, nkx)
+      type(compliance_operator), intent(inout) :: op
+      integer, intent(in) :: nkx
+      integer :: my, row, mirror
+      do my = op%grid%ny/2 + 1, op%grid%ny - 1
+         row = my*nkx
+         mirror = (op%grid%ny - my)*nkx
+         op%metric(row + 1:row + nkx) = op%metric(mirror + 1:mirror + nkx)
+         if (op%coupled) op%full(row + 1:row + nkx) = op%full(mirror + 1:mirror + nkx)
+      end do
+   end subroutine mirror_rows
 
    !> The quantities derived from the multipliers: diagonal, largest (the real-space column
    !> is made when a CG solve asks for it: prepare_cg).
@@ -242,13 +261,14 @@ contains
    !> Make the real-space column of M that the constrained CG's column updates need.
    subroutine prepare_cg(self)
       class(compliance_operator), intent(inout) :: self
-      real(wp), allocatable :: unit_load(:)
       if (allocated(self%column) .or. self%distributed) return
-      allocate (unit_load(self%n), self%column(self%n))
+      allocate (self%column(self%n))
       call advise_huge_pages(self%column)
-      unit_load = 0.0_wp
-      unit_load(1) = 1.0_wp
-      call self%apply_metric(unit_load, self%column)
+      ! (the unit load at the first point, written straight into the transform's buffer)
+      self%fft%real_buffer = 0.0_wp
+      self%fft%real_buffer(1) = 1.0_wp
+      call multiply_in_buffer(self, self%metric)
+      self%column = self%fft%real_buffer
    end subroutine prepare_cg
 
    !> Leave the uniform (k = 0) mode out of the operator and return its multiplier (h/M for
@@ -552,42 +572,52 @@ contains
    !> real-space diagonal of the inverse.
    subroutine prepare_gcr(self)
       class(compliance_operator), intent(inout) :: self
-      complex(wp), allocatable :: g(:)
-      real(wp), allocatable :: unit_load(:)
+      ! (G_eff itself where it is complex: no copy of the multiplier)
+      if (self%coupled) then
+         call prepare_gcr_with(self, self%full)
+      else
+         call prepare_gcr_with(self, cmplx(self%metric, 0.0_wp, kind=wp))
+      end if
+   end subroutine prepare_gcr
+
+   !> prepare_gcr with G_eff = g on the half spectrum.
+   subroutine prepare_gcr_with(self, g)
+      class(compliance_operator), intent(inout) :: self
+      complex(wp), contiguous, intent(in) :: g(:)
       integer :: n
       n = self%n
-      if (self%coupled) then
-         g = self%full
-      else
-         g = cmplx(self%metric, 0.0_wp, kind=wp)
-      end if
       if (allocated(self%inverse_full)) deallocate (self%inverse_full)
-      allocate (self%inverse_full(self%nk), unit_load(n))
+      allocate (self%inverse_full(self%nk))
       call advise_huge_pages(self%inverse_full)
-      call advise_huge_pages(unit_load)
       where (abs(g) > 0.0_wp)
          self%inverse_full = 1.0_wp/g
       elsewhere
          self%inverse_full = (0.0_wp, 0.0_wp)
       end where
-      ! (the unit load at the first point, on the rank holding it)
-      unit_load = 0.0_wp
-      if (self%fft%y_start == 0) unit_load(1) = 1.0_wp
+      ! (the unit load at the first point, on the rank holding it, written straight into
+      ! the transform's buffer)
       if (.not. self%distributed) then
          if (.not. allocated(self%full_column)) then
             allocate (self%full_column(n))
             call advise_huge_pages(self%full_column)
          end if
-         self%fft%real_buffer = unit_load
+         call unit_load_in_buffer(self)
          call multiply_complex_in_buffer(self, g)
          self%full_column = self%fft%real_buffer
       end if
-      self%fft%real_buffer = unit_load
+      call unit_load_in_buffer(self)
       call multiply_complex_in_buffer(self, self%inverse_full)
       self%inverse_diagonal = 0.0_wp
       if (self%fft%y_start == 0) self%inverse_diagonal = self%fft%real_buffer(1)
       if (self%distributed) call broadcast(self%inverse_diagonal)
-   end subroutine prepare_gcr
+   end subroutine prepare_gcr_with
+
+   !> fft%real_buffer <- a unit load at the first point of the grid (on the rank holding it).
+   subroutine unit_load_in_buffer(self)
+      class(compliance_operator), intent(inout) :: self
+      self%fft%real_buffer = 0.0_wp
+      if (self%fft%y_start == 0 .and. self%n > 0) self%fft%real_buffer(1) = 1.0_wp
+   end subroutine unit_load_in_buffer
 
    !> fft%real_buffer <- G_eff fft%real_buffer (see metric_in_buffer).
    subroutine full_in_buffer(self)

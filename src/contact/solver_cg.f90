@@ -150,11 +150,14 @@ contains
          ! per iteration.
          do
             if (stale .or. since_fresh >= refresh_interval) then
-               call op%apply_metric(p, w)
+               ! w = M p in the transform's buffer, read there by the state's pass (w itself
+               ! is written once, at the end, from d)
+               buffer = p
+               call op%metric_in_buffer()
                outcome%fft_pairs = outcome%fft_pairs + 1
                since_fresh = 0
                stale = .false.
-               call fresh_state(p, w, b, load_scale, d, sums)
+               call fresh_state(p, buffer, b, load_scale, d, sums)
                load_scale = 1.0_wp
             end if
             ! the state is evaluated after scaling p by load_scale, and d so that d + b
