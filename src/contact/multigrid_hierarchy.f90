@@ -102,6 +102,9 @@ module lc_contact_multigrid_hierarchy
       !> the plan: the operator's own on the finest grid, `plan` on the coarser ones
       type(fft_plan), pointer :: fft => null()
       type(fft_plan), allocatable :: plan
+      !> the rows' transforms (solve_rows): fft's, or on a slab (h%on_slabs) a plan of the
+      !> slab's rows of its own, whose rows are whole
+      type(fft_plan), pointer :: rows_fft => null()
       real(wp) :: inv_n = 1.0_wp
       real(wp), allocatable :: symbol(:)       !< circulant part, half spectrum (nx/2 + 1) x ny
       real(wp), allocatable :: multiplier(:)   !< symbol/n, as applied after an unscaled r2c
@@ -436,7 +439,15 @@ contains
          ! the ranks, the V-cycle run alike, and each rank interpolating onto its own rows)
          call restrict_slab(h, r, h%level(1)%rhs)
          call vcycle(h, 1)
-         call prolong_slab_add(h, h%level(1)%x, z, h%free(1:size(r)), r, omega/h%level(0)%jacobi_diagonal)
+         if (h%rows) then
+            call solve_rows(h, 0, r)
+            associate (step => h%level(0)%rows_fft%real_buffer)
+            step = h%free(1:size(r))*step
+            call prolong_slab_add(h, h%level(1)%x, z, h%free(1:size(r)), step, omega)
+            end associate
+         else
+            call prolong_slab_add(h, h%level(1)%x, z, h%free(1:size(r)), r, omega/h%level(0)%jacobi_diagonal)
+         end if
          return
       end if
       call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
@@ -445,7 +456,7 @@ contains
          ! (the step masked, as r is; the coarse levels have their own buffers, so this one
          ! still holds it for prolong_add)
          call solve_rows(h, h%top, r)
-         associate (step => h%level(h%top)%fft%real_buffer)
+         associate (step => h%level(h%top)%rows_fft%real_buffer)
          step = h%free(1:size(r))*step
          call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), step, omega)
          end associate
@@ -505,13 +516,15 @@ contains
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
       real(wp), contiguous, intent(in) :: r(:)
-      integer :: row, nkx
-      associate (lv => h%level(t))
-      call copy(r, lv%fft%real_buffer)
-      call lv%fft%rows_forward_unscaled()
+      integer :: row, nkx, rows
+      associate (lv => h%level(t), fft => h%level(t)%rows_fft)
+      ! (on a slab, its rows)
+      rows = merge(h%ny_local, lv%ny, t == 0 .and. h%on_slabs)
+      call copy(r, fft%real_buffer)
+      call fft%rows_forward_unscaled()
       nkx = lv%nx/2 + 1
-      do row = 0, lv%ny - 1
-         associate (coefficients => lv%fft%spectrum(row*nkx + 1:(row + 1)*nkx))
+      do row = 0, rows - 1
+         associate (coefficients => fft%spectrum(row*nkx + 1:(row + 1)*nkx))
          if (lv%row_shift(row + 1) == 0.0_wp) then
             coefficients = coefficients*lv%row_inverse
          else
@@ -519,7 +532,7 @@ contains
          end if
          end associate
       end do
-      call lv%fft%rows_backward()
+      call fft%rows_backward()
       h%pairs = h%pairs + 0.5_wp*real(lv%n, wp)/h%n_fine
       end associate
    end subroutine solve_rows
@@ -825,9 +838,8 @@ contains
       h%n_fine = nx*ny
       h%on_slabs = op%distributed
       if (h%on_slabs) then
-         if (h%rows .or. h%coarsest == 0) then
-            call fatal_error(error, 'multigrid: a hierarchy on slabs takes Jacobi steps and a coarser grid', &
-               & code_internal)
+         if (h%coarsest == 0) then
+            call fatal_error(error, 'multigrid: a hierarchy on slabs needs a coarser grid', code_internal)
             return
          end if
          h%y_start = op%fft%y_start
@@ -859,7 +871,14 @@ contains
             lv%fft => lv%plan
          end if
          if (h%rows) then
-            call lv%fft%plan_rows(error)
+            lv%rows_fft => lv%fft
+            if (t == 0 .and. h%on_slabs) then
+               allocate (lv%plan)
+               call lv%plan%init(lv%nx, h%ny_local, 1, error)
+               if (allocated(error)) return
+               lv%rows_fft => lv%plan
+            end if
+            call lv%rows_fft%plan_rows(error)
             if (allocated(error)) return
             allocate (lv%row_symbol(lv%nx/2 + 1), lv%row_inverse(lv%nx/2 + 1), lv%row_shift(lv%ny))
             lv%row_shift = 0.0_wp
@@ -968,7 +987,7 @@ contains
       if (h%complex) then
          do t = top, h%coarsest
             associate (lv => h%level(t))
-            if (.not. allocated(lv%odd)) allocate (lv%odd(size(lv%symbol)), lv%cmultiplier(size(lv%symbol)))
+            if (.not. allocated(lv%odd)) allocate (lv%odd(size(lv%symbol)), lv%cmultiplier(size(lv%multiplier)))
             end associate
          end do
          if (.not. allocated(h%pivots)) allocate (h%pivots(size(h%dense, 1)))
@@ -1005,7 +1024,11 @@ contains
             lv%multiplier = lv%symbol*lv%inv_n
          end if
          if (h%complex) then
-            lv%cmultiplier = cmplx(lv%symbol, lv%odd, kind=wp)*lv%inv_n
+            if (t == 0 .and. h%on_slabs) then
+               call slab_multiplier(lv)
+            else
+               lv%cmultiplier = cmplx(lv%symbol, lv%odd, kind=wp)*lv%inv_n
+            end if
             do k = 1, size(lv%symbol)
                if (lv%symbol(k) > 0.0_wp) lv%jacobi_diagonal = max(lv%jacobi_diagonal, &
                   & jacobi_margin*omega*(lv%symbol(k)**2 + lv%odd(k)**2)/(2*lv%symbol(k)))
@@ -1386,14 +1409,17 @@ contains
       across_ranks = h%on_slabs .and. h%top == 0
    end function across_ranks
 
-   !> The finest grid's multiplier on this rank's modes of the operator's transposed
-   !> spectrum (fft_plan%mode_indices), from its whole symbol.
+   !> The finest grid's multiplier (and complex one, where the symbol has an imaginary part)
+   !> on this rank's modes of the operator's transposed spectrum (fft_plan%mode_indices),
+   !> from its whole symbol.
    subroutine slab_multiplier(lv)
       type(grid_level), intent(inout) :: lv
-      integer :: i, mx, my
+      integer :: i, mx, my, k
       do i = 1, size(lv%multiplier)
          call lv%fft%mode_indices(i, mx, my)
-         lv%multiplier(i) = lv%symbol(mx + (lv%nx/2 + 1)*my + 1)*lv%inv_n
+         k = mx + (lv%nx/2 + 1)*my + 1
+         lv%multiplier(i) = lv%symbol(k)*lv%inv_n
+         if (allocated(lv%odd)) lv%cmultiplier(i) = cmplx(lv%symbol(k), lv%odd(k), kind=wp)*lv%inv_n
       end do
    end subroutine slab_multiplier
 

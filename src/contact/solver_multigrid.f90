@@ -553,15 +553,29 @@ contains
       real(wp), allocatable :: u(:), o(:), c(:), kc(:), v(:), kv(:), dirs(:, :), kdirs(:, :), r(:), u_best(:)
       real(wp), allocatable :: symbol(:), odd(:)
       logical :: complex_symbol
-      real(wp) :: f, d, b_max, residual, contact, best, best_residual
+      real(wp) :: f, d, b_max, residual, contact, best, best_residual, points
       integer :: n, step, changed, j, last_progress, memory
       logical :: settled, finished, clipped, tension, stagnated, exact
-      logical :: rows
+      logical :: rows, global
 
       n = size(p)
+      ! (op on a slab of a distributed surface: the iteration's sums and maxima over the
+      ! ranks, points the whole grid's; the symbol of the hierarchy is read off the whole
+      ! spectra, of an operator of the whole grid made for it and freed)
+      global = op%distributed
+      points = merge(real(op%grid%points(), wp), real(n, wp), global)
       call op%prepare_gcr()
       ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows)
-      call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+      if (global) then
+         block
+            type(compliance_operator) :: whole
+            call whole_operator(op, whole, error)
+            if (allocated(error)) return
+            call coupled_symbol(whole, load_control, symbol, odd, complex_symbol, rows)
+         end block
+      else
+         call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+      end if
       if (complex_symbol) then
          call build_hierarchy(h, op, error, symbol, odd, rows=rows)
          if (allocated(error)) return
@@ -582,16 +596,23 @@ contains
          if (real(op%inverse_full(j)) > 0.0_wp) &
             & d = max(d, jacobi_margin*omega*abs(op%inverse_full(j))**2/(2*real(op%inverse_full(j))))
       end do
+      if (global) d = global_max(d)
       memory = gcr_memory
       allocate (u(n), o(n), c(n), kc(n), v(n), kv(n), r(n), u_best(n), dirs(n, memory), kdirs(n, memory))
       f = merge(mean_pressure, 0.0_wp, load_control)
       o = b
       if (.not. load_control) o = o + s
       b_max = maxval(abs(o))
+      if (global) b_max = global_max(b_max)
       ! the start: u = G p, less (load control) the mean of G p - b over p's contact set
       call op%apply_full(p, u)
       h%pairs = h%pairs + 1.0_wp
-      if (load_control .and. any(p > 0.0_wp)) then
+      if (global) then
+         if (load_control .and. global_any(any(p > 0.0_wp))) then
+            s = global_sum(sum(u - b, mask=p > 0.0_wp))/global_sum(count(p > 0.0_wp))
+            u = u - s
+         end if
+      else if (load_control .and. any(p > 0.0_wp)) then
          s = sum(u - b, mask=p > 0.0_wp)/count(p > 0.0_wp)
          u = u - s
       end if
@@ -607,8 +628,9 @@ contains
          outcome%iterations = step
          u = max(o, u - (omega/d)*p)
          call apply_k(u, p)
-         scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest)
-         call examine(u, p, o, scales, h%free, residual, contact, changed, tension)
+         scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest, global)
+         call examine(u, p, o, scales, h%free(1:n), residual, contact, changed, tension)
+         if (global) call examine_over_ranks(n, residual, contact, changed, tension)
          if (step <= size(history)) history(step) = residual
          call progress%tick(step, residual, contact)
          if (residual <= tol) exit
@@ -627,14 +649,19 @@ contains
             last_progress = step
             u = u_best
             call apply_k(u, p)
-            call examine(u, p, o, scales, h%free, residual, contact, changed, tension)
+            call examine(u, p, o, scales, h%free(1:n), residual, contact, changed, tension)
+            if (global) call examine_over_ranks(n, residual, contact, changed, tension)
             changed = max(changed, 1)
          end if
          if (load_control .and. contact == 0.0_wp) then
-            u = u - minval(u - o)
+            if (global) then
+               u = u + global_max(maxval(o - u))
+            else
+               u = u - minval(u - o)
+            end if
             cycle
          end if
-         settled = step > 1 .and. changed <= settled_fraction*contact*n .and. .not. tension
+         settled = step > 1 .and. changed <= settled_fraction*contact*points .and. .not. tension
          if (changed > 0 .or. step == 1) call set_contact(h)
          finished = .false.
          if (settled) then
@@ -652,6 +679,7 @@ contains
             exit
          end if
          call project_direction(u, o, c, v, clipped)
+         if (global) clipped = global_any(clipped)
          if (clipped) then
             call apply_k(v, kv, shift=0.0_wp)
          else
@@ -660,6 +688,8 @@ contains
          if (exact) then
             u = u + v
             p = p + kv
+         else if (global) then
+            call line_step(v, kv, global_sum(dot_product(v, kv)), u, p, global_sum(dot_product(p, v)))
          else
             call line_step(v, kv, dot_product(v, kv), u, p)
          end if
@@ -729,29 +759,38 @@ contains
          c = 0.0_wp
          kc = 0.0_wp
          stagnated = .false.
-         r = -h%free*p
-         b_norm = euclidean_norm(r)
+         r = -h%free(1:n)*p
+         b_norm = norm_over(r, global)
          if (b_norm == 0.0_wp) return
          columns = 0
          gone = .false.
          do it = 1, max_steps
             if (columns == memory) columns = 0
             columns = columns + 1
-            associate (z => dirs(:, columns), kz => kdirs(:, columns), free => h%free)
+            associate (z => dirs(:, columns), kz => kdirs(:, columns), free => h%free(1:n))
             call precondition(h, r, z)
             call apply_k(z, kz, shift=0.0_wp)
             ! (orthogonal on the free points to the stored images)
-            call orthogonalise(z, kz, dirs(:, :columns - 1), kdirs(:, :columns - 1), free)
+            if (global) then
+               call orthogonalise_over_ranks(z, kz, dirs(:, :columns - 1), kdirs(:, :columns - 1), free)
+            else
+               call orthogonalise(z, kz, dirs(:, :columns - 1), kdirs(:, :columns - 1), free)
+            end if
             call masked_products(kz, r, free, norm, gamma)
+            if (global) call add_pair_over_ranks(norm, gamma)
             norm = sqrt(norm)
             if (.not. norm > 0.0_wp) exit
             ! the minimal-residual step along z (z and kz then scaled to a unit image)
             gamma = gamma/norm**2
             if (check .and. .not. gone) then
                call step_and_check(u, o, p, gamma, z, kz, free, c, kc, r, scales, res, violated)
+               if (global) then
+                  res = global_max(res)
+                  violated = global_any(violated)
+               end if
                z = z/norm
                kz = kz/norm
-               r_norm = euclidean_norm(r)
+               r_norm = norm_over(r, global)
                if (violated) then
                   ! the set is not yet the final one: go on as a Newton step
                   gone = .true.
@@ -763,11 +802,12 @@ contains
                end if
             else
                call minimal_residual_step(gamma, norm, z, kz, free, c, kc, r, r_norm)
+               if (global) r_norm = norm_over(r, global)
                if (r_norm <= merge(violated_reduction, reduction, gone)*b_norm) exit
             end if
             end associate
          end do
-         stagnated = check .and. .not. finished .and. it > max_steps .and. euclidean_norm(r) > violated_reduction*b_norm
+         stagnated = check .and. .not. finished .and. it > max_steps .and. norm_over(r, global) > violated_reduction*b_norm
       end subroutine truncated_gcr
    end subroutine coupled_tnnmg
 
@@ -1148,6 +1188,38 @@ contains
       tension = totals(3) > 0.0_wp
    end subroutine examine_over_ranks
 
+   !> orthogonalise on a slab: each beta_k summed over the ranks before the column is
+   !> subtracted (one message a column: Gram-Schmidt's columns in turn).
+   subroutine orthogonalise_over_ranks(z, kz, dirs, kdirs, free)
+      real(wp), contiguous, intent(inout) :: z(:), kz(:)
+      real(wp), contiguous, intent(in) :: dirs(:, :), kdirs(:, :), free(:)
+      real(wp) :: beta
+      integer :: k, j
+      do k = 1, size(dirs, 2)
+         beta = 0.0_wp
+         !$omp simd reduction(+:beta)
+         do j = 1, size(z)
+            beta = beta + free(j)*kz(j)*kdirs(j, k)
+         end do
+         beta = global_sum(beta)
+         !$omp simd
+         do j = 1, size(z)
+            z(j) = z(j) - beta*dirs(j, k)
+            kz(j) = kz(j) - beta*kdirs(j, k)
+         end do
+      end do
+   end subroutine orthogonalise_over_ranks
+
+   !> a, b <- their sums over the ranks (one message).
+   subroutine add_pair_over_ranks(a, b)
+      real(wp), intent(inout) :: a, b
+      real(wp) :: pair(2)
+      pair = [a, b]
+      call sum_over_ranks(pair)
+      a = pair(1)
+      b = pair(2)
+   end subroutine add_pair_over_ranks
+
    !> |x| of a field, over the ranks where `global` (x a slab).
    real(wp) function norm_over(x, global) result(norm)
       real(wp), contiguous, intent(in) :: x(:)
@@ -1330,8 +1402,13 @@ contains
       real(wp), allocatable :: history(:)
       allocate (history(budget))
       if (solves_on_slabs(problem%op)) then
-         call multigrid_on_slabs(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
-            & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
+         if (symmetric_form(problem%op, error)) then
+            call multigrid_on_slabs(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
+               & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
+         else if (.not. allocated(error)) then
+            call coupled_tnnmg(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
+               & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
+         end if
       else if (problem%op%distributed) then
          call solve_gathered(problem, state, budget, nested, history, progress, error)
       else if (problem%op%coupled .or. len(multigrid_refusal(problem%op)) > 0) then
@@ -1348,16 +1425,36 @@ contains
    end subroutine solve_by_multigrid
 
    !> Whether the multigrid method solves the scene of the distributed operator `op` on the
-   !> slabs (multigrid_on_slabs): the symmetric form (frictionless, elastic) of a compliance
-   !> that falls with |q| (rise_refusal reads a whole spectrum: a rising one is left to the
-   !> gathered stage), on a grid with a nested coarse grid. The others are gathered
-   !> (solve_gathered).
+   !> slabs (multigrid_on_slabs, coupled_tnnmg): a grid whose V-cycle has a coarse grid
+   !> below the finest and whose nested iteration starts on a coarser one (from 1024
+   !> points). The others are gathered (solve_gathered).
    logical function solves_on_slabs(op)
       type(compliance_operator), intent(in) :: op
-      solves_on_slabs = op%distributed .and. .not. (op%coupled .or. op%kernel%viscoelastic) .and. op%metric_falls
+      solves_on_slabs = op%distributed
       if (solves_on_slabs) solves_on_slabs = len(size_refusal(op)) == 0 .and. &
          & halvings(op%grid%nx, op%grid%ny, nested_coarsest) >= 1
    end function solves_on_slabs
+
+   !> Whether the scene of `op` takes the symmetric form (multigrid) rather than the coupled
+   !> one, as solve_by_multigrid decides serially: a distributed operator whose compliance
+   !> does not fall with |q| everywhere is decided on an operator of the whole grid, made
+   !> for it and freed (rise_refusal reads a whole spectrum).
+   logical function symmetric_form(op, error) result(symmetric)
+      type(compliance_operator), intent(in) :: op
+      type(error_type), allocatable, intent(out) :: error
+      symmetric = .not. (op%coupled .or. op%kernel%viscoelastic)
+      if (.not. symmetric) return
+      if (op%distributed .and. .not. op%metric_falls) then
+         block
+            type(compliance_operator) :: whole
+            call whole_operator(op, whole, error)
+            if (allocated(error)) return
+            symmetric = len(multigrid_refusal(whole)) == 0
+         end block
+      else
+         symmetric = len(multigrid_refusal(op)) == 0
+      end if
+   end function symmetric_form
 
    !> multigrid on the slabs of a surface shared among the ranks (op on this rank's slab:
    !> docs/decisions/028-distributed-multigrid.md). The nested iteration's coarse grids are
