@@ -61,6 +61,7 @@ module lc_contact_solver_multigrid
    private
    public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
    public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, whole_operator, solves_on_slabs
+   public :: whole_spectra
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -569,8 +570,7 @@ contains
       if (global) then
          block
             type(compliance_operator) :: whole
-            call whole_operator(op, whole, error)
-            if (allocated(error)) return
+            call whole_spectra(op, whole)
             call coupled_symbol(whole, load_control, symbol, odd, complex_symbol, rows)
          end block
       else
@@ -1402,10 +1402,10 @@ contains
       real(wp), allocatable :: history(:)
       allocate (history(budget))
       if (solves_on_slabs(problem%op)) then
-         if (symmetric_form(problem%op, error)) then
+         if (symmetric_form(problem%op)) then
             call multigrid_on_slabs(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
                & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
-         else if (.not. allocated(error)) then
+         else
             call coupled_tnnmg(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
                & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
          end if
@@ -1437,18 +1437,16 @@ contains
 
    !> Whether the scene of `op` takes the symmetric form (multigrid) rather than the coupled
    !> one, as solve_by_multigrid decides serially: a distributed operator whose compliance
-   !> does not fall with |q| everywhere is decided on an operator of the whole grid, made
-   !> for it and freed (rise_refusal reads a whole spectrum).
-   logical function symmetric_form(op, error) result(symmetric)
+   !> does not fall with |q| everywhere is decided on its whole spectra (whole_spectra,
+   !> freed after: rise_refusal reads a whole spectrum).
+   logical function symmetric_form(op) result(symmetric)
       type(compliance_operator), intent(in) :: op
-      type(error_type), allocatable, intent(out) :: error
       symmetric = .not. (op%coupled .or. op%kernel%viscoelastic)
       if (.not. symmetric) return
       if (op%distributed .and. .not. op%metric_falls) then
          block
             type(compliance_operator) :: whole
-            call whole_operator(op, whole, error)
-            if (allocated(error)) return
+            call whole_spectra(op, whole)
             symmetric = len(multigrid_refusal(whole)) == 0
          end block
       else
@@ -1611,6 +1609,47 @@ contains
       if (allocated(error)) return
       if (op%dropped_uniform /= 0.0_wp) call whole%drop_uniform_mode(uniform)
    end subroutine whole_operator
+
+   !> The spectra of the distributed operator `op` on the whole half spectrum, on every rank
+   !> (each rank's modes, summed over the ranks), in an operator without plans: what the
+   !> multigrid's measures and the symbol of its hierarchy read (multigrid_refusal,
+   !> coupled_refusal, coupled_symbol, loss_among_short_waves, rows_ahead_of_gcr, never a
+   !> transform). The metric, and G_eff where coupled: 1.5 doubles a point of the grid, where
+   !> an operator of the whole grid (whole_operator) holds its plans' buffers besides.
+   subroutine whole_spectra(op, whole)
+      type(compliance_operator), intent(in) :: op
+      type(compliance_operator), intent(out) :: whole
+      real(wp), allocatable :: parts(:)
+      integer :: i, mx, my, k, nk
+      nk = op%grid%modes()
+      whole%grid = op%grid
+      whole%kernel = op%kernel
+      whole%n = op%grid%points()
+      whole%nk = nk
+      whole%friction = op%friction
+      whole%coupled = op%coupled
+      whole%monotone = op%monotone
+      whole%metric_falls = op%metric_falls
+      whole%diagonal = op%diagonal
+      whole%largest = op%largest
+      whole%inv_n = op%inv_n
+      whole%dropped_uniform = op%dropped_uniform
+      whole%compliance = op%compliance
+      allocate (parts(merge(3, 1, op%coupled)*nk))
+      parts = 0.0_wp
+      do i = 1, op%nk
+         call op%fft%mode_indices(i, mx, my)
+         k = mx + (op%grid%nx/2 + 1)*my + 1
+         parts(k) = op%metric(i)
+         if (op%coupled) then
+            parts(nk + k) = real(op%full(i))
+            parts(2*nk + k) = aimag(op%full(i))
+         end if
+      end do
+      call sum_over_ranks(parts)
+      whole%metric = parts(1:nk)
+      if (op%coupled) whole%full = cmplx(parts(nk + 1:2*nk), parts(2*nk + 1:3*nk), kind=wp)
+   end subroutine whole_spectra
 
    pure function multigrid_name(self) result(name)
       class(multigrid_solver), intent(in) :: self
