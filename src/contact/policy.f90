@@ -309,7 +309,6 @@ contains
       if (ind%coupled) then
          first = 'gcr'
          why = 'a coupled operator (friction, or a sliding viscoelastic layer): the constrained GCR'
-         if (ind%distributed .and. len(ind%refusal) > 0) why = why // ' (no multigrid method: ' // ind%refusal // ')'
       end if
       if (len(ind%refusal) > 0) return
 
