@@ -533,7 +533,8 @@ contains
    !> too. p: in, the
    !> start (the coarse start's interpolated solution, or the caller's guess); out, the
    !> solution, or the best iterate if it did not converge. The metric must pass
-   !> metric_refusal.
+   !> metric_refusal. A distributed op (solves_on_slabs): p, w, gap and b are its slab, the
+   !> finest grid's iteration on the slabs (docs/decisions/028-distributed-multigrid.md).
    subroutine coupled_tnnmg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
          & history, progress, error)
       type(compliance_operator), intent(inout), target :: op
@@ -562,7 +563,7 @@ contains
       n = size(p)
       ! (op on a slab of a distributed surface: the iteration's sums and maxima over the
       ! ranks, points the whole grid's; the symbol of the hierarchy is read off the whole
-      ! spectra, of an operator of the whole grid made for it and freed)
+      ! spectra, gathered for it and freed: whole_spectra)
       global = op%distributed
       points = merge(real(op%grid%points(), wp), real(n, wp), global)
       call op%prepare_gcr()
