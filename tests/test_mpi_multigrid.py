@@ -10,21 +10,25 @@ slabs and of every sum the iteration takes over the ranks (the energies, line se
 CG and GCR products, the restriction's shares of the first coarse grid). Both solves run to
 tol = 1e-12 (the complementarity residual relative to p_m and the relief); two solutions
 that close to the unique one agree to about that, so SAME = 1e-10 relative (test_mpi.py) is
-met with two decades to spare (measured: 3e-15 to 4e-14) and fails on a slab's rows
-misplaced in the restriction or the interpolation (the coarse correction then points
-elsewhere: more iterations, or no convergence within the budget), a sum left on one rank
-(the ranks would take different steps and the transforms would mix them), or a symbol
-read at the wrong modes.
+met with two decades to spare (measured: 3e-15 to 4e-14) and fails on a sum left on one
+rank (the ranks would take different steps and the transforms would mix them) or a
+symbol read at the wrong modes (another operator: another answer). A preconditioner gone
+wrong still reaches the unique answer, in the same or more iterations: the slabs'
+preconditioner, stiffness and interpolation are checked against the whole grid's by
+tests/fortran/test_multigrid_slabs.f90, run here under mpirun (a share of the restriction
+moved to the wrong coarse row fails it on 2 and 3 ranks).
 """
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 import h5py
 import pytest
 
-from test_mpi import assert_same, executable, needs_mpi, run_mpi, run_serial
+from conftest import build_unit_program
+from test_mpi import assert_same, executable, launcher_env, needs_mpi, run_mpi, run_serial
 
 #: a standard linear solid sliding on a thin incompressible layer with friction whose loss
 #: among the waves short along x exceeds 3 (E_inf/E0 = 100 at V tau/lambda = 0.1, h/lambda =
@@ -125,3 +129,24 @@ def test_serial_methods_are_refused_by_name_on_several_ranks(method, tmp_path):
     message = done.stderr + done.stdout
     assert f"method = '{method}' runs on one MPI rank" in message and "'multigrid'" in message, message
     assert not (tmp_path / "refused.h5").exists()
+
+
+@pytest.fixture(scope="module")
+def slabs_program() -> Path:
+    """tests/fortran/test_multigrid_slabs, built in build/unit when needed."""
+    built, program = build_unit_program("test_multigrid_slabs")
+    assert built.returncode == 0 and program.exists(), built.stdout[-2000:]
+    return program
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [1, 2, 3, 4])
+def test_the_slabs_precondition_as_the_whole_grid(ranks, slabs_program):
+    """The hierarchy on the slabs against the whole grid's on every rank
+    (tests/fortran/test_multigrid_slabs.f90): B r, K x and x.K x, the interpolation onto the
+    slab, for a real symbol, a complex one, and one smoothed by rows, to 1e-12."""
+    done = subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(slabs_program)], capture_output=True,
+                          text=True, env=launcher_env(), timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("checks passed") == ranks
+    assert "FAIL" not in done.stdout
