@@ -24,10 +24,11 @@
 !> them: nx x ny points, x fastest; spectra on the half spectrum (nx/2 + 1) x ny.
 module lc_contact_multigrid_hierarchy
    use lc_base_kinds, only: wp
-   use lc_base_errors, only: error_type
+   use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_fft_plans, only: fft_plan
    use lc_contact_operator, only: compliance_operator, multiply_spectrum, multiply_complex
    use lc_base_threads, only: active_threads, parallel_points, reduction_blocks, block_range
+   use lc_base_parallel, only: global_sum, sum_over_ranks
    implicit none (type, external)
    private
    interface
@@ -51,6 +52,7 @@ module lc_contact_multigrid_hierarchy
    public :: build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, worst_smoothing
    public :: worst_row_smoothing, solve_rows
    public :: precondition, apply_stiffness, level_operator
+   public :: across_ranks, interpolate_onto_slab, sampled_symbol
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
    !> step lowers the energy monotonically; 2/3 damps the upper half of the spectrum best.
@@ -100,6 +102,9 @@ module lc_contact_multigrid_hierarchy
       !> the plan: the operator's own on the finest grid, `plan` on the coarser ones
       type(fft_plan), pointer :: fft => null()
       type(fft_plan), allocatable :: plan
+      !> the rows' transforms (solve_rows): fft's, or on a slab (h%on_slabs) a plan of the
+      !> slab's rows of its own, whose rows are whole
+      type(fft_plan), pointer :: rows_fft => null()
       real(wp) :: inv_n = 1.0_wp
       real(wp), allocatable :: symbol(:)       !< circulant part, half spectrum (nx/2 + 1) x ny
       real(wp), allocatable :: multiplier(:)   !< symbol/n, as applied after an unscaled r2c
@@ -150,6 +155,12 @@ module lc_contact_multigrid_hierarchy
       real(wp), allocatable :: coarse_column(:)  !< real-space column of its circulant part
       real(wp) :: pairs = 0.0_wp
       integer :: vcycles = 0
+      !> The finest grid on this rank's slab of a surface shared among the job's ranks
+      !> (docs/decisions/028-distributed-multigrid.md): its fields hold the rows y_start+1 ..
+      !> y_start+ny_local, its multiplier the rank's columns of the transposed spectrum (the
+      !> operator's plan); the coarser grids are whole, and alike on every rank.
+      logical :: on_slabs = .false.
+      integer :: y_start = 0, ny_local = 0
    end type hierarchy
 
 contains
@@ -423,13 +434,29 @@ contains
          call coarsest_solve(h, z)
          return
       end if
+      if (across_ranks(h)) then
+         ! (the first coarse grid whole on every rank: each slab's share of P^T r summed over
+         ! the ranks, the V-cycle run alike, and each rank interpolating onto its own rows)
+         call restrict_slab(h, r, h%level(1)%rhs)
+         call vcycle(h, 1)
+         if (h%rows) then
+            call solve_rows(h, 0, r)
+            associate (step => h%level(0)%rows_fft%real_buffer)
+            step = h%free(1:size(r))*step
+            call prolong_slab_add(h, h%level(1)%x, z, h%free(1:size(r)), step, omega)
+            end associate
+         else
+            call prolong_slab_add(h, h%level(1)%x, z, h%free(1:size(r)), r, omega/h%level(0)%jacobi_diagonal)
+         end if
+         return
+      end if
       call restrict(h, h%top, r, h%level(h%top + 1)%rhs)
       call vcycle(h, h%top + 1)
       if (h%rows) then
          ! (the step masked, as r is; the coarse levels have their own buffers, so this one
          ! still holds it for prolong_add)
          call solve_rows(h, h%top, r)
-         associate (step => h%level(h%top)%fft%real_buffer)
+         associate (step => h%level(h%top)%rows_fft%real_buffer)
          step = h%free(1:size(r))*step
          call prolong_add(h, h%top, h%level(h%top + 1)%x, z, h%free(1:size(r)), step, omega)
          end associate
@@ -489,13 +516,15 @@ contains
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
       real(wp), contiguous, intent(in) :: r(:)
-      integer :: row, nkx
-      associate (lv => h%level(t))
-      call copy(r, lv%fft%real_buffer)
-      call lv%fft%rows_forward_unscaled()
+      integer :: row, nkx, rows
+      associate (lv => h%level(t), fft => h%level(t)%rows_fft)
+      ! (on a slab, its rows)
+      rows = merge(h%ny_local, lv%ny, t == 0 .and. h%on_slabs)
+      call copy(r, fft%real_buffer)
+      call fft%rows_forward_unscaled()
       nkx = lv%nx/2 + 1
-      do row = 0, lv%ny - 1
-         associate (coefficients => lv%fft%spectrum(row*nkx + 1:(row + 1)*nkx))
+      do row = 0, rows - 1
+         associate (coefficients => fft%spectrum(row*nkx + 1:(row + 1)*nkx))
          if (lv%row_shift(row + 1) == 0.0_wp) then
             coefficients = coefficients*lv%row_inverse
          else
@@ -503,7 +532,7 @@ contains
          end if
          end associate
       end do
-      call lv%fft%rows_backward()
+      call fft%rows_backward()
       h%pairs = h%pairs + 0.5_wp*real(lv%n, wp)/h%n_fine
       end associate
    end subroutine solve_rows
@@ -608,7 +637,10 @@ contains
       f = 0.0_wp
       if (present(shift)) f = shift
       call read_out(h%level(h%top)%fft%real_buffer, x, f, y, dot)
-      if (present(xy)) xy = dot
+      if (present(xy)) then
+         if (across_ranks(h)) dot = global_sum(dot)
+         xy = dot
+      end if
    end subroutine apply_stiffness
 
    !> y = buffer + f and x.buffer in one pass (see copy)
@@ -804,7 +836,19 @@ contains
       end if
       h%coarsest = ubound(shapes, 2)
       h%n_fine = nx*ny
-      allocate (h%level(0:h%coarsest), h%free(nx*ny))
+      h%on_slabs = op%distributed
+      if (h%on_slabs) then
+         if (h%coarsest == 0) then
+            call fatal_error(error, 'multigrid: a hierarchy on slabs needs a coarser grid', code_internal)
+            return
+         end if
+         h%y_start = op%fft%y_start
+         h%ny_local = op%fft%ny_local
+         ! (the slab's contact set, or a whole coarse grid's in the nested iteration)
+         allocate (h%level(0:h%coarsest), h%free(max(nx*h%ny_local, shapes(1, 1)*shapes(2, 1))))
+      else
+         allocate (h%level(0:h%coarsest), h%free(nx*ny))
+      end if
       h%free = 1.0_wp
       do t = 0, h%coarsest
          associate (lv => h%level(t))
@@ -827,16 +871,29 @@ contains
             lv%fft => lv%plan
          end if
          if (h%rows) then
-            call lv%fft%plan_rows(error)
+            lv%rows_fft => lv%fft
+            if (t == 0 .and. h%on_slabs) then
+               allocate (lv%plan)
+               call lv%plan%init(lv%nx, h%ny_local, 1, error)
+               if (allocated(error)) return
+               lv%rows_fft => lv%plan
+            end if
+            call lv%rows_fft%plan_rows(error)
             if (allocated(error)) return
             allocate (lv%row_symbol(lv%nx/2 + 1), lv%row_inverse(lv%nx/2 + 1), lv%row_shift(lv%ny))
             lv%row_shift = 0.0_wp
          end if
-         allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier((lv%nx/2 + 1)*lv%ny))
+         ! (on slabs the finest grid's symbol is whole, for the Galerkin symbols below it, its
+         ! multiplier the rank's modes)
+         allocate (lv%symbol((lv%nx/2 + 1)*lv%ny), lv%multiplier(merge(op%nk, (lv%nx/2 + 1)*lv%ny, &
+            & t == 0 .and. h%on_slabs)))
          ! (the finest grid is never a coarse one of the V-cycle)
          ! (the stencil couples rows on a surface only)
          if (t > 0) allocate (lv%penalty(-1:1, -reach:reach, m), lv%jacobi(m), lv%rhs(m), lv%x(m), lv%residual(m))
-         if (t < h%coarsest .and. lv%halve_y) then
+         if (t == 0 .and. h%on_slabs) then
+            ! (the slab's rows on the next grid's x: restrict_slab, prolong_slab_add)
+            allocate (lv%halfway(merge(lv%nx/2, lv%nx, lv%halve_x)*h%ny_local))
+         else if (t < h%coarsest .and. lv%halve_y) then
             allocate (lv%halfway(merge(m/2, m, lv%halve_x)), lv%window(-1:1, -1:1, shapes(1, t + 1), -1:1))
          end if
          end associate
@@ -882,6 +939,22 @@ contains
       if (load_control) stiffness(1) = 0.0_wp
    end function level_symbol
 
+   !> level_symbol from the stiffness `finest` on the half spectrum of the nx x ny grid
+   !> (level_symbol's of that grid): the same values on the mx x my grid, where the operator
+   !> holds only its rank's modes.
+   pure function sampled_symbol(finest, nx, ny, mx, my) result(stiffness)
+      real(wp), contiguous, intent(in) :: finest(:)
+      integer, intent(in) :: nx, ny, mx, my
+      real(wp) :: stiffness((mx/2 + 1)*my)
+      integer :: kx, ky, sy
+      do ky = 0, my - 1
+         sy = merge(ky, ky - my, 2*ky <= my)
+         do kx = 0, mx/2
+            stiffness(kx + (mx/2 + 1)*ky + 1) = finest(mode_index(nx, ny, kx, sy))
+         end do
+      end do
+   end function sampled_symbol
+
    !> f (nx x ny) at every step-th point along each axis longer than 1.
    pure subroutine sample(f, nx, ny, step, fc)
       integer, intent(in) :: nx, ny, step
@@ -914,7 +987,7 @@ contains
       if (h%complex) then
          do t = top, h%coarsest
             associate (lv => h%level(t))
-            if (.not. allocated(lv%odd)) allocate (lv%odd(size(lv%symbol)), lv%cmultiplier(size(lv%symbol)))
+            if (.not. allocated(lv%odd)) allocate (lv%odd(size(lv%symbol)), lv%cmultiplier(size(lv%multiplier)))
             end associate
          end do
          if (.not. allocated(h%pivots)) allocate (h%pivots(size(h%dense, 1)))
@@ -945,9 +1018,17 @@ contains
          end do
          lv%circulant_diagonal = lv%circulant_diagonal*lv%inv_n
          lv%jacobi_diagonal = max(lv%circulant_diagonal, jacobi_margin*omega*maxval(lv%symbol)/2)
-         lv%multiplier = lv%symbol*lv%inv_n
+         if (t == 0 .and. h%on_slabs) then
+            call slab_multiplier(lv)
+         else
+            lv%multiplier = lv%symbol*lv%inv_n
+         end if
          if (h%complex) then
-            lv%cmultiplier = cmplx(lv%symbol, lv%odd, kind=wp)*lv%inv_n
+            if (t == 0 .and. h%on_slabs) then
+               call slab_multiplier(lv)
+            else
+               lv%cmultiplier = cmplx(lv%symbol, lv%odd, kind=wp)*lv%inv_n
+            end if
             do k = 1, size(lv%symbol)
                if (lv%symbol(k) > 0.0_wp) lv%jacobi_diagonal = max(lv%jacobi_diagonal, &
                   & jacobi_margin*omega*(lv%symbol(k)**2 + lv%odd(k)**2)/(2*lv%symbol(k)))
@@ -1032,7 +1113,9 @@ contains
       real(wp), allocatable :: row_penalty(:, :)
       do t = h%top + 1, h%coarsest
          associate (c => h%level(t), f => h%level(t - 1))
-         if (h%surface) then
+         if (across_ranks(h) .and. t == 1) then
+            call coarsen_slab(h)
+         else if (h%surface) then
             call coarsen_surface(h, t)
          else if (t == h%top + 1) then
             call galerkin_diagonal(h%free, penalty*h%level(h%top)%circulant_diagonal, f%nx, 0, c%penalty)
@@ -1319,4 +1402,194 @@ contains
       h%pairs = h%pairs + 0.5_wp*(coarse%n + fine%n)/h%n_fine
       end associate
    end subroutine interpolate
+   !> Whether the grid being solved is the finest one on this rank's slab (h%on_slabs): its
+   !> sums and maxima then run over the ranks.
+   pure logical function across_ranks(h)
+      type(hierarchy), intent(in) :: h
+      across_ranks = h%on_slabs .and. h%top == 0
+   end function across_ranks
+
+   !> The finest grid's multiplier (and complex one, where the symbol has an imaginary part)
+   !> on this rank's modes of the operator's transposed spectrum (fft_plan%mode_indices),
+   !> from its whole symbol.
+   subroutine slab_multiplier(lv)
+      type(grid_level), intent(inout) :: lv
+      integer :: i, mx, my, k
+      do i = 1, size(lv%multiplier)
+         call lv%fft%mode_indices(i, mx, my)
+         k = mx + (lv%nx/2 + 1)*my + 1
+         lv%multiplier(i) = lv%symbol(k)*lv%inv_n
+         if (allocated(lv%odd)) lv%cmultiplier(i) = cmplx(lv%symbol(k), lv%odd(k), kind=wp)*lv%inv_n
+      end do
+   end subroutine slab_multiplier
+
+   !> coarse (level 1, whole) = P^T fine, fine this rank's slab of level 0: its rows
+   !> restricted along x, each row's share then added into the coarse rows it reaches along
+   !> y (an even row y into y/2, an odd one half into (y - 1)/2 and half into (y + 1)/2,
+   !> periodic), and the shares summed over the ranks: the halo rows of a restriction
+   !> without messages between neighbours (one MPI_Allreduce of the coarse grid).
+   subroutine restrict_slab(h, fine, coarse)
+      type(hierarchy), intent(inout) :: h
+      real(wp), contiguous, intent(in) :: fine(:)
+      real(wp), contiguous, intent(out) :: coarse(:)
+      integer :: mx, j, y, cy, first
+      associate (lv => h%level(0), c => h%level(1))
+      mx = c%nx
+      if (lv%halve_x) then
+         call restrict_x(fine, lv%halfway, lv%nx, h%ny_local)
+      else
+         lv%halfway = fine
+      end if
+      coarse = 0.0_wp
+      do j = 0, h%ny_local - 1
+         y = h%y_start + j
+         first = j*mx + 1
+         associate (row => lv%halfway(first:first + mx - 1))
+         if (.not. lv%halve_y) then
+            coarse(y*mx + 1:(y + 1)*mx) = row
+         else if (mod(y, 2) == 0) then
+            cy = y/2
+            coarse(cy*mx + 1:(cy + 1)*mx) = coarse(cy*mx + 1:(cy + 1)*mx) + row
+         else
+            cy = (y - 1)/2
+            coarse(cy*mx + 1:(cy + 1)*mx) = coarse(cy*mx + 1:(cy + 1)*mx) + 0.5_wp*row
+            cy = modulo(cy + 1, c%ny)
+            coarse(cy*mx + 1:(cy + 1)*mx) = coarse(cy*mx + 1:(cy + 1)*mx) + 0.5_wp*row
+         end if
+         end associate
+      end do
+      call sum_over_ranks(coarse)
+      end associate
+   end subroutine restrict_slab
+
+   !> fine (this rank's slab of level 0) <- scale base + free P coarse, coarse level 1's
+   !> whole field (every rank holds it: no halo row is sent): the slab's rows of P along y,
+   !> then along x (prolong_slab_add is precondition's prolong_add on the slab).
+   subroutine prolong_slab_add(h, coarse, fine, free, base, scale)
+      type(hierarchy), intent(inout) :: h
+      real(wp), contiguous, intent(in) :: coarse(:)
+      real(wp), contiguous, intent(inout) :: fine(:)
+      real(wp), contiguous, intent(in) :: free(:), base(:)
+      real(wp), intent(in) :: scale
+      integer :: mx, j, y, cy, first
+      associate (lv => h%level(0), c => h%level(1))
+      mx = c%nx
+      do j = 0, h%ny_local - 1
+         y = h%y_start + j
+         first = j*mx + 1
+         if (.not. lv%halve_y) then
+            lv%halfway(first:first + mx - 1) = coarse(y*mx + 1:(y + 1)*mx)
+         else if (mod(y, 2) == 0) then
+            cy = y/2
+            lv%halfway(first:first + mx - 1) = coarse(cy*mx + 1:(cy + 1)*mx)
+         else
+            cy = (y - 1)/2
+            lv%halfway(first:first + mx - 1) = 0.5_wp*(coarse(cy*mx + 1:(cy + 1)*mx) &
+               & + coarse(modulo(cy + 1, c%ny)*mx + 1:(modulo(cy + 1, c%ny) + 1)*mx))
+         end if
+      end do
+      if (lv%halve_x) then
+         call prolong_x_add(lv%halfway, fine, lv%nx, h%ny_local, free, base, scale)
+      else
+         call add_masked(lv%halfway, fine, free, base, scale)
+      end if
+      end associate
+   end subroutine prolong_slab_add
+
+   !> Level 1's penalty stencil P^T (d D_A) P from this rank's rows of the contact set: each
+   !> fine row's 3-point stencil coarsened along x (galerkin_diagonal), its share added into
+   !> the coarse rows it reaches along y (coarsen_y_row's terms of that row), and the shares
+   !> summed over the ranks (one MPI_Allreduce of the stencil).
+   subroutine coarsen_slab(h)
+      type(hierarchy), intent(inout) :: h
+      real(wp), allocatable :: b(:, :, :), flat(:)
+      integer :: nx, j, y, cy, k, shares, share
+      associate (f => h%level(0), c => h%level(1))
+      nx = f%nx
+      allocate (b(-1:1, -1:1, c%nx))
+      c%penalty = 0.0_wp
+      do j = 0, h%ny_local - 1
+         y = h%y_start + j
+         associate (free => h%free(j*nx + 1:(j + 1)*nx))
+         if (f%halve_x) then
+            call galerkin_diagonal(free, penalty*f%circulant_diagonal, nx, 1, b)
+         else
+            b = 0.0_wp
+            b(0, 0, :) = penalty*f%circulant_diagonal*(1.0_wp - free)
+         end if
+         end associate
+         if (.not. f%halve_y) then
+            c%penalty(:, :, y*c%nx + 1:(y + 1)*c%nx) = b
+            cycle
+         end if
+         ! (an even row is row 2 cy of the coarse row cy; an odd one row 2 cy + 1 of cy and
+         ! 2 cy' - 1 of cy' = cy + 1)
+         shares = merge(1, 2, mod(y, 2) == 0)
+         do share = 1, shares
+            if (shares == 1) then
+               cy = y/2
+               k = 0
+            else if (share == 1) then
+               cy = (y - 1)/2
+               k = 1
+            else
+               cy = modulo((y - 1)/2 + 1, c%ny)
+               k = -1
+            end if
+            call add_y_share(b, k, c%nx, c%penalty(:, :, cy*c%nx + 1:(cy + 1)*c%nx))
+         end do
+      end do
+      flat = reshape(c%penalty, [size(c%penalty)])
+      call sum_over_ranks(flat)
+      c%penalty = reshape(flat, shape(c%penalty))
+      end associate
+   end subroutine coarsen_slab
+
+   !> c <- c + the terms of coarsen_y_row that the row `row` (the fine row 2 cy + k of the
+   !> coarse row cy) contributes.
+   pure subroutine add_y_share(row, k, nx, c)
+      integer, intent(in) :: k, nx
+      real(wp), intent(in) :: row(-1:1, -1:1, 0:nx - 1)
+      real(wp), intent(inout) :: c(-1:1, -1:1, 0:nx - 1)
+      integer :: to(2, -2:2), ix, e, j
+      real(wp) :: of(2, -2:2)
+      call interpolation_weights(to, of)
+      do e = -1, 1
+         do j = 1, 2
+            do ix = 0, nx - 1
+               c(:, to(j, k + e), ix) = c(:, to(j, k + e), ix) + (of(1, k)*of(j, k + e))*row(:, e, ix)
+            end do
+         end do
+      end do
+   end subroutine add_y_share
+
+   !> uf (this rank's slab of level 0) = the spectral interpolation of uc (level 1, whole on
+   !> every rank): interpolate, each rank filling its own modes of the transposed spectrum.
+   subroutine interpolate_onto_slab(h, uc, uf)
+      type(hierarchy), intent(inout) :: h
+      real(wp), contiguous, intent(in) :: uc(:)
+      real(wp), contiguous, intent(out) :: uf(:)
+      complex(wp) :: value
+      integer :: i, mx, my, sy, nkc
+      associate (coarse => h%level(1), fine => h%level(0))
+      nkc = coarse%nx/2 + 1
+      coarse%fft%real_buffer = uc
+      call coarse%fft%forward()
+      do i = 1, fine%fft%nk
+         call fine%fft%mode_indices(i, mx, my)
+         sy = merge(my, my - fine%ny, 2*my <= fine%ny)
+         value = (0.0_wp, 0.0_wp)
+         if (2*mx <= coarse%nx .and. 2*abs(sy) <= coarse%ny) then
+            value = coarse%fft%spectrum(mx + nkc*modulo(sy, coarse%ny) + 1)
+            ! (a coarse Nyquist mode is a cosine: half of it at each of its two fine images)
+            if (2*mx == coarse%nx) value = 0.5_wp*value
+            if (2*abs(sy) == coarse%ny) value = 0.5_wp*value
+         end if
+         fine%fft%spectrum(i) = value
+      end do
+      call fine%fft%backward()
+      uf = fine%fft%real_buffer
+      h%pairs = h%pairs + 0.5_wp*(coarse%n + fine%n)/h%n_fine
+      end associate
+   end subroutine interpolate_onto_slab
 end module lc_contact_multigrid_hierarchy

@@ -28,7 +28,7 @@ module lc_contact_policy
    use lc_contact_solver_newton, only: dense_points
    use lc_contact_solver_gfmd, only: gfmd_refusal
    use lc_contact_solver_multigrid, only: multigrid_refusal, metric_refusal, coupled_refusal, rows_ahead_of_gcr, &
-      & loss_among_short_waves, short_loss_limit, whole_operator
+      & loss_among_short_waves, short_loss_limit, whole_spectra, solves_on_slabs
    implicit none (type, external)
    private
    public :: problem_indicators, solve_plan, measure_problem, measure_start, plan_solve, max_stages
@@ -85,18 +85,17 @@ module lc_contact_policy
       !> multigrid method smooths it by rows where the GCR is slow
       logical :: rows_ahead = .false.
       !> a surface shared among the ranks of an MPI job (docs/decisions/023-mpi-slabs.md):
-      !> the constrained CG and GCR (GCR keeping its history, then Anderson's iteration) and
-      !> GFMD solve it on the slabs; the multigrid method solves the whole grid on every rank
-      !> (docs/decisions/028-distributed-multigrid.md), asked by name only; dense Newton not
+      !> the constrained CG and GCR (GCR keeping its history, then Anderson's iteration),
+      !> GFMD and the multigrid method (its finest grid: docs/decisions/028-distributed-multigrid.md)
+      !> solve it on the slabs; dense Newton not
       logical :: distributed = .false.
+      !> ... the multigrid method with its finest grid on the slabs (solves_on_slabs); else
+      !> the grid, too small to halve into a nested coarse grid, is gathered onto every rank
+      logical :: multigrid_on_slabs = .false.
    end type problem_indicators
 
-   !> The methods a distributed surface may ask for by name, and why 'auto' takes no
-   !> multigrid method there: it would hold the whole grid on every rank.
-   character(len=*), parameter :: distributed_methods = "'auto', 'cg', 'gcr', 'anderson', 'gfmd' or " // &
-      & "'multigrid' (the whole grid on every rank)"
-   character(len=*), parameter :: distributed_refusal = 'the multigrid method solves the whole grid on ' // &
-      & "every rank (asked by name only); distributed runs use gcr/cg"
+   !> The methods a distributed surface may ask for by name.
+   character(len=*), parameter :: distributed_methods = "'auto', 'cg', 'gcr', 'anderson', 'gfmd' or 'multigrid'"
 
    !> The methods to run, in turn, the coarse start before them, and why.
    type :: solve_plan
@@ -126,21 +125,13 @@ contains
       if (trim(method) == 'gfmd') ind%gfmd_refusal = gfmd_refusal(op)
       if (op%distributed) then
          ind%distributed = .true.
-         ! 'auto' keeps a shared surface on the methods that run on the slabs
-         if (trim(method) /= 'multigrid') then
-            ind%refusal = distributed_refusal
-            return
-         end if
-         ! (the multigrid's measures read a whole spectrum: taken on an operator of the whole
-         ! grid, which the method solves on every rank)
+         ind%multigrid_on_slabs = solves_on_slabs(op)
+         if (all(trim(method) /= [character(len=9) :: 'auto', 'multigrid'])) return
+         ! (the multigrid's measures read whole spectra: gathered onto every rank for them,
+         ! and freed)
          block
             type(compliance_operator) :: whole
-            type(error_type), allocatable :: error
-            call whole_operator(op, whole, error)
-            if (allocated(error)) then
-               ind%refusal = 'the operator of the whole grid could not be made: ' // error%message
-               return
-            end if
+            call whole_spectra(op, whole)
             call measure_multigrid(ind, whole, load_control)
          end block
          return
@@ -176,9 +167,23 @@ contains
       ind%start_contacts = count(p > 0.0_wp)
       if (ind%distributed) ind%start_contacts = global_sum(ind%start_contacts)
       if (trim(ind%method) /= 'auto' .or. len(ind%refusal) > 0) return
-      ! (a shared surface under 'auto' has its refusal: returned above)
-      if (loss_needed(ind)) ind%short_wave_loss = loss_among_short_waves(op)
-      if (rows_needed(ind)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
+      if (.not. (loss_needed(ind) .or. rows_needed(ind))) return
+      if (ind%distributed) then
+         ! (whole spectra, as measure_problem's)
+         block
+            type(compliance_operator) :: whole
+            call whole_spectra(op, whole)
+            call measure_spectra(whole)
+         end block
+      else
+         call measure_spectra(op)
+      end if
+   contains
+      subroutine measure_spectra(op)
+         type(compliance_operator), intent(in) :: op
+         if (loss_needed(ind)) ind%short_wave_loss = loss_among_short_waves(op)
+         if (rows_needed(ind)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
+      end subroutine measure_spectra
    end subroutine measure_start
 
    !> The plan for a problem with indicators `ind` (before the coarse start: the first
@@ -245,6 +250,14 @@ contains
          end if
       end if
 
+      ! (a shared surface: where the multigrid method holds its finest grid)
+      if (first == 'multigrid' .and. ind%distributed) then
+         if (ind%multigrid_on_slabs) then
+            why = why // ' (its finest grid on the slabs, its coarse grids whole on every rank)'
+         else
+            why = why // ' (the grid gathered whole onto every rank)'
+         end if
+      end if
       call add(plan, first)
       ! (the multigrid method makes its own nested iteration on a symmetric operator; on the
       ! coupled form it takes the start, whose contact set is nearly right)
@@ -296,7 +309,6 @@ contains
       if (ind%coupled) then
          first = 'gcr'
          why = 'a coupled operator (friction, or a sliding viscoelastic layer): the constrained GCR'
-         if (ind%distributed) why = why // ' (no multigrid method: ' // ind%refusal // ')'
       end if
       if (len(ind%refusal) > 0) return
 

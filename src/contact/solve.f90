@@ -145,10 +145,11 @@ contains
       coupled_memory = kernel%coupled(friction)
       if (.not. coupled_memory .and. may_multigrid .and. grid%is_line()) &
          & coupled_memory = kernel%compliance_rise(2*pi/grid%lx, pi*grid%nx/grid%lx) > allowed_rise
-      ! (a shared surface takes the multigrid method by name only, and it then solves the
-      ! whole grid on every rank: decision 028)
-      if (distributed) may_multigrid = trim(scene%solver%method) == 'multigrid'
-      call check_memory(merge(n, n_local, distributed .and. may_multigrid), coupled_memory, scene%solver%memory, &
+      ! (a shared surface's multigrid holds its slab and, on every rank, the whole first coarse
+      ! grid and those below it, and the finest grid's symbols: counted as a quarter of the
+      ! grid's points at the multigrid's doubles a point, decision 028)
+      call check_memory(merge(n_local + n/4, n_local, distributed .and. may_multigrid), coupled_memory, &
+         & scene%solver%memory, &
          & scene%stress .and. grid%ny > 1, &
          & may_multigrid, grid%is_line(), trim(scene%solver%method) == 'gfmd', error)
       if (allocated(error)) return

@@ -47,11 +47,11 @@ module lc_contact_solver_multigrid
    use lc_base_memory, only: available_bytes
    use lc_base_strings, only: to_string, formatted
    use lc_contact_operator, only: compliance_operator, build_operator
-   use lc_base_parallel, only: allgather_rows, slab
+   use lc_base_parallel, only: allgather_rows, slab, global_sum, global_max, global_any, sum_over_ranks, max_over_ranks
    use lc_base_threads, only: active_threads
    use lc_contact_multigrid_hierarchy, only: hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, &
       & build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, precondition, worst_smoothing, &
-      & apply_stiffness, worst_row_smoothing, accepted_smoothing
+      & apply_stiffness, worst_row_smoothing, accepted_smoothing, across_ranks, interpolate_onto_slab, sampled_symbol
    use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
    use lc_contact_progress, only: progress_log
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
@@ -60,7 +60,8 @@ module lc_contact_solver_multigrid
    implicit none (type, external)
    private
    public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
-   public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, whole_operator
+   public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, whole_operator, solves_on_slabs
+   public :: whole_spectra
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -532,7 +533,8 @@ contains
    !> too. p: in, the
    !> start (the coarse start's interpolated solution, or the caller's guess); out, the
    !> solution, or the best iterate if it did not converge. The metric must pass
-   !> metric_refusal.
+   !> metric_refusal. A distributed op (solves_on_slabs): p, w, gap and b are its slab, the
+   !> finest grid's iteration on the slabs (docs/decisions/028-distributed-multigrid.md).
    subroutine coupled_tnnmg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
          & history, progress, error)
       type(compliance_operator), intent(inout), target :: op
@@ -553,15 +555,28 @@ contains
       real(wp), allocatable :: u(:), o(:), c(:), kc(:), v(:), kv(:), dirs(:, :), kdirs(:, :), r(:), u_best(:)
       real(wp), allocatable :: symbol(:), odd(:)
       logical :: complex_symbol
-      real(wp) :: f, d, b_max, residual, contact, best, best_residual
+      real(wp) :: f, d, b_max, residual, contact, best, best_residual, points
       integer :: n, step, changed, j, last_progress, memory
       logical :: settled, finished, clipped, tension, stagnated, exact
-      logical :: rows
+      logical :: rows, global
 
       n = size(p)
+      ! (op on a slab of a distributed surface: the iteration's sums and maxima over the
+      ! ranks, points the whole grid's; the symbol of the hierarchy is read off the whole
+      ! spectra, gathered for it and freed: whole_spectra)
+      global = op%distributed
+      points = merge(real(op%grid%points(), wp), real(n, wp), global)
       call op%prepare_gcr()
       ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows)
-      call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+      if (global) then
+         block
+            type(compliance_operator) :: whole
+            call whole_spectra(op, whole)
+            call coupled_symbol(whole, load_control, symbol, odd, complex_symbol, rows)
+         end block
+      else
+         call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+      end if
       if (complex_symbol) then
          call build_hierarchy(h, op, error, symbol, odd, rows=rows)
          if (allocated(error)) return
@@ -582,16 +597,23 @@ contains
          if (real(op%inverse_full(j)) > 0.0_wp) &
             & d = max(d, jacobi_margin*omega*abs(op%inverse_full(j))**2/(2*real(op%inverse_full(j))))
       end do
+      if (global) d = global_max(d)
       memory = gcr_memory
       allocate (u(n), o(n), c(n), kc(n), v(n), kv(n), r(n), u_best(n), dirs(n, memory), kdirs(n, memory))
       f = merge(mean_pressure, 0.0_wp, load_control)
       o = b
       if (.not. load_control) o = o + s
       b_max = maxval(abs(o))
+      if (global) b_max = global_max(b_max)
       ! the start: u = G p, less (load control) the mean of G p - b over p's contact set
       call op%apply_full(p, u)
       h%pairs = h%pairs + 1.0_wp
-      if (load_control .and. any(p > 0.0_wp)) then
+      if (global) then
+         if (load_control .and. global_any(any(p > 0.0_wp))) then
+            s = global_sum(sum(u - b, mask=p > 0.0_wp))/global_sum(count(p > 0.0_wp))
+            u = u - s
+         end if
+      else if (load_control .and. any(p > 0.0_wp)) then
          s = sum(u - b, mask=p > 0.0_wp)/count(p > 0.0_wp)
          u = u - s
       end if
@@ -607,8 +629,9 @@ contains
          outcome%iterations = step
          u = max(o, u - (omega/d)*p)
          call apply_k(u, p)
-         scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest)
-         call examine(u, p, o, scales, h%free, residual, contact, changed, tension)
+         scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest, global)
+         call examine(u, p, o, scales, h%free(1:n), residual, contact, changed, tension)
+         if (global) call examine_over_ranks(n, residual, contact, changed, tension)
          if (step <= size(history)) history(step) = residual
          call progress%tick(step, residual, contact)
          if (residual <= tol) exit
@@ -627,14 +650,19 @@ contains
             last_progress = step
             u = u_best
             call apply_k(u, p)
-            call examine(u, p, o, scales, h%free, residual, contact, changed, tension)
+            call examine(u, p, o, scales, h%free(1:n), residual, contact, changed, tension)
+            if (global) call examine_over_ranks(n, residual, contact, changed, tension)
             changed = max(changed, 1)
          end if
          if (load_control .and. contact == 0.0_wp) then
-            u = u - minval(u - o)
+            if (global) then
+               u = u + global_max(maxval(o - u))
+            else
+               u = u - minval(u - o)
+            end if
             cycle
          end if
-         settled = step > 1 .and. changed <= settled_fraction*contact*n .and. .not. tension
+         settled = step > 1 .and. changed <= settled_fraction*contact*points .and. .not. tension
          if (changed > 0 .or. step == 1) call set_contact(h)
          finished = .false.
          if (settled) then
@@ -652,6 +680,7 @@ contains
             exit
          end if
          call project_direction(u, o, c, v, clipped)
+         if (global) clipped = global_any(clipped)
          if (clipped) then
             call apply_k(v, kv, shift=0.0_wp)
          else
@@ -660,6 +689,8 @@ contains
          if (exact) then
             u = u + v
             p = p + kv
+         else if (global) then
+            call line_step(v, kv, global_sum(dot_product(v, kv)), u, p, global_sum(dot_product(p, v)))
          else
             call line_step(v, kv, dot_product(v, kv), u, p)
          end if
@@ -729,29 +760,38 @@ contains
          c = 0.0_wp
          kc = 0.0_wp
          stagnated = .false.
-         r = -h%free*p
-         b_norm = euclidean_norm(r)
+         r = -h%free(1:n)*p
+         b_norm = norm_over(r, global)
          if (b_norm == 0.0_wp) return
          columns = 0
          gone = .false.
          do it = 1, max_steps
             if (columns == memory) columns = 0
             columns = columns + 1
-            associate (z => dirs(:, columns), kz => kdirs(:, columns), free => h%free)
+            associate (z => dirs(:, columns), kz => kdirs(:, columns), free => h%free(1:n))
             call precondition(h, r, z)
             call apply_k(z, kz, shift=0.0_wp)
             ! (orthogonal on the free points to the stored images)
-            call orthogonalise(z, kz, dirs(:, :columns - 1), kdirs(:, :columns - 1), free)
+            if (global) then
+               call orthogonalise_over_ranks(z, kz, dirs(:, :columns - 1), kdirs(:, :columns - 1), free)
+            else
+               call orthogonalise(z, kz, dirs(:, :columns - 1), kdirs(:, :columns - 1), free)
+            end if
             call masked_products(kz, r, free, norm, gamma)
+            if (global) call add_pair_over_ranks(norm, gamma)
             norm = sqrt(norm)
             if (.not. norm > 0.0_wp) exit
             ! the minimal-residual step along z (z and kz then scaled to a unit image)
             gamma = gamma/norm**2
             if (check .and. .not. gone) then
                call step_and_check(u, o, p, gamma, z, kz, free, c, kc, r, scales, res, violated)
+               if (global) then
+                  res = global_max(res)
+                  violated = global_any(violated)
+               end if
                z = z/norm
                kz = kz/norm
-               r_norm = euclidean_norm(r)
+               r_norm = norm_over(r, global)
                if (violated) then
                   ! the set is not yet the final one: go on as a Newton step
                   gone = .true.
@@ -763,11 +803,12 @@ contains
                end if
             else
                call minimal_residual_step(gamma, norm, z, kz, free, c, kc, r, r_norm)
+               if (global) r_norm = norm_over(r, global)
                if (r_norm <= merge(violated_reduction, reduction, gone)*b_norm) exit
             end if
             end associate
          end do
-         stagnated = check .and. .not. finished .and. it > max_steps .and. euclidean_norm(r) > violated_reduction*b_norm
+         stagnated = check .and. .not. finished .and. it > max_steps .and. norm_over(r, global) > violated_reduction*b_norm
       end subroutine truncated_gcr
    end subroutine coupled_tnnmg
 
@@ -853,16 +894,20 @@ contains
       real(wp), contiguous, intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
       type(residual_scales) :: scales
-      real(wp) :: residual, diagonal, vkv, b_max, contact
+      real(wp) :: residual, diagonal, vkv, b_max, contact, points
       integer :: m, step, changed
-      logical :: settled, finished, clipped, tension
+      logical :: settled, finished, clipped, tension, global
 
       m = size(u)
+      ! (the finest grid on the slabs: sums and maxima over the ranks, points the whole grid's)
+      global = across_ranks(h)
+      points = merge(real(h%n_fine, wp), real(m, wp), global)
       associate (c => work%c(1:m), kc => work%kc(1:m), cg_work => work%cg(1:m, :), v => work%cg(1:m, 1), &
          & kv => work%cg(1:m, 2))
       h%free(1:m) = 1.0_wp
       diagonal = h%level(h%top)%jacobi_diagonal
       b_max = maxval(abs(o))
+      if (global) b_max = global_max(b_max)
       u = max(u, o)
       call apply_stiffness(h, u, p, shift=f)
       converged = .false.
@@ -872,10 +917,11 @@ contains
          ! nonlinear smoother: projected damped Jacobi
          u = max(o, u - (omega/diagonal)*p)
          call apply_stiffness(h, u, p, shift=f)
-         scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest)
+         scales = scales_of(u, p, load_control, f, g_ref, b_max, op%largest, global)
          ! (the free points and how many changed are found in the same pass: the
          ! truncated problem below needs them)
          call examine(u, p, o, scales, h%free(1:m), residual, contact, changed, tension)
+         if (global) call examine_over_ranks(m, residual, contact, changed, tension)
          call record(step, residual, contact)
          if (residual <= tol) then
             converged = .true.
@@ -884,12 +930,16 @@ contains
          if (load_control .and. contact == 0.0_wp) then
             ! nothing touches: the energy falls along the rigid shift until the lowest point
             ! touches (K(0) = 0, so p does not change); the truncated problem would be singular
-            u = u - minval(u - o)
+            if (global) then
+               u = u + global_max(maxval(o - u))
+            else
+               u = u - minval(u - o)
+            end if
             cycle
          end if
          ! the truncated problem on the free points; the finishing phase once the contact set
          ! has settled
-         settled = step > 1 .and. changed <= settled_fraction*contact*m .and. .not. tension
+         settled = step > 1 .and. changed <= settled_fraction*contact*points .and. .not. tension
          ! (the coarse operators depend on the set only)
          if (changed > 0 .or. step == 1) call set_contact(h)
          finished = .false.
@@ -907,13 +957,19 @@ contains
          end if
          ! projection onto u >= o and exact line search on the quadratic J
          call project_direction(u, o, c, v, clipped)
+         if (global) clipped = global_any(clipped)
          if (clipped) then
             call apply_stiffness(h, v, kv, xy=vkv)
          else
             kv = kc
             vkv = dot_product(v, kv)
+            if (global) vkv = global_sum(vkv)
          end if
-         call line_step(v, kv, vkv, u, p)
+         if (global) then
+            call line_step(v, kv, vkv, u, p, global_sum(dot_product(p, v)))
+         else
+            call line_step(v, kv, vkv, u, p)
+         end if
       end do
       end associate
    contains
@@ -945,13 +1001,19 @@ contains
 
    !> u <- u + alpha v, p <- p + alpha K v with alpha = min(1, -p.v/v.K v), the exact line
    !> search of the (symmetric part's) quadratic energy along v; no step unless v.K v > 0.
-   pure subroutine line_step(v, kv, vkv, u, p)
+   !> pv: p.v where it is given (a sum over the ranks).
+   pure subroutine line_step(v, kv, vkv, u, p, pv)
       real(wp), contiguous, intent(in) :: v(:), kv(:)
       real(wp), intent(in) :: vkv
       real(wp), contiguous, intent(inout) :: u(:), p(:)
+      real(wp), intent(in), optional :: pv
       real(wp) :: alpha
       if (.not. vkv > 0.0_wp) return
-      alpha = min(1.0_wp, max(0.0_wp, -dot_product(p, v)/vkv))
+      if (present(pv)) then
+         alpha = min(1.0_wp, max(0.0_wp, -pv/vkv))
+      else
+         alpha = min(1.0_wp, max(0.0_wp, -dot_product(p, v)/vkv))
+      end if
       u = u + alpha*v
       p = p + alpha*kv
    end subroutine line_step
@@ -978,19 +1040,22 @@ contains
       real(wp), intent(out), optional :: residual
       real(wp) :: rz, rz_old, b_norm, r_norm, dkd, a
       logical :: violated, gone   !< gone: a point left the feasible set
+      logical :: global           !< the finest grid on the slabs: sums over the ranks
       integer :: it, m, j
 
       m = size(u)
+      global = across_ranks(h)
       gone = .false.
       c = 0.0_wp
       kc = 0.0_wp
       if (present(finished)) finished = .false.
       associate (r => work(:, 1), d => work(:, 2), kd => work(:, 3), free => h%free(1:m))
       r = -free*p
-      b_norm = euclidean_norm(r)
+      b_norm = norm_over(r, global)
       if (b_norm == 0.0_wp) return
       call precondition(h, r, d)
       rz = dot_product(r, d)
+      if (global) rz = global_sum(rz)
       do it = 1, max_steps
          ! (d is zero on the contact set, as the preconditioner's output: d.I K d = d.K d)
          call apply_stiffness(h, d, kd, xy=dkd)
@@ -998,11 +1063,15 @@ contains
          a = rz/dkd
          if (present(scales) .and. .not. gone) then
             call step_and_check(u, o, p, a, d, kd, free, c, kc, r, scales, residual, violated)
+            if (global) then
+               residual = global_max(residual)
+               violated = global_any(violated)
+            end if
             if (violated) then
                ! the set is not yet the final one: go on as a Newton step (to a residual
                ! reduced by violated_reduction), which the line search then projects
                gone = .true.
-               if (euclidean_norm(r) <= violated_reduction*b_norm) exit
+               if (norm_over(r, global) <= violated_reduction*b_norm) exit
             else if (residual <= tol) then
                finished = .true.
                exit
@@ -1016,12 +1085,14 @@ contains
                r(j) = r(j) - a*free(j)*kd(j)
                r_norm = r_norm + r(j)**2
             end do
+            if (global) r_norm = global_sum(r_norm)
             if (sqrt(r_norm) <= merge(violated_reduction, reduction, gone)*b_norm) exit
          end if
          if (it == max_steps) exit
          rz_old = rz
          call precondition(h, r, kd)
          rz = dot_product(r, kd)
+         if (global) rz = global_sum(rz)
          d = kd + (rz/rz_old)*d
       end do
       end associate
@@ -1029,12 +1100,14 @@ contains
 
    !> p_ref (p_m, or the mean pressure under displacement control), g_ref and the rounding
    !> floor of the gap for the state (u, p).
-   pure function scales_of(u, p, load_control, f, g_ref, b_max, largest) result(scales)
+   !> global: u and p are a slab, the maxima and the mean taken over the ranks.
+   function scales_of(u, p, load_control, f, g_ref, b_max, largest, global) result(scales)
       real(wp), contiguous, intent(in) :: u(:), p(:)
       logical, intent(in) :: load_control
       real(wp), intent(in) :: f, g_ref, b_max, largest
+      logical, intent(in), optional :: global
       type(residual_scales) :: scales
-      real(wp) :: p_ref, u_max, p_max, p_sum
+      real(wp) :: p_ref, u_max, p_max, p_sum, points, maxima(2)
       integer :: j
       u_max = 0.0_wp
       p_max = -huge(1.0_wp)
@@ -1045,7 +1118,18 @@ contains
          p_max = max(p_max, p(j))
          p_sum = p_sum + p(j)
       end do
-      p_ref = merge(f, p_sum/size(p), load_control)
+      points = size(p)
+      if (present(global)) then
+         if (global) then
+            maxima = [u_max, p_max]
+            call max_over_ranks(maxima)
+            u_max = maxima(1)
+            p_max = maxima(2)
+            p_sum = global_sum(p_sum)
+            points = global_sum(points)
+         end if
+      end if
+      p_ref = merge(f, p_sum/points, load_control)
       scales%p_scale = 1.0_wp/max(p_ref, tiny(1.0_wp))
       scales%g_scale = 1.0_wp/g_ref
       scales%floor = rounding_floor(u_max, b_max, p_max, largest)
@@ -1086,6 +1170,67 @@ contains
       changed = nint(moved)
       tension = pulled > 0.0_wp
    end subroutine examine
+
+   !> examine's results on a slab made the whole surface's: the largest residual, the
+   !> contact fraction and the changed points counted over the ranks (m: the slab's points),
+   !> tension on any rank.
+   subroutine examine_over_ranks(m, residual, contact, changed, tension)
+      integer, intent(in) :: m
+      real(wp), intent(inout) :: residual, contact
+      integer, intent(inout) :: changed
+      logical, intent(inout) :: tension
+      real(wp) :: totals(4)
+      ! (the slab's contact points recovered exactly from its fraction: integers below 2^53)
+      totals = [real(nint(contact*m), wp), real(changed, wp), merge(1.0_wp, 0.0_wp, tension), real(m, wp)]
+      call sum_over_ranks(totals)
+      residual = global_max(residual)
+      contact = totals(1)/totals(4)
+      changed = nint(totals(2))
+      tension = totals(3) > 0.0_wp
+   end subroutine examine_over_ranks
+
+   !> orthogonalise on a slab: each beta_k summed over the ranks before the column is
+   !> subtracted (one message a column: Gram-Schmidt's columns in turn).
+   subroutine orthogonalise_over_ranks(z, kz, dirs, kdirs, free)
+      real(wp), contiguous, intent(inout) :: z(:), kz(:)
+      real(wp), contiguous, intent(in) :: dirs(:, :), kdirs(:, :), free(:)
+      real(wp) :: beta
+      integer :: k, j
+      do k = 1, size(dirs, 2)
+         beta = 0.0_wp
+         !$omp simd reduction(+:beta)
+         do j = 1, size(z)
+            beta = beta + free(j)*kz(j)*kdirs(j, k)
+         end do
+         beta = global_sum(beta)
+         !$omp simd
+         do j = 1, size(z)
+            z(j) = z(j) - beta*dirs(j, k)
+            kz(j) = kz(j) - beta*kdirs(j, k)
+         end do
+      end do
+   end subroutine orthogonalise_over_ranks
+
+   !> a, b <- their sums over the ranks (one message).
+   subroutine add_pair_over_ranks(a, b)
+      real(wp), intent(inout) :: a, b
+      real(wp) :: pair(2)
+      pair = [a, b]
+      call sum_over_ranks(pair)
+      a = pair(1)
+      b = pair(2)
+   end subroutine add_pair_over_ranks
+
+   !> |x| of a field, over the ranks where `global` (x a slab).
+   real(wp) function norm_over(x, global) result(norm)
+      real(wp), contiguous, intent(in) :: x(:)
+      logical, intent(in) :: global
+      if (global) then
+         norm = sqrt(global_sum(sum(x**2)))
+      else
+         norm = euclidean_norm(x)
+      end if
+   end function norm_over
 
    !> z, kz <- z - sum_k beta_k dirs_k, kz - sum_k beta_k kdirs_k with beta_k = (I kz, kdirs_k),
    !> one column after the other (modified Gram-Schmidt on the free points against unit
@@ -1205,27 +1350,46 @@ contains
       real(wp), intent(inout) :: s
       real(wp), intent(out) :: residual
       logical, intent(in), optional :: full   !< w = G_eff p (a coupled operator)
-      real(wp) :: p_ref
+      real(wp) :: p_ref, maxima(3)
       integer :: contact
-      p_ref = merge(mean_pressure, sum(p)/size(p), load_control)
+      ! (a distributed operator: the fields are its slab, the sums and maxima over the ranks)
+      p_ref = merge(mean_pressure, mean_of(p), load_control)
       where (p > 0.0_wp .and. p*g_ref >= (u - w)*p_ref)
          gap = p
       elsewhere
          gap = 0.0_wp
       end where
       p = gap
-      if (load_control) call normalise(p, mean_pressure)
+      if (load_control) call normalise(p, mean_pressure, across_ranks=op%distributed)
       if (present(full)) then
          call op%apply_full(p, w)
       else
          call op%apply_metric(p, w)
       end if
       contact = count(p > 0.0_wp)
-      if (load_control .and. contact > 0) s = sum(w - b, mask=p > 0.0_wp)/contact
+      if (op%distributed) contact = global_sum(contact)
+      if (load_control .and. contact > 0) then
+         if (op%distributed) then
+            s = global_sum(sum(w - b, mask=p > 0.0_wp))/contact
+         else
+            s = sum(w - b, mask=p > 0.0_wp)/contact
+         end if
+      end if
       gap = w - b - s
-      p_ref = merge(mean_pressure, sum(p)/size(p), load_control)
-      residual = complementarity_residual(p, gap, p_ref, g_ref, &
-         & rounding_floor(maxval(abs(w)), maxval(abs(b)), maxval(p), op%largest))
+      p_ref = merge(mean_pressure, mean_of(p), load_control)
+      maxima = [maxval(abs(w)), maxval(abs(b)), maxval(p)]
+      if (op%distributed) call max_over_ranks(maxima)
+      residual = complementarity_residual(p, gap, p_ref, g_ref, rounding_floor(maxima(1), maxima(2), maxima(3), op%largest))
+      if (op%distributed) residual = global_max(residual)
+   contains
+      real(wp) function mean_of(x)
+         real(wp), contiguous, intent(in) :: x(:)
+         if (op%distributed) then
+            mean_of = global_sum(sum(x))/global_sum(real(size(x), wp))
+         else
+            mean_of = sum(x)/size(x)
+         end if
+      end function mean_of
    end subroutine returned_fields
    subroutine solve_by_multigrid(self, problem, state, budget, outcome, progress, error)
       class(multigrid_solver), intent(inout) :: self
@@ -1238,7 +1402,15 @@ contains
       type(multigrid_outcome) :: nested
       real(wp), allocatable :: history(:)
       allocate (history(budget))
-      if (problem%op%distributed) then
+      if (solves_on_slabs(problem%op)) then
+         if (symmetric_form(problem%op)) then
+            call multigrid_on_slabs(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
+               & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
+         else
+            call coupled_tnnmg(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
+               & problem%g_ref, problem%tol, budget, state%p, state%w, state%gap, nested, history, progress, error)
+         end if
+      else if (problem%op%distributed) then
          call solve_gathered(problem, state, budget, nested, history, progress, error)
       else if (problem%op%coupled .or. len(multigrid_refusal(problem%op)) > 0) then
          call coupled_tnnmg(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, &
@@ -1252,6 +1424,140 @@ contains
          & fft_pairs=nested%fft_pairs, residual=nested%residual, &
          & history=history(1:min(nested%iterations, size(history))))
    end subroutine solve_by_multigrid
+
+   !> Whether the multigrid method solves the scene of the distributed operator `op` on the
+   !> slabs (multigrid_on_slabs, coupled_tnnmg): a grid whose V-cycle has a coarse grid
+   !> below the finest and whose nested iteration starts on a coarser one (from 1024
+   !> points). The others are gathered (solve_gathered).
+   logical function solves_on_slabs(op)
+      type(compliance_operator), intent(in) :: op
+      solves_on_slabs = op%distributed
+      if (solves_on_slabs) solves_on_slabs = len(size_refusal(op)) == 0 .and. &
+         & halvings(op%grid%nx, op%grid%ny, nested_coarsest) >= 1
+   end function solves_on_slabs
+
+   !> Whether the scene of `op` takes the symmetric form (multigrid) rather than the coupled
+   !> one, as solve_by_multigrid decides serially: a distributed operator whose compliance
+   !> does not fall with |q| everywhere is decided on its whole spectra (whole_spectra,
+   !> freed after: rise_refusal reads a whole spectrum).
+   logical function symmetric_form(op) result(symmetric)
+      type(compliance_operator), intent(in) :: op
+      symmetric = .not. (op%coupled .or. op%kernel%viscoelastic)
+      if (.not. symmetric) return
+      if (op%distributed .and. .not. op%metric_falls) then
+         block
+            type(compliance_operator) :: whole
+            call whole_spectra(op, whole)
+            symmetric = len(multigrid_refusal(whole)) == 0
+         end block
+      else
+         symmetric = len(multigrid_refusal(op)) == 0
+      end if
+   end function symmetric_form
+
+   !> multigrid on the slabs of a surface shared among the ranks (op on this rank's slab:
+   !> docs/decisions/028-distributed-multigrid.md). The nested iteration's coarse grids are
+   !> whole and alike on every rank (the profile at every second point gathered, one
+   !> MPI_Allreduce of that grid); the finest grid's iteration runs on the slabs, its sums and
+   !> maxima over the ranks, K applied by the operator's distributed transforms; its
+   !> preconditioner's first coarse grid is gathered (restrict_slab), the V-cycle below it
+   !> run whole and alike, and its correction interpolated onto each slab. p, w, gap: this
+   !> rank's slab; s the whole surface's on every rank. The scene must pass solves_on_slabs.
+   subroutine multigrid_on_slabs(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, &
+         & history, progress, error)
+      type(compliance_operator), intent(inout), target :: op
+      real(wp), contiguous, intent(in) :: b(:)
+      logical, intent(in) :: load_control
+      real(wp), intent(in) :: mean_pressure
+      real(wp), intent(inout) :: s
+      real(wp), intent(in) :: g_ref, tol
+      integer, intent(in) :: max_iter
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(out) :: w(:), gap(:)
+      type(multigrid_outcome), intent(out) :: outcome
+      real(wp), contiguous, intent(inout) :: history(:)
+      type(progress_log), intent(inout) :: progress
+      type(error_type), allocatable, intent(out) :: error
+      type(hierarchy), target :: h
+      type(workspace) :: work, coarse_work
+      real(wp), allocatable :: u(:), finest(:), b_half(:), uc(:), oc(:), pc(:), scratch(:)
+      real(wp) :: f
+      integer :: n, nx, ny, j, nested, m, mc, m1, steps
+      logical :: converged
+
+      n = size(p)
+      nx = op%grid%nx
+      ny = op%grid%ny
+      finest = whole_stiffness(op, load_control)
+      call build_hierarchy(h, op, error)
+      if (allocated(error)) return
+      f = merge(mean_pressure, 0.0_wp, load_control)
+      nested = halvings(nx, ny, nested_coarsest)
+      m1 = h%level(1)%n
+      allocate (coarse_work%c(m1), coarse_work%kc(m1), coarse_work%cg(m1, 3), uc(m1), oc(m1), pc(m1), scratch(m1))
+      b_half = gathered_half(b, nx, ny, h%y_start, h%ny_local)
+      ! the coarse grids of the nested iteration, whole: the coarsest to tol, the others one
+      ! iteration each
+      do j = nested, 1, -1
+         m = h%level(j)%n
+         call set_grid(h, j, sampled_symbol(finest, nx, ny, h%level(j)%nx, h%level(j)%ny))
+         call sample(b_half, nx/2, ny/2, 2**(j - 1), oc(1:m))
+         if (.not. load_control) oc(1:m) = oc(1:m) + s
+         if (j == nested) then
+            uc(1:m) = oc(1:m)
+         else
+            mc = h%level(j + 1)%n
+            scratch(1:mc) = uc(1:mc)
+            call interpolate(h, j, scratch(1:mc), uc(1:m))
+         end if
+         call tnnmg(h, coarse_work, op, uc(1:m), oc(1:m), f, load_control, g_ref, tol, merge(max_iter, 1, j == nested), &
+            & pc(1:m), steps, converged)
+      end do
+      deallocate (coarse_work%c, coarse_work%kc, coarse_work%cg, oc, pc, scratch, b_half)
+      ! the finest grid, on the slabs, to tol on the fields returned
+      call set_grid(h, 0, finest)
+      deallocate (finest)
+      allocate (u(n), work%c(n), work%kc(n), work%cg(n, 3))
+      call interpolate_onto_slab(h, uc, u)
+      deallocate (uc)
+      call finest_iterations(h, work, op, u, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, &
+         & outcome, history, progress)
+   end subroutine multigrid_on_slabs
+
+   !> The stiffness K = 1/M on the whole half spectrum of the distributed operator's grid
+   !> (level_symbol's of the finest grid): each rank's modes, summed over the ranks.
+   function whole_stiffness(op, load_control) result(stiffness)
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
+      real(wp), allocatable :: stiffness(:)
+      integer :: i, mx, my
+      allocate (stiffness(op%grid%modes()))
+      stiffness = 0.0_wp
+      do i = 1, op%nk
+         call op%fft%mode_indices(i, mx, my)
+         if (op%metric(i) > 0.0_wp) stiffness(mx + (op%grid%nx/2 + 1)*my + 1) = 1.0_wp/op%metric(i)
+      end do
+      call sum_over_ranks(stiffness)
+      if (load_control) stiffness(1) = 0.0_wp
+   end function whole_stiffness
+
+   !> The field b of nx x ny points (this rank's slab: rows y_start+1 .. y_start+ny_local) at
+   !> every second point along each axis, whole on every rank: each rank's even rows, summed
+   !> over the ranks.
+   function gathered_half(b, nx, ny, y_start, ny_local) result(half)
+      real(wp), contiguous, intent(in) :: b(:)
+      integer, intent(in) :: nx, ny, y_start, ny_local
+      real(wp), allocatable :: half(:)
+      integer :: j, y, mx
+      mx = nx/2
+      allocate (half(mx*(ny/2)))
+      half = 0.0_wp
+      do j = 0, ny_local - 1
+         y = y_start + j
+         if (mod(y, 2) == 0) half((y/2)*mx + 1:(y/2 + 1)*mx) = b(j*nx + 1:(j + 1)*nx:2)
+      end do
+      call sum_over_ranks(half)
+   end function gathered_half
 
    !> The multigrid solve of a surface shared among the ranks (problem%op on this rank's
    !> slab; docs/decisions/028-distributed-multigrid.md): the profile and the start gathered
@@ -1304,6 +1610,47 @@ contains
       if (allocated(error)) return
       if (op%dropped_uniform /= 0.0_wp) call whole%drop_uniform_mode(uniform)
    end subroutine whole_operator
+
+   !> The spectra of the distributed operator `op` on the whole half spectrum, on every rank
+   !> (each rank's modes, summed over the ranks), in an operator without plans: what the
+   !> multigrid's measures and the symbol of its hierarchy read (multigrid_refusal,
+   !> coupled_refusal, coupled_symbol, loss_among_short_waves, rows_ahead_of_gcr, never a
+   !> transform). The metric, and G_eff where coupled: 1.5 doubles a point of the grid, where
+   !> an operator of the whole grid (whole_operator) holds its plans' buffers besides.
+   subroutine whole_spectra(op, whole)
+      type(compliance_operator), intent(in) :: op
+      type(compliance_operator), intent(out) :: whole
+      real(wp), allocatable :: parts(:)
+      integer :: i, mx, my, k, nk
+      nk = op%grid%modes()
+      whole%grid = op%grid
+      whole%kernel = op%kernel
+      whole%n = op%grid%points()
+      whole%nk = nk
+      whole%friction = op%friction
+      whole%coupled = op%coupled
+      whole%monotone = op%monotone
+      whole%metric_falls = op%metric_falls
+      whole%diagonal = op%diagonal
+      whole%largest = op%largest
+      whole%inv_n = op%inv_n
+      whole%dropped_uniform = op%dropped_uniform
+      whole%compliance = op%compliance
+      allocate (parts(merge(3, 1, op%coupled)*nk))
+      parts = 0.0_wp
+      do i = 1, op%nk
+         call op%fft%mode_indices(i, mx, my)
+         k = mx + (op%grid%nx/2 + 1)*my + 1
+         parts(k) = op%metric(i)
+         if (op%coupled) then
+            parts(nk + k) = real(op%full(i))
+            parts(2*nk + k) = aimag(op%full(i))
+         end if
+      end do
+      call sum_over_ranks(parts)
+      whole%metric = parts(1:nk)
+      if (op%coupled) whole%full = cmplx(parts(nk + 1:2*nk), parts(2*nk + 1:3*nk), kind=wp)
+   end subroutine whole_spectra
 
    pure function multigrid_name(self) result(name)
       class(multigrid_solver), intent(in) :: self

@@ -211,21 +211,25 @@ contains
       call report(name, error%code == code_input .and. index(error%message, message_has) > 0, error%message)
    end subroutine refused
 
-   !> A surface shared among MPI ranks: 'auto' plans CG or GCR (GCR keeping its history, then
-   !> Anderson's iteration, as on one rank), never the multigrid method, which would hold the
-   !> whole grid on every rank, however large or hard the grid; the multigrid method,
-   !> Anderson and GFMD as asked; dense Newton refused by name.
+   !> A surface shared among MPI ranks: 'auto' plans as on one rank (the multigrid method
+   !> included: its finest grid on the slabs, and the reason says so), but no dense Newton
+   !> method; the multigrid method, Anderson and GFMD as asked; dense Newton refused by name.
    subroutine check_distributed()
       type(problem_indicators) :: ind
       ind = problem(2048**2, .false., .false.)
       ind%distributed = .true.
-      ind%refusal = 'the multigrid method solves the whole grid on every rank (asked by name only); ' // &
-         & 'distributed runs use gcr/cg'
-      call expect('distributed symmetric 2048^2', ind, .true., 'cg', 'distributed runs use gcr/cg')
+      ind%multigrid_on_slabs = .true.
+      call expect('distributed symmetric 2048^2', ind, .false., 'multigrid+cg', 'its finest grid on the slabs')
+      ind%points = 512**2
+      call expect('distributed symmetric 512^2', ind, .true., 'cg', 'constrained CG')
+      ind%points = 2048**2
       ind%coupled = .true.
       ind%start_iterations = 40
-      call expect('distributed coupled 2048^2, hard start', ind, .true., 'gcr+kept+anderson', &
-         & 'distributed runs use gcr/cg')
+      ind%metric_admitted = .true.
+      call expect('distributed coupled 2048^2, hard start', ind, .true., 'multigrid+gcr+kept+anderson', &
+         & 'its finest grid on the slabs')
+      ind%start_iterations = 5
+      call expect('distributed coupled 2048^2, easy start', ind, .true., 'gcr+kept+anderson', 'the constrained GCR')
       ind%points = 32**2
       call expect('distributed coupled 32^2 (no dense Newton)', ind, .true., 'gcr+kept+anderson', 'the constrained GCR')
       ind%method = 'anderson'
@@ -236,11 +240,12 @@ contains
       call expect('distributed gcr', ind, .true., 'gcr', '')
       ind%method = 'gfmd'
       call expect('distributed gfmd', ind, .true., 'gfmd', "method 'gfmd'")
-      ! (asked by name, the multigrid's measures are taken on the whole grid's operator)
       ind%method = 'multigrid'
-      ind%refusal = ''
       ind%points = 2048**2
       call expect('distributed multigrid by name', ind, .true., 'multigrid+gcr+kept+anderson', "method 'multigrid'")
+      ind%multigrid_on_slabs = .false.
+      call expect('distributed multigrid by name, gathered', ind, .true., 'multigrid+gcr+kept+anderson', &
+         & 'gathered whole onto every rank')
    end subroutine check_distributed
 
    !> What the memory check provides for: every grid where some start could send the
