@@ -40,20 +40,13 @@ module lc_fft_plans
    public :: fft_plan, transform_seconds
 
    !> Surfaces of at least this many points are transformed in two passes: the rows (r2c),
-   !> then the columns of the half spectrum in blocks of adjacent columns.
+   !> then the columns of the half spectrum in blocks of `column_block` adjacent columns.
    !> FFTW_ESTIMATE's plan for the 2D transform walks the columns one at a time with a
-   !> stride of nx/2 + 1 complex numbers, a cache line per element; blocks of adjacent
-   !> columns share the lines. The gain is steady from about 1000^2 on (docs/performance.md,
-   !> 'Cost': 'Large surfaces: a two-pass transform'; bench/fft_plans.c). The block is
-   !> `wide_block` columns where their ny complex values fit in `block_bytes` (FFTW copies a
-   !> block into a buffer of its own, transforms and copies it back: the copy stays in the
-   !> core's cache), else `column_block` (docs/decisions/024-fft-floor.md, 'Measured'). A
-   !> column's transform is the same arithmetic in a block of either width, so the same bits
-   !> where the last, narrower block is (nx/2 + 1 = 1 modulo 16: nx a multiple of 32).
+   !> stride of nx/2 + 1 complex numbers, a cache line per element; blocks of 8 share the
+   !> lines. The gain is steady from about 1000^2 on (docs/performance.md, 'Cost': 'Large surfaces:
+   !> a two-pass transform'; bench/fft_plans.c).
    integer, parameter :: split_points = 800000
-   integer, parameter :: column_block = 8, wide_block = 16
-   !> half the L2 cache of one core of the machines measured (512 KiB)
-   integer, parameter :: block_bytes = 262144
+   integer, parameter :: column_block = 8
    !> FFTW-MPI's own set-up is done (once per process)
    logical :: fftw_mpi_ready = .false.
    !> clock ticks this process spent in the grid transforms (forward_unscaled and backward,
@@ -80,9 +73,9 @@ module lc_fft_plans
       type(c_ptr), private :: r2c = c_null_ptr, c2r = c_null_ptr
       type(c_ptr), private :: real_memory = c_null_ptr, complex_memory = c_null_ptr
       !> two-pass surfaces (split_points): r2c and c2r above transform the rows; these the
-      !> columns, `block` at a time (the last block: `last_block` columns)
+      !> columns, `column_block` at a time (the last block: `last_block` columns)
       logical, private :: split = .false.
-      integer, private :: block = column_block, last_block = 0
+      integer, private :: last_block = 0
       !> the spectrum's memory once more: the out argument of the in-place column pass
       complex(c_double_complex), pointer, contiguous, private :: in_place(:) => null()
       type(c_ptr), private :: columns_forward = c_null_ptr, columns_backward = c_null_ptr
@@ -273,7 +266,7 @@ contains
    end subroutine unpad_rows
 
    !> The plans of a two-pass surface: rows r2c/c2r (contiguous), and the columns of the
-   !> half spectrum in blocks of `block` columns (stride nkx, in place; unaligned, since a block
+   !> half spectrum in blocks of column_block (stride nkx, in place; unaligned, since a block
    !> may start at any column). A null plan is caught by init.
    subroutine plan_split(self)
       class(fft_plan), intent(inout) :: self
@@ -288,8 +281,7 @@ contains
          & [nkx], 1_c_int, nkx, FFTW_ESTIMATE)
       self%c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], ny, self%spectrum, [nkx], 1_c_int, nkx, self%real_buffer, &
          & [nx], 1_c_int, nx, ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
-      self%block = merge(wide_block, column_block, int(wide_block, i8)*ny*16 <= block_bytes)
-      block = int(min(self%block, nkx), c_int)
+      block = int(min(column_block, nkx), c_int)
       ! (each block's plan runs on one thread: the blocks are shared out among the threads)
 #ifdef LC_OPENMP
       call fftw_plan_with_nthreads(1_c_int)
@@ -415,7 +407,7 @@ contains
       ! (fftw_execute_dft on new arrays is thread-safe; each block is transformed by the same
       ! plan whatever the thread count, so the bits do not depend on it)
       !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
-      do first = 1, nkx - self%last_block, self%block
+      do first = 1, nkx - self%last_block, column_block
          call fftw_execute_dft(block_plan, self%spectrum(first:), self%in_place(first:))
       end do
       !$omp end parallel do
@@ -443,7 +435,6 @@ contains
       self%last_backward = c_null_ptr
       self%split = .false.
       self%threads = 1
-      self%block = column_block
       self%last_block = 0
       if (c_associated(self%real_memory)) call fftw_free(self%real_memory)
       if (c_associated(self%complex_memory)) call fftw_free(self%complex_memory)
