@@ -504,7 +504,7 @@ def processes_marked(marker: str) -> list[int]:
 
 #: Scenes that each take seconds (a line of 2^18 points with friction on a thin layer: 11 s
 #: on a loaded 2-core machine): a Ctrl-C reaches them inside the library.
-SLOW_BASE = BASE.replace("n = 256", "n = 262144").replace("coefficient = 0.0", "coefficient = 0.3") \
+SLOW_BASE = BASE.replace("n = 256", "n = 1048576").replace("coefficient = 0.0", "coefficient = 0.3") \
     .replace("short_wavelength = 0.03125", "short_wavelength = 0.0001")
 
 

@@ -915,6 +915,7 @@ def _stop_workers(pool: ProcessPoolExecutor, running: list[Scene]) -> None:
     # (the executor keeps its worker processes by pid, until it shuts down; it offers no call
     # that ends them)
     workers = list((getattr(pool, "_processes", None) or {}).values())
+    manager = getattr(pool, "_executor_manager_thread", None)
     pool.shutdown(wait=False, cancel_futures=True)
     for worker in workers:
         if worker.is_alive():
@@ -925,6 +926,11 @@ def _stop_workers(pool: ProcessPoolExecutor, running: list[Scene]) -> None:
         if worker.is_alive():
             worker.kill()
             worker.join(1.0)
+    # (the executor's manager thread closes its wake-up pipe once it sees the workers gone;
+    # the interpreter's exit wakes every executor through that pipe, so a thread still
+    # closing it then races the exit and prints a traceback: let it finish first)
+    if manager is not None:
+        manager.join(5.0)
     for scene in running:
         for left in stale_temporary_results(scene.result_file.parent, scene.stem):
             left.unlink(missing_ok=True)
