@@ -299,8 +299,8 @@ def test_a_leakage_that_runs_out_of_memory_raises_code_5_at_every_limit():
 
 def test_a_leakage_leaves_tmpdir_as_it_found_it(tmp_path):
     """A run with the leakage (the executable) and lc.core_leakage in a Python process, with
-    TMPDIR a fresh directory holding another process's Open MPI session: afterwards it holds
-    that session only, as it was; the leakage is the closed form's."""
+    TMPDIR a fresh directory holding another process's Open MPI temporary files: afterwards it
+    holds those files only, as they were; the leakage is the closed form's."""
     import subprocess
     import sys
 
@@ -309,7 +309,7 @@ def test_a_leakage_leaves_tmpdir_as_it_found_it(tmp_path):
     tmpdir = tmp_path / "tmp"
     other = tmpdir / "ompi.host.0" / "pid.1"
     other.mkdir(parents=True)
-    (other / "contact.txt").write_text("another run's session\n")
+    (other / "contact.txt").write_text("another process's temporary file\n")
     before = sorted(str(p.relative_to(tmpdir)) for p in tmpdir.rglob("*"))
     env = dict(__import__("os").environ, TMPDIR=str(tmpdir))
 
