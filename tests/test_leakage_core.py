@@ -329,4 +329,4 @@ def test_a_leakage_leaves_tmpdir_as_it_found_it(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert float(proc.stdout) == pytest.approx(1 / np.mean(1 / stripes**3), rel=ITERATIVE)
     assert sorted(str(p.relative_to(tmpdir)) for p in tmpdir.rglob("*")) == before
-    assert (other / "contact.txt").read_text() == "another run's session\n"
+    assert (other / "contact.txt").read_text() == "another process's temporary file\n"
