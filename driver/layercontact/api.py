@@ -62,43 +62,19 @@ def layer_multipliers_lapack(kh, nu: float):
     return a, b, c
 
 
-@dataclass
-class LineResult:
-    """A solved line contact. Units are those of the inputs: lengths L, pressures S.
-
-    Fields are on the grid ``x_j = j period/n``; ``gap = w - (r - Lambda + Delta)``;
-    ``displacement_x``, ``shear`` and ``stress_xx`` (surface in-plane stress, tension
-    positive) are ``None`` when not asked for. ``spots`` is an ``(n_spots, 2)`` array of
-    trailing (-x) and leading (+x) edges; ``leak_rate = <g^3>/12`` is the flow across the
-    sliding direction per unit length, per unit pressure gradient, times the viscosity.
-    ``max_tension`` (and ``spot_max_tension`` per spot) resolve the square-root cusp of
-    ``stress_xx`` at a trailing edge sub-grid when there is friction; ``max_tension_grid``
-    (``spot_max_tension_grid``) is the largest grid value.
-    ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
-    ``solver`` names the methods that ran, joined by ``'+'`` where one went on from the
-    last one's iterate: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled scenes),
-    ``'multigrid'``, ``'anderson'``, ``'gfmd'``, ``'newton'``; after ``'multigrid'`` the
-    constrained CG (``'+cg'``) or GCR (``'+gcr'``) may finish, after ``'gcr'`` the GCR keeping
-    its history across clips (``'+kept'``) and the Anderson iteration (``'+anderson'``), and
-    on a grid of at most 2048 points with a unique solution the dense Newton method
-    (``'+newton'``). ``solver_reason`` says why method ``'auto'`` chose them (docs/numerics.md,
-    "How 'auto' chooses"); which fallback finishes may vary with rounding from one processor
-    to another, the solution does not. ``iterations`` counts the iterations of every method
-    (all inner CG iterations for Anderson, plus the Newton steps). ``residual_history``
-    holds the residual per iteration (per outer iteration for Anderson); from
-    :func:`solve_line`, the last ``HISTORY_CAPACITY`` (10000) of them.
-    """
+@dataclass(kw_only=True)
+class _SolvedContact:
+    """The fields a solved line and a solved surface share (:class:`LineResult`,
+    :class:`ArealResult`): the maps, the load, the friction and the solver's statistics."""
 
     pressure: np.ndarray
     gap: np.ndarray
     displacement_z: np.ndarray
     height: np.ndarray
-    period: float
     friction: float
     mean_pressure: float
     penetration: float
     contact_fraction: float
-    contact_length: float
     delta_mu: float
     delta_mu_spectral: float
     delta_mu_energy: float
@@ -127,26 +103,15 @@ class LineResult:
     coarse_time: float = 0.0
     #: of ``wall_time`` (s): the time in the grids' transforms, every grid's
     transform_time: float = 0.0
-    n_spots: int = 0
-    spots: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
-    mean_gap: float = float("nan")
-    leak_rate: float = float("nan")
-    displacement_x: np.ndarray | None = field(default=None, repr=False)
-    shear: np.ndarray | None = field(default=None, repr=False)
-    stress_xx: np.ndarray | None = field(default=None, repr=False)
-    spot_max_tension: np.ndarray | None = field(default=None, repr=False)
-    spot_tension_offset: np.ndarray | None = field(default=None, repr=False)
-    spot_max_tension_grid: np.ndarray | None = field(default=None, repr=False)
-    max_tension: float = float("nan")
-    max_tension_grid: float = float("nan")
-    max_tension_x: float = float("nan")
-    max_tension_offset: float = float("nan")
     dissipated_power: float = 0.0
     monotone: bool = True
-    pressure_shift: float = 0.0
-    summit_shift: float = 0.0
     normalised_pressure: float = float("nan")
     normalised_thickness: float = float("nan")
+    displacement_x: np.ndarray | None = field(default=None, repr=False)
+    stress_xx: np.ndarray | None = field(default=None, repr=False)
+    max_tension: float = float("nan")
+    max_tension_x: float = float("nan")
+    max_tension_offset: float = float("nan")
     #: with ``&output conductance``: the conductance per unit nominal area (``conductivity``
     #: per L, S/m^2 with S/m and m) and the normal interfacial stiffness ``dp_m/dDelta`` (S/L)
     #: at the solved contact set (docs/theory.md), NaN otherwise
@@ -156,12 +121,54 @@ class LineResult:
     conductance_iterations: int = 0
     stiffness_iterations: int = 0
     a_over_a0: float | None = None
-    companion: "LineResult | None" = field(default=None, repr=False)
 
     @property
     def total_friction(self) -> float:
         """mu_c + Delta mu: the macroscopic friction coefficient."""
         return self.friction + self.delta_mu
+
+
+@dataclass
+class LineResult(_SolvedContact):
+    """A solved line contact. Units are those of the inputs: lengths L, pressures S.
+
+    Fields are on the grid ``x_j = j period/n``; ``gap = w - (r - Lambda + Delta)``;
+    ``displacement_x``, ``shear`` and ``stress_xx`` (surface in-plane stress, tension
+    positive) are ``None`` when not asked for. ``spots`` is an ``(n_spots, 2)`` array of
+    trailing (-x) and leading (+x) edges; ``leak_rate = <g^3>/12`` is the flow across the
+    sliding direction per unit length, per unit pressure gradient, times the viscosity.
+    ``max_tension`` (and ``spot_max_tension`` per spot) resolve the square-root cusp of
+    ``stress_xx`` at a trailing edge sub-grid when there is friction; ``max_tension_grid``
+    (``spot_max_tension_grid``) is the largest grid value.
+    ``a_over_a0`` and ``companion`` are set when a frictionless companion was solved.
+    ``solver`` names the methods that ran, joined by ``'+'`` where one went on from the
+    last one's iterate: ``'cg'`` (symmetric scenes), ``'gcr'`` (coupled scenes),
+    ``'multigrid'``, ``'anderson'``, ``'gfmd'``, ``'newton'``; after ``'multigrid'`` the
+    constrained CG (``'+cg'``) or GCR (``'+gcr'``) may finish, after ``'gcr'`` the GCR keeping
+    its history across clips (``'+kept'``) and the Anderson iteration (``'+anderson'``), and
+    on a grid of at most 2048 points with a unique solution the dense Newton method
+    (``'+newton'``). ``solver_reason`` says why method ``'auto'`` chose them (docs/numerics.md,
+    "How 'auto' chooses"); which fallback finishes may vary with rounding from one processor
+    to another, the solution does not. ``iterations`` counts the iterations of every method
+    (all inner CG iterations for Anderson, plus the Newton steps). ``residual_history``
+    holds the residual per iteration (per outer iteration for Anderson); from
+    :func:`solve_line`, the last ``HISTORY_CAPACITY`` (10000) of them.
+    """
+
+    period: float
+    contact_length: float
+    n_spots: int = 0
+    spots: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
+    mean_gap: float = float("nan")
+    leak_rate: float = float("nan")
+    shear: np.ndarray | None = field(default=None, repr=False)
+    spot_max_tension: np.ndarray | None = field(default=None, repr=False)
+    spot_tension_offset: np.ndarray | None = field(default=None, repr=False)
+    spot_max_tension_grid: np.ndarray | None = field(default=None, repr=False)
+    max_tension_grid: float = float("nan")
+    pressure_shift: float = 0.0
+    summit_shift: float = 0.0
+    companion: "LineResult | None" = field(default=None, repr=False)
 
     @property
     def x(self) -> np.ndarray:
@@ -373,7 +380,7 @@ def _areal_result(*, scalars: dict, fields: dict, spots: dict, history, height, 
 
 
 @dataclass
-class ArealResult:
+class ArealResult(_SolvedContact):
     """A solved areal contact. Units are those of the inputs: lengths L, pressures S.
 
     Fields are ``(ny, nx)`` arrays on the grid ``x = j period_x/nx`` (axis 1, the sliding
@@ -398,70 +405,16 @@ class ArealResult:
     else None.
     """
 
-    pressure: np.ndarray
-    gap: np.ndarray
-    displacement_z: np.ndarray
-    height: np.ndarray
     period: tuple[float, float]
-    friction: float
-    mean_pressure: float
-    penetration: float
-    contact_fraction: float
     mean_gap: float
-    delta_mu: float
-    delta_mu_spectral: float
-    delta_mu_energy: float
-    delta_mu_profile: float
-    converged: bool
-    iterations: int
-    outer_iterations: int
-    solver: str
-    fft_pairs: int
-    residual: float
-    wall_time: float
-    residual_history: np.ndarray = field(repr=False)
-    #: why the methods of ``solver`` were chosen (docs/numerics.md, "How 'auto' chooses")
-    solver_reason: str = ""
-    #: the smallest gap, relative to the profile's height range, that double precision
-    #: resolves at this load; above ``tol`` the run reports ``converged = False``
-    gap_resolution: float = 0.0
-    #: the threads the solve ran on (``threads``, or what the job was given) and the
-    #: processes sharing its grid (1: this build has no MPI)
-    omp_threads: int = 1
-    mpi_ranks: int = 1
-    #: of ``wall_time`` (s): the finest grid's set-up (operator: FFT plans, multipliers) and
-    #: the coarse start (the solves on the coarser grids); the rest is the finest grid's
-    #: iterations
-    setup_time: float = 0.0
-    coarse_time: float = 0.0
-    #: of ``wall_time`` (s): the time in the grids' transforms, every grid's
-    transform_time: float = 0.0
-    dissipated_power: float = 0.0
-    monotone: bool = True
-    normalised_pressure: float = float("nan")
-    normalised_thickness: float = float("nan")
     patches: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
-    displacement_x: np.ndarray | None = field(default=None, repr=False)
     displacement_y: np.ndarray | None = field(default=None, repr=False)
-    stress_xx: np.ndarray | None = field(default=None, repr=False)
     stress_yy: np.ndarray | None = field(default=None, repr=False)
     stress_xy: np.ndarray | None = field(default=None, repr=False)
-    max_tension: float = float("nan")
-    max_tension_x: float = float("nan")
     max_tension_y: float = float("nan")
-    max_tension_offset: float = float("nan")
     max_principal_stress: float = float("nan")
     max_principal_x: float = float("nan")
     max_principal_y: float = float("nan")
-    #: with ``&output conductance``: the conductance per unit nominal area (``conductivity``
-    #: per L, S/m^2 with S/m and m) and the normal interfacial stiffness ``dp_m/dDelta`` (S/L)
-    #: at the solved contact set (docs/theory.md), NaN otherwise
-    conductance: float = float("nan")
-    contact_stiffness: float = float("nan")
-    conductance_converged: bool = True
-    conductance_iterations: int = 0
-    stiffness_iterations: int = 0
-    a_over_a0: float | None = None
     companion: "ArealResult | None" = field(default=None, repr=False)
     #: the Reynolds leakage of the gap computed by the run (``&output leakage = .true.``):
     #: :class:`layercontact.leakage.CoreLeakage` with ``k_eff_x``, ``k_eff_y``, ...; None otherwise
@@ -471,11 +424,6 @@ class ArealResult:
     def n_patches(self) -> int:
         """Number of contact patches."""
         return int(self.patches.shape[0])
-
-    @property
-    def total_friction(self) -> float:
-        """mu_c + Delta mu: the macroscopic friction coefficient."""
-        return self.friction + self.delta_mu
 
     @property
     def x(self) -> np.ndarray:
