@@ -8,6 +8,7 @@ program test_greens_layer
    use lc_base_errors, only: error_type, code_input
    use lc_greens_layer, only: layer_coefficients, halfspace_coupling, layer_coefficients_lapack, &
       layer_mode_response, x_series, x_large, lapack_x_min, lapack_x_max
+   use lc_test_checks, only: check, finish
    implicit none (type, external)
 
    !> Identities and exact limits: a few rounding errors.
@@ -22,33 +23,15 @@ program test_greens_layer
    real(wp), parameter :: tol_asymptotic = 1.0e-10_wp
    real(wp), parameter :: nus(*) = [-0.999_wp, -0.9_wp, -0.5_wp, 0.0_wp, 0.1_wp, 0.25_wp, 0.3_wp, 0.45_wp, &
                                     0.49_wp, 0.499_wp, 0.5_wp]
-   integer :: failures
 
-   failures = 0
    call check_limits()
    call check_invalid_input()
    call check_switch_continuity()
    call check_lapack()
    call check_reference_table()
-   if (failures > 0) then
-      print '(a, i0, a)', 'test_greens_layer: ', failures, ' check(s) FAILED'
-      error stop 1
-   end if
-   print '(a)', 'test_greens_layer: all checks passed'
+   call finish('layer compliance')
 
 contains
-
-   subroutine report(name, ok, worst)
-      character(len=*), intent(in) :: name
-      logical, intent(in) :: ok
-      real(wp), intent(in) :: worst
-      if (ok) then
-         print '(a, a, a, es9.2, a)', 'PASS  ', name, '  (worst ', worst, ')'
-      else
-         print '(a, a, a, es9.2, a)', 'FAIL  ', name, '  (worst ', worst, ')'
-         failures = failures + 1
-      end if
-   end subroutine report
 
    pure real(wp) function rel(a, b, floor)
       real(wp), intent(in) :: a, b, floor
@@ -66,7 +49,7 @@ contains
          call layer_coefficients(0.0_wp, nus(i), a, b, c)
          worst = max(worst, abs(a), abs(b), abs(c))
       end do
-      call report('x = 0 gives 1-A = 1-B = c = 0', worst <= 0.0_wp, worst)
+      call check(worst <= 0.0_wp, 'x = 0 gives 1-A = 1-B = c = 0', worst)
 
       ! x -> inf (1e6 and +inf): half-space, c = Dundurs' beta.
       inf = ieee_value(1.0_wp, ieee_positive_inf)
@@ -80,13 +63,13 @@ contains
          worst = max(worst, abs(a - 1), abs(b - 1), abs(c - beta))
          ok = ok .and. .not. ieee_is_nan(c)
       end do
-      call report('x = 1e6, +inf give the half-space (1, 1, beta)', ok .and. worst <= tol_identity, worst)
+      call check(ok .and. worst <= tol_identity, 'x = 1e6, +inf give the half-space (1, 1, beta)', worst)
 
       ! Half-space sign check 1: beta > 0 for nu < 0.5 (surface moves toward a compressive
       ! line load), 0 at nu = 0.5.
       ok = halfspace_coupling(0.3_wp) > 0 .and. abs(halfspace_coupling(0.5_wp)) <= 0.0_wp &
            .and. abs(halfspace_coupling(0.0_wp) - 0.5_wp) <= tol_identity
-      call report('half-space beta: +0.5 at nu=0, > 0 for nu<0.5, 0 at nu=0.5', ok, 0.0_wp)
+      call check(ok, 'half-space beta: +0.5 at nu=0, > 0 for nu<0.5, 0 at nu=0.5')
 
       ! Small x: 1-A ~ (1-2nu) x/(2(1-nu)^2) (constrained modulus, nu < 0.5) or (2/3) x^3
       ! (nu = 0.5), 1-B ~ x/(1-nu), c ~ x^2 (1-4nu)/(4(1-nu)^2) (c ~ -x^2 at nu = 0.5).
@@ -103,9 +86,9 @@ contains
          worst = max(worst, rel(b, x/(1 - nu), tiny(1.0_wp)))
          if (abs(1 - 4*nu) > 0.01_wp) worst = max(worst, rel(c, x**2*(1 - 4*nu)/(4*(1 - nu)**2), tiny(1.0_wp)))
       end do
-      call report('small-x asymptotics at x = 1e-7', worst <= tol_asymptotic, worst)
+      call check(worst <= tol_asymptotic, 'small-x asymptotics at x = 1e-7', worst)
       call layer_coefficients(x, 0.5_wp, a, b, c)
-      call report('sign check 2: thin incompressible layer has c ~ -x^2 < 0', c < 0, rel(c, -x**2, tiny(1.0_wp)))
+      call check(c < 0, 'sign check 2: thin incompressible layer has c ~ -x^2 < 0', rel(c, -x**2, tiny(1.0_wp)))
    end subroutine check_limits
 
    subroutine check_invalid_input()
@@ -119,7 +102,7 @@ contains
       ok = ok .and. ieee_is_nan(c)
       call layer_coefficients(-1.0_wp, 0.3_wp, a, b, c)
       ok = ok .and. ieee_is_nan(a)
-      call report('invalid x or nu give NaN', ok, 0.0_wp)
+      call check(ok, 'invalid x or nu give NaN')
 
       call layer_coefficients_lapack(0.5_wp*lapack_x_min, 0.3_wp, a, b, c, error)
       ok = allocated(error)
@@ -129,7 +112,7 @@ contains
       if (ok) ok = error%code == code_input
       call layer_coefficients_lapack(1.0_wp, 0.7_wp, a, b, c, error)
       if (ok) ok = allocated(error)
-      call report('LAPACK solver rejects x_h or nu outside its range (code_input)', ok, 0.0_wp)
+      call check(ok, 'LAPACK solver rejects x_h or nu outside its range (code_input)')
    end subroutine check_invalid_input
 
    subroutine check_switch_continuity()
@@ -153,7 +136,7 @@ contains
                         abs(v(3, -1) - v(3, 1))/scale_c)
          end do
       end do
-      call report('continuity across switches x = 1, 2, 20 (one ulp either side)', worst <= tol_reference, worst)
+      call check(worst <= tol_reference, 'continuity across switches x = 1, 2, 20 (one ulp either side)', worst)
    end subroutine check_switch_continuity
 
    subroutine check_lapack()
@@ -197,11 +180,11 @@ contains
       end do
       print '(a, es9.2, a, es9.2, a)', '      (LAPACK range [', lapack_x_min, ', ', lapack_x_max, &
          '], errors in units of tol = 1e-10*max(1, (1e-2/x)^2))'
-      call report('closed form vs LAPACK: 1-A', ok .and. worst_a <= 1, worst_a*tol_lapack)
-      call report('closed form vs LAPACK: 1-B', ok .and. worst_b <= 1, worst_b*tol_lapack)
-      call report('closed form vs LAPACK: c (same sign convention)', ok .and. worst_c <= 1, worst_c*tol_lapack)
-      call report('reciprocity d u_x/d p = -d w/d tau (LAPACK)', ok .and. worst_recip <= 1, worst_recip*tol_lapack)
-      call report('direct terms real, coupling imaginary (LAPACK)', ok .and. worst_imag <= 1, worst_imag*tol_lapack)
+      call check(ok .and. worst_a <= 1, 'closed form vs LAPACK: 1-A', worst_a*tol_lapack)
+      call check(ok .and. worst_b <= 1, 'closed form vs LAPACK: 1-B', worst_b*tol_lapack)
+      call check(ok .and. worst_c <= 1, 'closed form vs LAPACK: c (same sign convention)', worst_c*tol_lapack)
+      call check(ok .and. worst_recip <= 1, 'reciprocity d u_x/d p = -d w/d tau (LAPACK)', worst_recip*tol_lapack)
+      call check(ok .and. worst_imag <= 1, 'direct terms real, coupling imaginary (LAPACK)', worst_imag*tol_lapack)
 
       ! Sign checks from the independent solve: thick compressible layer c > 0 (beta),
       ! thin incompressible layer c < 0, direct compliances positive.
@@ -209,7 +192,7 @@ contains
       signs = .not. allocated(error) .and. cl > 0 .and. abs(cl - halfspace_coupling(0.3_wp)) <= 1.0e-12_wp
       call layer_coefficients_lapack(0.01_wp, 0.5_wp, al, bl, cl, error)
       signs = signs .and. .not. allocated(error) .and. cl < 0 .and. al > 0 .and. bl > 0
-      call report('LAPACK signs: c -> +beta (x=20, nu=0.3), c < 0 (x=0.01, nu=0.5)', signs, 0.0_wp)
+      call check(signs, 'LAPACK signs: c -> +beta (x=20, nu=0.3), c < 0 (x=0.01, nu=0.5)')
    end subroutine check_lapack
 
    subroutine check_reference_table()
@@ -222,7 +205,7 @@ contains
       if (command_argument_count() >= 1) call get_command_argument(1, path)
       open (newunit=unit, file=trim(path), status='old', action='read', iostat=ios, iomsg=message)
       if (ios /= 0) then
-         call report('mpmath table: open '//trim(path)//': '//trim(message), .false., 0.0_wp)
+         call check(.false., 'mpmath table: open '//trim(path)//': '//trim(message))
          return
       end if
       worst = 0
@@ -235,7 +218,7 @@ contains
          if (len_trim(line) == 0 .or. line(1:1) == '#') cycle
          read (line, *, iostat=ios) x, nu, ref
          if (ios /= 0) then
-            call report('mpmath table: unreadable line: '//trim(line), .false., 0.0_wp)
+            call check(.false., 'mpmath table: unreadable line: '//trim(line))
             cycle
          end if
          n = n + 1
@@ -257,7 +240,7 @@ contains
       print '(a, i0, a, a)', '      (', n, ' rows of ', trim(path)//')'
       do q = 1, 3
          print '(a, a, a, es9.2, a, es9.2)', '      worst ', names(q), ' at x = ', worst_x(q), ', nu = ', worst_nu(q)
-         call report('mpmath table: '//trim(names(q)), n > 0 .and. worst(q) <= tol_reference, worst(q))
+         call check(n > 0 .and. worst(q) <= tol_reference, 'mpmath table: '//trim(names(q)), worst(q))
       end do
    end subroutine check_reference_table
 end program test_greens_layer

@@ -10,6 +10,7 @@ program test_greens_stack
    use lc_greens_layer, only: layer_coefficients, halfspace_coupling
    use lc_greens_stack, only: stack_layer, stack_base, stack_compliance, stack_compliance_lapack, &
       base_rigid, base_halfspace
+   use lc_test_checks, only: check, finish
    implicit none (type, external)
 
    !> Stack against a closed form (single layer, N equal layers, own material, frictionless
@@ -24,9 +25,7 @@ program test_greens_stack
    real(wp), parameter :: tol_identity = 1.0e-13_wp
    real(wp), parameter :: nus(*) = [-0.5_wp, 0.0_wp, 0.3_wp, 0.45_wp, 0.49_wp, 0.5_wp]
    complex(wp), parameter :: i_unit = (0.0_wp, 1.0_wp)
-   integer :: failures
 
-   failures = 0
    call check_single_layer()
    call check_equal_layers()
    call check_own_material()
@@ -36,25 +35,9 @@ program test_greens_stack
    call check_mode_solver()
    call check_symmetry_positivity()
    call check_invalid_input()
-   if (failures > 0) then
-      print '(a, i0, a)', 'test_greens_stack: ', failures, ' check(s) FAILED'
-      error stop 1
-   end if
-   print '(a)', 'test_greens_stack: all checks passed'
+   call finish('stack compliance')
 
 contains
-
-   subroutine report(name, ok, worst)
-      character(len=*), intent(in) :: name
-      logical, intent(in) :: ok
-      real(wp), intent(in) :: worst
-      if (ok) then
-         print '(a, a, a, es9.2, a)', 'PASS  ', name, '  (worst ', worst, ')'
-      else
-         print '(a, a, a, es9.2, a)', 'FAIL  ', name, '  (worst ', worst, ')'
-         failures = failures + 1
-      end if
-   end subroutine report
 
    !> Distance between two compliances [1-B, i c; -i c', 1-A]: each entry relative to the scale
    !> sqrt(|(1-A)(1-B)|) of its row and column (c has genuine zeros).
@@ -100,8 +83,7 @@ contains
       type(error_type), allocatable :: error
       call stack_compliance(layers, base, q, plane, anti, error)
       if (allocated(error)) then
-         print '(a, a)', 'FAIL  stack_compliance: ', error%message
-         failures = failures + 1
+         call check(.false., 'stack_compliance: ' // error%message)
       end if
    end subroutine compliance
 
@@ -126,8 +108,8 @@ contains
             worst_t = max(worst_t, abs(anti - tanh(xs(i)))/tanh(xs(i)))
          end do
       end do
-      call report('one bonded layer on a rigid base == closed form (|q|h 1e-6..1e6)', worst <= tol_closed, worst)
-      call report('one bonded layer: antiplane t == tanh(|q|h)', worst_t <= tol_closed, worst_t)
+      call check(worst <= tol_closed, 'one bonded layer on a rigid base == closed form (|q|h 1e-6..1e6)', worst)
+      call check(worst_t <= tol_closed, 'one bonded layer: antiplane t == tanh(|q|h)', worst_t)
    end subroutine check_single_layer
 
    subroutine check_equal_layers()
@@ -158,8 +140,8 @@ contains
             end do
          end do
       end do
-      call report('2, 3, 7 equal bonded layers of h/N == one layer of h', worst <= tol_closed, worst)
-      call report('equal layers: antiplane', worst_t <= tol_closed, worst_t)
+      call check(worst <= tol_closed, '2, 3, 7 equal bonded layers of h/N == one layer of h', worst)
+      call check(worst_t <= tol_closed, 'equal layers: antiplane', worst_t)
    end subroutine check_equal_layers
 
    subroutine check_own_material()
@@ -189,16 +171,15 @@ contains
             worst_t = max(worst_t, abs(anti - 1))
          end do
       end do
-      call report('one and two bonded layers of the substrate''s material == half-space', worst <= tol_closed, worst)
-      call report('the same, antiplane t == 1', worst_t <= tol_closed, worst_t)
+      call check(worst <= tol_closed, 'one and two bonded layers of the substrate''s material == half-space', worst)
+      call check(worst_t <= tol_closed, 'the same, antiplane t == 1', worst_t)
       ! A slipping interface between equal materials is not the half-space.
       layers(1)%slip_below = .true.
       base%poisson = 0.3_wp
       layers%poisson = 0.3_wp
       call compliance(layers(1:1), base, 1.0_wp, plane, anti)
       slip_gap = distance(plane, p_matrix(1.0_wp, 1.0_wp, halfspace_coupling(0.3_wp)))
-      call report('a slipping interface in one material departs from the half-space (> 1e-2)', slip_gap > 1.0e-2_wp, &
-                  slip_gap)
+      call check(slip_gap > 1.0e-2_wp, 'a slipping interface in one material departs from the half-space (> 1e-2)', slip_gap)
    end subroutine check_own_material
 
    subroutine check_limits()
@@ -227,8 +208,8 @@ contains
          ratio = (1.0_wp/(1.0_wp + nus(j)))/(7.0_wp/(1.0_wp + base%poisson))
          worst_thin = max(worst_thin, abs(anti - ratio)/ratio)
       end do
-      call report('layer on a half-space, |q|h = 1e4: the layer''s half-space', worst_thick <= tol_closed, worst_thick)
-      call report('layer on a half-space, |q|h = 1e-8: the substrate''s half-space', worst_thin <= tol_limit, worst_thin)
+      call check(worst_thick <= tol_closed, 'layer on a half-space, |q|h = 1e4: the layer''s half-space', worst_thick)
+      call check(worst_thin <= tol_limit, 'layer on a half-space, |q|h = 1e-8: the substrate''s half-space', worst_thin)
    end subroutine check_limits
 
    subroutine check_stiff_substrate()
@@ -254,7 +235,7 @@ contains
       end do
       ! The substrate's own compliance enters at O(E/E_s) = 1e-14 relative to a compliance of
       ! the layer that is O(|q|h)^3 at nu = 0.5: 1e-8 relative at |q|h = 1e-2.
-      call report('layer on a half-space 1e14 times stiffer == rigid base', worst <= 1.0e-7_wp, worst)
+      call check(worst <= 1.0e-7_wp, 'layer on a half-space 1e14 times stiffer == rigid base', worst)
    end subroutine check_stiff_substrate
 
    !> Frictionless rigid base (derived in docs/theory.md): 1-A = S^2/(SC + x),
@@ -305,8 +286,8 @@ contains
             layers%thickness = 1.0_wp
          end do
       end do
-      call report('frictionless rigid base == closed form (1 and 3 layers, |q|h 1e-6..1e4)', worst <= tol_closed, worst)
-      call report('frictionless rigid base: antiplane t == coth(|q|h)', worst_t <= tol_closed, worst_t)
+      call check(worst <= tol_closed, 'frictionless rigid base == closed form (1 and 3 layers, |q|h 1e-6..1e4)', worst)
+      call check(worst_t <= tol_closed, 'frictionless rigid base: antiplane t == coth(|q|h)', worst_t)
    end subroutine check_frictionless_base
 
    !> A family of stacks against the dense mode solve.
@@ -370,8 +351,8 @@ contains
       end do
       do m = 1, 4
          write (tally, '(a, i0, a)') ' (', counts(m), ' cases)'
-         call report('mode solve of the whole stack: '//trim(names(m))//trim(tally), &
-                     worst(m) <= tol_modes .and. counts(m) >= 10, worst(m))
+         call check(worst(m) <= tol_modes .and. counts(m) >= 10, &
+            & 'mode solve of the whole stack: '//trim(names(m))//trim(tally), worst(m))
       end do
 
    end subroutine check_mode_solver
@@ -396,8 +377,7 @@ contains
       call compliance(layers, base, q, plane, anti)
       call stack_compliance_lapack(layers, base, q, plane_ref, anti_ref, error)
       if (allocated(error)) then
-         print '(a, a)', 'FAIL  mode solve: ', error%message
-         failures = failures + 1
+         call check(.false., 'mode solve: ' // error%message)
          return
       end if
       worst = max(worst, distance(plane, plane_ref), abs(anti - anti_ref)/abs(anti_ref))
@@ -443,10 +423,9 @@ contains
             worst_rec = max(worst_rec, abs(plane(1, 2) + plane(2, 1))/sqrt(abs(plane(1, 1)*plane(2, 2))))
          end do
       end do
-      call report('reciprocity: d u_l/d p == -d w/d tau_l (elastic and viscoelastic)', worst_rec <= 1.0e-10_wp, &
-                  worst_rec)
-      call report('elastic stacks: real 1-A, 1-B, c, t', worst_im <= 0.0_wp, worst_im)
-      call report('elastic stacks: Re(1-A) > 0 and positive-definite 2x2 (smallest ratio)', lowest > 0.0_wp, lowest)
+      call check(worst_rec <= 1.0e-10_wp, 'reciprocity: d u_l/d p == -d w/d tau_l (elastic and viscoelastic)', worst_rec)
+      call check(worst_im <= 0.0_wp, 'elastic stacks: real 1-A, 1-B, c, t', worst_im)
+      call check(lowest > 0.0_wp, 'elastic stacks: Re(1-A) > 0 and positive-definite 2x2 (smallest ratio)', lowest)
    end subroutine check_symmetry_positivity
 
    !> Invalid stacks are errors with code_input, never NaN.
@@ -477,6 +456,6 @@ contains
       base%young = 1.0_wp
       call stack_compliance_lapack(layer, base, 1.0e-4_wp, plane, anti, error)
       if (allocated(error)) caught = caught + merge(1, 0, error%code == code_input)
-      call report('invalid stacks and mode-solve ranges are input errors (6 of 6)', caught == 6, real(caught, wp))
+      call check(caught == 6, 'invalid stacks and mode-solve ranges are input errors (6 of 6)', real(caught, wp))
    end subroutine check_invalid_input
 end program test_greens_stack

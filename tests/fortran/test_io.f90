@@ -12,13 +12,12 @@ program test_io
    use lc_io_namelist, only: read_scene, read_scene_text, write_scene_namelist
    use lc_io_hdf5, only: check_output, write_results
    use lc_profiles_measured, only: measured_heights
+   use lc_test_checks, only: check, finish
    implicit none (type, external)
 
    character(len=*), parameter :: dir = 'test_io_scratch'
    character(len=*), parameter :: nl = new_line('a')
-   integer :: failures
 
-   failures = 0
    ! start from an empty scratch directory: the checks below expect files not to exist
    call execute_command_line('rm -rf ' // dir)
    call test_valid_namelist()
@@ -29,22 +28,9 @@ program test_io
    call test_result_scalars()
    call test_companion_of()
    call test_solve_scene_text()
-   if (failures > 0) then
-      write (*, '(i0, a)') failures, ' check(s) failed'
-      error stop 1
-   end if
-   write (*, '(a)') 'test_io: all checks passed'
+   call finish('input/output')
 
 contains
-
-   subroutine check(condition, label)
-      logical, intent(in) :: condition
-      character(len=*), intent(in) :: label
-      if (.not. condition) then
-         failures = failures + 1
-         write (*, '(a)') 'FAILED: ' // label
-      end if
-   end subroutine check
 
    !> The error exists, has `code` and its message contains every one of `parts`.
    subroutine check_error(error, code, parts, label)

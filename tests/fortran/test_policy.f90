@@ -6,10 +6,9 @@ program test_policy
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, code_input
    use lc_contact_policy, only: problem_indicators, solve_plan, plan_solve, may_take_multigrid
+   use lc_test_checks, only: check, finish
    implicit none (type, external)
-   integer :: failures
 
-   failures = 0
    call check_symmetric()
    call check_coupled()
    call check_after_a_hard_start()
@@ -18,26 +17,9 @@ program test_policy
    call check_refusals()
    call check_memory_view()
    call check_distributed()
-   if (failures > 0) then
-      print '(a, i0, a)', 'test_policy: ', failures, ' check(s) FAILED'
-      error stop 1
-   end if
-   print '(a)', 'test_policy: all checks passed'
+   call finish('policy')
 
 contains
-
-   subroutine report(name, ok, detail)
-      character(len=*), intent(in) :: name
-      logical, intent(in) :: ok
-      character(len=*), intent(in), optional :: detail
-      if (ok) then
-         print '(a, a)', 'PASS  ', name
-      else
-         print '(a, a)', 'FAIL  ', name
-         if (present(detail)) print '(6x, a)', detail
-         failures = failures + 1
-      end if
-   end subroutine report
 
    !> The indicators of a problem, everything else as in the type's defaults.
    function problem(points, line, coupled, viscoelastic, method) result(ind)
@@ -74,11 +56,11 @@ contains
       type(error_type), allocatable :: error
       call plan_solve(ind, .true., plan, error)
       if (allocated(error)) then
-         call report(name, .false., 'refused: ' // error%message)
+         call check(.false., name, detail='refused: ' // error%message)
          return
       end if
-      call report(name, path(plan) == wanted .and. (plan%coarse_start .eqv. coarse_start) .and. &
-         & index(plan%reason, reason_has) > 0, path(plan) // ' | ' // plan%reason)
+      call check(path(plan) == wanted .and. (plan%coarse_start .eqv. coarse_start) .and. &
+         & index(plan%reason, reason_has) > 0, name, detail=path(plan) // ' | ' // plan%reason)
    end subroutine expect
 
    subroutine check_symmetric()
@@ -205,10 +187,10 @@ contains
       type(error_type), allocatable :: error
       call plan_solve(ind, .true., plan, error)
       if (.not. allocated(error)) then
-         call report(name, .false., 'not refused: ' // path(plan))
+         call check(.false., name, detail='not refused: ' // path(plan))
          return
       end if
-      call report(name, error%code == code_input .and. index(error%message, message_has) > 0, error%message)
+      call check(error%code == code_input .and. index(error%message, message_has) > 0, name, detail=error%message)
    end subroutine refused
 
    !> A surface shared among MPI ranks: 'auto' plans as on one rank (the multigrid method
@@ -251,17 +233,15 @@ contains
    !> What the memory check provides for: every grid where some start could send the
    !> scene to the multigrid method.
    subroutine check_memory_view()
-      call report('memory: symmetric line of 4096', may_take_multigrid('auto', 4096, .true., .false., .false.))
-      call report('memory: symmetric line of 2048', .not. may_take_multigrid('auto', 2048, .true., .false., .false.))
-      call report('memory: coupled line of 8192', may_take_multigrid('auto', 8192, .true., .true., .false.))
-      call report('memory: elastic coupled line of 4096', &
-         & .not. may_take_multigrid('auto', 4096, .true., .true., .false.))
-      call report('memory: viscoelastic line of 1024', may_take_multigrid('auto', 1024, .true., .true., .true.))
-      call report('memory: viscoelastic surface of 128^2', may_take_multigrid('auto', 128**2, .false., .true., .true.))
-      call report('memory: elastic coupled surface of 512^2', &
-         & .not. may_take_multigrid('auto', 512**2, .false., .true., .false.))
-      call report('memory: method gcr never', .not. may_take_multigrid('gcr', 2**20, .true., .true., .true.))
-      call report('memory: method multigrid always', may_take_multigrid('multigrid', 64, .true., .false., .false.))
+      call check(may_take_multigrid('auto', 4096, .true., .false., .false.), 'memory: symmetric line of 4096')
+      call check(.not. may_take_multigrid('auto', 2048, .true., .false., .false.), 'memory: symmetric line of 2048')
+      call check(may_take_multigrid('auto', 8192, .true., .true., .false.), 'memory: coupled line of 8192')
+      call check(.not. may_take_multigrid('auto', 4096, .true., .true., .false.), 'memory: elastic coupled line of 4096')
+      call check(may_take_multigrid('auto', 1024, .true., .true., .true.), 'memory: viscoelastic line of 1024')
+      call check(may_take_multigrid('auto', 128**2, .false., .true., .true.), 'memory: viscoelastic surface of 128^2')
+      call check(.not. may_take_multigrid('auto', 512**2, .false., .true., .false.), 'memory: elastic coupled surface of 512^2')
+      call check(.not. may_take_multigrid('gcr', 2**20, .true., .true., .true.), 'memory: method gcr never')
+      call check(may_take_multigrid('multigrid', 64, .true., .false., .false.), 'memory: method multigrid always')
    end subroutine check_memory_view
 
 end program test_policy

@@ -21,6 +21,7 @@ program test_profiles
    use lc_profiles_surface, only: self_affine_surface, sinusoid_surface, spherical_cap, surface_mode_index
    use lc_profiles_measured, only: measured_heights, detrend_heights, mirror_heights, resample_heights
    use lc_profiles_profile, only: make_profile, profile_statistics
+   use lc_test_checks, only: check, finish
    implicit none (type, external)
 
    real(wp), parameter :: tol_target = 1.0e-12_wp
@@ -28,9 +29,7 @@ program test_profiles
    real(wp), parameter :: tol_slope = 1.0e-12_wp
    real(wp), parameter :: tol_closed = 1.0e-13_wp
    real(wp), parameter :: pi = acos(-1.0_wp)
-   integer :: failures
 
-   failures = 0
    call check_splitmix64()
    call check_scaling(512, 0.8_wp, 7_i8, 0.05_wp, not_set, 'rms gradient, n = 512, H = 0.8')
    call check_scaling(1001, 0.3_wp, 42_i8, 0.2_wp, not_set, 'rms gradient, odd n = 1001, H = 0.3')
@@ -51,31 +50,9 @@ program test_profiles
    call check_measured()
    call check_make_surface()
 
-   if (failures > 0) then
-      write (*, '(a, i0, a)') 'FAILED: ', failures, ' check(s)'
-      error stop 1
-   end if
-   write (*, '(a)') 'all profile checks passed'
+   call finish('profile')
 
 contains
-
-   subroutine report(ok, name, value)
-      logical, intent(in) :: ok
-      character(len=*), intent(in) :: name
-      real(wp), intent(in), optional :: value
-      character(len=4) :: status
-
-      status = 'PASS'
-      if (.not. ok) then
-         status = 'FAIL'
-         failures = failures + 1
-      end if
-      if (present(value)) then
-         write (*, '(a, 1x, a, a, es10.3)') status, name, ': ', value
-      else
-         write (*, '(a, 1x, a)') status, name
-      end if
-   end subroutine report
 
    !> 64-bit pattern from two 32-bit halves written in hex.
    pure integer(i8) function word(high, low)
@@ -86,17 +63,17 @@ contains
    subroutine check_splitmix64()
       ! Reference outputs of Vigna's splitmix64.c next(), checked with a Python big-int
       ! implementation.
-      call report(splitmix64(0_i8, 1_i8) == word(int(z'E220A839', i8), int(z'7B1DCDAF', i8)), &
+      call check(splitmix64(0_i8, 1_i8) == word(int(z'E220A839', i8), int(z'7B1DCDAF', i8)), &
          & 'splitmix64(seed 0) output 1 = 0xE220A8397B1DCDAF')
-      call report(splitmix64(0_i8, 2_i8) == word(int(z'6E789E6A', i8), int(z'A1B965F4', i8)), &
+      call check(splitmix64(0_i8, 2_i8) == word(int(z'6E789E6A', i8), int(z'A1B965F4', i8)), &
          & 'splitmix64(seed 0) output 2 = 0x6E789E6AA1B965F4')
-      call report(splitmix64(1_i8, 1_i8) == word(int(z'910A2DEC', i8), int(z'89025CC1', i8)), &
+      call check(splitmix64(1_i8, 1_i8) == word(int(z'910A2DEC', i8), int(z'89025CC1', i8)), &
          & 'splitmix64(seed 1) output 1 = 0x910A2DEC89025CC1')
-      call report(splitmix64(12345_i8, 3_i8) == word(int(z'1E9A57BC', i8), int(z'80E6721D', i8)), &
+      call check(splitmix64(12345_i8, 3_i8) == word(int(z'1E9A57BC', i8), int(z'80E6721D', i8)), &
          & 'splitmix64(seed 12345) output 3 = 0x1E9A57BC80E6721D')
       ! (z >> 11) * 2^-53 is exact, so equality is the right test.
-      call report(splitmix64_uniform(0_i8, 1_i8) == 0.8833108082136426_wp, 'splitmix64_uniform(seed 0) output 1')
-      call report(splitmix64_uniform(1_i8, 1_i8) == 0.5665615751722809_wp, 'splitmix64_uniform(seed 1) output 1')
+      call check(splitmix64_uniform(0_i8, 1_i8) == 0.8833108082136426_wp, 'splitmix64_uniform(seed 0) output 1')
+      call check(splitmix64_uniform(1_i8, 1_i8) == 0.5665615751722809_wp, 'splitmix64_uniform(seed 1) output 1')
    end subroutine check_splitmix64
 
    subroutine check_scaling(n, hurst, seed, rms_gradient, rms_height, label)
@@ -112,12 +89,12 @@ contains
       allocate (height(n))
       call self_affine_profile(n, period, hurst, seed, not_set, not_set, rms_gradient, rms_height, height, error)
       if (allocated(error)) then
-         call report(.false., label // ': ' // error%message)
+         call check(.false., label // ': ' // error%message)
          return
       end if
       call profile_statistics(height, period, measured_height, measured_gradient, max_height, error)
       if (allocated(error)) then
-         call report(.false., label // ': ' // error%message)
+         call check(.false., label // ': ' // error%message)
          return
       end if
       if (rms_gradient /= not_set) then
@@ -125,10 +102,10 @@ contains
       else
          deviation = abs(measured_height/rms_height - 1)
       end if
-      call report(deviation <= tol_target, label // ' equals target (relative error)', deviation)
+      call check(deviation <= tol_target, label // ' equals target (relative error)', deviation)
       deviation = abs(sum(height)/n)/measured_height
-      call report(deviation <= tol_mean, label // ' zero mean (|mean|/rms)', deviation)
-      call report(max_height > 0.0_wp .and. max_height >= measured_height, label // ' max height >= rms height')
+      call check(deviation <= tol_mean, label // ' zero mean (|mean|/rms)', deviation)
+      call check(max_height > 0.0_wp .and. max_height >= measured_height, label // ' max height >= rms height')
    end subroutine check_scaling
 
    subroutine check_reproducible()
@@ -139,8 +116,8 @@ contains
       call self_affine_profile(n, 1.0_wp, 0.8_wp, 3_i8, not_set, not_set, 0.1_wp, not_set, first, error)
       call self_affine_profile(n, 1.0_wp, 0.8_wp, 3_i8, not_set, not_set, 0.1_wp, not_set, second, error)
       call self_affine_profile(n, 1.0_wp, 0.8_wp, 4_i8, not_set, not_set, 0.1_wp, not_set, other, error)
-      call report(all(transfer(first, 1_i8, n) == transfer(second, 1_i8, n)), 'same seed gives identical bits')
-      call report(maxval(abs(first - other)) > 0.1_wp*maxval(abs(first)), 'different seed gives a different profile')
+      call check(all(transfer(first, 1_i8, n) == transfer(second, 1_i8, n)), 'same seed gives identical bits')
+      call check(maxval(abs(first - other)) > 0.1_wp*maxval(abs(first)), 'different seed gives a different profile')
    end subroutine check_reproducible
 
    !> Least-squares slope of log a_m vs log m over m_r..m_s, with a_m = 2 |f^(m)| from a
@@ -156,7 +133,7 @@ contains
       call self_affine_profile(n, period, hurst, 9_i8, period/m_r, period/m_s, not_set, 1.0_wp, height, error)
       call plan%init(n, 1, 1, error)
       if (allocated(error)) then
-         call report(.false., 'spectrum slope: ' // error%message)
+         call check(.false., 'spectrum slope: ' // error%message)
          return
       end if
       plan%real_buffer = height
@@ -168,11 +145,11 @@ contains
       y = log(amplitude(m_r:m_s))
       slope = sum((x - sum(x)/size(x))*(y - sum(y)/size(y)))/sum((x - sum(x)/size(x))**2)
       expected = -(1 + 2*hurst)/2
-      call report(abs(slope - expected) <= tol_slope, 'spectrum slope -(1+2H)/2 over m_r..m_s (error)', &
+      call check(abs(slope - expected) <= tol_slope, 'spectrum slope -(1+2H)/2 over m_r..m_s (error)', &
          & abs(slope - expected))
-      call report(maxval(abs(amplitude(1:m_r - 1)/amplitude(m_r) - 1)) <= tol_target, 'flat spectrum below m_r', &
+      call check(maxval(abs(amplitude(1:m_r - 1)/amplitude(m_r) - 1)) <= tol_target, 'flat spectrum below m_r', &
          & maxval(abs(amplitude(1:m_r - 1)/amplitude(m_r) - 1)))
-      call report(maxval(amplitude(m_s + 1:))/amplitude(m_s) <= tol_target, 'no modes above m_s (relative)', &
+      call check(maxval(amplitude(m_s + 1:))/amplitude(m_s) <= tol_target, 'no modes above m_s (relative)', &
          & maxval(amplitude(m_s + 1:))/amplitude(m_s))
    end subroutine check_slope
 
@@ -185,14 +162,14 @@ contains
 
       call sinusoid_profile(n, period, amplitude, mode, height)
       deviation = maxval(abs(height - [(amplitude*cos(2*pi*mode*real(j, wp)/n), j=0, n - 1)]))/amplitude
-      call report(deviation <= 1.0e-14_wp, 'sinusoid values amplitude cos(2 pi mode j/n) (max relative error)', deviation)
+      call check(deviation <= 1.0e-14_wp, 'sinusoid values amplitude cos(2 pi mode j/n) (max relative error)', deviation)
       call profile_statistics(height, period, rms_height, rms_gradient, max_height, error)
       deviation = abs(rms_height*sqrt(2.0_wp)/amplitude - 1)
-      call report(deviation <= tol_target, 'sinusoid rms height = amplitude/sqrt(2) (relative error)', deviation)
+      call check(deviation <= tol_target, 'sinusoid rms height = amplitude/sqrt(2) (relative error)', deviation)
       deviation = abs(rms_gradient*sqrt(2.0_wp)*period/(2*pi*mode*amplitude) - 1)
-      call report(deviation <= tol_target, 'sinusoid rms gradient = 2 pi mode amplitude/(sqrt(2) period)', deviation)
+      call check(deviation <= tol_target, 'sinusoid rms gradient = 2 pi mode amplitude/(sqrt(2) period)', deviation)
       deviation = abs(max_height/amplitude - 1)
-      call report(deviation <= tol_target, 'sinusoid max height = amplitude (relative error)', deviation)
+      call check(deviation <= tol_target, 'sinusoid max height = amplitude (relative error)', deviation)
    end subroutine check_sinusoid
 
    subroutine check_errors()
@@ -200,13 +177,13 @@ contains
       real(wp) :: height(64)
 
       call self_affine_profile(64, 1.0_wp, 1.2_wp, 1_i8, not_set, not_set, 0.1_wp, not_set, height, error)
-      call report(allocated(error), 'hurst = 1.2 is rejected')
-      if (allocated(error)) call report(error%code == code_input .and. index(error%message, 'hurst') > 0, &
+      call check(allocated(error), 'hurst = 1.2 is rejected')
+      if (allocated(error)) call check(error%code == code_input .and. index(error%message, 'hurst') > 0, &
          & 'its message names hurst: ' // error%message)
       call self_affine_profile(64, 1.0_wp, 0.8_wp, 1_i8, not_set, not_set, 0.1_wp, 0.1_wp, height, error)
-      call report(allocated(error), 'both rms_gradient and rms_height given is rejected')
+      call check(allocated(error), 'both rms_gradient and rms_height given is rejected')
       call self_affine_profile(64, 1.0_wp, 0.8_wp, 1_i8, 0.01_wp, 0.1_wp, 0.1_wp, not_set, height, error)
-      call report(allocated(error), 'rolloff_wavelength shorter than short_wavelength is rejected')
+      call check(allocated(error), 'rolloff_wavelength shorter than short_wavelength is rejected')
    end subroutine check_errors
 
    subroutine check_make_profile()
@@ -221,27 +198,27 @@ contains
       call make_profile(scene, height, error)
       call self_affine_profile(scene%n, scene%period, scene%profile%hurst, scene%profile%seed, not_set, not_set, &
          & 0.1_wp, not_set, direct, error)
-      call report(.not. allocated(error) .and. all(height == direct), 'make_profile self_affine = self_affine_profile')
+      call check(.not. allocated(error) .and. all(height == direct), 'make_profile self_affine = self_affine_profile')
 
       scene%profile%kind = 'sinusoid'
       scene%profile%amplitude = 0.5_wp
       scene%profile%mode = 2
       call make_profile(scene, height, error)
       call sinusoid_profile(scene%n, scene%period, 0.5_wp, 2, direct)
-      call report(.not. allocated(error) .and. all(height == direct), 'make_profile sinusoid = sinusoid_profile')
+      call check(.not. allocated(error) .and. all(height == direct), 'make_profile sinusoid = sinusoid_profile')
 
       scene%profile%amplitude = not_set
       call check_scene(scene, error)
-      call report(allocated(error), 'a sinusoid scene without amplitude is refused by check_scene')
+      call check(allocated(error), 'a sinusoid scene without amplitude is refused by check_scene')
 
       scene%profile%kind = 'file'
       scene%profile%file = '/nonexistent/layercontact_profile.h5'
       call make_profile(scene, height, error)
-      call report(allocated(error), 'make_profile file: a missing file is an error')
+      call check(allocated(error), 'make_profile file: a missing file is an error')
 
       scene%profile%kind = 'hertz'
       call make_profile(scene, height, error)
-      call report(allocated(error), 'make_profile unknown kind is an error')
+      call check(allocated(error), 'make_profile unknown kind is an error')
    end subroutine check_make_profile
 
    !> Rms height and gradient of a surface: the height from the grid values, the gradient by
@@ -284,7 +261,7 @@ contains
       call self_affine_surface(nx, ny, lx, ly, hurst, 11_i8, not_set, min(lx, ly)/8, rms_gradient, rms_height, &
          & height, error)
       if (allocated(error)) then
-         call report(.false., label // ': ' // error%message)
+         call check(.false., label // ': ' // error%message)
          return
       end if
       call surface_statistics(nx, ny, lx, ly, height, measured_height, measured_gradient, mean)
@@ -293,8 +270,8 @@ contains
       else
          deviation = abs(measured_height/rms_height - 1)
       end if
-      call report(deviation <= tol_target, label // ' equals target (relative error)', deviation)
-      call report(abs(mean)/measured_height <= tol_mean, label // ' zero mean (|mean|/rms)', abs(mean)/measured_height)
+      call check(deviation <= tol_target, label // ' equals target (relative error)', deviation)
+      call check(abs(mean)/measured_height <= tol_mean, label // ' zero mean (|mean|/rms)', abs(mean)/measured_height)
    end subroutine check_surface_scaling
 
    !> The coefficients of a synthesised surface, by a forward FFT: every kept mode has the
@@ -351,14 +328,14 @@ contains
          end do
       end do
       slope = (count*sxy - sx*sy)/(count*sxx - sx**2)
-      call report(kept == count_kept(), 'surface keeps the modes inside the circle kappa <= 1/short_wavelength')
-      call report(phase_error <= tol_target, 'surface phases 2 pi u(index(mx, my)) (max |exp(i phi) error|)', phase_error)
-      call report(amplitude_error <= tol_target, 'surface amplitudes (max(kappa, kappa_r)/kappa_r)^(-1-H)', &
+      call check(kept == count_kept(), 'surface keeps the modes inside the circle kappa <= 1/short_wavelength')
+      call check(phase_error <= tol_target, 'surface phases 2 pi u(index(mx, my)) (max |exp(i phi) error|)', phase_error)
+      call check(amplitude_error <= tol_target, 'surface amplitudes (max(kappa, kappa_r)/kappa_r)^(-1-H)', &
          & amplitude_error)
-      call report(abs(slope + (1 + hurst)) <= tol_slope, 'surface log-log slope of |f| = -(1+H) (error)', &
+      call check(abs(slope + (1 + hurst)) <= tol_slope, 'surface log-log slope of |f| = -(1+H) (error)', &
          & abs(slope + (1 + hurst)))
-      call report(outside <= tol_target*ratio0, 'surface: no modes beyond the short cut-off (relative)', outside/ratio0)
-      call report(abs(plan%spectrum(1)) <= tol_mean*ratio0, 'surface: zero mean coefficient')
+      call check(outside <= tol_target*ratio0, 'surface: no modes beyond the short cut-off (relative)', outside/ratio0)
+      call check(abs(plan%spectrum(1)) <= tol_mean*ratio0, 'surface: zero mean coefficient')
 
    end subroutine check_surface_modes
 
@@ -383,7 +360,7 @@ contains
       call self_affine_surface(32, 24, 1.0_wp, 0.75_wp, 0.6_wp, 3_i8, not_set, 0.1_wp, 0.1_wp, not_set, coarse, error)
       call self_affine_surface(64, 48, 1.0_wp, 0.75_wp, 0.6_wp, 3_i8, not_set, 0.1_wp, 0.1_wp, not_set, fine, error)
       deviation = maxval(abs(fine(1::2, 1::2) - coarse))/maxval(abs(coarse))
-      call report(deviation <= tol_target, 'surface on a grid twice as fine = the same surface (max relative)', &
+      call check(deviation <= tol_target, 'surface on a grid twice as fine = the same surface (max relative)', &
          & deviation)
    end subroutine check_surface_refinement
 
@@ -392,15 +369,15 @@ contains
       real(wp) :: height(16, 16)
 
       call self_affine_surface(16, 16, 1.0_wp, 1.0_wp, 0.0_wp, 1_i8, not_set, not_set, 0.1_wp, not_set, height, error)
-      call report(allocated(error), 'surface hurst = 0 is rejected')
-      if (allocated(error)) call report(error%code == code_input .and. index(error%message, '&profile: hurst') > 0, &
+      call check(allocated(error), 'surface hurst = 0 is rejected')
+      if (allocated(error)) call check(error%code == code_input .and. index(error%message, '&profile: hurst') > 0, &
          & 'its message names &profile hurst: ' // error%message)
       call self_affine_surface(16, 2, 1.0_wp, 1.0_wp, 0.8_wp, 1_i8, not_set, not_set, 0.1_wp, not_set, height, error)
-      call report(allocated(error), 'surface ny = 2 is rejected')
+      call check(allocated(error), 'surface ny = 2 is rejected')
       call self_affine_surface(16, 16, 1.0_wp, 1.0_wp, 0.8_wp, 1_i8, 0.05_wp, 0.2_wp, 0.1_wp, not_set, height, error)
-      call report(allocated(error), 'surface rolloff_wavelength shorter than short_wavelength is rejected')
+      call check(allocated(error), 'surface rolloff_wavelength shorter than short_wavelength is rejected')
       call self_affine_surface(16, 16, 1.0_wp, 1.0_wp, 0.8_wp, 1_i8, not_set, not_set, not_set, not_set, height, error)
-      call report(allocated(error), 'surface without rms_gradient and rms_height is rejected')
+      call check(allocated(error), 'surface without rms_gradient and rms_height is rejected')
    end subroutine check_surface_errors
 
    subroutine check_sinusoid_surface()
@@ -416,10 +393,10 @@ contains
          end do
       end do
       deviation = maxval(abs(height - expected))/amplitude
-      call report(deviation <= tol_closed, 'sinusoid surface = amplitude cos(2 pi (mode ix/nx + mode_y iy/ny))', deviation)
+      call check(deviation <= tol_closed, 'sinusoid surface = amplitude cos(2 pi (mode ix/nx + mode_y iy/ny))', deviation)
       call surface_statistics(nx, ny, lx, ly, height, rms_height, rms_gradient, mean)
       deviation = abs(rms_gradient*sqrt(2.0_wp)/(2*pi*amplitude*sqrt((mode/lx)**2 + (mode_y/ly)**2)) - 1)
-      call report(deviation <= tol_target, 'sinusoid surface rms gradient = 2 pi |kappa| amplitude/sqrt(2)', deviation)
+      call check(deviation <= tol_target, 'sinusoid surface rms gradient = 2 pi |kappa| amplitude/sqrt(2)', deviation)
    end subroutine check_sinusoid_surface
 
    subroutine check_spherical_cap()
@@ -440,10 +417,10 @@ contains
             deviation = max(deviation, abs(height(ix + 1, iy + 1) - expected)/radius)
          end do
       end do
-      call report(deviation <= tol_closed, 'spherical cap = sqrt(R^2 - rho^2) - R inside, -R outside', deviation)
-      call report(height(17, 11) == 0.0_wp .and. maxval(height) == 0.0_wp, &
+      call check(deviation <= tol_closed, 'spherical cap = sqrt(R^2 - rho^2) - R inside, -R outside', deviation)
+      call check(height(17, 11) == 0.0_wp .and. maxval(height) == 0.0_wp, &
          & 'spherical cap apex at (nx/2, ny/2) is the maximum, 0')
-      call report(minval(height) == -radius, 'spherical cap is -R beyond the sphere')
+      call check(minval(height) == -radius, 'spherical cap is -R beyond the sphere')
    end subroutine check_spherical_cap
 
    subroutine check_surface_text_file()
@@ -461,17 +438,17 @@ contains
       end do
       close (unit)
       call measured_heights(name, '', .true., 'auto', 'periodic', 'none', nx, ny, read_back, error)
-      call report(.not. allocated(error) .and. all(read_back == written), 'text surface file round trip (17 digits)')
+      call check(.not. allocated(error) .and. all(read_back == written), 'text surface file round trip (17 digits)')
       call measured_heights(name, '', .true., 'auto', 'periodic', 'none', nx, ny - 1, small, error)
-      call report(allocated(error), 'text surface file with too many lines is rejected')
-      if (allocated(error)) call report(error%code == code_input .and. index(error%message, "&profile: file = '") > 0, &
+      call check(allocated(error), 'text surface file with too many lines is rejected')
+      if (allocated(error)) call check(error%code == code_input .and. index(error%message, "&profile: file = '") > 0, &
          & 'its message names &profile file: ' // error%message)
       open (newunit=unit, file=name, status='old')
       close (unit, status='delete')
       call measured_heights('/nonexistent/surface.npy', '', .true., 'auto', 'periodic', 'none', nx, ny, read_back, &
          & error)
-      call report(allocated(error), 'missing .npy surface file is an error')
-      if (allocated(error)) call report(error%code == code_input, 'its code is code_input (bad input): ' // error%message)
+      call check(allocated(error), 'missing .npy surface file is an error')
+      if (allocated(error)) call check(error%code == code_input, 'its code is code_input (bad input): ' // error%message)
    end subroutine check_surface_text_file
 
    !> Detrending, mirroring and resampling of measured heights against closed forms.
@@ -488,19 +465,19 @@ contains
          end do
       end do
       call detrend_heights(height, 'plane')
-      call report(maxval(abs(height)) < 1.0e-13_wp, 'detrend plane removes a plane', maxval(abs(height)))
+      call check(maxval(abs(height)) < 1.0e-13_wp, 'detrend plane removes a plane', maxval(abs(height)))
       do iy = 1, 5
          do ix = 1, 7
             height(ix, iy) = 1.0_wp + 0.2_wp*ix - 0.7_wp*iy + 0.05_wp*ix**2 - 0.1_wp*iy**2 + 0.03_wp*ix*iy
          end do
       end do
       call detrend_heights(height, 'curvature')
-      call report(maxval(abs(height)) < 1.0e-12_wp, 'detrend curvature removes a quadric', maxval(abs(height)))
+      call check(maxval(abs(height)) < 1.0e-12_wp, 'detrend curvature removes a quadric', maxval(abs(height)))
 
       ! mirror: (mx, my) -> (2 mx, 2 my), h(2m-1-j) = h(j)
       height = reshape([(real(ix, wp), ix=1, 6)], [3, 2])
       call mirror_heights(height, .true.)
-      call report(all(shape(height) == [6, 4]) .and. all(height(:, 1) == [1, 2, 3, 3, 2, 1]) .and. &
+      call check(all(shape(height) == [6, 4]) .and. all(height(:, 1) == [1, 2, 3, 3, 2, 1]) .and. &
          & all(height(:, 4) == height(:, 1)) .and. all(height(:, 3) == height(:, 2)), 'mirror of a surface patch')
 
       ! Fourier resampling of a band-limited surface (modes 2 along x, 1 along y) is exact
@@ -510,7 +487,7 @@ contains
          expected = band_limited(sizes(1, k), sizes(2, k))
          allocate (resampled(sizes(1, k), sizes(2, k)))
          call resample_heights(height, resampled, error)
-         call report(.not. allocated(error) .and. maxval(abs(resampled - expected)) < 1.0e-13_wp, &
+         call check(.not. allocated(error) .and. maxval(abs(resampled - expected)) < 1.0e-13_wp, &
             & 'Fourier resampling of a band-limited surface ' // trim(adjustl(to_text(sizes(:, k)))), &
             & maxval(abs(resampled - expected)))
          deallocate (resampled)
@@ -550,7 +527,7 @@ contains
       call make_profile(scene, height, error)
       call self_affine_surface(32, 16, 2.0_wp, 1.0_wp, scene%profile%hurst, scene%profile%seed, not_set, not_set, &
          & 0.1_wp, not_set, direct, error)
-      call report(.not. allocated(error) .and. all(height == direct), 'make_profile areal self_affine = self_affine_surface')
+      call check(.not. allocated(error) .and. all(height == direct), 'make_profile areal self_affine = self_affine_surface')
 
       scene%profile%kind = 'sinusoid'
       scene%profile%amplitude = 0.5_wp
@@ -558,19 +535,19 @@ contains
       scene%profile%mode_y = 7
       call make_profile(scene, height, error)
       call sinusoid_surface(32, 16, 2.0_wp, 1.0_wp, 0.5_wp, 0, 7, direct)
-      call report(.not. allocated(error) .and. all(height == direct), 'make_profile areal sinusoid = sinusoid_surface')
+      call check(.not. allocated(error) .and. all(height == direct), 'make_profile areal sinusoid = sinusoid_surface')
       scene%profile%mode_y = 8
       call make_profile(scene, height, error)
-      call report(allocated(error), 'areal sinusoid mode_y = ny/2 (Nyquist) is rejected')
-      if (allocated(error)) call report(index(error%message, '&profile: mode_y') > 0, 'its message names mode_y: ' &
+      call check(allocated(error), 'areal sinusoid mode_y = ny/2 (Nyquist) is rejected')
+      if (allocated(error)) call check(index(error%message, '&profile: mode_y') > 0, 'its message names mode_y: ' &
          & // error%message)
 
       scene%profile%kind = 'sphere'
       call make_profile(scene, height, error)
-      call report(allocated(error), 'areal sphere without radius is rejected')
+      call check(allocated(error), 'areal sphere without radius is rejected')
       scene%profile%radius = 0.4_wp
       call make_profile(scene, height, error)
       call spherical_cap(32, 16, 2.0_wp, 1.0_wp, 0.4_wp, direct)
-      call report(.not. allocated(error) .and. all(height == direct), 'make_profile areal sphere = spherical_cap')
+      call check(.not. allocated(error) .and. all(height == direct), 'make_profile areal sphere = spherical_cap')
    end subroutine check_make_surface
 end program test_profiles
