@@ -80,8 +80,8 @@ module lc_contact_solver_gfmd
    !> The largest friction ratio mu_c |G_x|/|G_n| over the modes that the traction update
    !> relaxes: on the thinnest layer (h/lambda = 0.01) at 64² and 128² every load measured
    !> converges at 5.96 (0.2 % to full contact) and 6.44 (33-71 %), the dynamics diverges
-   !> at half contact from 6.92 (at 22-40 % from 9.6, at 15 % from 18); the limit keeps 13 %
-   !> below the first divergence and above the Fig. 3 family's 4.68
+   !> at half contact from 6.92 (at 32-42 % from 9.54, 22 % from 11.9, 15 % from 16.7); the
+   !> limit keeps 13 % below the first divergence and above the Fig. 3 family's 4.68
    !> (docs/decisions/001-gfmd-masses.md).
    real(wp), parameter :: max_friction_ratio = 6.0_wp
    !> The traction is updated once the largest unbalanced pressure is below this fraction
