@@ -1,6 +1,7 @@
 """GFMD's masses, a numpy prototype of the frictionless dynamics: one mass for every node
 (the Fortran solver's) against a mass per mode K(q)^alpha, with the hard wall either as the
-projection after each step or with the mass restricted to the free nodes.
+projection after each step or with the mass restricted to the free nodes; FIRE as in the
+solver (Bitzek et al.) or FIRE 2.0 (Guenole et al.).
 
 The scenes of bench/gfmd.py (the Fig. 3 surface: H = 0.8, shortest wavelength lambda/32, rms
 gradient 0.1, incompressible layer h/lambda = 0.05, loads p_m/(E* h/lambda) 0.0215 and 1:
