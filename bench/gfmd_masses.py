@@ -1,6 +1,7 @@
 """GFMD's masses, a numpy prototype of the frictionless dynamics: one mass for every node
 (the Fortran solver's) against a mass per mode K(q)^alpha, with the hard wall either as the
-projection after each step or with the mass restricted to the free nodes.
+projection after each step or with the mass restricted to the free nodes; FIRE as in the
+solver (Bitzek et al.) or FIRE 2.0 (Guenole et al.).
 
 The scenes of bench/gfmd.py (the Fig. 3 surface: H = 0.8, shortest wavelength lambda/32, rms
 gradient 0.1, incompressible layer h/lambda = 0.05, loads p_m/(E* h/lambda) 0.0215 and 1:
@@ -8,7 +9,7 @@ gradient 0.1, incompressible layer h/lambda = 0.05, loads p_m/(E* h/lambda) 0.02
 `--error` p_m of the default solver's at tol 1e-13 (checked every 10 steps); a step costs one
 transform pair with one mass, two with a mass per mode. docs/decisions/001-gfmd-masses.md.
 
-    .venv/bin/python bench/gfmd_masses.py [--sizes 64 128] [--max-steps 3000]
+    .venv/bin/python bench/gfmd_masses.py [--sizes 64 128] [--max-steps 3000] [--variants NAME ...]
 """
 
 from __future__ import annotations
@@ -39,11 +40,14 @@ def scene(n: int, load: float):
     return r, ref, g * np.sum(w_ref * w) / np.sum(w * w)
 
 
-def steps(r, ref, g, alpha=None, wall="projection", dt_max=1.0, error=1e-8, max_steps=3000):
+def steps(r, ref, g, alpha=None, wall="projection", dt_max=1.0, error=1e-8, max_steps=3000, fire2=False):
     """FIRE's steps to the default solver's pressure (None if not within max_steps) and the
     last error. alpha None: one mass (the largest stiffness); else a mass per mode K^alpha,
     scaled so that the stiffest mode has unit frequency. wall: 'projection' (the wall after
-    the step) or 'free' (the mass restricted to the free nodes and those the wall releases)."""
+    the step) or 'free' (the mass restricted to the free nodes and those the wall releases).
+    fire2: FIRE 2.0 (Guenole et al.): the mixing after the velocity's step, half a step back
+    when the power turns negative, no shrink in the first 20 steps, 20 steps of positive
+    power before the step grows, alpha_0 0.25."""
     pm = ref.mean_pressure
     k = np.zeros_like(g)
     k[g > 0] = 1 / g[g > 0]
@@ -56,7 +60,8 @@ def steps(r, ref, g, alpha=None, wall="projection", dt_max=1.0, error=1e-8, max_
         inverse_mass = 1 / mass
     u = np.full(r.shape, r.max())
     v = np.zeros_like(u)
-    dt, mix, positive, err = 0.25, FIRE_ALPHA0, 0, np.inf
+    alpha0, min_steps, delay = (0.25, 20, 20) if fire2 else (FIRE_ALPHA0, FIRE_MIN_STEPS, 0)
+    dt, mix, positive, err = 0.25, alpha0, 0, np.inf
     for step in range(1, max_steps + 1):
         p = np.fft.irfft2(k * np.fft.rfft2(u), s=r.shape) + pm
         contact = u <= r
@@ -70,14 +75,21 @@ def steps(r, ref, g, alpha=None, wall="projection", dt_max=1.0, error=1e-8, max_
                 a = np.where(contact & (p >= 0), 0.0, a)
         power = np.sum(v * a)
         if power > 0:
-            v = (1 - mix) * v + mix * np.sqrt(np.sum(v * v) / max(np.sum(a * a), 1e-300)) * a
+            if not fire2:
+                v = (1 - mix) * v + mix * np.sqrt(np.sum(v * v) / max(np.sum(a * a), 1e-300)) * a
             positive += 1
-            if positive > FIRE_MIN_STEPS:
+            if positive > min_steps:
                 dt, mix = min(dt * FIRE_GROW, dt_max), mix * FIRE_ALPHA_DECAY
         else:
+            if fire2:
+                u = np.maximum(u - 0.5 * dt * v, r)
             v[:] = 0
-            dt, mix, positive = dt * FIRE_SHRINK, FIRE_ALPHA0, 0
+            if step >= delay:
+                dt, mix = dt * FIRE_SHRINK, alpha0
+            positive = 0
         v = v + dt * a
+        if fire2 and power > 0:
+            v = (1 - mix) * v + mix * np.sqrt(np.sum(v * v) / max(np.sum(a * a), 1e-300)) * a
         u = u + dt * v
         below = u < r
         u[below] = r[below]
@@ -97,6 +109,8 @@ VARIANTS = {
     "K^0.5, free nodes": dict(alpha=0.5, wall="free"),
     "K^1, free nodes": dict(alpha=1.0, wall="free"),
     "K^1, free nodes, dt_max 1.8": dict(alpha=1.0, wall="free", dt_max=1.8),
+    "one mass, FIRE 2.0": dict(fire2=True),
+    "K^1, free nodes, FIRE 2.0": dict(alpha=1.0, wall="free", fire2=True),
 }
 
 
@@ -104,13 +118,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[64, 128])
     parser.add_argument("--max-steps", type=int, default=3000)
+    parser.add_argument("--variants", nargs="+", default=list(VARIANTS), help="names of VARIANTS to run")
     args = parser.parse_args()
     for n in args.sizes:
         for load in LOADS:
             r, ref, g = scene(n, load)
             print(f"{n}^2, p_m/(E* h/lambda) = {load:g}, contact {ref.contact_fraction:.3f}, "
                   f"default solver {ref.fft_pairs} pairs", flush=True)
-            for name, keys in VARIANTS.items():
+            for name in args.variants:
+                keys = VARIANTS[name]
                 count, err = steps(r, ref, g, max_steps=args.max_steps, **keys)
                 pairs = "-" if count is None else count * (1 if "alpha" not in keys else 2)
                 print(f"  {name:30s} steps {str(count):>5s}  pairs {pairs!s:>5s}  error {err:.1e}", flush=True)

@@ -97,6 +97,11 @@ def test_gfmd_on_fig3_scenes(n, thickness, friction, load):
     nodes within that bound, Delta mu and the penetration to 1e-6 relative (a residual of
     1e-9 moves the penetration by at most 1e-9 of the profile's peak-to-valley, below 1e-6
     of the penetration here)."""
+    assert_gfmd_agrees(n, thickness, friction, load)
+
+
+def assert_gfmd_agrees(n, thickness, friction, load):
+    """GFMD against the default solver on the Fig. 3 surface, as test_gfmd_on_fig3_scenes."""
     h = fig3_surface(n)
     keys = dict(thickness=thickness, poisson=0.5, friction=friction, normalised_pressure=load, stress=False)
     ref = lc.solve_areal(h, tol=1e-13, **keys)
@@ -120,11 +125,13 @@ def friction_ratio(n, thickness, friction):
     return friction * np.max(np.abs(tangential[keep]) / np.abs(normal[keep]))
 
 
-@pytest.mark.parametrize("thickness, friction", [(0.01, 0.5), (0.01, 1.5)], ids=["h001-mu05", "h001-mu15"])
+@pytest.mark.parametrize("thickness, friction", [(0.01, 0.26), (0.01, 0.5), (0.01, 1.5)],
+                         ids=["h001-mu026", "h001-mu05", "h001-mu15"])
 def test_gfmd_refuses_what_its_traction_update_cannot_relax(thickness, friction):
-    """The thinnest incompressible layer with friction: mu_c |G_x|/|G_n| reaches 12 (h/lambda
-    = 0.01, mu_c = 0.5) and 36 (mu_c = 1.5), beyond the 6 up to which the update of the
-    friction traction was measured to converge; the solve is refused before any step, and the
+    """The thinnest incompressible layer with friction: mu_c |G_x|/|G_n| reaches 6.2 (h/lambda
+    = 0.01, mu_c = 0.26, just beyond the limit 6), 12 (mu_c = 0.5) and 36 (mu_c = 1.5); the
+    dynamics was measured to diverge at half contact from 6.92 and at 22-40 % contact at 12
+    (docs/decisions/001-gfmd-masses.md); the solve is refused before any step, and the
     message names the default method."""
     assert friction_ratio(32, thickness, friction) > 6
     h = fig3_surface(32)
@@ -141,6 +148,14 @@ def test_gfmd_admits_the_fig3_family():
     dyn = lc.solve_areal(fig3_surface(32), thickness=0.05, poisson=0.5, friction=1.0, normalised_pressure=1.0,
                          tol=1e-8, method="gfmd", max_iter=20000, stress=False)
     assert dyn.solver == "gfmd" and dyn.converged
+
+
+def test_gfmd_converges_just_inside_its_limit():
+    """h/lambda = 0.01, mu_c = 0.25: the friction ratio 5.96, just inside the limit 6, at half
+    contact (p_m/(E* h/lambda) = 600), where a ratio of 6.92 makes the dynamics diverge:
+    admitted, and the contact of the default solver (the bounds of test_gfmd_on_fig3_scenes)."""
+    assert friction_ratio(64, 0.01, 0.25) == pytest.approx(5.96, abs=0.01)
+    assert_gfmd_agrees(64, 0.01, 0.25, 600.0)
 
 
 def test_gfmd_refuses_a_strongly_coupled_line():
