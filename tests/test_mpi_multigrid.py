@@ -96,7 +96,7 @@ def test_the_distributed_multigrid_gives_the_serial_answer(scene, tmp_path):
 @pytest.mark.parametrize("ranks", [2, 3])
 def test_auto_plans_the_multigrid_on_a_shared_surface_as_on_one_process(ranks, tmp_path):
     """The sliding scene that 'auto' sends to the multigrid method on one process (its loss
-    among the short waves, measured on its whole spectra gathered for the measure): on two
+    among the short waves, measured on the ranks' modes over the ranks): on two
     and three ranks 'auto' plans it too, says the finest grid is on the slabs, and gives the
     serial answer (SAME) in the serial run's iterations. (Its transform pairs may differ by a
     few: the coarse start runs on the slabs with its own sums.)"""

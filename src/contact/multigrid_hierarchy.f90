@@ -460,8 +460,12 @@ contains
       complex(wp) :: stiffness
       real(wp) :: mean, bound, factor, factors(3)
       real(wp) :: column(0:mx/2)
-      integer :: kx, ky, sy, pass, last
+      integer :: kx, ky, sy, pass, last, outer, inner, outer_count, inner_count, i
       last = min(mx/2, modes%x_start + modes%columns - 1)
+      ! (the modes in the order they are stored: the columns' modes in turn on a slab, the
+      ! rows' on a whole grid; a column's sum runs over ky in order either way)
+      outer_count = merge(last - modes%x_start + 1, my, modes%distributed)
+      inner_count = merge(my, last + 1, modes%distributed)
       column = 0.0_wp
       mean = 0.0_wp
       bound = 0.0_wp
@@ -469,20 +473,35 @@ contains
       mu_y = 0.0_wp
       mu_both = 0.0_wp
       do pass = 1, 2
-         ! (the modes in the order they are stored; a column's sum runs over ky either way)
-         if (modes%distributed) then
-            do kx = modes%x_start, last
-               do ky = 0, my - 1
-                  call take(kx, ky)
-               end do
+         do outer = 0, outer_count - 1
+            do inner = 0, inner_count - 1
+               if (modes%distributed) then
+                  kx = modes%x_start + outer
+                  ky = inner
+               else
+                  kx = inner
+                  ky = outer
+               end if
+               sy = merge(ky, ky - my, 2*ky <= my)
+               if (modes%distributed) then
+                  i = (kx - modes%x_start)*modes%ny + modulo(sy, modes%ny) + 1
+               else
+                  i = kx + (modes%nx/2 + 1)*modulo(sy, modes%ny) + 1
+               end if
+               stiffness = cmplx(symbol(i), 0.0_wp, kind=wp)
+               if (present(odd)) stiffness = cmplx(symbol(i), odd(i), kind=wp)
+               if (.not. real(stiffness) > 0.0_wp) cycle
+               if (pass == 1) then
+                  column(kx) = column(kx) + real(stiffness)
+                  bound = max(bound, abs(stiffness)**2/(2*real(stiffness)))
+               else
+                  factor = abs(1.0_wp - omega*stiffness/mean)
+                  if (4*kx > mx) mu_x = max(mu_x, factor)
+                  if (4*abs(sy) > my) mu_y = max(mu_y, factor)
+                  if (4*kx > mx .or. 4*abs(sy) > my) mu_both = max(mu_both, factor)
+               end if
             end do
-         else
-            do ky = 0, my - 1
-               do kx = 0, last
-                  call take(kx, ky)
-               end do
-            end do
-         end if
+         end do
          ! (the second pass takes the Jacobi diagonal for `mean`)
          if (pass == 1) then
             if (modes%distributed) then
@@ -502,23 +521,6 @@ contains
          mu_y = factors(2)
          mu_both = factors(3)
       end if
-   contains
-      subroutine take(kx, ky)
-         integer, intent(in) :: kx, ky
-         sy = merge(ky, ky - my, 2*ky <= my)
-         stiffness = cmplx(symbol(held_index(modes, kx, sy)), 0.0_wp, kind=wp)
-         if (present(odd)) stiffness = cmplx(real(stiffness), odd(held_index(modes, kx, sy)), kind=wp)
-         if (.not. real(stiffness) > 0.0_wp) return
-         if (pass == 1) then
-            column(kx) = column(kx) + real(stiffness)
-            bound = max(bound, abs(stiffness)**2/(2*real(stiffness)))
-         else
-            factor = abs(1.0_wp - omega*stiffness/mean)
-            if (4*kx > mx) mu_x = max(mu_x, factor)
-            if (4*abs(sy) > my) mu_y = max(mu_y, factor)
-            if (4*kx > mx .or. 4*abs(sy) > my) mu_both = max(mu_both, factor)
-         end if
-      end subroutine take
    end subroutine smoothing_factors
 
    !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse correction

@@ -460,7 +460,7 @@ contains
       type(compliance_operator), intent(in) :: op
       type(held_modes) :: modes
       real(wp), allocatable :: lowest(:)
-      integer :: nkx, ny, kx, ky, sign, step, last
+      integer :: nkx, ny, kx, ky, sign, step, last, i
       rise = 1.0_wp
       if (op%grid%modes() < 3) return
       modes = modes_of(op)
@@ -473,8 +473,8 @@ contains
          lowest = huge(1.0_wp)
          do kx = modes%x_start, last
             do ky = 0, ny - 1
-               if (.not. (kx == 0 .and. ky == 0) .and. op%metric(held_index(modes, kx, ky)) > 0.0_wp) &
-                  & lowest(ky) = min(lowest(ky), op%metric(held_index(modes, kx, ky)))
+               i = (kx - modes%x_start)*ny + ky + 1
+               if (.not. (kx == 0 .and. ky == 0) .and. op%metric(i) > 0.0_wp) lowest(ky) = min(lowest(ky), op%metric(i))
             end do
          end do
          call min_over_lower_ranks(lowest)
@@ -510,7 +510,11 @@ contains
          integer :: i
          ! (the uniform mode has no compliance of its own)
          if (kx == 0 .and. modulo(ky, ny) == 0) return
-         i = held_index(modes, kx, ky)
+         if (modes%distributed) then
+            i = (kx - modes%x_start)*ny + modulo(ky, ny) + 1
+         else
+            i = kx + nkx*modulo(ky, ny) + 1
+         end if
          if (.not. op%metric(i) > 0.0_wp) return
          lowest = min(lowest, op%metric(i))
          rise = max(rise, op%metric(i)/lowest)
@@ -1718,7 +1722,7 @@ contains
 
    !> The operator of the whole grid of `op` (a slab's, distributed) on this rank alone: the
    !> same grid, layer and friction, and its uniform mode left out where op's is
-   !> (drop_uniform_mode). What the multigrid method and its measures read: whole spectra.
+   !> (drop_uniform_mode): what the gathered multigrid solve (solve_gathered) iterates on.
    subroutine whole_operator(op, whole, error)
       type(compliance_operator), intent(in) :: op
       type(compliance_operator), intent(out) :: whole
