@@ -132,7 +132,7 @@ PLANS = {
     "moderate loss": (128, MODERATE, "gcr", "a coupled operator"),
     "rows ahead": (512, MODERATE, "multigrid", "smooths by rows"),
     "rising": (64, THIN, "cg", "rises too steeply for the symmetric multigrid method"),
-    "refused": (64, THIN.replace("0.05", "0.003"), "cg", "and the Jacobi step would smooth with a factor 0.99"),
+    "refused": (64, THIN.replace("0.05", "0.003"), "cg", "the Jacobi step would smooth with a factor 0.99"),
     "coupled, rising": (64, THIN + "&friction coefficient = 0.5 /\n", "gcr", "a coupled operator"),
     "compressible": (64, ELASTIC, "cg", "a symmetric operator: the constrained CG"),
 }
@@ -170,7 +170,8 @@ def test_auto_plans_a_shared_surface_as_one_process(scene, tmp_path):
     assert serial[0] == first and said in serial[1], serial
     for ranks in (2,) if n > 128 else (2, 3, 4):
         out = f"ranks{ranks}.h5"
-        done = run_mpi(ranks, [executable(), str(write_scene(tmp_path, f"ranks{ranks}", n, body, out))], tmp_path)
+        nml = write_scene(tmp_path, f"ranks{ranks}", n, body, out)
+        done = run_mpi(ranks, [executable(), str(nml)], tmp_path)
         assert done.returncode == 0, done.stderr
         assert plan(tmp_path / out) == serial, (ranks, serial, plan(tmp_path / out))
 
@@ -190,8 +191,8 @@ def test_the_policy_measures_the_slabs_as_the_whole_grid(ranks, policy_program):
     (tests/fortran/test_policy_slabs.f90): the compliance's rise, the loss profile and its
     peak, the smoothing factors of the real and the complex symbol, the refusals and the
     policy's indicators, bit for bit."""
-    done = subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(policy_program)], capture_output=True,
-                          text=True, env=launcher_env(), timeout=120)
+    done = subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(policy_program)],
+                          capture_output=True, text=True, env=launcher_env(), timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     assert done.stdout.count("checks passed") == ranks
     assert "FAIL" not in done.stdout
