@@ -457,15 +457,10 @@ contains
       real(wp), intent(in) :: symbol(:)
       real(wp), intent(in), optional :: odd(:)
       real(wp), intent(out) :: mu_x, mu_y, mu_both
-      complex(wp) :: stiffness
-      real(wp) :: mean, bound, factor, factors(3)
+      real(wp) :: mean, bound, factors(3)
       real(wp) :: column(0:mx/2)
-      integer :: kx, ky, sy, pass, last, outer, inner, outer_count, inner_count, i
+      integer :: kx, ky, sy, pass, last, base
       last = min(mx/2, modes%x_start + modes%columns - 1)
-      ! (the modes in the order they are stored: the columns' modes in turn on a slab, the
-      ! rows' on a whole grid; a column's sum runs over ky in order either way)
-      outer_count = merge(last - modes%x_start + 1, my, modes%distributed)
-      inner_count = merge(my, last + 1, modes%distributed)
       column = 0.0_wp
       mean = 0.0_wp
       bound = 0.0_wp
@@ -473,35 +468,25 @@ contains
       mu_y = 0.0_wp
       mu_both = 0.0_wp
       do pass = 1, 2
-         do outer = 0, outer_count - 1
-            do inner = 0, inner_count - 1
-               if (modes%distributed) then
-                  kx = modes%x_start + outer
-                  ky = inner
-               else
-                  kx = inner
-                  ky = outer
-               end if
-               sy = merge(ky, ky - my, 2*ky <= my)
-               if (modes%distributed) then
-                  i = (kx - modes%x_start)*modes%ny + modulo(sy, modes%ny) + 1
-               else
-                  i = kx + (modes%nx/2 + 1)*modulo(sy, modes%ny) + 1
-               end if
-               stiffness = cmplx(symbol(i), 0.0_wp, kind=wp)
-               if (present(odd)) stiffness = cmplx(symbol(i), odd(i), kind=wp)
-               if (.not. real(stiffness) > 0.0_wp) cycle
-               if (pass == 1) then
-                  column(kx) = column(kx) + real(stiffness)
-                  bound = max(bound, abs(stiffness)**2/(2*real(stiffness)))
-               else
-                  factor = abs(1.0_wp - omega*stiffness/mean)
-                  if (4*kx > mx) mu_x = max(mu_x, factor)
-                  if (4*abs(sy) > my) mu_y = max(mu_y, factor)
-                  if (4*kx > mx .or. 4*abs(sy) > my) mu_both = max(mu_both, factor)
-               end if
+         ! (the modes in the order they are stored: the columns in turn on a slab, the rows
+         ! on a whole grid; a column's sum runs over ky in order either way)
+         if (modes%distributed) then
+            do kx = modes%x_start, last
+               base = (kx - modes%x_start)*modes%ny + 1
+               do ky = 0, my - 1
+                  sy = merge(ky, ky - my, 2*ky <= my)
+                  call take(kx, sy, base + modulo(sy, modes%ny))
+               end do
             end do
-         end do
+         else
+            do ky = 0, my - 1
+               sy = merge(ky, ky - my, 2*ky <= my)
+               base = (modes%nx/2 + 1)*modulo(sy, modes%ny) + 1
+               do kx = 0, last
+                  call take(kx, sy, base + kx)
+               end do
+            end do
+         end if
          ! (the second pass takes the Jacobi diagonal for `mean`)
          if (pass == 1) then
             if (modes%distributed) then
@@ -521,6 +506,25 @@ contains
          mu_y = factors(2)
          mu_both = factors(3)
       end if
+   contains
+      !> the mode (kx, sy) of the mx x my grid, at index i of the held modes
+      subroutine take(kx, sy, i)
+         integer, intent(in) :: kx, sy, i
+         complex(wp) :: stiffness
+         real(wp) :: factor
+         stiffness = cmplx(symbol(i), 0.0_wp, kind=wp)
+         if (present(odd)) stiffness = cmplx(symbol(i), odd(i), kind=wp)
+         if (.not. real(stiffness) > 0.0_wp) return
+         if (pass == 1) then
+            column(kx) = column(kx) + real(stiffness)
+            bound = max(bound, abs(stiffness)**2/(2*real(stiffness)))
+         else
+            factor = abs(1.0_wp - omega*stiffness/mean)
+            if (4*kx > mx) mu_x = max(mu_x, factor)
+            if (4*abs(sy) > my) mu_y = max(mu_y, factor)
+            if (4*kx > mx .or. 4*abs(sy) > my) mu_both = max(mu_both, factor)
+         end if
+      end subroutine take
    end subroutine smoothing_factors
 
    !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse correction
