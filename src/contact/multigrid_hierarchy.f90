@@ -239,16 +239,21 @@ contains
    !> halving both axes leaves the short waves across it, soft, to a step that barely damps
    !> them. The full coarsening is kept if the other would end on a grid of more than
    !> coarsest_limit points.
-   subroutine coarsening_shapes(nx, ny, shapes, symbol, odd, modes)
+   subroutine coarsening_shapes(nx, ny, shapes, symbol, odd, modes, worst)
       integer, intent(in) :: nx, ny
       integer, allocatable, intent(out) :: shapes(:, :)
       real(wp), contiguous, intent(in), optional :: symbol(:), odd(:)
       !> the modes `symbol` holds (default: the whole half spectrum)
       type(held_modes), intent(in), optional :: modes
+      !> where the shapes are chosen by the smoothing factors: the largest factor of the
+      !> halvings taken (worst_smoothing's), else -1
+      real(wp), intent(out), optional :: worst
       integer, allocatable :: chosen(:, :)
       integer :: t, k, mx, my
-      real(wp) :: mu_x, mu_y, mu_both
+      real(wp) :: mu_x, mu_y, mu_both, taken
       logical :: can_x, can_y, can_both
+      if (present(worst)) worst = -1.0_wp
+      taken = 0.0_wp
       k = halvings(nx, ny, coarsest_points)
       allocate (shapes(2, 0:k))
       do t = 0, k
@@ -268,10 +273,13 @@ contains
          if (can_both .and. mu_both <= accepted_smoothing) then
             mx = mx/2
             my = my/2
+            taken = max(taken, mu_both)
          else if (can_x .and. (.not. can_y .or. mu_x <= mu_y)) then
             mx = mx/2
+            taken = max(taken, mu_x)
          else
             my = my/2
+            taken = max(taken, mu_y)
          end if
          chosen = reshape([chosen, mx, my], [2, size(chosen, 2) + 1])
       end do
@@ -279,6 +287,7 @@ contains
       deallocate (shapes)
       allocate (shapes(2, 0:size(chosen, 2) - 1))
       shapes(:, :) = chosen
+      if (present(worst)) worst = taken
    end subroutine coarsening_shapes
 
    !> Whether an axis of m points halves to one of at least shortest_side points.
@@ -352,7 +361,9 @@ contains
       real(wp) :: mu_x, mu_y, mu_both
       logical :: along_x, along_y
       integer :: t
-      call coarsening_shapes(nx, ny, shapes, symbol, odd, modes)
+      ! (the shapes chosen by their smoothing factors come with the worst of them)
+      call coarsening_shapes(nx, ny, shapes, symbol, odd, modes, worst)
+      if (worst >= 0.0_wp) return
       worst = 0.0_wp
       do t = 0, ubound(shapes, 2) - 1
          call smoothing_factors(held(nx, ny, modes), symbol, odd, shapes(1, t), shapes(2, t), mu_x, mu_y, mu_both)
