@@ -935,13 +935,14 @@ contains
    !> The grids of the V-cycle (coarsening_shapes), with their plans and work arrays
    !> (allocated once, for all the nested grids). With `symbol` (a surface's stiffness on the
    !> finest grid's half spectrum, `odd` its imaginary part) a grid may be halved along one
-   !> axis only.
-   subroutine build_hierarchy(h, op, error, symbol, odd, rows)
+   !> axis only. `modes`: the modes `symbol` holds (default: the whole half spectrum).
+   subroutine build_hierarchy(h, op, error, symbol, odd, rows, modes)
       type(hierarchy), intent(out), target :: h
       type(compliance_operator), intent(inout), target :: op
       type(error_type), allocatable, intent(out) :: error
       real(wp), contiguous, intent(in), optional :: symbol(:), odd(:)
       logical, intent(in), optional :: rows
+      type(held_modes), intent(in), optional :: modes
       integer, allocatable :: shapes(:, :)
       integer :: t, m, nx, ny, reach
       nx = op%grid%nx
@@ -950,9 +951,9 @@ contains
       h%surface = ny > 1
       if (present(rows)) h%rows = rows .and. h%surface
       if (h%rows) then
-         call row_shapes(nx, ny, symbol, odd, shapes)
+         call row_shapes(nx, ny, symbol, odd, shapes, modes)
       else
-         call coarsening_shapes(nx, ny, shapes, symbol, odd)
+         call coarsening_shapes(nx, ny, shapes, symbol, odd, modes)
       end if
       h%coarsest = ubound(shapes, 2)
       h%n_fine = nx*ny

@@ -639,18 +639,21 @@ contains
       points = merge(real(op%grid%points(), wp), real(n, wp), global)
       call op%prepare_gcr()
       ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows)
+      ! (the grids' shapes measured on the modes op holds, the symbol then held whole)
       call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+      if (complex_symbol) then
+         call build_hierarchy(h, op, error, symbol, odd, rows=rows, modes=modes_of(op))
+      else
+         call build_hierarchy(h, op, error, symbol, rows=rows, modes=modes_of(op))
+      end if
+      if (allocated(error)) return
       if (global) then
          symbol = whole_symbol(op, symbol)
          if (complex_symbol) odd = whole_symbol(op, odd)
       end if
       if (complex_symbol) then
-         call build_hierarchy(h, op, error, symbol, odd, rows=rows)
-         if (allocated(error)) return
          call set_grid(h, 0, symbol, odd)
       else
-         call build_hierarchy(h, op, error, symbol, rows=rows)
-         if (allocated(error)) return
          call set_grid(h, 0, symbol)
       end if
       ! (GCR takes a preconditioner that is not symmetric: a surface smooths only after the
