@@ -24,7 +24,9 @@ pressure, gap and displacement maps and the heights written, by slabs on several
 (/usr/bin/time's %M), "of serial" each rank's peak over the serial run's, and "doubles/pt"
 each rank's peak over 8 bytes a point of the whole grid, and their sum. Ratios are
 measured within this run. --runs chooses the runs (serial: no launcher; P: mpirun -n P);
-"coarse" is the coarse start's time (the result's coarse_time).
+"set-up" is the result's setup_time (the operator, its plans and the policy's measures of the
+finest grid), "coarse" the coarse start's time (the result's coarse_time), "FFT" the time
+inside the transforms, every grid's, the transposes included (transform_time).
 The FFT pairs come from bench/mpi_fft_pair.c, compiled here with mpicc.
 """
 
@@ -82,9 +84,12 @@ def scene(directory: Path, n: int, kind: str = "coupled", method: str = "auto", 
     return nml
 
 
-def run(ranks: int, nml: Path, program: str) -> tuple[float, float, list[float], str, int, float]:
-    """(solve s, run s, peak RSS MiB of each rank, solver, iterations, coarse start s) of one
-    run of `program`; ranks 0: no launcher."""
+Measured = tuple[float, float, list[float], str, int, float, float, float]
+
+
+def run(ranks: int, nml: Path, program: str) -> Measured:
+    """(solve s, run s, peak RSS MiB of each rank, solver, iterations, coarse start s, set-up s,
+    transforms s) of one run of `program`; ranks 0: no launcher."""
     # (each rank's /usr/bin/time report in a file of its own: rank.N)
     timed = ["sh", "-c", '/usr/bin/time -f "peak_rss_kib %M elapsed %e" -o "rank.${OMPI_COMM_WORLD_RANK:-0}" "$0" "$1"',
              program, str(nml)]
@@ -100,7 +105,9 @@ def run(ranks: int, nml: Path, program: str) -> tuple[float, float, list[float],
     elapsed = max(float(re.search(r"elapsed (\S+)", text).group(1)) for text in reports)
     with h5py.File(nml.parent / f"{nml.stem.split('_')[0]}.h5", "r") as f:
         coarse = float(f["results"].attrs["coarse_time"])
-    return solve, elapsed, peaks, solver, iterations, coarse
+        setup = float(f["results"].attrs["setup_time"])
+        transforms = float(f["results"].attrs["transform_time"])
+    return solve, elapsed, peaks, solver, iterations, coarse, setup, transforms
 
 
 def pairs(n: int) -> None:
@@ -154,10 +161,12 @@ def main() -> None:
                     if best is None or measured[0] < best[0]:
                         rows[(label, ranks, method)] = measured
         print(f"\n{title}, tol 1e-8, one thread per rank" + (", fields written" if args.fields else ""))
-        print(f"{'run':<30}{'solver':<16}{'iterations':>11}{'solve (s)':>10}{'coarse (s)':>11}{'run (s)':>9}"
+        print(f"{'run':<30}{'solver':<16}{'iterations':>11}{'solve (s)':>10}{'set-up (s)':>11}"
+              f"{'coarse (s)':>11}{'FFT (s)':>9}{'run (s)':>9}"
               f"{'serial/this':>13}{'peak RSS/rank (MiB)':>22}{'of serial':>14}{'doubles/pt':>18}")
         points = args.n**2
-        for (label, ranks, method), (solve, elapsed, peaks, solver, iterations, coarse) in rows.items():
+        for (label, ranks, method), measured in rows.items():
+            solve, elapsed, peaks, solver, iterations, coarse, setup, transforms = measured
             serial = rows.get((label, 0, "auto"))
             name = label + ("serial" if ranks == 0 else f"mpirun -n {ranks}")
             if method != "auto":
@@ -169,7 +178,8 @@ def main() -> None:
             per_point = "/".join(f"{d:.1f}" for d in doubles)
             if len(doubles) > 1:
                 per_point += f" ({sum(doubles):.1f})"
-            print(f"{name:<30}{solver:<16}{iterations:>11}{solve:>10.2f}{coarse:>11.2f}{elapsed:>9.2f}{speed:>13}"
+            print(f"{name:<30}{solver:<16}{iterations:>11}{solve:>10.2f}{setup:>11.2f}{coarse:>11.2f}"
+                  f"{transforms:>9.2f}{elapsed:>9.2f}{speed:>13}"
                   f"{rss:>22}{share:>14}{per_point:>18}")
     print(f"load average after: {os.getloadavg()[0]:.1f}")
 

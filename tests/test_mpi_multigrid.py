@@ -96,7 +96,7 @@ def test_the_distributed_multigrid_gives_the_serial_answer(scene, tmp_path):
 @pytest.mark.parametrize("ranks", [2, 3])
 def test_auto_plans_the_multigrid_on_a_shared_surface_as_on_one_process(ranks, tmp_path):
     """The sliding scene that 'auto' sends to the multigrid method on one process (its loss
-    among the short waves, measured on its whole spectra gathered for the measure): on two
+    among the short waves, measured on the ranks' modes over the ranks): on two
     and three ranks 'auto' plans it too, says the finest grid is on the slabs, and gives the
     serial answer (SAME) in the serial run's iterations. (Its transform pairs may differ by a
     few: the coarse start runs on the slabs with its own sums.)"""
@@ -114,6 +114,88 @@ def test_auto_plans_the_multigrid_on_a_shared_surface_as_on_one_process(ranks, t
         reason = f["results"].attrs["solver_reason"].decode()
     assert "loss among the short waves" in reason and "its finest grid on the slabs" in reason, reason
     assert_same(tmp_path / "serial.h5", tmp_path / "ranks.h5")
+
+
+#: a standard linear solid sliding with a moderate loss (E_inf/E0 = 10, V tau/lambda = 0.1,
+#: h/lambda = 0.16, nu = 0.5, mu_c = 0.5): below the loss among the short waves that sends
+#: SLIDING to the multigrid method at 128^2 (the GCR); at 512^2 its coarse start is hard and
+#: the multigrid method smooths it by rows where the GCR is slow (rule 3b, rows_ahead_of_gcr)
+MODERATE = SLIDING.replace("e_inf = 100.0", "e_inf = 10.0")
+#: frictionless incompressible layers (nu = 0.5): h/lambda = 0.05 rises too steeply for the
+#: symmetric multigrid method, which the coupled form's smoothing admits; h/lambda = 0.003
+#: the coupled form refuses too (its worst Jacobi smoothing factor 0.998, above 0.995)
+THIN = "&layer thickness = 0.05, poisson = 0.5 /\n&loading control = 'load', normalised_pressure = 0.15 /\n"
+#: under 'auto': the grid, the scene, the method it takes first serially and what its reason
+#: says of the measures; both sides of each threshold the measures on the slabs decide
+PLANS = {
+    "lossy": (128, SLIDING, "multigrid", "loss among the short waves is"),
+    "moderate loss": (128, MODERATE, "gcr", "a coupled operator"),
+    "rows ahead": (512, MODERATE, "multigrid", "smooths by rows"),
+    "rising": (64, THIN, "cg", "rises too steeply for the symmetric multigrid method"),
+    "refused": (64, THIN.replace("0.05", "0.003"), "cg", "the Jacobi step would smooth with a factor 0.99"),
+    "coupled, rising": (64, THIN + "&friction coefficient = 0.5 /\n", "gcr", "a coupled operator"),
+    "compressible": (64, ELASTIC, "cg", "a symmetric operator: the constrained CG"),
+}
+
+
+def plan(path: Path) -> tuple[str, str]:
+    """The method a run took first and the policy's reason, without what a shared surface adds
+    where the multigrid method runs (where its grids are)."""
+    with h5py.File(path, "r") as f:
+        attrs = f["results"].attrs
+        reason = attrs["solver_reason"].decode()
+        solver = attrs["solver"].decode()
+    for added in (" (its finest grid on the slabs, its coarse grids whole on every rank)",
+                  " (the grid gathered whole onto every rank)"):
+        reason = reason.replace(added, "")
+    return solver.split("+")[0], reason
+
+
+@needs_mpi
+@pytest.mark.parametrize("scene", sorted(PLANS))
+def test_auto_plans_a_shared_surface_as_one_process(scene, tmp_path):
+    """On P = 2, 3, 4 ranks 'auto' takes the serial run's first method for the serial run's
+    reason, word for word: the measures of the slabs (the compliance's rise, the smoothing
+    factors the coupled form admits or refuses, with the numbers the refusal quotes; the loss
+    among the short waves, quoted; whether rows smooth a hard coupled surface), each on the
+    rank's modes and reduced over the ranks, decide as the whole grid's. The scenes lie on
+    both sides of each threshold: the loss 3 among the short waves (lossy, moderate), the
+    rows' rule from 512^2 (rows ahead), the rise 4 and the coupled form's smoothing 0.995
+    (rising, refused), and the plain cases (coupled, compressible). The 512^2 scene runs on
+    2 ranks only (its solve takes seconds a run)."""
+    n, body, first, said = PLANS[scene]
+    body += "&solver tol = 1e-6 /\n"
+    assert run_serial(write_scene(tmp_path, "serial", n, body, "serial.h5")).returncode == 0
+    serial = plan(tmp_path / "serial.h5")
+    assert serial[0] == first and said in serial[1], serial
+    for ranks in (2,) if n > 128 else (2, 3, 4):
+        out = f"ranks{ranks}.h5"
+        nml = write_scene(tmp_path, f"ranks{ranks}", n, body, out)
+        done = run_mpi(ranks, [executable(), str(nml)], tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert plan(tmp_path / out) == serial, (ranks, serial, plan(tmp_path / out))
+
+
+@pytest.fixture(scope="module")
+def policy_program() -> Path:
+    """tests/fortran/test_policy_slabs, built in build/unit when needed."""
+    built, program = build_unit_program("test_policy_slabs")
+    assert built.returncode == 0 and program.exists(), built.stdout[-2000:]
+    return program
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [1, 2, 3, 4])
+def test_the_policy_measures_the_slabs_as_the_whole_grid(ranks, policy_program):
+    """The policy's measures on the slabs against the whole grid's on every rank
+    (tests/fortran/test_policy_slabs.f90): the compliance's rise, the loss profile and its
+    peak, the smoothing factors of the real and the complex symbol, the refusals and the
+    policy's indicators, bit for bit."""
+    done = subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(policy_program)],
+                          capture_output=True, text=True, env=launcher_env(), timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("checks passed") == ranks
+    assert "FAIL" not in done.stdout
 
 
 @needs_mpi

@@ -18,12 +18,13 @@ module lc_base_parallel
 #ifdef LC_MPI
    use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Allgatherv, &
       & MPI_Gatherv, MPI_Scatterv, MPI_Bcast, MPI_Abort, MPI_Initialized, MPI_IN_PLACE, MPI_SUM, MPI_MAX, MPI_MIN, &
-      & MPI_LOR, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_Barrier, MPI_Allgather, MPI_Alltoallv
+      & MPI_LOR, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_Barrier, MPI_Allgather, MPI_Alltoallv, MPI_Exscan
 #endif
    implicit none (type, external)
    private
    public :: parallel_start, parallel_end, is_distributed, rank_count, this_rank, is_root, slab, slab_rows, check_rank_count
    public :: largest_rank_count, global_sum, global_max, sum_over_ranks, max_over_ranks, global_any
+   public :: min_over_lower_ranks, max_over_lower_ranks
    public :: gather_rows, allgather_rows, scatter_rows, redistribute_rows
    public :: broadcast, abort_job, mpi_available, barrier
    public :: broadcast_from, sum_counts_over_ranks, global_maxloc, shifted_rows
@@ -227,6 +228,40 @@ contains
       if (.false.) x = x
 #endif
    end subroutine max_over_ranks
+
+   !> x <- the least of the lower ranks' x, element by element (huge on the first rank):
+   !> what a walk through the ranks in their order has seen before it reaches this one.
+   subroutine min_over_lower_ranks(x)
+      real(wp), contiguous, intent(inout) :: x(:)
+#ifdef LC_MPI
+      real(wp), allocatable :: below(:)
+      if (ranks > 1) then
+         allocate (below(size(x)))
+         call MPI_Exscan(x, below, size(x), MPI_DOUBLE_PRECISION, MPI_MIN, communicator)
+         ! (MPI leaves the first rank's result undefined)
+         if (rank == 0) below = huge(1.0_wp)
+         x = below
+         return
+      end if
+#endif
+      x = huge(1.0_wp)
+   end subroutine min_over_lower_ranks
+
+   !> x <- the largest of the lower ranks' x, element by element (-huge on the first rank).
+   subroutine max_over_lower_ranks(x)
+      real(wp), contiguous, intent(inout) :: x(:)
+#ifdef LC_MPI
+      real(wp), allocatable :: below(:)
+      if (ranks > 1) then
+         allocate (below(size(x)))
+         call MPI_Exscan(x, below, size(x), MPI_DOUBLE_PRECISION, MPI_MAX, communicator)
+         if (rank == 0) below = -huge(1.0_wp)
+         x = below
+         return
+      end if
+#endif
+      x = -huge(1.0_wp)
+   end subroutine max_over_lower_ranks
 
    logical function global_any(x) result(any_rank)
       logical, intent(in) :: x

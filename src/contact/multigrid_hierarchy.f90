@@ -28,7 +28,7 @@ module lc_contact_multigrid_hierarchy
    use lc_fft_plans, only: fft_plan
    use lc_contact_operator, only: compliance_operator, multiply_spectrum, multiply_complex
    use lc_base_threads, only: active_threads, parallel_points, reduction_blocks, block_range
-   use lc_base_parallel, only: global_sum, sum_over_ranks
+   use lc_base_parallel, only: global_sum, sum_over_ranks, global_max, max_over_ranks
    implicit none (type, external)
    private
    interface
@@ -53,6 +53,7 @@ module lc_contact_multigrid_hierarchy
    public :: worst_row_smoothing, solve_rows
    public :: precondition, apply_stiffness, level_operator
    public :: across_ranks, interpolate_onto_slab, sampled_symbol
+   public :: held_modes, modes_of, held_index
 
    !> Damping of the Jacobi steps (nonlinear smoother and V-cycle): below 1 the projected
    !> step lowers the energy monotonically; 2/3 damps the upper half of the spectrum best.
@@ -163,7 +164,51 @@ module lc_contact_multigrid_hierarchy
       integer :: y_start = 0, ny_local = 0
    end type hierarchy
 
+   !> The modes of a finest nx x ny grid's half spectrum that a symbol array holds: all of
+   !> them, kx fastest (a whole grid), or on a surface shared among the ranks this rank's
+   !> columns kx = x_start .. x_start+columns-1 with all ny rows, ky fastest (the distributed
+   !> plan's transposed spectrum: lc_fft_plans' mode_indices). The measures read off such a
+   !> symbol (smoothing_factors, row_smoothing_factor) take each column on the rank that holds
+   !> it and reduce over the ranks: a column's sum is added on its rank and the columns' sums
+   !> in the order of kx on every rank, maxima are exact, so every rank gets the whole grid's
+   !> values to the bit.
+   type :: held_modes
+      integer :: nx = 0, ny = 1
+      integer :: x_start = 0, columns = 0
+      logical :: distributed = .false.
+   end type held_modes
+
 contains
+
+   !> The modes `op` holds of its grid's half spectrum (its rank's columns if distributed).
+   function modes_of(op) result(modes)
+      type(compliance_operator), intent(in) :: op
+      type(held_modes) :: modes
+      modes = whole_modes(op%grid%nx, op%grid%ny)
+      if (.not. op%distributed) return
+      modes%x_start = op%fft%x_start
+      modes%columns = op%fft%nkx_local
+      modes%distributed = .true.
+   end function modes_of
+
+   !> All the modes of the half spectrum of an nx x ny grid (ny = 1: a line), kx fastest.
+   pure function whole_modes(nx, ny) result(modes)
+      integer, intent(in) :: nx, ny
+      type(held_modes) :: modes
+      modes = held_modes(nx=nx, ny=ny, x_start=0, columns=nx/2 + 1, distributed=.false.)
+   end function whole_modes
+
+   !> The index in the held array of the mode (kx, ky), kx one of the held columns, ky any
+   !> integer (periodic).
+   pure integer function held_index(modes, kx, ky) result(i)
+      type(held_modes), intent(in) :: modes
+      integer, intent(in) :: kx, ky
+      if (modes%distributed) then
+         i = (kx - modes%x_start)*modes%ny + modulo(ky, modes%ny) + 1
+      else
+         i = kx + (modes%nx/2 + 1)*modulo(ky, modes%ny) + 1
+      end if
+   end function held_index
 
    !> How many times a grid of nx x ny points (ny = 1: a line) halves along every axis
    !> longer than 1 while the result has at least `smallest` points (and at least
@@ -194,14 +239,21 @@ contains
    !> halving both axes leaves the short waves across it, soft, to a step that barely damps
    !> them. The full coarsening is kept if the other would end on a grid of more than
    !> coarsest_limit points.
-   subroutine coarsening_shapes(nx, ny, shapes, symbol, odd)
+   subroutine coarsening_shapes(nx, ny, shapes, symbol, odd, modes, worst)
       integer, intent(in) :: nx, ny
       integer, allocatable, intent(out) :: shapes(:, :)
       real(wp), contiguous, intent(in), optional :: symbol(:), odd(:)
+      !> the modes `symbol` holds (default: the whole half spectrum)
+      type(held_modes), intent(in), optional :: modes
+      !> where the shapes are chosen by the smoothing factors: the largest factor of the
+      !> halvings taken (worst_smoothing's), else -1
+      real(wp), intent(out), optional :: worst
       integer, allocatable :: chosen(:, :)
       integer :: t, k, mx, my
-      real(wp) :: mu_x, mu_y, mu_both
+      real(wp) :: mu_x, mu_y, mu_both, taken
       logical :: can_x, can_y, can_both
+      if (present(worst)) worst = -1.0_wp
+      taken = 0.0_wp
       k = halvings(nx, ny, coarsest_points)
       allocate (shapes(2, 0:k))
       do t = 0, k
@@ -217,14 +269,17 @@ contains
          can_y = halvable(my) .and. mx*(my/2) >= coarsest_points
          can_both = halvable(mx) .and. halvable(my) .and. (mx/2)*(my/2) >= coarsest_points
          if (.not. (can_x .or. can_y)) exit
-         call smoothing_factors(nx, ny, symbol, odd, mx, my, mu_x, mu_y, mu_both)
+         call smoothing_factors(held(nx, ny, modes), symbol, odd, mx, my, mu_x, mu_y, mu_both)
          if (can_both .and. mu_both <= accepted_smoothing) then
             mx = mx/2
             my = my/2
+            taken = max(taken, mu_both)
          else if (can_x .and. (.not. can_y .or. mu_x <= mu_y)) then
             mx = mx/2
+            taken = max(taken, mu_x)
          else
             my = my/2
+            taken = max(taken, mu_y)
          end if
          chosen = reshape([chosen, mx, my], [2, size(chosen, 2) + 1])
       end do
@@ -232,6 +287,7 @@ contains
       deallocate (shapes)
       allocate (shapes(2, 0:size(chosen, 2) - 1))
       shapes(:, :) = chosen
+      if (present(worst)) worst = taken
    end subroutine coarsening_shapes
 
    !> Whether an axis of m points halves to one of at least shortest_side points.
@@ -250,11 +306,12 @@ contains
    !> damp the waves short across the rows, as a line relaxation does; the 2:1 grids after
    !> it halve both axes (docs/decisions/015-row-smoothing.md, 'What is done', 'Grids with
    !> more rows than points along them').
-   subroutine row_shapes(nx, ny, symbol, odd, shapes)
+   subroutine row_shapes(nx, ny, symbol, odd, shapes, modes)
       integer, intent(in) :: nx, ny
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
       integer, allocatable, intent(out) :: shapes(:, :)
+      type(held_modes), intent(in), optional :: modes
       integer :: mx, my, k
       integer :: chosen(2, 0:64)
       logical :: can_x, can_y, can_both
@@ -273,7 +330,7 @@ contains
          can_y = my > mx .and. halvable(my) .and. mx*(my/2) >= coarsest_points
          can_both = halvable(mx) .and. halvable(my) .and. (mx/2)*(my/2) >= coarsest_points
          if (can_y .and. can_both) &
-            & can_both = row_smoothing_factor(nx, ny, symbol, odd, mx, my, .true.) <= accepted_smoothing
+            & can_both = row_smoothing_factor(held(nx, ny, modes), symbol, odd, mx, my, .true.) <= accepted_smoothing
          if (can_both) then
             mx = mx/2
             my = my/2
@@ -293,19 +350,23 @@ contains
    !> (coarsening_shapes; smoothing_factors for the halving each grid takes), for the
    !> stiffness symbol of the finest nx x ny grid (`odd` its imaginary part): near 1, some
    !> mode that the next grid cannot carry is barely damped.
-   function worst_smoothing(nx, ny, symbol, odd) result(worst)
+   function worst_smoothing(nx, ny, symbol, odd, modes) result(worst)
       integer, intent(in) :: nx, ny
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
+      !> the modes `symbol` holds (default: the whole half spectrum)
+      type(held_modes), intent(in), optional :: modes
       real(wp) :: worst
       integer, allocatable :: shapes(:, :)
       real(wp) :: mu_x, mu_y, mu_both
       logical :: along_x, along_y
       integer :: t
-      call coarsening_shapes(nx, ny, shapes, symbol, odd)
+      ! (the shapes chosen by their smoothing factors come with the worst of them)
+      call coarsening_shapes(nx, ny, shapes, symbol, odd, modes, worst)
+      if (worst >= 0.0_wp) return
       worst = 0.0_wp
       do t = 0, ubound(shapes, 2) - 1
-         call smoothing_factors(nx, ny, symbol, odd, shapes(1, t), shapes(2, t), mu_x, mu_y, mu_both)
+         call smoothing_factors(held(nx, ny, modes), symbol, odd, shapes(1, t), shapes(2, t), mu_x, mu_y, mu_both)
          along_x = shapes(1, t + 1) < shapes(1, t)
          along_y = shapes(2, t + 1) < shapes(2, t)
          if (along_x .and. along_y) then
@@ -321,26 +382,42 @@ contains
    !> The largest smoothing factor of the row smoothing step (solve_rows, damped by omega)
    !> over the grids of row_shapes, for the stiffness symbol of the finest nx x ny surface
    !> (`odd` its imaginary part).
-   function worst_row_smoothing(nx, ny, symbol, odd) result(worst)
+   function worst_row_smoothing(nx, ny, symbol, odd, modes) result(worst)
       integer, intent(in) :: nx, ny
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
+      !> the modes `symbol` holds (default: the whole half spectrum)
+      type(held_modes), intent(in), optional :: modes
       real(wp) :: worst
       integer, allocatable :: shapes(:, :)
       integer :: t
-      call row_shapes(nx, ny, symbol, odd, shapes)
+      call row_shapes(nx, ny, symbol, odd, shapes, modes)
       worst = 0.0_wp
       do t = 0, ubound(shapes, 2) - 1
-         worst = max(worst, row_smoothing_factor(nx, ny, symbol, odd, shapes(1, t), shapes(2, t), &
+         worst = max(worst, row_smoothing_factor(held(nx, ny, modes), symbol, odd, shapes(1, t), shapes(2, t), &
             & shapes(1, t + 1) < shapes(1, t)))
       end do
    end function worst_row_smoothing
 
+   !> `modes` if present, else the whole half spectrum of the nx x ny grid.
+   pure function held(nx, ny, modes)
+      integer, intent(in) :: nx, ny
+      type(held_modes), intent(in), optional :: modes
+      type(held_modes) :: held
+      if (present(modes)) then
+         held = modes
+      else
+         held = whole_modes(nx, ny)
+      end if
+   end function held
+
    !> The smoothing factor of the row step on an mx x my grid for the stiffness symbol of the
    !> finest nx x ny surface read at the grid's modes: the largest |1 - omega K(q)/K_row(kx)|
    !> over the modes the next grid cannot carry (halved along y, and along x if along_x).
-   function row_smoothing_factor(nx, ny, symbol, odd, mx, my, along_x) result(worst)
-      integer, intent(in) :: nx, ny, mx, my
+   !> A column's sum is its own: each rank takes its columns, the largest over the ranks.
+   function row_smoothing_factor(modes, symbol, odd, mx, my, along_x) result(worst)
+      type(held_modes), intent(in) :: modes
+      integer, intent(in) :: mx, my
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
       logical, intent(in) :: along_x
@@ -349,7 +426,7 @@ contains
       integer :: kx, ky
       worst = 0.0_wp
       ! (each column read twice, for its sum and for the factors, rather than stored)
-      do kx = 0, mx/2
+      do kx = modes%x_start, min(mx/2, modes%x_start + modes%columns - 1)
          row = 0.0_wp
          do ky = 0, my - 1
             row = row + stiffness_at(kx, ky)
@@ -361,12 +438,13 @@ contains
                & worst = max(worst, abs(1.0_wp - omega*stiffness_at(kx, ky)*row))
          end do
       end do
+      if (modes%distributed) worst = global_max(worst)
    contains
       !> the finest symbol at the mode (kx, ky) of the current grid
       pure complex(wp) function stiffness_at(kx, ky) result(k)
          integer, intent(in) :: kx, ky
          integer :: i
-         i = mode_index(nx, ny, kx, signed(ky))
+         i = held_index(modes, kx, signed(ky))
          k = symbol(i)
          if (present(odd)) k = cmplx(symbol(i), odd(i), kind=wp)
       end function stiffness_at
@@ -379,43 +457,85 @@ contains
 
    !> The smoothing factors of the damped Jacobi step (its diagonal as set_grid takes it, with
    !> the mean over the half spectrum) on
-   !> an mx x my grid for the stiffness symbol of the finest nx x ny grid read at the coarse
-   !> grid's modes: the largest |1 - omega K(q)/d| over the modes a grid halved along x
-   !> (mu_x), along y (mu_y) or along both (mu_both) does not carry.
-   pure subroutine smoothing_factors(nx, ny, symbol, odd, mx, my, mu_x, mu_y, mu_both)
-      integer, intent(in) :: nx, ny, mx, my
+   !> an mx x my grid for the stiffness symbol of the finest grid (the modes `modes` holds)
+   !> read at the coarse grid's modes: the largest |1 - omega K(q)/d| over the modes a grid
+   !> halved along x (mu_x), along y (mu_y) or along both (mu_both) does not carry. The mean
+   !> is summed column by column, then over the columns in the order of kx: held by several
+   !> ranks, each column's sum is its rank's and the same on any number of ranks.
+   subroutine smoothing_factors(modes, symbol, odd, mx, my, mu_x, mu_y, mu_both)
+      type(held_modes), intent(in) :: modes
+      integer, intent(in) :: mx, my
       real(wp), intent(in) :: symbol(:)
       real(wp), intent(in), optional :: odd(:)
       real(wp), intent(out) :: mu_x, mu_y, mu_both
-      complex(wp) :: stiffness
-      real(wp) :: mean, bound, factor
-      integer :: kx, ky, sy, pass
+      real(wp) :: mean, bound, factors(3)
+      real(wp) :: column(0:mx/2)
+      integer :: kx, ky, sy, pass, last, base
+      last = min(mx/2, modes%x_start + modes%columns - 1)
+      column = 0.0_wp
       mean = 0.0_wp
       bound = 0.0_wp
       mu_x = 0.0_wp
       mu_y = 0.0_wp
       mu_both = 0.0_wp
       do pass = 1, 2
-         do ky = 0, my - 1
-            sy = merge(ky, ky - my, 2*ky <= my)
-            do kx = 0, mx/2
-               stiffness = cmplx(symbol(mode_index(nx, ny, kx, sy)), 0.0_wp, kind=wp)
-               if (present(odd)) stiffness = cmplx(real(stiffness), odd(mode_index(nx, ny, kx, sy)), kind=wp)
-               if (.not. real(stiffness) > 0.0_wp) cycle
-               if (pass == 1) then
-                  mean = mean + real(stiffness)
-                  bound = max(bound, abs(stiffness)**2/(2*real(stiffness)))
-               else
-                  factor = abs(1.0_wp - omega*stiffness/mean)
-                  if (4*kx > mx) mu_x = max(mu_x, factor)
-                  if (4*abs(sy) > my) mu_y = max(mu_y, factor)
-                  if (4*kx > mx .or. 4*abs(sy) > my) mu_both = max(mu_both, factor)
-               end if
+         ! (the modes in the order they are stored: the columns in turn on a slab, the rows
+         ! on a whole grid; a column's sum runs over ky in order either way)
+         if (modes%distributed) then
+            do kx = modes%x_start, last
+               base = (kx - modes%x_start)*modes%ny + 1
+               do ky = 0, my - 1
+                  sy = merge(ky, ky - my, 2*ky <= my)
+                  call take(kx, sy, base + modulo(sy, modes%ny))
+               end do
             end do
-         end do
+         else
+            do ky = 0, my - 1
+               sy = merge(ky, ky - my, 2*ky <= my)
+               base = (modes%nx/2 + 1)*modulo(sy, modes%ny) + 1
+               do kx = 0, last
+                  call take(kx, sy, base + kx)
+               end do
+            end do
+         end if
          ! (the second pass takes the Jacobi diagonal for `mean`)
-         if (pass == 1) mean = max(mean/((mx/2 + 1)*my), jacobi_margin*omega*bound)
+         if (pass == 1) then
+            if (modes%distributed) then
+               call sum_over_ranks(column)
+               bound = global_max(bound)
+            end if
+            do kx = 0, mx/2
+               mean = mean + column(kx)
+            end do
+            mean = max(mean/((mx/2 + 1)*my), jacobi_margin*omega*bound)
+         end if
       end do
+      if (modes%distributed) then
+         factors = [mu_x, mu_y, mu_both]
+         call max_over_ranks(factors)
+         mu_x = factors(1)
+         mu_y = factors(2)
+         mu_both = factors(3)
+      end if
+   contains
+      !> the mode (kx, sy) of the mx x my grid, at index i of the held modes
+      subroutine take(kx, sy, i)
+         integer, intent(in) :: kx, sy, i
+         complex(wp) :: stiffness
+         real(wp) :: factor
+         stiffness = cmplx(symbol(i), 0.0_wp, kind=wp)
+         if (present(odd)) stiffness = cmplx(symbol(i), odd(i), kind=wp)
+         if (.not. real(stiffness) > 0.0_wp) return
+         if (pass == 1) then
+            column(kx) = column(kx) + real(stiffness)
+            bound = max(bound, abs(stiffness)**2/(2*real(stiffness)))
+         else
+            factor = abs(1.0_wp - omega*stiffness/mean)
+            if (4*kx > mx) mu_x = max(mu_x, factor)
+            if (4*abs(sy) > my) mu_y = max(mu_y, factor)
+            if (4*kx > mx .or. 4*abs(sy) > my) mu_both = max(mu_both, factor)
+         end if
+      end subroutine take
    end subroutine smoothing_factors
 
    !> z = B r, B = omega/d I + I P V P^T I: a damped Jacobi step and the coarse correction
@@ -815,13 +935,14 @@ contains
    !> The grids of the V-cycle (coarsening_shapes), with their plans and work arrays
    !> (allocated once, for all the nested grids). With `symbol` (a surface's stiffness on the
    !> finest grid's half spectrum, `odd` its imaginary part) a grid may be halved along one
-   !> axis only.
-   subroutine build_hierarchy(h, op, error, symbol, odd, rows)
+   !> axis only. `modes`: the modes `symbol` holds (default: the whole half spectrum).
+   subroutine build_hierarchy(h, op, error, symbol, odd, rows, modes)
       type(hierarchy), intent(out), target :: h
       type(compliance_operator), intent(inout), target :: op
       type(error_type), allocatable, intent(out) :: error
       real(wp), contiguous, intent(in), optional :: symbol(:), odd(:)
       logical, intent(in), optional :: rows
+      type(held_modes), intent(in), optional :: modes
       integer, allocatable :: shapes(:, :)
       integer :: t, m, nx, ny, reach
       nx = op%grid%nx
@@ -830,9 +951,9 @@ contains
       h%surface = ny > 1
       if (present(rows)) h%rows = rows .and. h%surface
       if (h%rows) then
-         call row_shapes(nx, ny, symbol, odd, shapes)
+         call row_shapes(nx, ny, symbol, odd, shapes, modes)
       else
-         call coarsening_shapes(nx, ny, shapes, symbol, odd)
+         call coarsening_shapes(nx, ny, shapes, symbol, odd, modes)
       end if
       h%coarsest = ubound(shapes, 2)
       h%n_fine = nx*ny

@@ -28,7 +28,7 @@ module lc_contact_policy
    use lc_contact_solver_newton, only: dense_points
    use lc_contact_solver_gfmd, only: gfmd_refusal
    use lc_contact_solver_multigrid, only: multigrid_refusal, metric_refusal, coupled_refusal, rows_ahead_of_gcr, &
-      & loss_among_short_waves, short_loss_limit, whole_spectra, solves_on_slabs
+      & loss_among_short_waves, short_loss_limit, solves_on_slabs
    implicit none (type, external)
    private
    public :: problem_indicators, solve_plan, measure_problem, measure_start, plan_solve, max_stages
@@ -127,15 +127,9 @@ contains
          ind%distributed = .true.
          ind%multigrid_on_slabs = solves_on_slabs(op)
          if (all(trim(method) /= [character(len=9) :: 'auto', 'multigrid'])) return
-         ! (the multigrid's measures read whole spectra: gathered onto every rank for them,
-         ! and freed)
-         block
-            type(compliance_operator) :: whole
-            call whole_spectra(op, whole)
-            call measure_multigrid(ind, whole, load_control)
-         end block
-         return
       end if
+      ! (on a slab each measure takes the rank's modes, reduced over the ranks: the whole
+      ! grid's values, docs/decisions/028-distributed-multigrid.md)
       call measure_multigrid(ind, op, load_control)
    end function measure_problem
 
@@ -167,23 +161,8 @@ contains
       ind%start_contacts = count(p > 0.0_wp)
       if (ind%distributed) ind%start_contacts = global_sum(ind%start_contacts)
       if (trim(ind%method) /= 'auto' .or. len(ind%refusal) > 0) return
-      if (.not. (loss_needed(ind) .or. rows_needed(ind))) return
-      if (ind%distributed) then
-         ! (whole spectra, as measure_problem's)
-         block
-            type(compliance_operator) :: whole
-            call whole_spectra(op, whole)
-            call measure_spectra(whole)
-         end block
-      else
-         call measure_spectra(op)
-      end if
-   contains
-      subroutine measure_spectra(op)
-         type(compliance_operator), intent(in) :: op
-         if (loss_needed(ind)) ind%short_wave_loss = loss_among_short_waves(op)
-         if (rows_needed(ind)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
-      end subroutine measure_spectra
+      if (loss_needed(ind)) ind%short_wave_loss = loss_among_short_waves(op)
+      if (rows_needed(ind)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
    end subroutine measure_start
 
    !> The plan for a problem with indicators `ind` (before the coarse start: the first

@@ -47,21 +47,22 @@ module lc_contact_solver_multigrid
    use lc_base_memory, only: available_bytes
    use lc_base_strings, only: to_string, formatted
    use lc_contact_operator, only: compliance_operator, build_operator
-   use lc_base_parallel, only: allgather_rows, slab, global_sum, global_max, global_any, sum_over_ranks, max_over_ranks
+   use lc_base_parallel, only: allgather_rows, slab, global_sum, global_max, global_any, sum_over_ranks, max_over_ranks, &
+      & min_over_lower_ranks, max_over_lower_ranks
    use lc_base_threads, only: active_threads
    use lc_contact_multigrid_hierarchy, only: hierarchy, omega, jacobi_margin, coarsest_points, coarsest_limit, &
       & build_hierarchy, halvings, level_symbol, set_grid, set_contact, sample, interpolate, precondition, worst_smoothing, &
-      & apply_stiffness, worst_row_smoothing, accepted_smoothing, across_ranks, interpolate_onto_slab, sampled_symbol
+      & apply_stiffness, worst_row_smoothing, accepted_smoothing, across_ranks, interpolate_onto_slab, sampled_symbol, &
+      & held_modes, modes_of, held_index
    use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
    use lc_contact_progress, only: progress_log
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
-   use lc_base_grid, only: grid_type
    implicit none (type, external)
    private
    public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
    public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, whole_operator, solves_on_slabs
-   public :: whole_spectra
+   public :: compliance_rise, loss_profile, loss_of
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -234,9 +235,9 @@ contains
       if (len(reason) == 0) return
       call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
       if (complex_symbol) then
-         worst = worst_smoothing(op%grid%nx, op%grid%ny, symbol, odd)
+         worst = worst_smoothing(op%grid%nx, op%grid%ny, symbol, odd, modes_of(op))
       else
-         worst = worst_smoothing(op%grid%nx, op%grid%ny, symbol)
+         worst = worst_smoothing(op%grid%nx, op%grid%ny, symbol, modes=modes_of(op))
       end if
       if (worst <= coupled_smoothing) then
          reason = ''
@@ -292,20 +293,22 @@ contains
       rows = rows .and. (loss_at_long_waves(op) .or. .not. complex_symbol)
    end function rows_ahead_of_gcr
 
-   !> The rule of row_smoothing for the stiffness symbol (+ i odd) of a grid; `odd` not
-   !> allocated (so absent) for a real symbol.
-   logical function rows_smooth(grid, symbol, odd) result(rows)
-      type(grid_type), intent(in) :: grid
+   !> The rule of row_smoothing for the stiffness symbol (+ i odd) of the grid of `op` on the
+   !> modes op holds (modes_of); `odd` not allocated (so absent) for a real symbol.
+   logical function rows_smooth(op, symbol, odd) result(rows)
+      type(compliance_operator), intent(in) :: op
       real(wp), contiguous, intent(in) :: symbol(:)
       real(wp), contiguous, intent(in), optional :: odd(:)
+      type(held_modes) :: modes
       rows = .false.
-      if (grid%is_line()) return
+      if (op%grid%is_line()) return
+      modes = modes_of(op)
       ! (the rows' factor only where the Jacobi steps smooth poorly: an elastic surface with
       ! friction is decided by the cheaper one; on rows of more than twice as many points as
       ! there are rows, only where they barely smooth: see elongated_row_smoothing)
-      if (worst_smoothing(grid%nx, grid%ny, symbol, odd) <= &
-         & merge(elongated_row_smoothing, row_smoothing, grid%nx > 2*grid%ny)) return
-      rows = worst_row_smoothing(grid%nx, grid%ny, symbol, odd) <= accepted_smoothing
+      if (worst_smoothing(op%grid%nx, op%grid%ny, symbol, odd, modes) <= &
+         & merge(elongated_row_smoothing, row_smoothing, op%grid%nx > 2*op%grid%ny)) return
+      rows = worst_row_smoothing(op%grid%nx, op%grid%ny, symbol, odd, modes) <= accepted_smoothing
    end function rows_smooth
 
    !> The stiffness symbol the coupled method's hierarchy is built on (half spectrum of the
@@ -315,7 +318,8 @@ contains
    !> along x is at most short_loss_limit and the grid is smoothed by rows (rows_smooth);
    !> else the metric's 1/|G_eff| (level_symbol), smoothed by rows only for a larger loss
    !> peaking at the grid's edge or in its top band (see short_loss_limit, top_band_loss).
-   !> rows: whether the grid is smoothed by rows.
+   !> rows: whether the grid is smoothed by rows. A distributed `op`: the symbol on its rank's
+   !> modes (modes_of), the decisions the whole grid's (every measure reduced over the ranks).
    subroutine coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
@@ -345,21 +349,55 @@ contains
          end where
          symbol = real(stiffness)
          odd = aimag(stiffness)
-         rows = rows_smooth(op%grid, symbol, odd)
+         rows = rows_smooth(op, symbol, odd)
          ! (a loss among the short waves: K's hierarchy only where it is smoothed by rows)
          complex_symbol = long .or. rows
          if (complex_symbol) return
          deallocate (symbol, odd)
       end if
-      symbol = level_symbol(op, load_control, op%grid%nx, op%grid%ny)
+      symbol = finest_symbol(op, load_control)
       ! (a large loss peaking at the grid's edge or beyond it, or, if at most top_band_loss,
       ! among the other modes no coarser grid carries; on grids no longer along x than
       ! across: see top_band_loss)
       if (large .and. op%grid%nx <= op%grid%ny) then
          if (2*(loss%peak + 1) >= op%grid%nx .or. &
-            & (4*loss%peak > op%grid%nx .and. loss%short_x <= top_band_loss)) rows = rows_smooth(op%grid, symbol)
+            & (4*loss%peak > op%grid%nx .and. loss%short_x <= top_band_loss)) rows = rows_smooth(op, symbol)
       end if
    end subroutine coupled_symbol
+
+   !> level_symbol of the grid of `op` itself, on the modes op holds: K = 1/M mode by mode (0
+   !> where M = 0, and at the uniform mode under load control).
+   function finest_symbol(op, load_control) result(stiffness)
+      type(compliance_operator), intent(in) :: op
+      logical, intent(in) :: load_control
+      real(wp) :: stiffness(op%nk)
+      type(held_modes) :: modes
+      modes = modes_of(op)
+      where (op%metric > 0.0_wp)
+         stiffness = 1.0_wp/op%metric
+      elsewhere
+         stiffness = 0.0_wp
+      end where
+      ! (the uniform mode: the first of the rank holding the column kx = 0)
+      if (load_control .and. modes%x_start == 0 .and. op%nk > 0) stiffness(1) = 0.0_wp
+   end function finest_symbol
+
+   !> The symbol (`part`: its real or imaginary part) held on the modes of the distributed
+   !> `op`, on the whole half spectrum on every rank: each rank's modes, summed over the ranks
+   !> (each mode is one rank's, so the sum is exact). What the hierarchy is built on.
+   function whole_symbol(op, part) result(whole)
+      type(compliance_operator), intent(in) :: op
+      real(wp), contiguous, intent(in) :: part(:)
+      real(wp), allocatable :: whole(:)
+      integer :: i, mx, my
+      allocate (whole(op%grid%modes()))
+      whole = 0.0_wp
+      do i = 1, op%nk
+         call op%fft%mode_indices(i, mx, my)
+         whole(mx + (op%grid%nx/2 + 1)*my + 1) = part(i)
+      end do
+      call sum_over_ranks(whole)
+   end function whole_symbol
 
    !> TNNMG iterations on the finest grid from u until the fields returned (p, w, gap, s;
    !> returned_fields) meet tol: where they miss it the iteration goes on to a smaller
@@ -415,36 +453,69 @@ contains
    !> (op%metric_falls). Along the axes, not by |q|: a sliding viscoelastic layer is stiffer
    !> along the sliding direction, tenfold between modes of one |q|, which the grids halved
    !> along one axis handle (coarsening_shapes); a rise along an axis is what pointwise
-   !> smoothing cannot.
-   pure real(wp) function compliance_rise(op) result(rise)
+   !> smoothing cannot. A distributed op walks its rank's columns (whole columns), and its
+   !> rows' walks go on from the least compliance of each row on the lower ranks' columns
+   !> (min_over_lower_ranks): the same minima and ratios as one walk of the whole row.
+   real(wp) function compliance_rise(op) result(rise)
       type(compliance_operator), intent(in) :: op
-      integer :: nkx, ny, kx, ky, sign, step
-      real(wp) :: lowest
+      type(held_modes) :: modes
+      real(wp), allocatable :: lowest(:)
+      integer :: nkx, ny, kx, ky, sign, step, last, i
       rise = 1.0_wp
-      if (op%nk < 3) return
+      if (op%grid%modes() < 3) return
+      modes = modes_of(op)
       nkx = op%grid%nx/2 + 1
       ny = op%grid%ny
-      do ky = 0, ny - 1
+      last = modes%x_start + modes%columns - 1
+      ! the rows (kx in order within each row; the walk's least value so far a row each)
+      allocate (lowest(0:ny - 1))
+      if (modes%distributed) then
          lowest = huge(1.0_wp)
-         do kx = 0, nkx - 1
-            call walk(kx + nkx*ky + 1, lowest, rise)
-         end do
-      end do
-      if (ny == 1) return
-      do kx = 0, nkx - 1
-         do sign = -1, 1, 2
-            lowest = huge(1.0_wp)
-            do step = 0, ny/2
-               call walk(kx + nkx*modulo(sign*step, ny) + 1, lowest, rise)
+         do kx = modes%x_start, last
+            do ky = 0, ny - 1
+               i = (kx - modes%x_start)*ny + ky + 1
+               if (.not. (kx == 0 .and. ky == 0) .and. op%metric(i) > 0.0_wp) lowest(ky) = min(lowest(ky), op%metric(i))
             end do
          end do
-      end do
+         call min_over_lower_ranks(lowest)
+         do kx = modes%x_start, last
+            do ky = 0, ny - 1
+               call walk(kx, ky, lowest(ky), rise)
+            end do
+         end do
+      else
+         lowest = huge(1.0_wp)
+         do ky = 0, ny - 1
+            do kx = 0, nkx - 1
+               call walk(kx, ky, lowest(ky), rise)
+            end do
+         end do
+      end if
+      ! the columns, each whole on the rank holding it
+      if (ny > 1) then
+         do kx = modes%x_start, last
+            do sign = -1, 1, 2
+               lowest(0) = huge(1.0_wp)
+               do step = 0, ny/2
+                  call walk(kx, sign*step, lowest(0), rise)
+               end do
+            end do
+         end do
+      end if
+      if (modes%distributed) rise = global_max(rise)
    contains
-      pure subroutine walk(i, lowest, rise)
-         integer, intent(in) :: i
+      pure subroutine walk(kx, ky, lowest, rise)
+         integer, intent(in) :: kx, ky
          real(wp), intent(inout) :: lowest, rise
+         integer :: i
          ! (the uniform mode has no compliance of its own)
-         if (i == 1 .or. .not. op%metric(i) > 0.0_wp) return
+         if (kx == 0 .and. modulo(ky, ny) == 0) return
+         if (modes%distributed) then
+            i = (kx - modes%x_start)*ny + modulo(ky, ny) + 1
+         else
+            i = kx + nkx*modulo(ky, ny) + 1
+         end if
+         if (.not. op%metric(i) > 0.0_wp) return
          lowest = min(lowest, op%metric(i))
          rise = max(rise, op%metric(i)/lowest)
       end subroutine walk
@@ -562,28 +633,27 @@ contains
 
       n = size(p)
       ! (op on a slab of a distributed surface: the iteration's sums and maxima over the
-      ! ranks, points the whole grid's; the symbol of the hierarchy is read off the whole
-      ! spectra, gathered for it and freed: whole_spectra)
+      ! ranks, points the whole grid's; the symbol of the hierarchy chosen on the ranks' modes
+      ! and gathered whole: whole_symbol)
       global = op%distributed
       points = merge(real(op%grid%points(), wp), real(n, wp), global)
       call op%prepare_gcr()
       ! (a surface's grids halved along the axes its symbol needs, or smoothed by rows)
-      if (global) then
-         block
-            type(compliance_operator) :: whole
-            call whole_spectra(op, whole)
-            call coupled_symbol(whole, load_control, symbol, odd, complex_symbol, rows)
-         end block
+      ! (the grids' shapes measured on the modes op holds, the symbol then held whole)
+      call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+      if (complex_symbol) then
+         call build_hierarchy(h, op, error, symbol, odd, rows=rows, modes=modes_of(op))
       else
-         call coupled_symbol(op, load_control, symbol, odd, complex_symbol, rows)
+         call build_hierarchy(h, op, error, symbol, rows=rows, modes=modes_of(op))
+      end if
+      if (allocated(error)) return
+      if (global) then
+         symbol = whole_symbol(op, symbol)
+         if (complex_symbol) odd = whole_symbol(op, odd)
       end if
       if (complex_symbol) then
-         call build_hierarchy(h, op, error, symbol, odd, rows=rows)
-         if (allocated(error)) return
          call set_grid(h, 0, symbol, odd)
       else
-         call build_hierarchy(h, op, error, symbol, rows=rows)
-         if (allocated(error)) return
          call set_grid(h, 0, symbol)
       end if
       ! (GCR takes a preconditioner that is not symmetric: a surface smooths only after the
@@ -821,7 +891,7 @@ contains
    !> short_loss_limit), whose Jacobi steps damp those modes better
    !> (docs/decisions/012-coupled-multigrid.md, 'The hierarchy of K itself where the loss lies
    !> at long waves').
-   pure logical function loss_at_long_waves(op) result(long)
+   logical function loss_at_long_waves(op) result(long)
       type(compliance_operator), intent(in) :: op
       long = .false.
       if (op%coupled) long = at_long_waves(loss_of(op))
@@ -836,24 +906,89 @@ contains
    end function at_long_waves
 
    !> The loss |Im K|/Re K of K = 1/G_eff (= |Im G_eff|/Re G_eff) of the coupled scene of
-   !> `op`, mode by mode, summarised in one pass (loss_profile).
-   pure type(loss_profile) function loss_of(op) result(profile)
+   !> `op`, mode by mode, summarised in one pass (loss_profile) over the half spectrum, row
+   !> by row (kx fastest). The peak is the kx of the last mode whose loss exceeds by 1e-9 the
+   !> largest before it in that order. A distributed op (its rank's columns): each of its
+   !> modes compared with the largest loss before it in the same order, from the whole rows
+   !> before its row and its row's modes on the lower ranks' columns (max_over_lower_ranks);
+   !> the last such mode over the ranks gives the peak, the maxima are exact.
+   type(loss_profile) function loss_of(op) result(profile)
       type(compliance_operator), intent(in) :: op
-      real(wp) :: loss
-      integer :: i, nkx, kx, ky
+      type(held_modes) :: modes
+      real(wp), allocatable :: before(:), rows(:)
+      real(wp) :: loss, summary(4), running
+      integer :: i, nkx, kx, ky, last, position
       nkx = op%grid%nx/2 + 1
-      do i = 2, op%nk
-         if (.not. real(op%full(i)) > 0.0_wp) cycle
-         loss = abs(aimag(op%full(i)))/real(op%full(i))
-         kx = mod(i - 1, nkx)
-         ky = (i - 1)/nkx
-         ky = min(ky, op%grid%ny - ky)
-         if (loss > profile%largest*(1.0_wp + 1.0e-9_wp)) profile%peak = kx
-         profile%largest = max(profile%largest, loss)
-         if (16*kx <= op%grid%nx .and. (op%grid%is_line() .or. 16*ky <= op%grid%ny)) &
+      if (.not. op%distributed) then
+         do i = 2, op%nk
+            if (.not. real(op%full(i)) > 0.0_wp) cycle
+            loss = abs(aimag(op%full(i)))/real(op%full(i))
+            kx = mod(i - 1, nkx)
+            ky = (i - 1)/nkx
+            if (loss > profile%largest*(1.0_wp + 1.0e-9_wp)) profile%peak = kx
+            profile%largest = max(profile%largest, loss)
+            call summarise(kx, ky, loss)
+         end do
+         return
+      end if
+      modes = modes_of(op)
+      last = modes%x_start + modes%columns - 1
+      ! (each row's largest on this rank's columns; then before(ky): the largest before this
+      ! rank's first mode of row ky, in the whole spectrum's order)
+      allocate (rows(0:op%grid%ny - 1), before(0:op%grid%ny - 1))
+      rows = 0.0_wp
+      do kx = modes%x_start, last
+         do ky = 0, op%grid%ny - 1
+            if (loss_at(kx, ky, loss)) rows(ky) = max(rows(ky), loss)
+         end do
+      end do
+      before = rows
+      call max_over_lower_ranks(before)
+      call max_over_ranks(rows)
+      running = 0.0_wp
+      do ky = 0, op%grid%ny - 1
+         before(ky) = max(before(ky), running)
+         running = max(running, rows(ky))
+      end do
+      ! (the last mode, in that order, raising the largest: its position ky nkx + kx)
+      position = -1
+      do kx = modes%x_start, last
+         do ky = 0, op%grid%ny - 1
+            if (.not. loss_at(kx, ky, loss)) cycle
+            if (loss > before(ky)*(1.0_wp + 1.0e-9_wp)) position = max(position, ky*nkx + kx)
+            before(ky) = max(before(ky), loss)
+            call summarise(kx, ky, loss)
+         end do
+      end do
+      summary = [real(position, wp), running, profile%long, profile%short_x]
+      call max_over_ranks(summary)
+      profile%largest = summary(2)
+      profile%long = summary(3)
+      profile%short_x = summary(4)
+      profile%peak = 0
+      if (summary(1) >= 0.0_wp) profile%peak = mod(nint(summary(1)), nkx)
+   contains
+      !> the loss of the held mode (kx, ky), if it has one (Re G_eff > 0; not the uniform mode)
+      logical function loss_at(kx, ky, loss) result(has)
+         integer, intent(in) :: kx, ky
+         real(wp), intent(out) :: loss
+         complex(wp) :: g
+         loss = 0.0_wp
+         g = op%full(held_index(modes, kx, ky))
+         has = .not. (kx == 0 .and. ky == 0) .and. real(g) > 0.0_wp
+         if (has) loss = abs(aimag(g))/real(g)
+      end function loss_at
+
+      !> the long waves' and the short waves' largest
+      subroutine summarise(kx, ky, loss)
+         integer, intent(in) :: kx, ky
+         real(wp), intent(in) :: loss
+         integer :: signed_ky
+         signed_ky = min(ky, op%grid%ny - ky)
+         if (16*kx <= op%grid%nx .and. (op%grid%is_line() .or. 16*signed_ky <= op%grid%ny)) &
             & profile%long = max(profile%long, loss)
          if (16*kx > op%grid%nx) profile%short_x = max(profile%short_x, loss)
-      end do
+      end subroutine summarise
    end function loss_of
 
    !> The largest loss tangent |Im C|/Re C of the layer's material over the grid's sliding
@@ -869,7 +1004,7 @@ contains
 
    !> The largest loss |Im K|/Re K of a coupled scene among its waves short along x
    !> (|kx| > nx/16).
-   pure real(wp) function loss_among_short_waves(op) result(loss)
+   real(wp) function loss_among_short_waves(op) result(loss)
       type(compliance_operator), intent(in) :: op
       type(loss_profile) :: profile
       profile = loss_of(op)
@@ -1437,22 +1572,12 @@ contains
    end function solves_on_slabs
 
    !> Whether the scene of `op` takes the symmetric form (multigrid) rather than the coupled
-   !> one, as solve_by_multigrid decides serially: a distributed operator whose compliance
-   !> does not fall with |q| everywhere is decided on its whole spectra (whole_spectra,
-   !> freed after: rise_refusal reads a whole spectrum).
+   !> one, as solve_by_multigrid decides serially (a distributed operator's refusal measured
+   !> on the ranks' modes, over the ranks).
    logical function symmetric_form(op) result(symmetric)
       type(compliance_operator), intent(in) :: op
       symmetric = .not. (op%coupled .or. op%kernel%viscoelastic)
-      if (.not. symmetric) return
-      if (op%distributed .and. .not. op%metric_falls) then
-         block
-            type(compliance_operator) :: whole
-            call whole_spectra(op, whole)
-            symmetric = len(multigrid_refusal(whole)) == 0
-         end block
-      else
-         symmetric = len(multigrid_refusal(op)) == 0
-      end if
+      if (symmetric) symmetric = len(multigrid_refusal(op)) == 0
    end function symmetric_form
 
    !> multigrid on the slabs of a surface shared among the ranks (op on this rank's slab:
@@ -1600,7 +1725,7 @@ contains
 
    !> The operator of the whole grid of `op` (a slab's, distributed) on this rank alone: the
    !> same grid, layer and friction, and its uniform mode left out where op's is
-   !> (drop_uniform_mode). What the multigrid method and its measures read: whole spectra.
+   !> (drop_uniform_mode): what the gathered multigrid solve (solve_gathered) iterates on.
    subroutine whole_operator(op, whole, error)
       type(compliance_operator), intent(in) :: op
       type(compliance_operator), intent(out) :: whole
@@ -1610,47 +1735,6 @@ contains
       if (allocated(error)) return
       if (op%dropped_uniform /= 0.0_wp) call whole%drop_uniform_mode(uniform)
    end subroutine whole_operator
-
-   !> The spectra of the distributed operator `op` on the whole half spectrum, on every rank
-   !> (each rank's modes, summed over the ranks), in an operator without plans: what the
-   !> multigrid's measures and the symbol of its hierarchy read (multigrid_refusal,
-   !> coupled_refusal, coupled_symbol, loss_among_short_waves, rows_ahead_of_gcr, never a
-   !> transform). The metric, and G_eff where coupled: 1.5 doubles a point of the grid, where
-   !> an operator of the whole grid (whole_operator) holds its plans' buffers besides.
-   subroutine whole_spectra(op, whole)
-      type(compliance_operator), intent(in) :: op
-      type(compliance_operator), intent(out) :: whole
-      real(wp), allocatable :: parts(:)
-      integer :: i, mx, my, k, nk
-      nk = op%grid%modes()
-      whole%grid = op%grid
-      whole%kernel = op%kernel
-      whole%n = op%grid%points()
-      whole%nk = nk
-      whole%friction = op%friction
-      whole%coupled = op%coupled
-      whole%monotone = op%monotone
-      whole%metric_falls = op%metric_falls
-      whole%diagonal = op%diagonal
-      whole%largest = op%largest
-      whole%inv_n = op%inv_n
-      whole%dropped_uniform = op%dropped_uniform
-      whole%compliance = op%compliance
-      allocate (parts(merge(3, 1, op%coupled)*nk))
-      parts = 0.0_wp
-      do i = 1, op%nk
-         call op%fft%mode_indices(i, mx, my)
-         k = mx + (op%grid%nx/2 + 1)*my + 1
-         parts(k) = op%metric(i)
-         if (op%coupled) then
-            parts(nk + k) = real(op%full(i))
-            parts(2*nk + k) = aimag(op%full(i))
-         end if
-      end do
-      call sum_over_ranks(parts)
-      whole%metric = parts(1:nk)
-      if (op%coupled) whole%full = cmplx(parts(nk + 1:2*nk), parts(2*nk + 1:3*nk), kind=wp)
-   end subroutine whole_spectra
 
    pure function multigrid_name(self) result(name)
       class(multigrid_solver), intent(in) :: self
