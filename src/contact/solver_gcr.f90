@@ -31,7 +31,7 @@ module lc_contact_solver_gcr
    use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
-   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range, copy_field, largest_magnitude
    use lc_base_pages, only: advise_huge_pages
    use lc_base_parallel, only: global_sum, global_max, sum_over_ranks, max_over_ranks
    implicit none (type, external)
@@ -167,7 +167,7 @@ contains
       buffer => op%buffer()
       p = max(p, 0.0_wp)
       if (load_control) call normalise(p, mean_pressure, across_ranks)
-      b_max = maxval(abs(b))
+      b_max = largest_magnitude(b)
       if (across_ranks) b_max = global_max(b_max)
       columns = 0
       newest = 0
@@ -176,7 +176,7 @@ contains
       best = huge(1.0_wp)
       best_residual = huge(1.0_wp)
       last_progress = 0
-      p_best = p
+      call copy_field(p, p_best)
       set_changed = .false.
       load_scale = 1.0_wp
 
@@ -203,7 +203,7 @@ contains
          end if
          if (outcome%residual < best_residual) then
             best_residual = outcome%residual
-            p_best = p
+            call copy_field(p, p_best)
          end if
          if (present(progress)) call progress%tick(it, outcome%residual, real(n_contact, wp)/op%grid%points())
          if (outcome%converged .or. it > max_iter) exit
@@ -332,7 +332,7 @@ contains
       ! not converged: return the best iterate, with w = G_eff p afresh (the updated w may
       ! differ from it by a constant, see above, and by the drift of the updates)
       if (.not. outcome%converged) then
-         if (best_residual < outcome%residual) p = p_best
+         if (best_residual < outcome%residual) call copy_field(p_best, p)
          call op%apply_full(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
          call evaluate(p, w, b, 1.0_wp, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
