@@ -98,16 +98,11 @@ contains
       largest = maxval(abs(field))
    end function block_largest
 
-   !> copy_field on a block (a procedure of its own, which vectorises: decisions/022; a
-   !> loop, not glibc's memcpy, whose string moves valgrind counts byte by byte).
+   !> copy_field on a block (a procedure of its own: decisions/022).
    pure subroutine copy_block(source, target)
       real(wp), contiguous, intent(in) :: source(:)
       real(wp), contiguous, intent(out) :: target(:)
-      integer :: j
-      !$omp simd
-      do j = 1, size(source)
-         target(j) = source(j)
-      end do
+      target = source
    end subroutine copy_block
 
    !> fill_field on a block.
