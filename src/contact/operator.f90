@@ -735,11 +735,11 @@ contains
    subroutine apply_real(self, multiplier, p, w)
       class(compliance_operator), intent(inout) :: self
       real(wp), contiguous, intent(in) :: multiplier(:)
-      real(wp), contiguous, intent(in) :: p(:)
-      real(wp), contiguous, intent(out) :: w(:)
-      call copy_field(p, self%fft%real_buffer)
+      real(wp), intent(in) :: p(:)
+      real(wp), intent(out) :: w(:)
+      self%fft%real_buffer = p
       call multiply_in_buffer(self, multiplier)
-      call copy_field(self%fft%real_buffer, w)
+      w = self%fft%real_buffer
    end subroutine apply_real
 
    !> fft%real_buffer <- multiplier * fft%real_buffer.
@@ -755,10 +755,10 @@ contains
    subroutine apply_complex(self, multiplier, p, w)
       class(compliance_operator), intent(inout) :: self
       complex(wp), contiguous, intent(in) :: multiplier(:)
-      real(wp), contiguous, intent(in) :: p(:)
-      real(wp), contiguous, intent(out) :: w(:)
-      call copy_field(p, self%fft%real_buffer)
+      real(wp), intent(in) :: p(:)
+      real(wp), intent(out) :: w(:)
+      self%fft%real_buffer = p
       call multiply_complex_in_buffer(self, multiplier)
-      call copy_field(self%fft%real_buffer, w)
+      w = self%fft%real_buffer
    end subroutine apply_complex
 end module lc_contact_operator

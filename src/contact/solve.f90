@@ -329,11 +329,10 @@ contains
       ! reports the residual without the floor and does not claim convergence.
       associate (p => state%p, w => state%w, gap => state%gap)
          if (across_ranks) then
-            result%gap_resolution = rounding_floor(global_max(largest_magnitude(w)), &
-               & global_max(largest_magnitude(height)), global_max(maxval(p)), op%largest)/g_ref
+            result%gap_resolution = rounding_floor(global_max(largest_magnitude(w)), global_max(maxval(abs(height))), &
+               & global_max(maxval(p)), op%largest)/g_ref
          else
-            result%gap_resolution = rounding_floor(largest_magnitude(w), largest_magnitude(height), maxval(p), &
-               & op%largest)/g_ref
+            result%gap_resolution = rounding_floor(largest_magnitude(w), maxval(abs(height)), maxval(p), op%largest)/g_ref
          end if
          if (result%converged) then
             if (across_ranks) then
