@@ -53,12 +53,12 @@ import time
 
 # MPI_Allreduce calls in one plain GCR iteration with load control, counted in
 # src/contact/solver_gcr.f90 (evaluate: sum_over_ranks, max_over_ranks, field_points,
-# sum_over_ranks, global_max; project_on_set's set_mean; history_products; set_norm;
-# normalised_step; update; scale_to_load's field_points; one fewer where the compiler
-# skips merge's unused field_points). An iteration that lets points
-# in adds reorthonormalise's 3, one after a change of the set history_products,
-# clip_negative, total_pressure and another evaluate (8).
-ALLREDUCES_PER_ITERATION = 11
+# sum_over_ranks, global_max; project_on_set's set_mean; history_products; set_norm's
+# set_mean and its sums (the norm and the step's product); update; scale_to_load's
+# field_points; one fewer where the compiler skips merge's unused field_points). An
+# iteration that lets points in adds reorthonormalise's 3, one after a change of the set
+# history_products, clip_negative, total_pressure and another evaluate (8).
+ALLREDUCES_PER_ITERATION = 10
 
 MIB = 2.0**20
 #: src/contact/solve.f90: a coarse level is solved on the slabs from this many rows a rank,

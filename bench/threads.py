@@ -3,6 +3,7 @@ coupled surface and a 2048² frictionless one, each thread count alternately, in
 
     .venv/bin/python bench/threads.py [--n 2048] [--threads 1 2] [--repeats 2]
     .venv/bin/python bench/threads.py --pairs    # FFT pairs of lines and surfaces only
+    .venv/bin/python bench/threads.py --contention [--n 1024 2048]   # two processes' pairs at once
 
 Scenes: the isotropic self-affine surface of lc.self_affine_surface (H = 0.8, shortest
 wavelength 8 points, rms gradient 0.1, seed 1) on an incompressible layer of
@@ -19,12 +20,20 @@ competes with whatever else runs.
 ``--pairs`` times one FFT pair of lines of 2^14 .. 2^21 points and surfaces of 256² ..
 2048² on 1 and 2 threads instead (the best of 3 rounds, both thread counts twice,
 alternately): what lc_contact_solve's smallest_threaded_line rests on.
+
+``--contention`` times one FFT pair of each grid on one thread in a process alone, then in
+two processes started together (each its own pair, the same grid: what the two cores'
+shared memory bandwidth and caches leave each), and on two threads in one process, in
+rounds alternating the three (the best of each kept): if two processes' pairs take as long
+as one alone, two threads are bounded by the split of the work, not by the memory.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import subprocess
+import sys
 import time
 
 import layercontact as lc
@@ -59,17 +68,51 @@ def pairs_table(threads: list[int]) -> None:
               + f" | {best[threads[0]] / best[threads[-1]]:.2f} |", flush=True)
 
 
+def timed_processes(nx: int, processes: int, rounds: int) -> list[float]:
+    """One pair of an nx x nx grid on one thread in each of `processes` processes started
+    together (each best of `rounds` rounds), seconds."""
+    code = ("import sys; sys.path.insert(0, %r); import threads as t; "
+            "print(min(t.pair_seconds(%d, 1) for _ in range(%d)))") % (os.path.dirname(os.path.abspath(__file__)), nx,
+                                                                    rounds)
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    started = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, env=env)
+               for _ in range(processes)]
+    return [float(p.communicate()[0].split()[-1]) for p in started]
+
+
+def contention_table(sizes: list[int], rounds: int) -> None:
+    """One pair alone, in two processes at once and on two threads (best of `rounds`)."""
+    print("| grid | 1 process, 1 thread (ms) | 2 processes at once, each (ms) | slowdown | 1 process, 2 threads (ms) "
+          "| 2 threads / 1 |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for n in sizes:
+        alone, shared, threaded = [], [], []
+        for _ in range(rounds):
+            alone += timed_processes(n, 1, 3)
+            shared.append(max(timed_processes(n, 2, 3)))
+            threaded.append(pair_seconds(n, 2))
+        print(f"| {n}² | {min(alone) * 1e3:.1f} | {min(shared) * 1e3:.1f} | {min(shared) / min(alone):.2f} "
+              f"| {min(threaded) * 1e3:.1f} | {min(alone) / min(threaded):.2f} |", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=2048)
+    parser.add_argument("--n", type=int, nargs="+", default=[2048],
+                        help="grid size (the first; --contention: each)")
     parser.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--repeats", type=int, default=2, help="solves per scene and thread count (best kept)")
     parser.add_argument("--pairs", action="store_true", help="time FFT pairs of lines and surfaces only")
+    parser.add_argument("--contention", action="store_true",
+                        help="one pair alone, in two single-thread processes at once, on two threads")
     args = parser.parse_args()
-    n = args.n
+    n = args.n[0]
     print(f"load average (1, 5, 15 min) before: {load()}; CPUs of this process: {len(os.sched_getaffinity(0))}")
     if args.pairs:
         pairs_table(args.threads)
+        print(f"load average after: {load()}")
+        return
+    if args.contention:
+        contention_table(args.n, max(args.repeats, 1))
         print(f"load average after: {load()}")
         return
     heights = lc.self_affine_surface(n, 0.8, seed=1, short_wavelength=8 / n)

@@ -10,12 +10,14 @@ module lc_base_threads
 #ifdef LC_OPENMP
    use omp_lib, only: omp_set_num_threads, omp_get_max_threads
 #endif
+   use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_base_strings, only: to_string
    implicit none (type, external)
    private
    public :: openmp_available, job_threads, solve_threads, use_threads, active_threads, most_threads
    public :: parallel_points, reduction_block, reduction_blocks, block_range
+   public :: copy_field, fill_field, largest_magnitude
 
    !> The largest thread count &solver threads accepts.
    integer, parameter :: most_threads = 1024
@@ -48,6 +50,67 @@ contains
       first = (block - 1)*reduction_block + 1
       last = min(block*reduction_block, n)
    end subroutine block_range
+
+   !> target <- source, by blocks on the solve's threads. A copy into a fresh array is its
+   !> first touch too: each thread then zeroes the pages of its own blocks (the kernel's
+   !> page clearing, a sizeable part of a solve's set-up, is shared as the pass is).
+   subroutine copy_field(source, target)
+      real(wp), contiguous, intent(in) :: source(:)
+      real(wp), contiguous, intent(out) :: target(:)
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(source) >= parallel_points)
+      do block = 1, reduction_blocks(size(source))
+         call block_range(block, size(source), first, last)
+         call copy_block(source(first:last), target(first:last))
+      end do
+   end subroutine copy_field
+
+   !> field <- value, by blocks on the solve's threads (the first touch of a fresh field,
+   !> as copy_field).
+   subroutine fill_field(field, value)
+      real(wp), contiguous, intent(out) :: field(:)
+      real(wp), intent(in) :: value
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(field) >= parallel_points)
+      do block = 1, reduction_blocks(size(field))
+         call block_range(block, size(field), first, last)
+         call fill_block(field(first:last), value)
+      end do
+   end subroutine fill_field
+
+   !> max |field| (0 for an empty field), by blocks on the solve's threads: a maximum is
+   !> exact in any order, so the same on any thread count.
+   real(wp) function largest_magnitude(field) result(largest)
+      real(wp), contiguous, intent(in) :: field(:)
+      real(wp) :: maxima(reduction_blocks(size(field)))
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(size(field) >= parallel_points)
+      do block = 1, size(maxima)
+         call block_range(block, size(field), first, last)
+         maxima(block) = block_largest(field(first:last))
+      end do
+      largest = maxval(maxima)
+   end function largest_magnitude
+
+   !> largest_magnitude on a block.
+   pure real(wp) function block_largest(field) result(largest)
+      real(wp), contiguous, intent(in) :: field(:)
+      largest = maxval(abs(field))
+   end function block_largest
+
+   !> copy_field on a block (a procedure of its own: decisions/022).
+   pure subroutine copy_block(source, target)
+      real(wp), contiguous, intent(in) :: source(:)
+      real(wp), contiguous, intent(out) :: target(:)
+      target = source
+   end subroutine copy_block
+
+   !> fill_field on a block.
+   pure subroutine fill_block(field, value)
+      real(wp), contiguous, intent(out) :: field(:)
+      real(wp), intent(in) :: value
+      field = value
+   end subroutine fill_block
 
    !> True if this build runs a solve on several threads (OpenMP and FFTW's threads).
    pure logical function openmp_available()

@@ -26,7 +26,7 @@ module lc_contact_operator
    use lc_fft_plans, only: fft_plan
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
-   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range, copy_field, fill_field
    use lc_base_pages, only: advise_huge_pages
    use lc_base_parallel, only: global_sum, global_max, max_over_ranks, global_any, broadcast
    implicit none (type, external)
@@ -121,10 +121,9 @@ contains
       integer, intent(in) :: threads
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: distributed
-      real(wp) :: qx, qy, q, q_min, q_max, extremes(2)
-      complex(wp) :: g, one_minus_a, one_minus_b, c, t
-      real(wp), allocatable :: factor(:)
-      integer :: i, mx, my, nkx
+      real(wp) :: q_min, q_max, extremes(2)
+      real(wp), allocatable :: factor(:), q_ranges(:, :)
+      integer :: i, mx, nkx, block, first, last
 
       call op%fft%init(grid%nx, grid%ny, threads, error, distributed)
       if (allocated(error)) return
@@ -163,42 +162,26 @@ contains
          if (op%coupled) op%full(1) = op%metric(1)
       end if
 
-      q_min = huge(1.0_wp)
-      q_max = 0.0_wp
-      do i = 1, op%nk
-         call op%fft%mode_indices(i, mx, my)
-         if (mx == 0 .and. my == 0) cycle
-         ! (a whole surface's row my > ny/2 has the q_y of row ny - my negated, and the
-         ! multipliers depend on |q| and q_x alone: mirror_rows copies it, the same bits)
-         if (.not. op%distributed .and. 2*my > grid%ny) cycle
-         call grid%wavevector(my*nkx + mx + 1, qx, qy)
-         q = hypot(qx, qy)
-         q_min = min(q_min, q)
-         q_max = max(q_max, q)
-         call kernel%factors(q, qx, one_minus_a, one_minus_b, c, t)
-         g = 2.0_wp/q*op%compliance(mx + 1)*(one_minus_a - (0.0_wp, 1.0_wp)*friction*c*(qx/q))
-         ! A Nyquist column mode is its own mirror image (q_x = +-pi/dx), so its multiplier is
-         ! the mirror average (G(q_x, q_y) + G(-q_x, q_y))/2 = Re G
-         if (2*mx == grid%nx) g = real(g, wp)
-         op%metric(i) = abs(g)
-         if (op%coupled) op%full(i) = g
+      ! (the modes by blocks on the solve's threads: each mode's multipliers are its own,
+      ! and minima and maxima are exact in any order)
+      allocate (q_ranges(2, reduction_blocks(op%nk)))
+      !$omp parallel do schedule(static) private(first, last) if(op%nk >= parallel_points)
+      do block = 1, size(q_ranges, 2)
+         call block_range(block, op%nk, first, last)
+         call mode_multipliers(op, first, last, q_ranges(:, block))
       end do
+      q_min = minval(q_ranges(1, :))
+      q_max = maxval(q_ranges(2, :))
       if (.not. op%distributed) call mirror_rows(op, nkx)
       allocate (op%preconditioner(op%nk))
       call advise_huge_pages(op%preconditioner)
-      where (op%metric > 0.0_wp)
-         op%preconditioner = 1.0_wp/op%metric
-      elsewhere
-         op%preconditioner = 0.0_wp
-      end where
-      ! (an elastic law has one compliance: the factor is 1)
-      if (kernel%viscoelastic) then
-         factor = (abs(op%compliance)/abs(op%compliance(2)))**preconditioner_exponent
-         do i = 1, op%nk
-            call op%fft%mode_indices(i, mx, my)
-            op%preconditioner(i) = op%preconditioner(i)*factor(mx + 1)
-         end do
-      end if
+      ! (an elastic law has one compliance: no factor)
+      if (kernel%viscoelastic) factor = (abs(op%compliance)/abs(op%compliance(2)))**preconditioner_exponent
+      !$omp parallel do schedule(static) private(first, last) if(op%nk >= parallel_points)
+      do block = 1, reduction_blocks(op%nk)
+         call block_range(block, op%nk, first, last)
+         call preconditioner_block(op, factor, first, last)
+      end do
       ! The solution is unique when the operator is monotone, Re G_eff >= 0 on every mode
       ! (always for elastic layers; not always for viscoelastic ones with friction).
       op%monotone = .true.
@@ -215,26 +198,88 @@ contains
       call derive(op)
    end subroutine build_operator
 
+   !> build_operator's multipliers of the modes first..last (metric, and full where coupled);
+   !> q_range = (the least, the largest |q| among them; huge and 0 if none).
+   subroutine mode_multipliers(op, first, last, q_range)
+      type(compliance_operator), intent(inout) :: op
+      integer, intent(in) :: first, last
+      real(wp), intent(out) :: q_range(2)
+      real(wp) :: qx, qy, q
+      complex(wp) :: g, one_minus_a, one_minus_b, c, t
+      integer :: i, mx, my, nkx
+      nkx = op%grid%nkx()
+      q_range = [huge(1.0_wp), 0.0_wp]
+      do i = first, last
+         call op%fft%mode_indices(i, mx, my)
+         if (mx == 0 .and. my == 0) cycle
+         ! (a whole surface's row my > ny/2 has the q_y of row ny - my negated, and the
+         ! multipliers depend on |q| and q_x alone: mirror_rows copies it, the same bits)
+         if (.not. op%distributed .and. 2*my > op%grid%ny) cycle
+         call op%grid%wavevector(my*nkx + mx + 1, qx, qy)
+         q = hypot(qx, qy)
+         q_range(1) = min(q_range(1), q)
+         q_range(2) = max(q_range(2), q)
+         call op%kernel%factors(q, qx, one_minus_a, one_minus_b, c, t)
+         g = 2.0_wp/q*op%compliance(mx + 1)*(one_minus_a - (0.0_wp, 1.0_wp)*op%friction*c*(qx/q))
+         ! A Nyquist column mode is its own mirror image (q_x = +-pi/dx), so its multiplier is
+         ! the mirror average (G(q_x, q_y) + G(-q_x, q_y))/2 = Re G
+         if (2*mx == op%grid%nx) g = real(g, wp)
+         op%metric(i) = abs(g)
+         if (op%coupled) op%full(i) = g
+      end do
+   end subroutine mode_multipliers
+
+   !> The preconditioner of the modes first..last: 1/M (0 where M = 0), times the
+   !> material's factor of the mode's column where `factor` is allocated (viscoelastic).
+   subroutine preconditioner_block(op, factor, first, last)
+      type(compliance_operator), intent(inout) :: op
+      real(wp), allocatable, intent(in) :: factor(:)
+      integer, intent(in) :: first, last
+      integer :: i, mx, my
+      do i = first, last
+         if (op%metric(i) > 0.0_wp) then
+            op%preconditioner(i) = 1.0_wp/op%metric(i)
+         else
+            op%preconditioner(i) = 0.0_wp
+         end if
+      end do
+      if (.not. allocated(factor)) return
+      do i = first, last
+         call op%fft%mode_indices(i, mx, my)
+         op%preconditioner(i) = op%preconditioner(i)*factor(mx + 1)
+      end do
+   end subroutine preconditioner_block
+
    !> The multipliers of the rows my > ny/2 of a whole surface's half spectrum from the rows
    !> ny - my (q_y negated: |q| and q_x are the same), which build_operator left out: half
    !> the kernel's evaluations on a surface.
    subroutine mirror_rows(op, nkx)
       type(compliance_operator), intent(inout) :: op
       integer, intent(in) :: nkx
-      integer :: my, row, mirror
+      integer :: my
+      !$omp parallel do schedule(static) if(op%nk >= parallel_points)
       do my = op%grid%ny/2 + 1, op%grid%ny - 1
-         row = my*nkx
-         mirror = (op%grid%ny - my)*nkx
-         op%metric(row + 1:row + nkx) = op%metric(mirror + 1:mirror + nkx)
-         if (op%coupled) op%full(row + 1:row + nkx) = op%full(mirror + 1:mirror + nkx)
+         call mirror_row(op, nkx, my)
       end do
    end subroutine mirror_rows
+
+   !> mirror_rows on the row my.
+   subroutine mirror_row(op, nkx, my)
+      type(compliance_operator), intent(inout) :: op
+      integer, intent(in) :: nkx, my
+      integer :: row, mirror
+      row = my*nkx
+      mirror = (op%grid%ny - my)*nkx
+      op%metric(row + 1:row + nkx) = op%metric(mirror + 1:mirror + nkx)
+      if (op%coupled) op%full(row + 1:row + nkx) = op%full(mirror + 1:mirror + nkx)
+   end subroutine mirror_row
 
    !> The quantities derived from the multipliers: diagonal, largest (the real-space column
    !> is made when a CG solve asks for it: prepare_cg).
    subroutine derive(op)
       type(compliance_operator), intent(inout) :: op
-      integer :: n, row, nkx, first, last
+      real(wp), allocatable :: row_sums(:), maxima(:, :)
+      integer :: n, row, nkx, block, first, last
       n = op%grid%points()
       nkx = op%grid%nkx()
       ! (1/n) sum over the whole spectrum, row by row of the half spectrum: modes
@@ -244,19 +289,48 @@ contains
          ! (this rank's columns: every mode twice, less those standing for themselves)
          op%diagonal = global_sum(2*sum(op%metric) - sum(op%metric(op%once)))
       else
+         ! (each row's sum on the solve's threads, the rows' added in order: the same bits
+         ! on any number of threads)
+         allocate (row_sums(op%grid%ny))
+         !$omp parallel do schedule(static) if(op%nk >= parallel_points)
          do row = 1, op%grid%ny
-            first = (row - 1)*nkx + 1
-            last = row*nkx
-            op%diagonal = op%diagonal + (op%metric(first) + 2*sum(op%metric(first + 1:last)) &
-               & - merge(op%metric(last), 0.0_wp, mod(op%grid%nx, 2) == 0))
+            row_sums(row) = row_weighted_sum(op%metric((row - 1)*nkx + 1:row*nkx), mod(op%grid%nx, 2) == 0)
+         end do
+         do row = 1, op%grid%ny
+            op%diagonal = op%diagonal + row_sums(row)
          end do
       end if
       op%diagonal = op%diagonal/n
-      op%largest = maxval(op%metric)
-      if (op%coupled) op%largest = max(op%largest, maxval(abs(op%full)))
+      ! (the largest multipliers by blocks: maxima are exact in any order)
+      allocate (maxima(2, reduction_blocks(op%nk)))
+      !$omp parallel do schedule(static) private(first, last) if(op%nk >= parallel_points)
+      do block = 1, size(maxima, 2)
+         call block_range(block, op%nk, first, last)
+         call largest_multipliers(op, first, last, maxima(:, block))
+      end do
+      op%largest = maxval(maxima(1, :))
+      if (op%coupled) op%largest = max(op%largest, maxval(maxima(2, :)))
       if (op%distributed) op%largest = global_max(op%largest)
       if (allocated(op%column)) deallocate (op%column)
    end subroutine derive
+
+   !> A row of the half spectrum's share of the diagonal: its mode mx = 0 once, the others
+   !> twice, less the Nyquist mode once more (`even`: nx even).
+   pure real(wp) function row_weighted_sum(metric, even) result(total)
+      real(wp), contiguous, intent(in) :: metric(:)
+      logical, intent(in) :: even
+      total = metric(1) + 2*sum(metric(2:)) - merge(metric(size(metric)), 0.0_wp, even)
+   end function row_weighted_sum
+
+   !> derive's maxima on the modes first..last: (max M, max |G_eff| where coupled).
+   subroutine largest_multipliers(op, first, last, maxima)
+      type(compliance_operator), intent(in) :: op
+      integer, intent(in) :: first, last
+      real(wp), intent(out) :: maxima(2)
+      maxima(1) = maxval(op%metric(first:last))
+      maxima(2) = 0.0_wp
+      if (op%coupled) maxima(2) = maxval(abs(op%full(first:last)))
+   end subroutine largest_multipliers
 
    !> Make the real-space column of M that the constrained CG's column updates need.
    subroutine prepare_cg(self)
@@ -265,10 +339,10 @@ contains
       allocate (self%column(self%n))
       call advise_huge_pages(self%column)
       ! (the unit load at the first point, written straight into the transform's buffer)
-      self%fft%real_buffer = 0.0_wp
+      call fill_field(self%fft%real_buffer, 0.0_wp)
       self%fft%real_buffer(1) = 1.0_wp
       call multiply_in_buffer(self, self%metric)
-      self%column = self%fft%real_buffer
+      call copy_field(self%fft%real_buffer, self%column)
    end subroutine prepare_cg
 
    !> Leave the uniform (k = 0) mode out of the operator and return its multiplier (h/M for
@@ -584,16 +658,16 @@ contains
    subroutine prepare_gcr_with(self, g)
       class(compliance_operator), intent(inout) :: self
       complex(wp), contiguous, intent(in) :: g(:)
-      integer :: n
+      integer :: n, block, first, last
       n = self%n
       if (allocated(self%inverse_full)) deallocate (self%inverse_full)
       allocate (self%inverse_full(self%nk))
       call advise_huge_pages(self%inverse_full)
-      where (abs(g) > 0.0_wp)
-         self%inverse_full = 1.0_wp/g
-      elsewhere
-         self%inverse_full = (0.0_wp, 0.0_wp)
-      end where
+      !$omp parallel do schedule(static) private(first, last) if(self%nk >= parallel_points)
+      do block = 1, reduction_blocks(self%nk)
+         call block_range(block, self%nk, first, last)
+         call invert_block(g(first:last), self%inverse_full(first:last))
+      end do
       ! (the unit load at the first point, on the rank holding it, written straight into
       ! the transform's buffer)
       if (.not. self%distributed) then
@@ -603,7 +677,7 @@ contains
          end if
          call unit_load_in_buffer(self)
          call multiply_complex_in_buffer(self, g)
-         self%full_column = self%fft%real_buffer
+         call copy_field(self%fft%real_buffer, self%full_column)
       end if
       call unit_load_in_buffer(self)
       call multiply_complex_in_buffer(self, self%inverse_full)
@@ -612,10 +686,21 @@ contains
       if (self%distributed) call broadcast(self%inverse_diagonal)
    end subroutine prepare_gcr_with
 
+   !> inverse = 1/g (0 where g = 0) on a block of modes.
+   pure subroutine invert_block(g, inverse)
+      complex(wp), contiguous, intent(in) :: g(:)
+      complex(wp), contiguous, intent(out) :: inverse(:)
+      where (abs(g) > 0.0_wp)
+         inverse = 1.0_wp/g
+      elsewhere
+         inverse = (0.0_wp, 0.0_wp)
+      end where
+   end subroutine invert_block
+
    !> fft%real_buffer <- a unit load at the first point of the grid (on the rank holding it).
    subroutine unit_load_in_buffer(self)
       class(compliance_operator), intent(inout) :: self
-      self%fft%real_buffer = 0.0_wp
+      call fill_field(self%fft%real_buffer, 0.0_wp)
       if (self%fft%y_start == 0 .and. self%n > 0) self%fft%real_buffer(1) = 1.0_wp
    end subroutine unit_load_in_buffer
 

@@ -22,7 +22,7 @@ module lc_contact_solve
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
    use lc_contact_operator, only: compliance_operator, build_operator
-   use lc_contact_residual, only: rounding_floor, complementarity_residual
+   use lc_contact_residual, only: rounding_floor, field_residual
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_policy, only: problem_indicators, solve_plan, measure_problem, measure_start, plan_solve, &
       & may_take_multigrid
@@ -32,7 +32,8 @@ module lc_contact_solve
    use lc_base_memory, only: check_memory
    use lc_base_pages, only: advise_huge_pages
    use lc_fft_plans, only: transform_seconds
-   use lc_base_threads, only: solve_threads, use_threads, active_threads
+   use lc_base_threads, only: solve_threads, use_threads, active_threads, fill_field, largest_magnitude, &
+      & parallel_points
    use lc_base_parallel, only: is_distributed, slab, global_sum, global_max, allgather_rows, rank_count, &
       & redistribute_rows
    use lc_base_slab, only: empty_rank
@@ -177,11 +178,12 @@ contains
                & 'allowed: a profile with relief, or mean_pressure', code_input)
             return
          end if
-         state%p = pm
+         ! (the first touch of p's pages on the solve's threads)
+         call fill_field(state%p, pm)
          state%s = 0.0_wp
       else
          pm = 0.0_wp
-         state%p = 0.0_wp
+         call fill_field(state%p, 0.0_wp)
          state%s = scene%penetration - lambda_max
       end if
       call system_clock(finish)
@@ -327,17 +329,17 @@ contains
       ! reports the residual without the floor and does not claim convergence.
       associate (p => state%p, w => state%w, gap => state%gap)
          if (across_ranks) then
-            result%gap_resolution = rounding_floor(global_max(maxval(abs(w))), global_max(maxval(abs(height))), &
+            result%gap_resolution = rounding_floor(global_max(largest_magnitude(w)), global_max(maxval(abs(height))), &
                & global_max(maxval(p)), op%largest)/g_ref
          else
-            result%gap_resolution = rounding_floor(maxval(abs(w)), maxval(abs(height)), maxval(p), op%largest)/g_ref
+            result%gap_resolution = rounding_floor(largest_magnitude(w), maxval(abs(height)), maxval(p), op%largest)/g_ref
          end if
          if (result%converged) then
             if (across_ranks) then
-               plain = global_max(complementarity_residual(p, gap, merge(pm, global_sum(sum(p))/grid%points(), &
+               plain = global_max(field_residual(p, gap, merge(pm, global_sum(sum(p))/grid%points(), &
                   & load_control), g_ref, 0.0_wp))
             else
-               plain = complementarity_residual(p, gap, merge(pm, sum(p)/size(p), load_control), g_ref, 0.0_wp)
+               plain = field_residual(p, gap, merge(pm, sum(p)/size(p), load_control), g_ref, 0.0_wp)
             end if
             if (plain > scene%solver%tol) then
                result%converged = .false.
@@ -497,32 +499,38 @@ contains
       end do
    end subroutine interpolate_from_slabs
 
-   !> The values of f at every second point (along both axes of a surface).
-   pure function restrict(grid, f) result(fc)
+   !> The values of f at every second point (along both axes of a surface; its rows on the
+   !> solve's threads).
+   function restrict(grid, f) result(fc)
       type(grid_type), intent(in) :: grid
-      real(wp), intent(in) :: f(:)
+      real(wp), contiguous, intent(in) :: f(:)
       real(wp), allocatable :: fc(:)
+      integer :: nxc, k
       if (grid%is_line()) then
          fc = f(1:grid%nx:2)
-      else
-         fc = reshape(reshape_grid(f, grid%nx, grid%ny, 2), [grid%points()/4])
+         return
       end if
+      nxc = grid%nx/2
+      allocate (fc(grid%points()/4))
+      !$omp parallel do schedule(static) if(grid%points() >= parallel_points)
+      do k = 1, grid%ny/2
+         call sample_row(f(2*(k - 1)*grid%nx + 1:(2*k - 1)*grid%nx), fc((k - 1)*nxc + 1:k*nxc))
+      end do
    end function restrict
 
-   !> f(nx, ny) sampled at every `step`-th point along both axes.
-   pure function reshape_grid(f, nx, ny, step) result(fc)
-      real(wp), intent(in) :: f(nx, ny)
-      integer, intent(in) :: nx, ny, step
-      real(wp) :: fc(nx/step, ny/step)
-      fc = f(1:nx:step, 1:ny:step)
-   end function reshape_grid
+   !> Every second value of a row (the first, third, ...).
+   pure subroutine sample_row(row, sampled)
+      real(wp), contiguous, intent(in) :: row(:)
+      real(wp), contiguous, intent(out) :: sampled(:)
+      sampled = row(1:size(row):2)
+   end subroutine sample_row
 
    !> f on this grid from fc on the grid of every second point: linear (bilinear on a
    !> surface) interpolation, periodic.
-   pure subroutine interpolate(grid, fc, f)
+   subroutine interpolate(grid, fc, f)
       type(grid_type), intent(in) :: grid
-      real(wp), intent(in) :: fc(:)
-      real(wp), intent(out) :: f(:)
+      real(wp), contiguous, intent(in) :: fc(:)
+      real(wp), contiguous, intent(out) :: f(:)
       integer :: n
       if (grid%is_line()) then
          n = grid%nx
@@ -533,13 +541,47 @@ contains
       end if
    end subroutine interpolate
 
-   pure subroutine interpolate_surface(fc, f, nx, ny)
+   !> The bilinear interpolation of a surface, its rows on the solve's threads: the rows of
+   !> the coarse points along x first (fine rows 1, 3, ...), then the rows between them, the
+   !> mean of their neighbours (periodic).
+   subroutine interpolate_surface(fc, f, nx, ny)
       integer, intent(in) :: nx, ny
-      real(wp), intent(in) :: fc(nx/2, ny/2)
-      real(wp), intent(out) :: f(nx, ny)
-      f(1:nx:2, 1:ny:2) = fc
-      f(2:nx:2, 1:ny:2) = 0.5_wp*(fc + cshift(fc, 1, dim=1))
-      f(:, 2:ny:2) = 0.5_wp*(f(:, 1:ny:2) + cshift(f(:, 1:ny:2), 1, dim=2))
+      real(wp), contiguous, intent(in) :: fc(:)
+      real(wp), contiguous, intent(out) :: f(:)
+      integer :: k, nxc, below, above
+      nxc = nx/2
+      !$omp parallel do schedule(static) if(nx*ny >= parallel_points)
+      do k = 1, ny/2
+         call interpolate_row(fc((k - 1)*nxc + 1:k*nxc), f(2*(k - 1)*nx + 1:(2*k - 1)*nx))
+      end do
+      !$omp parallel do schedule(static) private(below, above) if(nx*ny >= parallel_points)
+      do k = 1, ny/2
+         below = 2*(k - 1)*nx
+         above = modulo(2*k, ny)*nx
+         call mean_row(f(below + 1:below + nx), f(above + 1:above + nx), f(below + nx + 1:below + 2*nx))
+      end do
    end subroutine interpolate_surface
+
+   !> A fine row from a coarse one: the coarse values at the odd points, the mean of their
+   !> neighbours (periodic) between them.
+   pure subroutine interpolate_row(coarse, fine)
+      real(wp), contiguous, intent(in) :: coarse(:)
+      real(wp), contiguous, intent(out) :: fine(:)
+      integer :: i, m
+      m = size(coarse)
+      do i = 1, m - 1
+         fine(2*i - 1) = coarse(i)
+         fine(2*i) = 0.5_wp*(coarse(i) + coarse(i + 1))
+      end do
+      fine(2*m - 1) = coarse(m)
+      fine(2*m) = 0.5_wp*(coarse(m) + coarse(1))
+   end subroutine interpolate_row
+
+   !> between = the mean of the rows below and above it.
+   pure subroutine mean_row(below, above, between)
+      real(wp), contiguous, intent(in) :: below(:), above(:)
+      real(wp), contiguous, intent(out) :: between(:)
+      between = 0.5_wp*(below + above)
+   end subroutine mean_row
 
 end module lc_contact_solve

@@ -20,7 +20,7 @@ module lc_contact_solver_cg
    use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
-   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range, copy_field, fill_field, largest_magnitude
    use lc_base_pages, only: advise_huge_pages
    use lc_contact_residual, only: complementarity_residual, rounding_floor, normalise
    use lc_base_parallel, only: global_sum, global_max, sum_over_ranks, max_over_ranks
@@ -96,7 +96,7 @@ contains
       type(grid_sums) :: sums
       real(wp) :: gnorm, gnorm_old, tau, best, beta, b_max, m_max, load_scale, p_ref, g_floor
       real(wp) :: gt_sum, gz_sum, z_mean, t_sum, t_left, t_shift, denominator
-      integer :: it, n, n_contact, last_progress, since_fresh, n_changed
+      integer :: it, n, n_contact, last_progress, since_fresh, n_changed, block, first, last
       logical :: restart, preconditioned, stale, entered, safeguarded
 
       ! The iteration works on the raw gap d = w - b (kept in `gap`) instead of w: the
@@ -113,7 +113,7 @@ contains
       call advise_huge_pages(t)
       call op%prepare_cg()
       buffer => op%buffer()
-      t = 0.0_wp
+      call fill_field(t, 0.0_wp)
       t_sum = 0.0_wp
       t_left = 0.0_wp
       gnorm_old = 1.0_wp
@@ -135,7 +135,7 @@ contains
       safeguarded = .not. op%metric_falls
       best = huge(1.0_wp)
       last_progress = 0
-      b_max = maxval(abs(b))
+      b_max = largest_magnitude(b)
       if (across_ranks) b_max = global_max(b_max)
       m_max = op%largest
 
@@ -152,7 +152,7 @@ contains
             if (stale .or. since_fresh >= refresh_interval) then
                ! w = M p in the transform's buffer, read there by the state's pass (w itself
                ! is written once, at the end, from d)
-               buffer = p
+               call copy_field(p, buffer)
                call op%metric_in_buffer()
                outcome%fft_pairs = outcome%fft_pairs + 1
                since_fresh = 0
@@ -265,7 +265,12 @@ contains
          end if
       end do
       ! the fields returned (w = M p was computed afresh for the last evaluation)
-      call final_fields(d, b, s, w, gap)
+      ! (by blocks on the solve's threads: the first touch of w too)
+      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
+      do block = 1, reduction_blocks(size(p))
+         call block_range(block, size(p), first, last)
+         call final_fields(gap(first:last), b(first:last), s, w(first:last), gap(first:last))
+      end do
       end associate
    end subroutine constrained_cg
 

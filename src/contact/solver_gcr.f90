@@ -31,7 +31,7 @@ module lc_contact_solver_gcr
    use lc_base_errors, only: error_type
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
-   use lc_base_threads, only: parallel_points, reduction_blocks, block_range
+   use lc_base_threads, only: parallel_points, reduction_blocks, block_range, copy_field, largest_magnitude
    use lc_base_pages, only: advise_huge_pages
    use lc_base_parallel, only: global_sum, global_max, sum_over_ranks, max_over_ranks
    implicit none (type, external)
@@ -147,6 +147,7 @@ contains
       real(wp), allocatable :: dirs(:, :), images(:, :), d(:), coeff(:), p_best(:)
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa, residual_norm2, p_sum
+      real(wp) :: gap_product
       real(wp) :: load_scale
       integer :: it, n, columns, newest, n_contact, n_changed, since_fresh, last_progress
       logical :: stale, entered, set_changed, projected, keep
@@ -167,7 +168,7 @@ contains
       buffer => op%buffer()
       p = max(p, 0.0_wp)
       if (load_control) call normalise(p, mean_pressure, across_ranks)
-      b_max = maxval(abs(b))
+      b_max = largest_magnitude(b)
       if (across_ranks) b_max = global_max(b_max)
       columns = 0
       newest = 0
@@ -176,7 +177,7 @@ contains
       best = huge(1.0_wp)
       best_residual = huge(1.0_wp)
       last_progress = 0
-      p_best = p
+      call copy_field(p, p_best)
       set_changed = .false.
       load_scale = 1.0_wp
 
@@ -203,7 +204,7 @@ contains
          end if
          if (outcome%residual < best_residual) then
             best_residual = outcome%residual
-            p_best = p
+            call copy_field(p, p_best)
          end if
          if (present(progress)) call progress%tick(it, outcome%residual, real(n_contact, wp)/op%grid%points())
          if (outcome%converged .or. it > max_iter) exit
@@ -266,7 +267,7 @@ contains
             call history_products(images(:, 1:columns), p, buffer, coeff(1:columns))
             call subtract_history(dirs(:, 1:columns), images(:, 1:columns), coeff(1:columns), d, buffer)
          end if
-         call set_norm(p, load_control, buffer, centre, norm)
+         call set_norm(p, load_control, buffer, gap, centre, norm, gap_product)
          ! (the stored images are orthonormal on the set: Pythagoras gives the norm before)
          norm_before = sqrt(norm**2 + sum(coeff(1:columns)**2))
          if (.not. norm_before > 0.0_wp) then
@@ -293,15 +294,16 @@ contains
             newest = 0
             cycle
          end if
-         ! the minimal-residual step: alpha = (r, u) for the unit image u; r = -gap on the set
-         ! (the normalised direction and image go straight into the history)
+         ! the minimal-residual step: alpha = (r, u) for the unit image u = (a - centre)/norm;
+         ! r = -gap on the set (the update normalises the direction and image, straight into
+         ! the history, in its pass)
          newest = mod(newest, memory) + 1
          columns = min(columns + 1, memory)
-         call normalised_step(p, gap, centre, norm, d, buffer, dirs(:, newest), images(:, newest), alpha)
+         alpha = -gap_product/norm
          ! the coefficient of the preconditioned residual in the step, for letting points in
          step = alpha/norm
-         call update(p, w, gap, dirs(:, newest), images(:, newest), alpha, step*kappa, buffer, n_changed, &
-            & n_clipped, entered, p_sum)
+         call update(p, w, gap, d, buffer, centre, 1.0_wp/norm, alpha, step*kappa, dirs(:, newest), &
+            & images(:, newest), n_changed, n_clipped, entered, p_sum)
          if (n_changed > column_updates .or. (n_changed > 0 .and. op%distributed)) then
             ! (a distributed operator has no real-space column: w is made afresh)
             stale = .true.
@@ -332,7 +334,7 @@ contains
       ! not converged: return the best iterate, with w = G_eff p afresh (the updated w may
       ! differ from it by a constant, see above, and by the drift of the updates)
       if (.not. outcome%converged) then
-         if (best_residual < outcome%residual) p = p_best
+         if (best_residual < outcome%residual) call copy_field(p_best, p)
          call op%apply_full(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
          call evaluate(p, w, b, 1.0_wp, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
@@ -543,41 +545,45 @@ contains
       end do
    end subroutine project_block
 
-   !> The mean of v over the contact set (`centre`, 0 without load control) and the norm of
-   !> v - centre on the set.
-   subroutine set_norm(p, load_control, v, centre, norm)
-      real(wp), contiguous, intent(in) :: p(:), v(:)
+   !> The mean of v over the contact set (`centre`, 0 without load control), the norm of
+   !> v - centre on the set, and gap_product = the sum of gap (v - centre) over the set (in
+   !> the same pass: the minimal-residual step along v's direction).
+   subroutine set_norm(p, load_control, v, gap, centre, norm, gap_product)
+      real(wp), contiguous, intent(in) :: p(:), v(:), gap(:)
       logical, intent(in) :: load_control
-      real(wp), intent(out) :: centre, norm
-      real(wp) :: sums(reduction_blocks(size(p)))
+      real(wp), intent(out) :: centre, norm, gap_product
+      real(wp) :: sums(2, reduction_blocks(size(p))), totals(2)
       integer :: block, first, last
       centre = set_mean(p, load_control, v)
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
-      do block = 1, size(sums)
+      do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         sums(block) = centred_squares(p(first:last), v(first:last), centre)
+         call centred_squares(p(first:last), v(first:last), gap(first:last), centre, sums(:, block))
       end do
-      if (across_ranks) then
-         norm = sqrt(global_sum(sum(sums)))
-      else
-         norm = sqrt(sum(sums))
-      end if
+      totals = [sum(sums(1, :)), sum(sums(2, :))]
+      if (across_ranks) call sum_over_ranks(totals)
+      norm = sqrt(totals(1))
+      gap_product = totals(2)
    end subroutine set_norm
 
-   !> On a block: the sum of (v - centre)^2 over the contact set.
-   real(wp) function centred_squares(p, v, centre) result(v2_sum)
-      real(wp), contiguous, intent(in) :: p(:), v(:)
+   !> On a block: sums = (the sum of (v - centre)^2, of gap (v - centre)) over the contact set.
+   subroutine centred_squares(p, v, gap, centre, sums)
+      real(wp), contiguous, intent(in) :: p(:), v(:), gap(:)
       real(wp), intent(in) :: centre
-      real(wp) :: inside, x
+      real(wp), intent(out) :: sums(2)
+      real(wp) :: inside, x, v2_sum, gv_sum
       integer :: j
       v2_sum = 0.0_wp
-      !$omp simd reduction(+:v2_sum) private(inside, x)
+      gv_sum = 0.0_wp
+      !$omp simd reduction(+:v2_sum, gv_sum) private(inside, x)
       do j = 1, size(p)
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
          x = (v(j) - centre)*inside
          v2_sum = v2_sum + x*x
+         gv_sum = gv_sum + gap(j)*x
       end do
-   end function centred_squares
+      sums = [v2_sum, gv_sum]
+   end subroutine centred_squares
 
    !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
    !> (The stored images are centred on the set, so the mean of a need not be removed.)
@@ -654,52 +660,19 @@ contains
       end do
    end subroutine subtract_block
 
-   !> The direction d scaled by 1/norm, and its image a centred (whole grid) and scaled alike,
-   !> into d_unit and a_unit; alpha = (-gap, a_unit) on the contact set: the step along
-   !> d_unit that minimises the residual on the set.
-   subroutine normalised_step(p, gap, centre, norm, d, a, d_unit, a_unit, alpha)
-      real(wp), contiguous, intent(in) :: p(:), gap(:), d(:), a(:)
-      real(wp), intent(in) :: centre, norm
-      real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
-      real(wp), intent(out) :: alpha
-      real(wp) :: sums(reduction_blocks(size(p)))
-      integer :: block, first, last
-      !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
-      do block = 1, size(sums)
-         call block_range(block, size(p), first, last)
-         sums(block) = scaled_step(p(first:last), gap(first:last), centre, 1.0_wp/norm, d(first:last), &
-            & a(first:last), d_unit(first:last), a_unit(first:last))
-      end do
-      alpha = sum(sums)
-      if (across_ranks) alpha = global_sum(alpha)
-   end subroutine normalised_step
-
-   !> normalised_step on a block: d_unit, a_unit and the block's part of alpha.
-   real(wp) function scaled_step(p, gap, centre, scale, d, a, d_unit, a_unit) result(alpha)
-      real(wp), contiguous, intent(in) :: p(:), gap(:), d(:), a(:)
-      real(wp), intent(in) :: centre, scale
-      real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
-      real(wp) :: inside
-      integer :: j
-      alpha = 0.0_wp
-      !$omp simd reduction(+:alpha) private(inside)
-      do j = 1, size(p)
-         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         d_unit(j) = d(j)*scale
-         a_unit(j) = (a(j) - centre)*scale
-         alpha = alpha - gap(j)*a_unit(j)*inside
-      end do
-   end function scaled_step
-
-   !> One pass: p <- p + alpha d and w <- w + alpha a; points out of contact with a negative
-   !> gap are let in with -let_in_scale gap (Polonsky & Keer's rule: the preconditioned step
-   !> there), negative pressures clipped. delta: the change of p that was not along d
-   !> (nonzero at the points clipped or let in), for the column updates of w; p_sum: sum p.
-   subroutine update(p, w, gap, d, a, alpha, let_in_scale, delta, n_changed, n_clipped, entered, p_sum)
+   !> One pass: the direction d and its image a normalised, d_unit = scale d and a_unit =
+   !> scale (a - centre) (into the history), p <- p + alpha d_unit and w <- w + alpha a_unit;
+   !> points out of contact with a negative gap are let in with -let_in_scale gap (Polonsky &
+   !> Keer's rule: the preconditioned step there), negative pressures clipped. a_delta: in,
+   !> the image a; out, the change of p that was not along d (nonzero at the points clipped
+   !> or let in), for the column updates of w; p_sum: sum p.
+   subroutine update(p, w, gap, d, a_delta, centre, scale, alpha, let_in_scale, d_unit, a_unit, n_changed, &
+         & n_clipped, entered, p_sum)
       real(wp), contiguous, intent(inout) :: p(:), w(:)
-      real(wp), contiguous, intent(in) :: gap(:), d(:), a(:)
-      real(wp), intent(in) :: alpha, let_in_scale
-      real(wp), contiguous, intent(out) :: delta(:)
+      real(wp), contiguous, intent(in) :: gap(:), d(:)
+      real(wp), contiguous, intent(inout) :: a_delta(:)
+      real(wp), intent(in) :: centre, scale, alpha, let_in_scale
+      real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
       integer, intent(out) :: n_changed
       integer, intent(out) :: n_clipped
       logical, intent(out) :: entered
@@ -710,8 +683,8 @@ contains
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         call update_block(p(first:last), w(first:last), gap(first:last), d(first:last), a(first:last), alpha, &
-            & let_in_scale, delta(first:last), sums(:, block))
+         call update_block(p(first:last), w(first:last), gap(first:last), d(first:last), a_delta(first:last), &
+            & centre, scale, alpha, let_in_scale, d_unit(first:last), a_unit(first:last), sums(:, block))
       end do
       ! (the counts are exact in any order; the sum of p added block by block in order)
       clip_count = sum(sums(1, :))
@@ -732,29 +705,34 @@ contains
    end subroutine update
 
    !> update on a block; sums = (points clipped, let in, changed, sum of the new p).
-   subroutine update_block(p, w, gap, d, a, alpha, let_in_scale, delta, sums)
+   subroutine update_block(p, w, gap, d, a_delta, centre, scale, alpha, let_in_scale, d_unit, a_unit, sums)
       real(wp), contiguous, intent(inout) :: p(:), w(:)
-      real(wp), contiguous, intent(in) :: gap(:), d(:), a(:)
-      real(wp), intent(in) :: alpha, let_in_scale
-      real(wp), contiguous, intent(out) :: delta(:)
+      real(wp), contiguous, intent(in) :: gap(:), d(:)
+      real(wp), contiguous, intent(inout) :: a_delta(:)
+      real(wp), intent(in) :: centre, scale, alpha, let_in_scale
+      real(wp), contiguous, intent(out) :: d_unit(:), a_unit(:)
       real(wp), intent(out) :: sums(4)
-      real(wp) :: trial, p_new, c, clip_count, enter_count, changed_count, p_sum
+      real(wp) :: trial, p_new, c, du, au, clip_count, enter_count, changed_count, p_sum
       integer :: j
       clip_count = 0.0_wp
       enter_count = 0.0_wp
       changed_count = 0.0_wp
       p_sum = 0.0_wp
-      !$omp simd reduction(+:clip_count, enter_count, changed_count, p_sum) private(trial, p_new, c)
+      !$omp simd reduction(+:clip_count, enter_count, changed_count, p_sum) private(trial, p_new, c, du, au)
       do j = 1, size(p)
-         trial = p(j) + alpha*d(j)   ! (d = 0 off the contact set)
+         du = d(j)*scale
+         au = (a_delta(j) - centre)*scale
+         d_unit(j) = du
+         a_unit(j) = au
+         trial = p(j) + alpha*du   ! (d = 0 off the contact set)
          ! let in: out of contact (p = 0) and overlapping
          c = merge(1.0_wp, 0.0_wp, p(j) <= 0.0_wp)*merge(1.0_wp, 0.0_wp, gap(j) < 0.0_wp)
          p_new = c*max(-let_in_scale*gap(j), 0.0_wp) + (1.0_wp - c)*trial
          enter_count = enter_count + c*merge(1.0_wp, 0.0_wp, p_new > 0.0_wp)
          clip_count = clip_count + merge(1.0_wp, 0.0_wp, p_new < 0.0_wp)
          p_new = merge(p_new, 0.0_wp, p_new >= 0.0_wp)   ! clip (a NaN too)
-         w(j) = w(j) + alpha*a(j)
-         delta(j) = p_new - trial
+         w(j) = w(j) + alpha*au
+         a_delta(j) = p_new - trial
          changed_count = changed_count + merge(1.0_wp, 0.0_wp, p_new /= trial)
          p(j) = p_new
          p_sum = p_sum + p_new

@@ -27,6 +27,7 @@ module lc_fft_plans
    use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_base_strings, only: to_string
    use lc_base_pages, only: advise_huge_pages
+   use lc_base_threads, only: fill_field
    use lc_base_parallel, only: is_distributed, slab
 #ifdef LC_MPI
    use lc_base_parallel, only: communicator
@@ -141,7 +142,8 @@ contains
       call c_f_pointer(self%complex_memory, self%spectrum, [self%nk])
       call advise_huge_pages(self%real_buffer)
       call advise_huge_pages(self%spectrum)
-      self%real_buffer = 0.0_wp
+      ! (the first touch on the solve's threads, each its blocks' pages)
+      call fill_field(self%real_buffer, 0.0_wp)
       ! FFTW's dimensions are in C order: the last one (x) is contiguous
       if (ny == 1) then
          self%r2c = fftw_plan_dft_r2c_1d(int(nx, c_int), self%real_buffer, self%spectrum, FFTW_ESTIMATE)
