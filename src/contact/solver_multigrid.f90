@@ -1655,14 +1655,10 @@ contains
       type(compliance_operator), intent(in) :: op
       logical, intent(in) :: load_control
       real(wp), allocatable :: stiffness(:)
-      integer :: i, mx, my
-      allocate (stiffness(op%grid%modes()))
-      stiffness = 0.0_wp
-      do i = 1, op%nk
-         call op%fft%mode_indices(i, mx, my)
-         if (op%metric(i) > 0.0_wp) stiffness(mx + (op%grid%nx/2 + 1)*my + 1) = 1.0_wp/op%metric(i)
-      end do
-      call sum_over_ranks(stiffness)
+      real(wp), allocatable :: held(:)
+      allocate (held(op%nk), source=0.0_wp)
+      where (op%metric(1:op%nk) > 0.0_wp) held = 1.0_wp/op%metric(1:op%nk)
+      stiffness = whole_symbol(op, held)
       if (load_control) stiffness(1) = 0.0_wp
    end function whole_stiffness
 
