@@ -147,10 +147,13 @@ contains
       real(wp), allocatable :: dirs(:, :), images(:, :), d(:), coeff(:), p_best(:)
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa, residual_norm2, p_sum
-      real(wp) :: gap_product
+      real(wp) :: gap_product, image_sum
       real(wp) :: load_scale
       integer :: it, n, columns, newest, n_contact, n_changed, since_fresh, last_progress
       logical :: stale, entered, set_changed, projected, keep
+      !> p is the best iterate and p_best not yet a copy of it: the copy is taken by the next
+      !> pass that changes p (the update's, as it reads p), not in a pass of its own
+      logical :: best_pending
       integer :: n_clipped, n_negative
 
       across_ranks = op%distributed
@@ -177,7 +180,7 @@ contains
       best = huge(1.0_wp)
       best_residual = huge(1.0_wp)
       last_progress = 0
-      call copy_field(p, p_best)
+      best_pending = .false.
       set_changed = .false.
       load_scale = 1.0_wp
 
@@ -204,7 +207,7 @@ contains
          end if
          if (outcome%residual < best_residual) then
             best_residual = outcome%residual
-            call copy_field(p, p_best)
+            best_pending = .true.
          end if
          if (present(progress)) call progress%tick(it, outcome%residual, real(n_contact, wp)/op%grid%points())
          if (outcome%converged .or. it > max_iter) exit
@@ -217,6 +220,7 @@ contains
 
          if (n_contact == 0) then
             ! displacement control with nothing in contact yet: load the overlapping points
+            call keep_best()
             call let_in_overlaps(p, gap, 1.0_wp/op%diagonal, n_changed)
             if (n_changed == 0) exit
             columns = 0
@@ -230,6 +234,7 @@ contains
             ! along them by coeff = (r, u_i) (r = -gap on the set, in the buffer); pressures
             ! it makes negative are clipped (and the history dropped then); state again
             set_changed = .false.
+            call keep_best()
             call history_products(images(:, 1:columns), p, buffer, coeff(1:columns))
             call subtract_history(dirs(:, 1:columns), images(:, 1:columns), -coeff(1:columns), p, w)
             call clip_negative(p, d, n_negative)
@@ -264,15 +269,22 @@ contains
          outcome%fft_pairs = outcome%fft_pairs + 1
          coeff = 0.0_wp
          if (columns > 0) then
+            ! (the subtraction's pass sums the new image over the set too: its centre)
             call history_products(images(:, 1:columns), p, buffer, coeff(1:columns))
-            call subtract_history(dirs(:, 1:columns), images(:, 1:columns), coeff(1:columns), d, buffer)
+            call subtract_history(dirs(:, 1:columns), images(:, 1:columns), coeff(1:columns), d, buffer, p, &
+               & image_sum)
+            centre = 0.0_wp
+            if (load_control) centre = image_sum/max(real(n_contact, wp), 1.0_wp)
+         else
+            centre = set_mean(p, load_control, buffer)
          end if
-         call set_norm(p, load_control, buffer, gap, centre, norm, gap_product)
+         call set_norm(p, buffer, gap, centre, norm, gap_product)
          ! (the stored images are orthonormal on the set: Pythagoras gives the norm before)
          norm_before = sqrt(norm**2 + sum(coeff(1:columns)**2))
          if (.not. norm_before > 0.0_wp) then
             ! no direction on the set (e.g. one point in contact under load control: its gap
             ! is s exactly): let the overlapping points in and start afresh
+            call keep_best()
             call let_in_overlaps(p, gap, 1.0_wp/op%diagonal, n_changed)
             if (n_changed == 0) then
                ! (after a projection step, which may have left just this point and solved
@@ -303,7 +315,8 @@ contains
          ! the coefficient of the preconditioned residual in the step, for letting points in
          step = alpha/norm
          call update(p, w, gap, d, buffer, centre, 1.0_wp/norm, alpha, step*kappa, dirs(:, newest), &
-            & images(:, newest), n_changed, n_clipped, entered, p_sum)
+            & images(:, newest), n_changed, n_clipped, entered, p_sum, best_pending, p_best)
+         best_pending = .false.
          if (n_changed > column_updates .or. (n_changed > 0 .and. op%distributed)) then
             ! (a distributed operator has no real-space column: w is made afresh)
             stale = .true.
@@ -334,12 +347,22 @@ contains
       ! not converged: return the best iterate, with w = G_eff p afresh (the updated w may
       ! differ from it by a constant, see above, and by the drift of the updates)
       if (.not. outcome%converged) then
-         if (best_residual < outcome%residual) call copy_field(p_best, p)
+         ! (p itself where it was not changed since it was the best: a refreshed w may have
+         ! moved its residual)
+         if (best_residual < outcome%residual .and. .not. best_pending) call copy_field(p_best, p)
          call op%apply_full(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
          call evaluate(p, w, b, 1.0_wp, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
             & n_contact, outcome%residual, residual_norm2, buffer)
       end if
+
+   contains
+
+      !> p_best <- p where p is the best iterate not yet copied, before p changes.
+      subroutine keep_best()
+         if (best_pending) call copy_field(p, p_best)
+         best_pending = .false.
+      end subroutine keep_best
    end subroutine constrained_gcr
 
    !> sum p (over the ranks, across_ranks).
@@ -545,16 +568,15 @@ contains
       end do
    end subroutine project_block
 
-   !> The mean of v over the contact set (`centre`, 0 without load control), the norm of
-   !> v - centre on the set, and gap_product = the sum of gap (v - centre) over the set (in
+   !> The norm of v - centre on the contact set (`centre`: v's mean there under load
+   !> control, 0 otherwise), and gap_product = the sum of gap (v - centre) over the set (in
    !> the same pass: the minimal-residual step along v's direction).
-   subroutine set_norm(p, load_control, v, gap, centre, norm, gap_product)
+   subroutine set_norm(p, v, gap, centre, norm, gap_product)
       real(wp), contiguous, intent(in) :: p(:), v(:), gap(:)
-      logical, intent(in) :: load_control
-      real(wp), intent(out) :: centre, norm, gap_product
+      real(wp), intent(in) :: centre
+      real(wp), intent(out) :: norm, gap_product
       real(wp) :: sums(2, reduction_blocks(size(p))), totals(2)
       integer :: block, first, last
-      centre = set_mean(p, load_control, v)
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
@@ -631,17 +653,31 @@ contains
       end do
    end subroutine block_products
 
-   !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks.
-   subroutine subtract_history(dirs, images, coeff, d, a)
+   !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks;
+   !> with p, set_sum = the sum of the new a over the contact set (p > 0), taken while each
+   !> block is in the cache (blocks added in order: the same bits on any number of threads).
+   subroutine subtract_history(dirs, images, coeff, d, a, p, set_sum)
       real(wp), contiguous, intent(in) :: dirs(:, :), images(:, :)
       real(wp), intent(in) :: coeff(:)
       real(wp), contiguous, intent(inout) :: d(:), a(:)
-      integer :: i0, i1
-      !$omp parallel do schedule(static) private(i1) if(size(a) >= parallel_points)
-      do i0 = 1, size(a), block_rows
+      real(wp), contiguous, intent(in), optional :: p(:)
+      real(wp), intent(out), optional :: set_sum
+      real(wp), allocatable :: partial(:)
+      integer :: i0, i1, block
+      allocate (partial((size(a) + block_rows - 1)/block_rows))
+      !$omp parallel do schedule(static) private(i0, i1) if(size(a) >= parallel_points)
+      do block = 1, size(partial)
+         i0 = (block - 1)*block_rows + 1
          i1 = min(size(a), i0 + block_rows - 1)
          call subtract_block(dirs, images, coeff, i0, i1, d, a)
+         if (present(p)) call block_set_sum(p, a, i0, i1, partial(block))
       end do
+      if (.not. present(set_sum)) return
+      set_sum = 0.0_wp
+      do block = 1, size(partial)
+         set_sum = set_sum + partial(block)
+      end do
+      if (across_ranks) set_sum = global_sum(set_sum)
    end subroutine subtract_history
 
    !> subtract_history on the rows i0..i1.
@@ -660,14 +696,28 @@ contains
       end do
    end subroutine subtract_block
 
+   !> The sum of a over the contact set on the rows i0..i1.
+   subroutine block_set_sum(p, a, i0, i1, total)
+      real(wp), contiguous, intent(in) :: p(:), a(:)
+      integer, intent(in) :: i0, i1
+      real(wp), intent(out) :: total
+      integer :: i
+      total = 0.0_wp
+      !$omp simd reduction(+:total)
+      do i = i0, i1
+         total = total + a(i)*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
+      end do
+   end subroutine block_set_sum
+
    !> One pass: the direction d and its image a normalised, d_unit = scale d and a_unit =
    !> scale (a - centre) (into the history), p <- p + alpha d_unit and w <- w + alpha a_unit;
    !> points out of contact with a negative gap are let in with -let_in_scale gap (Polonsky &
    !> Keer's rule: the preconditioned step there), negative pressures clipped. a_delta: in,
    !> the image a; out, the change of p that was not along d (nonzero at the points clipped
-   !> or let in), for the column updates of w; p_sum: sum p.
+   !> or let in), for the column updates of w; p_sum: sum p. keep: p_before <- p first (the
+   !> copy of the best iterate, taken in this pass while it reads p).
    subroutine update(p, w, gap, d, a_delta, centre, scale, alpha, let_in_scale, d_unit, a_unit, n_changed, &
-         & n_clipped, entered, p_sum)
+         & n_clipped, entered, p_sum, keep, p_before)
       real(wp), contiguous, intent(inout) :: p(:), w(:)
       real(wp), contiguous, intent(in) :: gap(:), d(:)
       real(wp), contiguous, intent(inout) :: a_delta(:)
@@ -677,12 +727,15 @@ contains
       integer, intent(out) :: n_clipped
       logical, intent(out) :: entered
       real(wp), intent(out) :: p_sum
+      logical, intent(in) :: keep
+      real(wp), contiguous, intent(inout) :: p_before(:)
       real(wp) :: clip_count, enter_count, changed_count, totals(4)
       real(wp) :: sums(4, reduction_blocks(size(p)))
       integer :: block, first, last
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
+         if (keep) call copy_block(p(first:last), p_before(first:last))
          call update_block(p(first:last), w(first:last), gap(first:last), d(first:last), a_delta(first:last), &
             & centre, scale, alpha, let_in_scale, d_unit(first:last), a_unit(first:last), sums(:, block))
       end do
@@ -703,6 +756,13 @@ contains
       n_clipped = nint(clip_count)
       entered = enter_count > 0.0_wp
    end subroutine update
+
+   !> copy = v on a block (left in the cache for the pass that goes on with it).
+   subroutine copy_block(v, copy)
+      real(wp), contiguous, intent(in) :: v(:)
+      real(wp), contiguous, intent(out) :: copy(:)
+      copy = v
+   end subroutine copy_block
 
    !> update on a block; sums = (points clipped, let in, changed, sum of the new p).
    subroutine update_block(p, w, gap, d, a_delta, centre, scale, alpha, let_in_scale, d_unit, a_unit, sums)
