@@ -147,10 +147,10 @@ contains
       real(wp), allocatable :: dirs(:, :), images(:, :), d(:), coeff(:), p_best(:)
       real(wp), pointer, contiguous :: buffer(:)
       real(wp) :: b_max, best, best_residual, norm_before, norm, alpha, step, centre, kappa, residual_norm2, p_sum
-      real(wp) :: gap_product, image_sum
+      real(wp) :: gap_product
       real(wp) :: load_scale
       integer :: it, n, columns, newest, n_contact, n_changed, since_fresh, last_progress
-      logical :: stale, entered, set_changed, projected, keep
+      logical :: stale, entered, set_changed, projected, keep, fresh
       !> p is the best iterate and p_best not yet a copy of it: the copy is taken by the next
       !> pass that changes p (the update's, as it reads p), not in a pass of its own
       logical :: best_pending
@@ -188,14 +188,17 @@ contains
          ! as in the constrained CG: w is updated in place, recomputed every
          ! refresh_interval iterations, when many points changed, and to confirm convergence
          do
-            if (stale .or. since_fresh >= refresh_interval) then
-               call op%apply_full(p, w)
+            fresh = stale .or. since_fresh >= refresh_interval
+            if (fresh) then
+               ! (G_eff p is left in the buffer: the evaluation's first pass scales it into w)
+               call copy_field(p, buffer)
+               call op%full_in_buffer()
                outcome%fft_pairs = outcome%fft_pairs + 1
                since_fresh = 0
                stale = .false.
             end if
             call evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
-               & n_contact, outcome%residual, residual_norm2, buffer)
+               & n_contact, outcome%residual, residual_norm2, buffer, fresh)
             load_scale = 1.0_wp
             if (since_fresh == 0 .or. .not. (outcome%residual <= tol .or. it > max_iter)) exit
             stale = .true.
@@ -252,7 +255,7 @@ contains
             if (load_control) call scale_to_load(p, mean_pressure, stale, total_pressure(p), load_scale)
             if (stale) cycle   ! (p vanished and was reset: w afresh first)
             call evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
-               & n_contact, outcome%residual, residual_norm2, buffer)
+               & n_contact, outcome%residual, residual_norm2, buffer, .false.)
             load_scale = 1.0_wp
             if (n_contact == 0) cycle
          end if
@@ -269,16 +272,10 @@ contains
          outcome%fft_pairs = outcome%fft_pairs + 1
          coeff = 0.0_wp
          if (columns > 0) then
-            ! (the subtraction's pass sums the new image over the set too: its centre)
             call history_products(images(:, 1:columns), p, buffer, coeff(1:columns))
-            call subtract_history(dirs(:, 1:columns), images(:, 1:columns), coeff(1:columns), d, buffer, p, &
-               & image_sum)
-            centre = 0.0_wp
-            if (load_control) centre = image_sum/max(real(n_contact, wp), 1.0_wp)
-         else
-            centre = set_mean(p, load_control, buffer)
+            call subtract_history(dirs(:, 1:columns), images(:, 1:columns), coeff(1:columns), d, buffer)
          end if
-         call set_norm(p, buffer, gap, centre, norm, gap_product)
+         call set_norm(p, load_control, buffer, gap, centre, norm, gap_product)
          ! (the stored images are orthonormal on the set: Pythagoras gives the norm before)
          norm_before = sqrt(norm**2 + sum(coeff(1:columns)**2))
          if (.not. norm_before > 0.0_wp) then
@@ -353,7 +350,7 @@ contains
          call op%apply_full(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
          call evaluate(p, w, b, 1.0_wp, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
-            & n_contact, outcome%residual, residual_norm2, buffer)
+            & n_contact, outcome%residual, residual_norm2, buffer, .false.)
       end if
 
    contains
@@ -381,16 +378,19 @@ contains
 
    !> Two passes: p and w scaled by load_scale, s (the mean of w - b over the contact set
    !> under load control), the gap w - b - s, the complementarity residual, and -gap on the
-   !> contact set (0 elsewhere) in `masked`, the preconditioner's input.
+   !> contact set (0 elsewhere) in `masked`, the preconditioner's input. fresh: w is read
+   !> from `masked` (the transform's buffer, holding G_eff p afresh), not from w.
    subroutine evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, m_max, s, gap, n_contact, &
-         & residual, norm2, masked)
+         & residual, norm2, masked, fresh)
       real(wp), contiguous, intent(inout) :: p(:), w(:)
       real(wp), contiguous, intent(in) :: b(:)
       real(wp), intent(in) :: load_scale
       logical, intent(in) :: load_control
       real(wp), intent(in) :: mean_pressure, g_ref, b_max, m_max
       real(wp), intent(inout) :: s
-      real(wp), contiguous, intent(out) :: gap(:), masked(:)
+      real(wp), contiguous, intent(out) :: gap(:)
+      real(wp), contiguous, intent(inout) :: masked(:)
+      logical, intent(in) :: fresh
       integer, intent(out) :: n_contact
       real(wp), intent(out) :: residual
       real(wp), intent(out) :: norm2   !< sum of gap^2 over the contact set
@@ -402,7 +402,12 @@ contains
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         call scale_and_sum(p(first:last), w(first:last), b(first:last), load_scale, sums(:, block))
+         if (fresh) then
+            call scale_fresh_and_sum(p(first:last), masked(first:last), w(first:last), b(first:last), load_scale, &
+               & sums(:, block))
+         else
+            call scale_and_sum(p(first:last), w(first:last), b(first:last), load_scale, sums(:, block))
+         end if
       end do
       w_max = maxval(sums(4, :))
       p_max = maxval(sums(5, :))
@@ -472,6 +477,34 @@ contains
       end do
       sums = [contact, gap_sum, p_sum, w_max, p_max]
    end subroutine scale_and_sum
+
+   !> scale_and_sum with w = load_scale times `fresh` (G_eff p, read from the buffer).
+   subroutine scale_fresh_and_sum(p, fresh, w, b, load_scale, sums)
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(in) :: fresh(:), b(:)
+      real(wp), contiguous, intent(out) :: w(:)
+      real(wp), intent(in) :: load_scale
+      real(wp), intent(out) :: sums(5)
+      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, inside
+      integer :: j
+      contact = 0.0_wp
+      gap_sum = 0.0_wp
+      p_sum = 0.0_wp
+      w_max = 0.0_wp
+      p_max = 0.0_wp
+      !$omp simd reduction(+:contact, gap_sum, p_sum) reduction(max:w_max, p_max) private(inside)
+      do j = 1, size(p)
+         p(j) = p(j)*load_scale
+         w(j) = fresh(j)*load_scale
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         contact = contact + inside
+         gap_sum = gap_sum + (w(j) - b(j))*inside
+         p_sum = p_sum + p(j)
+         w_max = max(w_max, abs(w(j)))
+         p_max = max(p_max, p(j))
+      end do
+      sums = [contact, gap_sum, p_sum, w_max, p_max]
+   end subroutine scale_fresh_and_sum
 
    !> evaluate's second pass on a block: the gap, -gap on the contact set in `masked`;
    !> sums = (sum of gap + p (finite unless a value is not), sum of gap^2 over the contact
@@ -568,43 +601,69 @@ contains
       end do
    end subroutine project_block
 
-   !> The norm of v - centre on the contact set (`centre`: v's mean there under load
-   !> control, 0 otherwise), and gap_product = the sum of gap (v - centre) over the set (in
-   !> the same pass: the minimal-residual step along v's direction).
-   subroutine set_norm(p, v, gap, centre, norm, gap_product)
+   !> The mean of v over the contact set (`centre`, 0 without load control), the norm of
+   !> v - centre on the set, and gap_product = the sum of gap (v - centre) over the set (the
+   !> minimal-residual step along v's direction), in one pass over the grid: each block of
+   !> points is centred on its own mean on the set while it is in the cache, and the blocks'
+   !> sums are combined as the partial sums of a variance are (Chan, Golub & LeVeque,
+   !> "Algorithms for computing the sample variance: analysis and recommendations"): no
+   !> square of a mean is subtracted from a sum of squares.
+   subroutine set_norm(p, load_control, v, gap, centre, norm, gap_product)
       real(wp), contiguous, intent(in) :: p(:), v(:), gap(:)
-      real(wp), intent(in) :: centre
-      real(wp), intent(out) :: norm, gap_product
-      real(wp) :: sums(2, reduction_blocks(size(p))), totals(2)
+      logical, intent(in) :: load_control
+      real(wp), intent(out) :: centre, norm, gap_product
+      real(wp) :: sums(5, reduction_blocks(size(p))), totals(2), block_mean
       integer :: block, first, last
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         call centred_squares(p(first:last), v(first:last), gap(first:last), centre, sums(:, block))
+         call centred_squares(p(first:last), v(first:last), gap(first:last), sums(:, block))
       end do
+      ! (blocks added in order: the same bits on any number of threads)
       totals = [sum(sums(1, :)), sum(sums(2, :))]
+      if (across_ranks) call sum_over_ranks(totals)
+      centre = 0.0_wp
+      if (load_control) centre = totals(2)/max(totals(1), 1.0_wp)
+      totals = 0.0_wp
+      do block = 1, size(sums, 2)
+         block_mean = sums(2, block)/max(sums(1, block), 1.0_wp)
+         totals(1) = totals(1) + sums(3, block) + sums(1, block)*(block_mean - centre)**2
+         totals(2) = totals(2) + sums(4, block) + (block_mean - centre)*sums(5, block)
+      end do
       if (across_ranks) call sum_over_ranks(totals)
       norm = sqrt(totals(1))
       gap_product = totals(2)
    end subroutine set_norm
 
-   !> On a block: sums = (the sum of (v - centre)^2, of gap (v - centre)) over the contact set.
-   subroutine centred_squares(p, v, gap, centre, sums)
+   !> On a block, over the contact set: sums = (its points, the sum of v, of (v - m)^2, of
+   !> gap (v - m), of gap), m the block's mean of v on the set (the block is read twice,
+   !> the second time from the cache).
+   subroutine centred_squares(p, v, gap, sums)
       real(wp), contiguous, intent(in) :: p(:), v(:), gap(:)
-      real(wp), intent(in) :: centre
-      real(wp), intent(out) :: sums(2)
-      real(wp) :: inside, x, v2_sum, gv_sum
+      real(wp), intent(out) :: sums(5)
+      real(wp) :: inside, x, contact, v_sum, mean, v2_sum, gv_sum, g_sum
       integer :: j
-      v2_sum = 0.0_wp
-      gv_sum = 0.0_wp
-      !$omp simd reduction(+:v2_sum, gv_sum) private(inside, x)
+      contact = 0.0_wp
+      v_sum = 0.0_wp
+      !$omp simd reduction(+:contact, v_sum) private(inside)
       do j = 1, size(p)
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         x = (v(j) - centre)*inside
+         contact = contact + inside
+         v_sum = v_sum + v(j)*inside
+      end do
+      mean = v_sum/max(contact, 1.0_wp)
+      v2_sum = 0.0_wp
+      gv_sum = 0.0_wp
+      g_sum = 0.0_wp
+      !$omp simd reduction(+:v2_sum, gv_sum, g_sum) private(inside, x)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         x = (v(j) - mean)*inside
          v2_sum = v2_sum + x*x
          gv_sum = gv_sum + gap(j)*x
+         g_sum = g_sum + gap(j)*inside
       end do
-      sums = [v2_sum, gv_sum]
+      sums = [contact, v_sum, v2_sum, gv_sum, g_sum]
    end subroutine centred_squares
 
    !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
@@ -653,31 +712,17 @@ contains
       end do
    end subroutine block_products
 
-   !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks;
-   !> with p, set_sum = the sum of the new a over the contact set (p > 0), taken while each
-   !> block is in the cache (blocks added in order: the same bits on any number of threads).
-   subroutine subtract_history(dirs, images, coeff, d, a, p, set_sum)
+   !> d <- d - sum_k coeff(k) dirs(:, k), a <- a - sum_k coeff(k) images(:, k), by blocks.
+   subroutine subtract_history(dirs, images, coeff, d, a)
       real(wp), contiguous, intent(in) :: dirs(:, :), images(:, :)
       real(wp), intent(in) :: coeff(:)
       real(wp), contiguous, intent(inout) :: d(:), a(:)
-      real(wp), contiguous, intent(in), optional :: p(:)
-      real(wp), intent(out), optional :: set_sum
-      real(wp), allocatable :: partial(:)
-      integer :: i0, i1, block
-      allocate (partial((size(a) + block_rows - 1)/block_rows))
-      !$omp parallel do schedule(static) private(i0, i1) if(size(a) >= parallel_points)
-      do block = 1, size(partial)
-         i0 = (block - 1)*block_rows + 1
+      integer :: i0, i1
+      !$omp parallel do schedule(static) private(i1) if(size(a) >= parallel_points)
+      do i0 = 1, size(a), block_rows
          i1 = min(size(a), i0 + block_rows - 1)
          call subtract_block(dirs, images, coeff, i0, i1, d, a)
-         if (present(p)) call block_set_sum(p, a, i0, i1, partial(block))
       end do
-      if (.not. present(set_sum)) return
-      set_sum = 0.0_wp
-      do block = 1, size(partial)
-         set_sum = set_sum + partial(block)
-      end do
-      if (across_ranks) set_sum = global_sum(set_sum)
    end subroutine subtract_history
 
    !> subtract_history on the rows i0..i1.
@@ -695,19 +740,6 @@ contains
          end do
       end do
    end subroutine subtract_block
-
-   !> The sum of a over the contact set on the rows i0..i1.
-   subroutine block_set_sum(p, a, i0, i1, total)
-      real(wp), contiguous, intent(in) :: p(:), a(:)
-      integer, intent(in) :: i0, i1
-      real(wp), intent(out) :: total
-      integer :: i
-      total = 0.0_wp
-      !$omp simd reduction(+:total)
-      do i = i0, i1
-         total = total + a(i)*merge(1.0_wp, 0.0_wp, p(i) > 0.0_wp)
-      end do
-   end subroutine block_set_sum
 
    !> One pass: the direction d and its image a normalised, d_unit = scale d and a_unit =
    !> scale (a - centre) (into the history), p <- p + alpha d_unit and w <- w + alpha a_unit;
