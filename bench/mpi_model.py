@@ -54,7 +54,7 @@ import time
 # MPI_Allreduce calls in one plain GCR iteration with load control, counted in
 # src/contact/solver_gcr.f90 (evaluate: sum_over_ranks, max_over_ranks, field_points,
 # sum_over_ranks, global_max; project_on_set's set_mean; history_products; set_norm's
-# set_mean and its sums (the norm and the step's product); update; scale_to_load's
+# two (the centre's sums, then the norm and the step's product); update; scale_to_load's
 # field_points; one fewer where the compiler skips merge's unused field_points). An
 # iteration that lets points in adds reorthonormalise's 3, one after a change of the set
 # history_products, clip_negative, total_pressure and another evaluate (8).

@@ -92,6 +92,10 @@ module lc_contact_policy
       !> ... the multigrid method with its finest grid on the slabs (solves_on_slabs); else
       !> the grid, too small to halve into a nested coarse grid, is gathered onto every rank
       logical :: multigrid_on_slabs = .false.
+      !> the multigrid method's measures (refusal, metric_admitted) are left to measure_start:
+      !> under 'auto' a coupled operator reads them only where its start is hard or it may be
+      !> lossy among its short waves (rules 3a, 3b)
+      logical :: multigrid_deferred = .false.
    end type problem_indicators
 
    !> The methods a distributed surface may ask for by name.
@@ -128,6 +132,10 @@ contains
          ind%multigrid_on_slabs = solves_on_slabs(op)
          if (all(trim(method) /= [character(len=9) :: 'auto', 'multigrid'])) return
       end if
+      ! (a coupled operator under 'auto' takes the constrained GCR unless its start says
+      ! otherwise: the measures wait for the start, which most grids never need)
+      ind%multigrid_deferred = trim(method) == 'auto' .and. op%coupled
+      if (ind%multigrid_deferred) return
       ! (on a slab each measure takes the rank's modes, reduced over the ranks: the whole
       ! grid's values, docs/decisions/028-distributed-multigrid.md)
       call measure_multigrid(ind, op, load_control)
@@ -160,7 +168,12 @@ contains
       ind%start_multigrid = took_multigrid
       ind%start_contacts = count(p > 0.0_wp)
       if (ind%distributed) ind%start_contacts = global_sum(ind%start_contacts)
-      if (trim(ind%method) /= 'auto' .or. len(ind%refusal) > 0) return
+      if (trim(ind%method) /= 'auto') return
+      if (ind%multigrid_deferred .and. (hard(ind) .or. loss_needed(ind))) then
+         call measure_multigrid(ind, op, load_control)
+         ind%multigrid_deferred = .false.
+      end if
+      if (ind%multigrid_deferred .or. len(ind%refusal) > 0) return
       if (loss_needed(ind)) ind%short_wave_loss = loss_among_short_waves(op)
       if (rows_needed(ind)) ind%rows_ahead = rows_ahead_of_gcr(op, load_control)
    end subroutine measure_start

@@ -150,7 +150,10 @@ contains
       real(wp) :: gap_product
       real(wp) :: load_scale
       integer :: it, n, columns, newest, n_contact, n_changed, since_fresh, last_progress
-      logical :: stale, entered, set_changed, projected, keep
+      logical :: stale, entered, set_changed, projected, keep, fresh
+      !> p is the best iterate and p_best not yet a copy of it: the copy is taken by the next
+      !> pass that changes p (the update's, as it reads p), not in a pass of its own
+      logical :: best_pending
       integer :: n_clipped, n_negative
 
       across_ranks = op%distributed
@@ -177,7 +180,7 @@ contains
       best = huge(1.0_wp)
       best_residual = huge(1.0_wp)
       last_progress = 0
-      call copy_field(p, p_best)
+      best_pending = .false.
       set_changed = .false.
       load_scale = 1.0_wp
 
@@ -185,14 +188,17 @@ contains
          ! as in the constrained CG: w is updated in place, recomputed every
          ! refresh_interval iterations, when many points changed, and to confirm convergence
          do
-            if (stale .or. since_fresh >= refresh_interval) then
-               call op%apply_full(p, w)
+            fresh = stale .or. since_fresh >= refresh_interval
+            if (fresh) then
+               ! (G_eff p is left in the buffer: the evaluation's first pass scales it into w)
+               call copy_field(p, buffer)
+               call op%full_in_buffer()
                outcome%fft_pairs = outcome%fft_pairs + 1
                since_fresh = 0
                stale = .false.
             end if
             call evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
-               & n_contact, outcome%residual, residual_norm2, buffer)
+               & n_contact, outcome%residual, residual_norm2, buffer, fresh)
             load_scale = 1.0_wp
             if (since_fresh == 0 .or. .not. (outcome%residual <= tol .or. it > max_iter)) exit
             stale = .true.
@@ -204,7 +210,7 @@ contains
          end if
          if (outcome%residual < best_residual) then
             best_residual = outcome%residual
-            call copy_field(p, p_best)
+            best_pending = .true.
          end if
          if (present(progress)) call progress%tick(it, outcome%residual, real(n_contact, wp)/op%grid%points())
          if (outcome%converged .or. it > max_iter) exit
@@ -217,6 +223,7 @@ contains
 
          if (n_contact == 0) then
             ! displacement control with nothing in contact yet: load the overlapping points
+            call keep_best()
             call let_in_overlaps(p, gap, 1.0_wp/op%diagonal, n_changed)
             if (n_changed == 0) exit
             columns = 0
@@ -230,6 +237,7 @@ contains
             ! along them by coeff = (r, u_i) (r = -gap on the set, in the buffer); pressures
             ! it makes negative are clipped (and the history dropped then); state again
             set_changed = .false.
+            call keep_best()
             call history_products(images(:, 1:columns), p, buffer, coeff(1:columns))
             call subtract_history(dirs(:, 1:columns), images(:, 1:columns), -coeff(1:columns), p, w)
             call clip_negative(p, d, n_negative)
@@ -247,7 +255,7 @@ contains
             if (load_control) call scale_to_load(p, mean_pressure, stale, total_pressure(p), load_scale)
             if (stale) cycle   ! (p vanished and was reset: w afresh first)
             call evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
-               & n_contact, outcome%residual, residual_norm2, buffer)
+               & n_contact, outcome%residual, residual_norm2, buffer, .false.)
             load_scale = 1.0_wp
             if (n_contact == 0) cycle
          end if
@@ -273,6 +281,7 @@ contains
          if (.not. norm_before > 0.0_wp) then
             ! no direction on the set (e.g. one point in contact under load control: its gap
             ! is s exactly): let the overlapping points in and start afresh
+            call keep_best()
             call let_in_overlaps(p, gap, 1.0_wp/op%diagonal, n_changed)
             if (n_changed == 0) then
                ! (after a projection step, which may have left just this point and solved
@@ -303,7 +312,8 @@ contains
          ! the coefficient of the preconditioned residual in the step, for letting points in
          step = alpha/norm
          call update(p, w, gap, d, buffer, centre, 1.0_wp/norm, alpha, step*kappa, dirs(:, newest), &
-            & images(:, newest), n_changed, n_clipped, entered, p_sum)
+            & images(:, newest), n_changed, n_clipped, entered, p_sum, best_pending, p_best)
+         best_pending = .false.
          if (n_changed > column_updates .or. (n_changed > 0 .and. op%distributed)) then
             ! (a distributed operator has no real-space column: w is made afresh)
             stale = .true.
@@ -334,12 +344,22 @@ contains
       ! not converged: return the best iterate, with w = G_eff p afresh (the updated w may
       ! differ from it by a constant, see above, and by the drift of the updates)
       if (.not. outcome%converged) then
-         if (best_residual < outcome%residual) call copy_field(p_best, p)
+         ! (p itself where it was not changed since it was the best: a refreshed w may have
+         ! moved its residual)
+         if (best_residual < outcome%residual .and. .not. best_pending) call copy_field(p_best, p)
          call op%apply_full(p, w)
          outcome%fft_pairs = outcome%fft_pairs + 1
          call evaluate(p, w, b, 1.0_wp, load_control, mean_pressure, g_ref, b_max, op%largest, s, gap, &
-            & n_contact, outcome%residual, residual_norm2, buffer)
+            & n_contact, outcome%residual, residual_norm2, buffer, .false.)
       end if
+
+   contains
+
+      !> p_best <- p where p is the best iterate not yet copied, before p changes.
+      subroutine keep_best()
+         if (best_pending) call copy_field(p, p_best)
+         best_pending = .false.
+      end subroutine keep_best
    end subroutine constrained_gcr
 
    !> sum p (over the ranks, across_ranks).
@@ -358,16 +378,19 @@ contains
 
    !> Two passes: p and w scaled by load_scale, s (the mean of w - b over the contact set
    !> under load control), the gap w - b - s, the complementarity residual, and -gap on the
-   !> contact set (0 elsewhere) in `masked`, the preconditioner's input.
+   !> contact set (0 elsewhere) in `masked`, the preconditioner's input. fresh: w is read
+   !> from `masked` (the transform's buffer, holding G_eff p afresh), not from w.
    subroutine evaluate(p, w, b, load_scale, load_control, mean_pressure, g_ref, b_max, m_max, s, gap, n_contact, &
-         & residual, norm2, masked)
+         & residual, norm2, masked, fresh)
       real(wp), contiguous, intent(inout) :: p(:), w(:)
       real(wp), contiguous, intent(in) :: b(:)
       real(wp), intent(in) :: load_scale
       logical, intent(in) :: load_control
       real(wp), intent(in) :: mean_pressure, g_ref, b_max, m_max
       real(wp), intent(inout) :: s
-      real(wp), contiguous, intent(out) :: gap(:), masked(:)
+      real(wp), contiguous, intent(out) :: gap(:)
+      real(wp), contiguous, intent(inout) :: masked(:)
+      logical, intent(in) :: fresh
       integer, intent(out) :: n_contact
       real(wp), intent(out) :: residual
       real(wp), intent(out) :: norm2   !< sum of gap^2 over the contact set
@@ -379,7 +402,12 @@ contains
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         call scale_and_sum(p(first:last), w(first:last), b(first:last), load_scale, sums(:, block))
+         if (fresh) then
+            call scale_fresh_and_sum(p(first:last), masked(first:last), w(first:last), b(first:last), load_scale, &
+               & sums(:, block))
+         else
+            call scale_and_sum(p(first:last), w(first:last), b(first:last), load_scale, sums(:, block))
+         end if
       end do
       w_max = maxval(sums(4, :))
       p_max = maxval(sums(5, :))
@@ -449,6 +477,34 @@ contains
       end do
       sums = [contact, gap_sum, p_sum, w_max, p_max]
    end subroutine scale_and_sum
+
+   !> scale_and_sum with w = load_scale times `fresh` (G_eff p, read from the buffer).
+   subroutine scale_fresh_and_sum(p, fresh, w, b, load_scale, sums)
+      real(wp), contiguous, intent(inout) :: p(:)
+      real(wp), contiguous, intent(in) :: fresh(:), b(:)
+      real(wp), contiguous, intent(out) :: w(:)
+      real(wp), intent(in) :: load_scale
+      real(wp), intent(out) :: sums(5)
+      real(wp) :: contact, gap_sum, p_sum, w_max, p_max, inside
+      integer :: j
+      contact = 0.0_wp
+      gap_sum = 0.0_wp
+      p_sum = 0.0_wp
+      w_max = 0.0_wp
+      p_max = 0.0_wp
+      !$omp simd reduction(+:contact, gap_sum, p_sum) reduction(max:w_max, p_max) private(inside)
+      do j = 1, size(p)
+         p(j) = p(j)*load_scale
+         w(j) = fresh(j)*load_scale
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         contact = contact + inside
+         gap_sum = gap_sum + (w(j) - b(j))*inside
+         p_sum = p_sum + p(j)
+         w_max = max(w_max, abs(w(j)))
+         p_max = max(p_max, p(j))
+      end do
+      sums = [contact, gap_sum, p_sum, w_max, p_max]
+   end subroutine scale_fresh_and_sum
 
    !> evaluate's second pass on a block: the gap, -gap on the contact set in `masked`;
    !> sums = (sum of gap + p (finite unless a value is not), sum of gap^2 over the contact
@@ -546,43 +602,68 @@ contains
    end subroutine project_block
 
    !> The mean of v over the contact set (`centre`, 0 without load control), the norm of
-   !> v - centre on the set, and gap_product = the sum of gap (v - centre) over the set (in
-   !> the same pass: the minimal-residual step along v's direction).
+   !> v - centre on the set, and gap_product = the sum of gap (v - centre) over the set (the
+   !> minimal-residual step along v's direction), in one pass over the grid: each block of
+   !> points is centred on its own mean on the set while it is in the cache, and the blocks'
+   !> sums are combined as the partial sums of a variance are (Chan, Golub & LeVeque,
+   !> "Algorithms for computing the sample variance: analysis and recommendations"): no
+   !> square of a mean is subtracted from a sum of squares.
    subroutine set_norm(p, load_control, v, gap, centre, norm, gap_product)
       real(wp), contiguous, intent(in) :: p(:), v(:), gap(:)
       logical, intent(in) :: load_control
       real(wp), intent(out) :: centre, norm, gap_product
-      real(wp) :: sums(2, reduction_blocks(size(p))), totals(2)
+      real(wp) :: sums(5, reduction_blocks(size(p))), totals(2), block_mean
       integer :: block, first, last
-      centre = set_mean(p, load_control, v)
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
-         call centred_squares(p(first:last), v(first:last), gap(first:last), centre, sums(:, block))
+         call centred_squares(p(first:last), v(first:last), gap(first:last), sums(:, block))
       end do
+      ! (blocks added in order: the same bits on any number of threads)
       totals = [sum(sums(1, :)), sum(sums(2, :))]
+      if (across_ranks) call sum_over_ranks(totals)
+      centre = 0.0_wp
+      if (load_control) centre = totals(2)/max(totals(1), 1.0_wp)
+      totals = 0.0_wp
+      do block = 1, size(sums, 2)
+         block_mean = sums(2, block)/max(sums(1, block), 1.0_wp)
+         totals(1) = totals(1) + sums(3, block) + sums(1, block)*(block_mean - centre)**2
+         totals(2) = totals(2) + sums(4, block) + (block_mean - centre)*sums(5, block)
+      end do
       if (across_ranks) call sum_over_ranks(totals)
       norm = sqrt(totals(1))
       gap_product = totals(2)
    end subroutine set_norm
 
-   !> On a block: sums = (the sum of (v - centre)^2, of gap (v - centre)) over the contact set.
-   subroutine centred_squares(p, v, gap, centre, sums)
+   !> On a block, over the contact set: sums = (its points, the sum of v, of (v - m)^2, of
+   !> gap (v - m), of gap), m the block's mean of v on the set (the block is read twice,
+   !> the second time from the cache).
+   subroutine centred_squares(p, v, gap, sums)
       real(wp), contiguous, intent(in) :: p(:), v(:), gap(:)
-      real(wp), intent(in) :: centre
-      real(wp), intent(out) :: sums(2)
-      real(wp) :: inside, x, v2_sum, gv_sum
+      real(wp), intent(out) :: sums(5)
+      real(wp) :: inside, x, contact, v_sum, mean, v2_sum, gv_sum, g_sum
       integer :: j
-      v2_sum = 0.0_wp
-      gv_sum = 0.0_wp
-      !$omp simd reduction(+:v2_sum, gv_sum) private(inside, x)
+      contact = 0.0_wp
+      v_sum = 0.0_wp
+      !$omp simd reduction(+:contact, v_sum) private(inside)
       do j = 1, size(p)
          inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
-         x = (v(j) - centre)*inside
+         contact = contact + inside
+         v_sum = v_sum + v(j)*inside
+      end do
+      mean = v_sum/max(contact, 1.0_wp)
+      v2_sum = 0.0_wp
+      gv_sum = 0.0_wp
+      g_sum = 0.0_wp
+      !$omp simd reduction(+:v2_sum, gv_sum, g_sum) private(inside, x)
+      do j = 1, size(p)
+         inside = merge(1.0_wp, 0.0_wp, p(j) > 0.0_wp)
+         x = (v(j) - mean)*inside
          v2_sum = v2_sum + x*x
          gv_sum = gv_sum + gap(j)*x
+         g_sum = g_sum + gap(j)*inside
       end do
-      sums = [v2_sum, gv_sum]
+      sums = [contact, v_sum, v2_sum, gv_sum, g_sum]
    end subroutine centred_squares
 
    !> coeff(i) = (a, images(:, i)) over the contact set, in one sweep by blocks of rows.
@@ -665,9 +746,10 @@ contains
    !> points out of contact with a negative gap are let in with -let_in_scale gap (Polonsky &
    !> Keer's rule: the preconditioned step there), negative pressures clipped. a_delta: in,
    !> the image a; out, the change of p that was not along d (nonzero at the points clipped
-   !> or let in), for the column updates of w; p_sum: sum p.
+   !> or let in), for the column updates of w; p_sum: sum p. keep: p_before <- p first (the
+   !> copy of the best iterate, taken in this pass while it reads p).
    subroutine update(p, w, gap, d, a_delta, centre, scale, alpha, let_in_scale, d_unit, a_unit, n_changed, &
-         & n_clipped, entered, p_sum)
+         & n_clipped, entered, p_sum, keep, p_before)
       real(wp), contiguous, intent(inout) :: p(:), w(:)
       real(wp), contiguous, intent(in) :: gap(:), d(:)
       real(wp), contiguous, intent(inout) :: a_delta(:)
@@ -677,12 +759,15 @@ contains
       integer, intent(out) :: n_clipped
       logical, intent(out) :: entered
       real(wp), intent(out) :: p_sum
+      logical, intent(in) :: keep
+      real(wp), contiguous, intent(inout) :: p_before(:)
       real(wp) :: clip_count, enter_count, changed_count, totals(4)
       real(wp) :: sums(4, reduction_blocks(size(p)))
       integer :: block, first, last
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
       do block = 1, size(sums, 2)
          call block_range(block, size(p), first, last)
+         if (keep) call copy_block(p(first:last), p_before(first:last))
          call update_block(p(first:last), w(first:last), gap(first:last), d(first:last), a_delta(first:last), &
             & centre, scale, alpha, let_in_scale, d_unit(first:last), a_unit(first:last), sums(:, block))
       end do
@@ -703,6 +788,13 @@ contains
       n_clipped = nint(clip_count)
       entered = enter_count > 0.0_wp
    end subroutine update
+
+   !> copy = v on a block (left in the cache for the pass that goes on with it).
+   subroutine copy_block(v, copy)
+      real(wp), contiguous, intent(in) :: v(:)
+      real(wp), contiguous, intent(out) :: copy(:)
+      copy = v
+   end subroutine copy_block
 
    !> update on a block; sums = (points clipped, let in, changed, sum of the new p).
    subroutine update_block(p, w, gap, d, a_delta, centre, scale, alpha, let_in_scale, d_unit, a_unit, sums)
