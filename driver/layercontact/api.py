@@ -194,6 +194,7 @@ def solve_line(
     method: str | None = None,
     precondition: bool | None = None,
     coarse_start: bool | None = None,
+    gfmd_mass: str | None = None,
     progress: bool | None = None,
     tol: float | None = None,
     max_iter: int | None = None,
@@ -278,8 +279,8 @@ def solve_line(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
-        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
+        gfmd_mass=gfmd_mass, progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads,
+        stress=stress, conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
         **stack_keywords("solve_line", stack))
     runs = _solve_scene(h, {"scene": {"n": h.size, "period": period}, **groups}, areal=False,
                         companion=bool(companion), stress=stress)
@@ -453,6 +454,7 @@ def solve_areal(
     method: str | None = None,
     precondition: bool | None = None,
     coarse_start: bool | None = None,
+    gfmd_mass: str | None = None,
     progress: bool | None = None,
     tol: float | None = None,
     max_iter: int | None = None,
@@ -481,8 +483,8 @@ def solve_areal(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
-        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
+        gfmd_mass=gfmd_mass, progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads,
+        stress=stress, conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
         **stack_keywords("solve_areal", stack))
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
     runs = _solve_scene(np.ascontiguousarray(h).ravel(), {"scene": scene, **groups}, areal=True,

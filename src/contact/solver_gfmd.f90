@@ -96,6 +96,9 @@ module lc_contact_solver_gfmd
    !> the steps of the dynamics growing where the traction is solved less well).
    integer, parameter :: update_krylov = 10
    real(wp), parameter :: update_forcing = 0.1_wp
+   !> &solver gfmd_mass = 'auto' takes the mass per mode on grids of at least this many
+   !> points: MEASURED BELOW (placeholder)
+   real(wp), parameter :: mode_mass_points = huge(1.0_wp)
 
    !> What one GFMD solve did.
    type :: gfmd_outcome
@@ -123,7 +126,7 @@ contains
    !> history(k) receives the residual of the k-th check (every check_interval steps) when
    !> present.
    subroutine gfmd(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, error, &
-         & history, progress)
+         & history, progress, mode_mass)
       type(compliance_operator), intent(inout) :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -137,7 +140,10 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
+      !> a mass per mode on the free set (mode_mass) instead of one mass for every node
+      logical, intent(in), optional :: mode_mass
       complex(wp), allocatable :: normal(:), tangential(:), stiffness(:), coupling(:), inverse_full(:)
+      complex(wp), allocatable :: inverse_mass(:)
       real(wp), allocatable :: u(:), v(:), a(:), lambda(:), p_best(:)
       real(wp), allocatable :: tau(:), offset(:), basis(:, :), change(:), response(:)
       logical, allocatable :: inside(:)
@@ -145,7 +151,7 @@ contains
       real(wp) :: dt, alpha, power, v_norm, a_norm, s_best, uniform, b_max, mass, residual, friction
       real(wp) :: imbalance, mismatch, mismatch_floor, contact_points, points, sums(3), maxima(2)
       integer :: step, since_negative, checks, n, j, since_update
-      logical :: with_traction, across_ranks
+      logical :: with_traction, across_ranks, per_mode
 
       n = size(p)
       across_ranks = op%distributed
@@ -176,6 +182,14 @@ contains
       if (across_ranks) call max_over_ranks(maxima)
       b_max = maxima(1)
       mass = maxima(2)
+      per_mode = .false.
+      if (present(mode_mass)) per_mode = mode_mass
+      if (per_mode) then
+         ! the mass of a mode its stiffness |K_n(q)| (every mode at unit frequency); the
+         ! modes without stiffness (the uniform mode under load control) get the smallest
+         call mode_masses(stiffness, across_ranks, inverse_mass)
+         mass = 1.0_wp
+      end if
       uniform = merge(mean_pressure, 0.0_wp, load_control)
       ! start from the displacement of the guess (its friction traction held); under load
       ! control the wall is placed where it touches the highest point of the gap, and the
@@ -223,6 +237,20 @@ contains
             lambda(j) = merge(max(buffer(j), 0.0_wp), 0.0_wp, u(j) <= b(j) + s)
             a(j) = -(buffer(j) - lambda(j))/mass   ! -rho/m
          end do
+         if (with_traction) imbalance = mass*maxval(abs(a))   ! max |rho|
+         if (per_mode) then
+            ! a = P_F M^-1 (-rho): the mass per mode's multiplier, then the free set F, the
+            ! nodes off the wall and those it releases (p < 0); on the others rho = 0, so
+            ! that rho = P_F rho already (one more transform pair: the mask of F sits
+            ! between M^-1 and the next step's K_n)
+            buffer = a
+            call op%multiply_complex_in_buffer(inverse_mass)
+            outcome%fft_pairs = outcome%fft_pairs + 1
+            !$omp simd
+            do j = 1, n
+               a(j) = merge(buffer(j), 0.0_wp, u(j) > b(j) + s .or. a(j) /= 0.0_wp)
+            end do
+         end if
          ! FIRE: mix the velocity towards the force, grow the step while the power is
          ! positive, stop and shrink it when it turns negative
          ! (the power and the two norms in one sum over the ranks)
@@ -278,7 +306,7 @@ contains
             ! the dynamics has relaxed the problem of the current traction well enough
             ! against what the traction itself is off by: update it
             since_update = since_update + 1
-            maxima = [mass*maxval(abs(a)), maxval(abs(friction*lambda - tau))]   ! max |rho|, the mismatch
+            maxima = [imbalance, maxval(abs(friction*lambda - tau))]   ! max |rho|, the mismatch
             if (across_ranks) call max_over_ranks(maxima)
             imbalance = maxima(1)
             mismatch = maxima(2)
@@ -549,6 +577,24 @@ contains
       end if
    end function gfmd_refusal
 
+   !> 1/M(q) of the mass per mode M(q) = |K_n(q)|, the modes with K_n = 0 (the uniform mode
+   !> under load control) given the smallest nonzero |K_n| of the grid (on a slab: of every
+   !> rank's modes).
+   subroutine mode_masses(stiffness, across_ranks, inverse_mass)
+      complex(wp), intent(in) :: stiffness(:)
+      logical, intent(in) :: across_ranks
+      complex(wp), allocatable, intent(out) :: inverse_mass(:)
+      real(wp) :: smallest
+      smallest = minval(abs(stiffness), mask=abs(stiffness) > 0.0_wp)   ! (huge on a rank without any)
+      if (across_ranks) smallest = -global_max(-smallest)
+      allocate (inverse_mass(size(stiffness)))
+      where (abs(stiffness) > 0.0_wp)
+         inverse_mass = 1.0_wp/abs(stiffness)
+      elsewhere
+         inverse_mass = 1.0_wp/smallest
+      end where
+   end subroutine mode_masses
+
    !> The largest |Im g|/Re g over the multipliers g /= 0 (huge where Re g <= 0).
    pure real(wp) function stiffness_phase(g) result(ratio)
       complex(wp), intent(in) :: g(:)
@@ -596,9 +642,18 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(gfmd_outcome) :: dynamics
       real(wp), allocatable :: history(:)
+      logical :: per_mode
+      select case (trim(problem%gfmd_mass))
+      case ('mode')
+         per_mode = .true.
+      case ('one')
+         per_mode = .false.
+      case default   ! 'auto'
+         per_mode = real(problem%op%grid%points(), wp) >= mode_mass_points
+      end select
       allocate (history(budget))
       call gfmd(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
-         & problem%tol, budget, state%p, state%w, state%gap, dynamics, error, history, progress)
+         & problem%tol, budget, state%p, state%w, state%gap, dynamics, error, history, progress, per_mode)
       if (allocated(error)) return
       outcome = solve_outcome(converged=dynamics%converged, iterations=dynamics%iterations, &
          & outer_iterations=dynamics%updates, fft_pairs=dynamics%fft_pairs, residual=dynamics%residual, &
