@@ -96,9 +96,10 @@ module lc_contact_solver_gfmd
    !> the steps of the dynamics growing where the traction is solved less well).
    integer, parameter :: update_krylov = 10
    real(wp), parameter :: update_forcing = 0.1_wp
-   !> &solver gfmd_mass = 'auto' takes the mass per mode on grids of at least this many
-   !> points: MEASURED BELOW (placeholder)
-   real(wp), parameter :: mode_mass_points = huge(1.0_wp)
+   !> &solver gfmd_mass = 'auto' takes the mass per mode on grids of at least
+   !> mode_mass_points points whose start has contact on at most mode_mass_contact of the
+   !> surface: PLACEHOLDER
+   real(wp), parameter :: mode_mass_points = 262144.0_wp, mode_mass_contact = 0.1_wp
 
    !> What one GFMD solve did.
    type :: gfmd_outcome
@@ -649,7 +650,7 @@ contains
       case ('one')
          per_mode = .false.
       case default   ! 'auto'
-         per_mode = real(problem%op%grid%points(), wp) >= mode_mass_points
+         per_mode = takes_mode_mass(problem%op, state%p)
       end select
       allocate (history(budget))
       call gfmd(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
@@ -659,6 +660,22 @@ contains
          & outer_iterations=dynamics%updates, fft_pairs=dynamics%fft_pairs, residual=dynamics%residual, &
          & history=history(1:min(dynamics%checks, size(history))))
    end subroutine solve_by_gfmd
+
+   !> Whether &solver gfmd_mass = 'auto' takes the mass per mode: on a grid of at least
+   !> mode_mass_points points whose start (the coarse start's solution) has contact on at
+   !> most mode_mass_contact of the surface, but some (a start without contact, or a uniform
+   !> pressure, says nothing of the contact to come).
+   logical function takes_mode_mass(op, p)
+      type(compliance_operator), intent(in) :: op
+      real(wp), intent(in) :: p(:)
+      real(wp) :: points, touching
+      points = real(op%grid%points(), wp)
+      takes_mode_mass = .false.
+      if (points < mode_mass_points) return
+      touching = real(count(p > 0.0_wp), wp)
+      if (op%distributed) touching = global_sum(touching)
+      takes_mode_mass = touching > 0.0_wp .and. touching <= mode_mass_contact*points
+   end function takes_mode_mass
 
    pure function gfmd_name(self) result(name)
       class(gfmd_solver), intent(in) :: self
