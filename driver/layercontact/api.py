@@ -265,7 +265,9 @@ def solve_line(
     roughness). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
-    in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard
+    in the grid size; see bench/iterations.py). ``gfmd_mass`` (default ``'auto'``): the
+    masses of method ``'gfmd'``, ``'one'`` for every node or a mass per ``'mode'`` on the
+    nodes off the wall (docs/namelist.md). ``progress=True`` prints a line to standard
     error for each grid level solved and every 2 s within a level (iteration, residual,
     contact fraction, elapsed time): it comes from the compiled core, so it shows in a
     terminal, not in a notebook cell.

@@ -14,9 +14,18 @@
 !> rho = p - lambda drives the motion,
 !>    m d2u/dt2 = -rho,
 !> with one mass m for every node, the largest stiffness of a mode, so that the stiffest
-!> mode has unit frequency; FIRE's damped semi-implicit Euler steps integrate it. A mass
-!> per mode equal to its stiffness (all modes at one frequency) is not used: with the
-!> wall's projection in real space it makes FIRE's step collapse (docs/decisions).
+!> mode has unit frequency (&solver gfmd_mass = 'one'); FIRE's damped semi-implicit Euler
+!> steps integrate it. Or a mass per mode, its stiffness M(q) = |K_n(q)| (every mode at unit
+!> frequency; 'mode'), on the free set F (the nodes off the wall and those it releases):
+!>    d2u/dt2 = -P_F M^-1 rho,
+!> which on the current F is the dynamics preconditioned by the symmetric positive
+!> P_F M^-1 P_F (rho = 0 off F). With the wall as the projection alone the mass per mode
+!> spreads a free node's force onto the contact nodes and FIRE's step collapses. One mass
+!> is the Nyquist mode's stiffness, which doubles with the grid, and the modes a sparse
+!> contact leaves free slow down with it: its steps grow with the grid there (200 to 410
+!> from 64² to 1024² at 2 % contact); the mass per mode's stay flat or fall (210 to 140),
+!> at two transform pairs a step: 'auto' takes it where that was measured cheaper
+!> (takes_mode_mass; docs/decisions/001-gfmd-masses.md).
 !>
 !> Friction. For the dynamics the friction traction is an external in-plane load on the
 !> contact nodes, held between updates, so the dynamics relaxes a symmetric problem (with tau in the stiffness, the
@@ -36,7 +45,7 @@
 !>
 !> Convergence is judged, as for the other solvers, on the complementarity residual of the
 !> pressure the wall carries (p = lambda, w = G_eff lambda, gap = w - b - s), not on an
-!> energy. A step costs one transform pair, a check one more.
+!> energy. A step costs one transform pair (two with the mass per mode), a check one more.
 !>
 !> On a surface shared among the ranks of an MPI job (an operator on a slab,
 !> docs/decisions/023-mpi-slabs.md) every step is the same: the points' work on the slab,
@@ -242,8 +251,9 @@ contains
          if (per_mode) then
             ! a = P_F M^-1 (-rho): the mass per mode's multiplier, then the free set F, the
             ! nodes off the wall and those it releases (p < 0); on the others rho = 0, so
-            ! that rho = P_F rho already (one more transform pair: the mask of F sits
-            ! between M^-1 and the next step's K_n)
+            ! that rho = P_F rho already. One more transform pair: the wall's reaction (the
+            ! mask of the contact nodes) sits between K_n and M^-1, and the mask of F
+            ! between M^-1 and the next step's K_n (docs/decisions/001-gfmd-masses.md)
             buffer = a
             call op%multiply_complex_in_buffer(inverse_mass)
             outcome%fft_pairs = outcome%fft_pairs + 1
