@@ -107,8 +107,13 @@ module lc_contact_solver_gfmd
    real(wp), parameter :: update_forcing = 0.1_wp
    !> &solver gfmd_mass = 'auto' takes the mass per mode on grids of at least
    !> mode_mass_points points whose start has contact on at most mode_mass_contact of the
-   !> surface: PLACEHOLDER
-   real(wp), parameter :: mode_mass_points = 262144.0_wp, mode_mass_contact = 0.1_wp
+   !> surface, where it was measured to take fewer transform pairs than one mass (the Fig. 3
+   !> surface, h/lambda = 0.05 and 0.16, mu_c = 0, 0.5 and 1, tol 1e-8): at ~2 % contact
+   !> 1.08 / 0.89 / 0.75 times one mass's pairs at 256² / 512² / 1024² (six scenes summed;
+   !> 0.79 at 2048², frictionless), at 0.5 % 0.82 and 0.75 at 512² and 1024², but 1.08 and
+   !> 1.24 at 6.6 % and 1.08-1.88 at 22-32 % (docs/decisions/001-gfmd-masses.md). The
+   !> limit 4 % lies between 2.3 % (cheaper) and 6.6 % (not).
+   real(wp), parameter :: mode_mass_points = 262144.0_wp, mode_mass_contact = 0.04_wp
 
    !> What one GFMD solve did.
    type :: gfmd_outcome
