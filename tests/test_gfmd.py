@@ -162,6 +162,23 @@ def test_gfmd_steps_with_a_mass_per_mode_do_not_grow_with_the_grid():
     assert steps["mode", 256] < steps["one", 256]
 
 
+@pytest.mark.parametrize("n, load, per_mode", [(256, 0.02154, False), (512, 0.02154, True), (512, 0.1, False)],
+                         ids=["256-2%", "512-2%", "512-7%"])
+def test_gfmd_auto_takes_the_mass_per_mode_at_sparse_contact_from_512(n, load, per_mode):
+    """gfmd_mass = 'auto' takes the mass per mode (two transform pairs a step) where it was
+    measured to take fewer pairs than one mass: from 512² where the coarse start's contact is
+    at most 4 % (2 % here: 420 pairs against 421 at 512², 359 against 520 at 1024²), one
+    mass (a pair a step and one per check) on 256² (494 against 367 pairs) and at 6.6 %
+    contact (359 against 331 at 512²); h/lambda = 0.05, frictionless. The pairs per step
+    tell which ran: 1.1-1.3 with one mass (a pair a step, one a check of ten steps, and the
+    coarse start's), 2 or more with the mass per mode."""
+    h = fig3_surface(n)
+    dyn = lc.solve_areal(h, thickness=0.05, poisson=0.5, normalised_pressure=load, stress=False, tol=1e-8,
+                         method="gfmd", max_iter=20000)
+    assert dyn.converged
+    assert (dyn.fft_pairs >= 2 * dyn.iterations) == per_mode
+
+
 def test_gfmd_refuses_an_unknown_mass():
     """A gfmd_mass that is not one of the three is refused with the group, the variable, the
     value and the allowed ones, before any solve."""
