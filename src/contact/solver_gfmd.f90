@@ -676,17 +676,17 @@ contains
          & history=history(1:min(dynamics%checks, size(history))))
    end subroutine solve_by_gfmd
 
-   !> Whether &solver gfmd_mass = 'auto' takes the mass per mode: on a grid of at least
+   !> Whether &solver gfmd_mass = 'auto' takes the mass per mode: on a surface of at least
    !> mode_mass_points points whose start (the coarse start's solution) has contact on at
    !> most mode_mass_contact of the surface, but some (a start without contact, or a uniform
-   !> pressure, says nothing of the contact to come).
+   !> pressure, says nothing of the contact to come). Not on a line: measured on surfaces.
    logical function takes_mode_mass(op, p)
       type(compliance_operator), intent(in) :: op
       real(wp), intent(in) :: p(:)
       real(wp) :: points, touching
       points = real(op%grid%points(), wp)
       takes_mode_mass = .false.
-      if (points < mode_mass_points) return
+      if (op%grid%is_line() .or. points < mode_mass_points) return
       touching = real(count(p > 0.0_wp), wp)
       if (op%distributed) touching = global_sum(touching)
       takes_mode_mass = touching > 0.0_wp .and. touching <= mode_mass_contact*points
