@@ -105,9 +105,9 @@ module lc_contact_solver_gfmd
    !> the steps of the dynamics growing where the traction is solved less well).
    integer, parameter :: update_krylov = 10
    real(wp), parameter :: update_forcing = 0.1_wp
-   !> &solver gfmd_mass = 'auto' takes the mass per mode on grids of at least
+   !> &solver gfmd_mass = 'auto' takes the mass per mode on surfaces of at least
    !> mode_mass_points points whose start has contact on at most mode_mass_contact of the
-   !> surface, where it was measured to take fewer transform pairs than one mass (the Fig. 3
+   !> surface (takes_mode_mass), where it was measured to take fewer transform pairs than one mass (the Fig. 3
    !> surface, h/lambda = 0.05 and 0.16, mu_c = 0, 0.5 and 1, tol 1e-8): at ~2 % contact
    !> 1.08 / 0.89 / 0.75 times one mass's pairs at 256² / 512² / 1024² (six scenes summed;
    !> 0.79 at 2048², frictionless), at 0.5 % 0.82 and 0.75 at 512² and 1024², but 1.08 and
