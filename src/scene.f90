@@ -84,6 +84,9 @@ module lc_scene
       !> start from the solution on the grid of every second point (recursively): the
       !> contact set is then nearly known and the fine-grid iterations few
       logical :: coarse_start = .true.
+      !> GFMD's masses: auto | one (one mass for every node) | mode (a mass per mode on the
+      !> free set; lc_contact_solver_gfmd)
+      character(len=max_string) :: gfmd_mass = 'auto'
       !> threads of one solve; 0: what the job was given (lc_base_threads)
       integer :: threads = 0
       !> progress on standard error: a line per grid level and every 2 s within one

@@ -100,12 +100,13 @@ def test_gfmd_on_fig3_scenes(n, thickness, friction, load):
     assert_gfmd_agrees(n, thickness, friction, load)
 
 
-def assert_gfmd_agrees(n, thickness, friction, load):
-    """GFMD against the default solver on the Fig. 3 surface, as test_gfmd_on_fig3_scenes."""
+def assert_gfmd_agrees(n, thickness, friction, load, mass="auto"):
+    """GFMD (its masses `mass`, &solver gfmd_mass) against the default solver on the Fig. 3
+    surface, as test_gfmd_on_fig3_scenes; returns GFMD's result."""
     h = fig3_surface(n)
     keys = dict(thickness=thickness, poisson=0.5, friction=friction, normalised_pressure=load, stress=False)
     ref = lc.solve_areal(h, tol=1e-13, **keys)
-    dyn = lc.solve_areal(h, tol=TOL, method="gfmd", max_iter=20000, **keys)
+    dyn = lc.solve_areal(h, tol=TOL, method="gfmd", gfmd_mass=mass, max_iter=20000, **keys)
     assert dyn.solver == "gfmd" and dyn.converged and dyn.residual <= TOL
     bound = pressure_bound(h, thickness, 0.5, friction, TOL + 1e-13, ref.mean_pressure)
     assert np.max(np.abs(dyn.pressure - ref.pressure)) <= bound
@@ -113,6 +114,79 @@ def assert_gfmd_agrees(n, thickness, friction, load):
     assert np.count_nonzero(differ) <= 2 and np.all(ref.pressure[differ] <= bound)
     assert abs(dyn.delta_mu - ref.delta_mu) <= 1e-6 * max(abs(ref.delta_mu), 1e-3)
     assert dyn.penetration == pytest.approx(ref.penetration, rel=1e-6)
+    return dyn
+
+
+MODE_MASS_SCENES = {  # id: (mu_c, p_m/(E* h/lambda), grids), h/lambda = 0.05
+    "frictionless-2%": (0.0, 0.02154, (64, 128)),
+    "frictionless-26%": (0.0, 1.0, (64, 128)),
+    "mu05-2%": (0.5, 0.02154, (64,)),
+    "mu05-28%": (0.5, 1.0, (64, 128)),
+    "mu1-2%": (1.0, 0.02154, (64,)),
+    "mu1-32%": (1.0, 1.0, (64,)),
+}
+
+
+@pytest.mark.parametrize(
+    "n, friction, load",
+    [pytest.param(n, mu, load, id=f"{name}-{n}") for name, (mu, load, grids) in MODE_MASS_SCENES.items()
+     for n in grids],
+)
+def test_gfmd_with_a_mass_per_mode_agrees(n, friction, load):
+    """&solver gfmd_mass = 'mode' (a mass per mode on the free set) on Fig. 3 scenes of the
+    thin layer (h/lambda = 0.05), frictionless and with the friction traction's Newton
+    update: the contact of the default solver to the bounds of test_gfmd_on_fig3_scenes,
+    and two transform pairs a step (the mass's multiplier applied)."""
+    dyn = assert_gfmd_agrees(n, 0.05, friction, load, mass="mode")
+    assert dyn.fft_pairs >= 2 * dyn.iterations
+
+
+def test_gfmd_steps_with_a_mass_per_mode_do_not_grow_with_the_grid():
+    """At 2 % contact (h/lambda = 0.05, the Fig. 3 surface) one mass for every node, the
+    stiffest mode's stiffness (which doubles with the grid), leaves the modes between the
+    contact spots ever slower: its steps grow from 64² to 256² (200 to 290, measured),
+    while with a mass per mode every mode has one frequency and the steps stay flat (210,
+    180, 200). The mass per mode's steps grow by at most 1.15 (measured 0.95, the one
+    mass's 1.45: the bound fails if the mass per mode is not applied), and stay below the
+    one mass's at 256²."""
+    steps = {}
+    for mass in ("one", "mode"):
+        for n in (64, 256):
+            h = fig3_surface(n)
+            dyn = lc.solve_areal(h, thickness=0.05, poisson=0.5, normalised_pressure=0.02154, stress=False,
+                                 tol=1e-8, method="gfmd", gfmd_mass=mass, max_iter=20000)
+            assert dyn.converged
+            steps[mass, n] = dyn.iterations
+    assert steps["mode", 256] <= 1.15 * steps["mode", 64]
+    assert steps["one", 256] > 1.3 * steps["one", 64]
+    assert steps["mode", 256] < steps["one", 256]
+
+
+@pytest.mark.parametrize("n, load, per_mode", [(256, 0.02154, False), (512, 0.02154, True), (512, 0.1, False)],
+                         ids=["256-2%", "512-2%", "512-7%"])
+def test_gfmd_auto_takes_the_mass_per_mode_at_sparse_contact_from_512(n, load, per_mode):
+    """gfmd_mass = 'auto' takes the mass per mode (two transform pairs a step) where it was
+    measured to take fewer pairs than one mass: from 512² where the coarse start's contact is
+    at most 4 % (2 % here: 420 pairs against 421 at 512², 359 against 520 at 1024²), one
+    mass (a pair a step and one per check) on 256² (494 against 367 pairs) and at 6.6 %
+    contact (359 against 331 at 512²); h/lambda = 0.05, frictionless. The pairs per step
+    tell which ran: 1.1-1.3 with one mass (a pair a step, one a check of ten steps, and the
+    coarse start's), 2 or more with the mass per mode."""
+    h = fig3_surface(n)
+    dyn = lc.solve_areal(h, thickness=0.05, poisson=0.5, normalised_pressure=load, stress=False, tol=1e-8,
+                         method="gfmd", max_iter=20000)
+    assert dyn.converged
+    assert (dyn.fft_pairs >= 2 * dyn.iterations) == per_mode
+
+
+def test_gfmd_refuses_an_unknown_mass():
+    """A gfmd_mass that is not one of the three is refused with the group, the variable, the
+    value and the allowed ones, before any solve."""
+    with pytest.raises(lc.InputError, match="&solver: gfmd_mass = heavy is not allowed; allowed: 'auto', "
+                                            "'one' or 'mode'") as refused:
+        lc.solve_areal(fig3_surface(32), thickness=0.05, poisson=0.5, normalised_pressure=1.0, method="gfmd",
+                       gfmd_mass="heavy")
+    assert refused.value.code == 2
 
 
 def friction_ratio(n, thickness, friction):
@@ -209,18 +283,20 @@ def test_gfmd_refuses_a_lossy_sliding_layer():
 
 
 #: the distributed scenes: a thin incompressible layer (h/lambda = 0.05) at ~6 % contact,
-#: frictionless and with mu_c = 0.5 (friction ratio 2.3: the traction update runs)
-MPI_SCENES = {"frictionless": 0.0, "coupled": 0.5}
+#: frictionless and with mu_c = 0.5 (friction ratio 2.3: the traction update runs), with one
+#: mass and with a mass per mode (its multiplier on each rank's modes)
+MPI_SCENES = {"frictionless": (0.0, "one"), "coupled": (0.5, "one"), "frictionless-mode": (0.0, "mode"),
+              "coupled-mode": (0.5, "mode")}
 
 
-def write_gfmd_scene(directory, name, friction, output, thickness=0.05, n=64):
+def write_gfmd_scene(directory, name, friction, output, thickness=0.05, n=64, mass="auto"):
     nml = directory / f"{name}.nml"
     nml.write_text(
         f"&scene geometry = 'areal', n = {n}, ny = {n} /\n"
         f"&layer thickness = {thickness}, poisson = 0.5 /\n&friction coefficient = {friction} /\n"
         f"&profile kind = 'self_affine', hurst = 0.8, seed = 3, short_wavelength = {8 / n} /\n"
         "&loading control = 'load', normalised_pressure = 0.15 /\n"
-        "&solver method = 'gfmd', tol = 1e-13, max_iter = 20000 /\n"
+        f"&solver method = 'gfmd', gfmd_mass = '{mass}', tol = 1e-13, max_iter = 20000 /\n"
         f"&output file = '{output}', overwrite = .true., stress = .false. /\n")
     return nml
 
@@ -234,13 +310,15 @@ def test_distributed_gfmd_gives_the_serial_answer(scene, tmp_path):
     solution by ~1e-12 of the largest pressure (measured: 4e-13 against the default solver's);
     the FIRE trajectories differ by the ranks' order of summation (their step counts may
     differ), not the answer. A misplaced slab, a sum or a maximum taken on one rank only, or
-    the uniform mode looked for on the wrong rank moves the answer by percents."""
-    serial = write_gfmd_scene(tmp_path, scene, MPI_SCENES[scene], "serial.h5")
+    the uniform mode looked for on the wrong rank moves the answer by percents. With the mass
+    per mode (gfmd_mass = 'mode') each rank multiplies its own modes by the inverse masses."""
+    friction, mass = MPI_SCENES[scene]
+    serial = write_gfmd_scene(tmp_path, scene, friction, "serial.h5", mass=mass)
     done = run_serial(serial)
     assert done.returncode == 0, done.stderr
     for ranks in (1, 2, 3, 4):
         out = f"ranks{ranks}.h5"
-        nml = write_gfmd_scene(tmp_path, f"{scene}{ranks}", MPI_SCENES[scene], out)
+        nml = write_gfmd_scene(tmp_path, f"{scene}{ranks}", friction, out, mass=mass)
         done = run_mpi(ranks, [executable(), str(nml)], tmp_path)
         assert done.returncode == 0, done.stderr
         assert_same(tmp_path / "serial.h5", tmp_path / out)

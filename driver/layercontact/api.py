@@ -194,6 +194,7 @@ def solve_line(
     method: str | None = None,
     precondition: bool | None = None,
     coarse_start: bool | None = None,
+    gfmd_mass: str | None = None,
     progress: bool | None = None,
     tol: float | None = None,
     max_iter: int | None = None,
@@ -264,7 +265,9 @@ def solve_line(
     roughness). ``precondition`` applies the Fourier stiffness 1/M to the residual on the
     contact set (fewer CG iterations). ``coarse_start`` starts from the solution on the grid
     of every second point, recursively down to 512 points (fine-grid iterations nearly flat
-    in the grid size; see bench/iterations.py). ``progress=True`` prints a line to standard
+    in the grid size; see bench/iterations.py). ``gfmd_mass`` (default ``'auto'``): the
+    masses of method ``'gfmd'``, ``'one'`` for every node or a mass per ``'mode'`` on the
+    nodes off the wall (docs/namelist.md). ``progress=True`` prints a line to standard
     error for each grid level solved and every 2 s within a level (iteration, residual,
     contact fraction, elapsed time): it comes from the compiled core, so it shows in a
     terminal, not in a notebook cell.
@@ -278,8 +281,8 @@ def solve_line(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
-        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
+        gfmd_mass=gfmd_mass, progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads,
+        stress=stress, conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
         **stack_keywords("solve_line", stack))
     runs = _solve_scene(h, {"scene": {"n": h.size, "period": period}, **groups}, areal=False,
                         companion=bool(companion), stress=stress)
@@ -453,6 +456,7 @@ def solve_areal(
     method: str | None = None,
     precondition: bool | None = None,
     coarse_start: bool | None = None,
+    gfmd_mass: str | None = None,
     progress: bool | None = None,
     tol: float | None = None,
     max_iter: int | None = None,
@@ -481,8 +485,8 @@ def solve_areal(
         thickness=thickness, young=young, poisson=poisson, friction=friction, companion=companion,
         mean_pressure=mean_pressure, normalised_pressure=normalised_pressure, penetration=penetration,
         material=material, speed=speed, method=method, precondition=precondition, coarse_start=coarse_start,
-        progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads, stress=stress,
-        conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
+        gfmd_mass=gfmd_mass, progress=progress, tol=tol, max_iter=max_iter, memory=memory, threads=threads,
+        stress=stress, conductance=conductance, conductivity=conductivity, conductance_base=conductance_base,
         **stack_keywords("solve_areal", stack))
     scene = {"geometry": "areal", "nx": nx, "ny": ny, "period": lx, "period_y": ly}
     runs = _solve_scene(np.ascontiguousarray(h).ravel(), {"scene": scene, **groups}, areal=True,

@@ -263,6 +263,11 @@ VARIABLES: tuple[Variable, ...] = (
     Variable("solver", "coarse_start", "logical", ".true.", "", "both", ".true. or .false.",
              "start from the solution on the grid of every second point (recursively, down to 512)",
              "scene%solver%coarse_start"),
+    Variable("solver", "gfmd_mass", "string", "'auto'", "", "both", "'auto', 'one' or 'mode'",
+             "the masses of method `'gfmd'`: `'one'` for every node (the stiffest mode's stiffness), `'mode'` "
+             "a mass per mode, its stiffness, on the nodes off the wall (every mode at one frequency: steps "
+             "nearly flat in the grid size, two transform pairs a step), `'auto'` [below the table](#solver-method)",
+             "scene%solver%gfmd_mass", choices=("auto", "one", "mode")),
     Variable("solver", "threads", "integer", "0", "", "both", "0 <= threads <= 1024",
              "threads of one solve (OpenMP loops and FFTW's threads); 0: what the job was given "
              "(`OMP_NUM_THREADS`, else `SLURM_CPUS_PER_TASK`, else the CPUs the process may run on); "

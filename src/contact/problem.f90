@@ -25,6 +25,7 @@ module lc_contact_problem
       integer :: max_iter = 100000         !< iterations of the whole solve, every method's counted
       integer :: memory = 20               !< directions kept by the GCR and the Anderson iteration
       logical :: precondition = .true.     !< the Fourier preconditioners of the CG and the GCR
+      character(len=8) :: gfmd_mass = 'auto'   !< GFMD's masses: 'auto', 'one' or 'mode' (lc_contact_solver_gfmd)
    end type contact_problem
 
    !> The fields a solver changes: on entry the start, on exit the solution (or the best

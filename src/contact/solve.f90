@@ -312,6 +312,7 @@ contains
       problem%max_iter = scene%solver%max_iter
       problem%memory = scene%solver%memory
       problem%precondition = scene%solver%precondition
+      problem%gfmd_mass = scene%solver%gfmd_mass
       call solve_in_stages(plan%stages(1:plan%count), problem, state, outcome, progress, error)
       if (allocated(error)) return
       result%solver = outcome%path

@@ -14,9 +14,18 @@
 !> rho = p - lambda drives the motion,
 !>    m d2u/dt2 = -rho,
 !> with one mass m for every node, the largest stiffness of a mode, so that the stiffest
-!> mode has unit frequency; FIRE's damped semi-implicit Euler steps integrate it. A mass
-!> per mode equal to its stiffness (all modes at one frequency) is not used: with the
-!> wall's projection in real space it makes FIRE's step collapse (docs/decisions).
+!> mode has unit frequency (&solver gfmd_mass = 'one'); FIRE's damped semi-implicit Euler
+!> steps integrate it. Or a mass per mode, its stiffness M(q) = |K_n(q)| (every mode at unit
+!> frequency; 'mode'), on the free set F (the nodes off the wall and those it releases):
+!>    d2u/dt2 = -P_F M^-1 rho,
+!> which on the current F is the dynamics preconditioned by the symmetric positive
+!> P_F M^-1 P_F (rho = 0 off F). With the wall as the projection alone the mass per mode
+!> spreads a free node's force onto the contact nodes and FIRE's step collapses. One mass
+!> is the Nyquist mode's stiffness, which doubles with the grid, and the modes a sparse
+!> contact leaves free slow down with it: its steps grow with the grid there (200 to 410
+!> from 64² to 1024² at 2 % contact); the mass per mode's stay flat or fall (210 to 140),
+!> at two transform pairs a step: 'auto' takes it where that was measured cheaper
+!> (takes_mode_mass; docs/decisions/001-gfmd-masses.md).
 !>
 !> Friction. For the dynamics the friction traction is an external in-plane load on the
 !> contact nodes, held between updates, so the dynamics relaxes a symmetric problem (with tau in the stiffness, the
@@ -36,7 +45,7 @@
 !>
 !> Convergence is judged, as for the other solvers, on the complementarity residual of the
 !> pressure the wall carries (p = lambda, w = G_eff lambda, gap = w - b - s), not on an
-!> energy. A step costs one transform pair, a check one more.
+!> energy. A step costs one transform pair (two with the mass per mode), a check one more.
 !>
 !> On a surface shared among the ranks of an MPI job (an operator on a slab,
 !> docs/decisions/023-mpi-slabs.md) every step is the same: the points' work on the slab,
@@ -96,6 +105,15 @@ module lc_contact_solver_gfmd
    !> the steps of the dynamics growing where the traction is solved less well).
    integer, parameter :: update_krylov = 10
    real(wp), parameter :: update_forcing = 0.1_wp
+   !> &solver gfmd_mass = 'auto' takes the mass per mode on surfaces of at least
+   !> mode_mass_points points whose start has contact on at most mode_mass_contact of the
+   !> surface (takes_mode_mass), where it was measured to take fewer transform pairs than one mass (the Fig. 3
+   !> surface, h/lambda = 0.05 and 0.16, mu_c = 0, 0.5 and 1, tol 1e-8): at ~2 % contact
+   !> 1.08 / 0.89 / 0.75 times one mass's pairs at 256² / 512² / 1024² (six scenes summed;
+   !> 0.79 at 2048², frictionless), at 0.5 % 0.82 and 0.75 at 512² and 1024², but 1.08 and
+   !> 1.24 at 6.6 % and 1.08-1.88 at 22-32 % (docs/decisions/001-gfmd-masses.md). The
+   !> limit 4 % lies between 2.3 % (cheaper) and 6.6 % (not).
+   real(wp), parameter :: mode_mass_points = 262144.0_wp, mode_mass_contact = 0.04_wp
 
    !> What one GFMD solve did.
    type :: gfmd_outcome
@@ -123,7 +141,7 @@ contains
    !> history(k) receives the residual of the k-th check (every check_interval steps) when
    !> present.
    subroutine gfmd(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, p, w, gap, outcome, error, &
-         & history, progress)
+         & history, progress, mode_mass)
       type(compliance_operator), intent(inout) :: op
       real(wp), contiguous, intent(in) :: b(:)
       logical, intent(in) :: load_control
@@ -137,7 +155,10 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
+      !> a mass per mode on the free set (mode_mass) instead of one mass for every node
+      logical, intent(in), optional :: mode_mass
       complex(wp), allocatable :: normal(:), tangential(:), stiffness(:), coupling(:), inverse_full(:)
+      complex(wp), allocatable :: inverse_mass(:)
       real(wp), allocatable :: u(:), v(:), a(:), lambda(:), p_best(:)
       real(wp), allocatable :: tau(:), offset(:), basis(:, :), change(:), response(:)
       logical, allocatable :: inside(:)
@@ -145,7 +166,7 @@ contains
       real(wp) :: dt, alpha, power, v_norm, a_norm, s_best, uniform, b_max, mass, residual, friction
       real(wp) :: imbalance, mismatch, mismatch_floor, contact_points, points, sums(3), maxima(2)
       integer :: step, since_negative, checks, n, j, since_update
-      logical :: with_traction, across_ranks
+      logical :: with_traction, across_ranks, per_mode
 
       n = size(p)
       across_ranks = op%distributed
@@ -176,6 +197,14 @@ contains
       if (across_ranks) call max_over_ranks(maxima)
       b_max = maxima(1)
       mass = maxima(2)
+      per_mode = .false.
+      if (present(mode_mass)) per_mode = mode_mass
+      if (per_mode) then
+         ! the mass of a mode its stiffness |K_n(q)| (every mode at unit frequency); the
+         ! modes without stiffness (the uniform mode under load control) get the smallest
+         call mode_masses(stiffness, across_ranks, inverse_mass)
+         mass = 1.0_wp
+      end if
       uniform = merge(mean_pressure, 0.0_wp, load_control)
       ! start from the displacement of the guess (its friction traction held); under load
       ! control the wall is placed where it touches the highest point of the gap, and the
@@ -223,6 +252,21 @@ contains
             lambda(j) = merge(max(buffer(j), 0.0_wp), 0.0_wp, u(j) <= b(j) + s)
             a(j) = -(buffer(j) - lambda(j))/mass   ! -rho/m
          end do
+         if (with_traction) imbalance = mass*maxval(abs(a))   ! max |rho|
+         if (per_mode) then
+            ! a = P_F M^-1 (-rho): the mass per mode's multiplier, then the free set F, the
+            ! nodes off the wall and those it releases (p < 0); on the others rho = 0, so
+            ! that rho = P_F rho already. One more transform pair: the wall's reaction (the
+            ! mask of the contact nodes) sits between K_n and M^-1, and the mask of F
+            ! between M^-1 and the next step's K_n (docs/decisions/001-gfmd-masses.md)
+            buffer = a
+            call op%multiply_complex_in_buffer(inverse_mass)
+            outcome%fft_pairs = outcome%fft_pairs + 1
+            !$omp simd
+            do j = 1, n
+               a(j) = merge(buffer(j), 0.0_wp, u(j) > b(j) + s .or. a(j) /= 0.0_wp)
+            end do
+         end if
          ! FIRE: mix the velocity towards the force, grow the step while the power is
          ! positive, stop and shrink it when it turns negative
          ! (the power and the two norms in one sum over the ranks)
@@ -278,7 +322,7 @@ contains
             ! the dynamics has relaxed the problem of the current traction well enough
             ! against what the traction itself is off by: update it
             since_update = since_update + 1
-            maxima = [mass*maxval(abs(a)), maxval(abs(friction*lambda - tau))]   ! max |rho|, the mismatch
+            maxima = [imbalance, maxval(abs(friction*lambda - tau))]   ! max |rho|, the mismatch
             if (across_ranks) call max_over_ranks(maxima)
             imbalance = maxima(1)
             mismatch = maxima(2)
@@ -549,6 +593,24 @@ contains
       end if
    end function gfmd_refusal
 
+   !> 1/M(q) of the mass per mode M(q) = |K_n(q)|, the modes with K_n = 0 (the uniform mode
+   !> under load control) given the smallest nonzero |K_n| of the grid (on a slab: of every
+   !> rank's modes).
+   subroutine mode_masses(stiffness, across_ranks, inverse_mass)
+      complex(wp), intent(in) :: stiffness(:)
+      logical, intent(in) :: across_ranks
+      complex(wp), allocatable, intent(out) :: inverse_mass(:)
+      real(wp) :: smallest
+      smallest = minval(abs(stiffness), mask=abs(stiffness) > 0.0_wp)   ! (huge on a rank without any)
+      if (across_ranks) smallest = -global_max(-smallest)
+      allocate (inverse_mass(size(stiffness)))
+      where (abs(stiffness) > 0.0_wp)
+         inverse_mass = 1.0_wp/abs(stiffness)
+      elsewhere
+         inverse_mass = 1.0_wp/smallest
+      end where
+   end subroutine mode_masses
+
    !> The largest |Im g|/Re g over the multipliers g /= 0 (huge where Re g <= 0).
    pure real(wp) function stiffness_phase(g) result(ratio)
       complex(wp), intent(in) :: g(:)
@@ -596,14 +658,39 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(gfmd_outcome) :: dynamics
       real(wp), allocatable :: history(:)
+      logical :: per_mode
+      select case (trim(problem%gfmd_mass))
+      case ('mode')
+         per_mode = .true.
+      case ('one')
+         per_mode = .false.
+      case default   ! 'auto'
+         per_mode = takes_mode_mass(problem%op, state%p)
+      end select
       allocate (history(budget))
       call gfmd(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
-         & problem%tol, budget, state%p, state%w, state%gap, dynamics, error, history, progress)
+         & problem%tol, budget, state%p, state%w, state%gap, dynamics, error, history, progress, per_mode)
       if (allocated(error)) return
       outcome = solve_outcome(converged=dynamics%converged, iterations=dynamics%iterations, &
          & outer_iterations=dynamics%updates, fft_pairs=dynamics%fft_pairs, residual=dynamics%residual, &
          & history=history(1:min(dynamics%checks, size(history))))
    end subroutine solve_by_gfmd
+
+   !> Whether &solver gfmd_mass = 'auto' takes the mass per mode: on a surface of at least
+   !> mode_mass_points points whose start (the coarse start's solution) has contact on at
+   !> most mode_mass_contact of the surface, but some (a start without contact, or a uniform
+   !> pressure, says nothing of the contact to come). Not on a line: measured on surfaces.
+   logical function takes_mode_mass(op, p)
+      type(compliance_operator), intent(in) :: op
+      real(wp), intent(in) :: p(:)
+      real(wp) :: points, touching
+      points = real(op%grid%points(), wp)
+      takes_mode_mass = .false.
+      if (op%grid%is_line() .or. points < mode_mass_points) return
+      touching = real(count(p > 0.0_wp), wp)
+      if (op%distributed) touching = global_sum(touching)
+      takes_mode_mass = touching > 0.0_wp .and. touching <= mode_mass_contact*points
+   end function takes_mode_mass
 
    pure function gfmd_name(self) result(name)
       class(gfmd_solver), intent(in) :: self
