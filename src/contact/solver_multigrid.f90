@@ -1324,24 +1324,33 @@ contains
       tension = totals(3) > 0.0_wp
    end subroutine examine_over_ranks
 
-   !> orthogonalise on a slab: each beta_k summed over the ranks before the column is
-   !> subtracted (one message a column: Gram-Schmidt's columns in turn).
+   !> orthogonalise on a slab, by classical Gram-Schmidt: every beta_k = (I kz, kdirs_k) of
+   !> the kz given, their sums over the ranks in one message, then the columns subtracted.
+   !> The stored images are orthonormal on the free points (each orthogonalised and scaled
+   !> to a unit image when it was stored, on the same free points), so these are modified
+   !> Gram-Schmidt's betas in exact arithmetic; one message an iteration instead of one a
+   !> column (up to gcr_memory - 1). The step that follows is exact whatever is left of the
+   !> images' orthogonality: it minimises the residual along kz and updates it by kz.
    subroutine orthogonalise_over_ranks(z, kz, dirs, kdirs, free)
       real(wp), contiguous, intent(inout) :: z(:), kz(:)
       real(wp), contiguous, intent(in) :: dirs(:, :), kdirs(:, :), free(:)
-      real(wp) :: beta
+      real(wp) :: beta(size(dirs, 2)), total
       integer :: k, j
-      do k = 1, size(dirs, 2)
-         beta = 0.0_wp
-         !$omp simd reduction(+:beta)
+      if (size(beta) == 0) return
+      do k = 1, size(beta)
+         total = 0.0_wp
+         !$omp simd reduction(+:total)
          do j = 1, size(z)
-            beta = beta + free(j)*kz(j)*kdirs(j, k)
+            total = total + free(j)*kz(j)*kdirs(j, k)
          end do
-         beta = global_sum(beta)
+         beta(k) = total
+      end do
+      call sum_over_ranks(beta)
+      do k = 1, size(beta)
          !$omp simd
          do j = 1, size(z)
-            z(j) = z(j) - beta*dirs(j, k)
-            kz(j) = kz(j) - beta*kdirs(j, k)
+            z(j) = z(j) - beta(k)*dirs(j, k)
+            kz(j) = kz(j) - beta(k)*kdirs(j, k)
          end do
       end do
    end subroutine orthogonalise_over_ranks
