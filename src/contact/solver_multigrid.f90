@@ -62,7 +62,7 @@ module lc_contact_solver_multigrid
    private
    public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
    public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, whole_operator, solves_on_slabs
-   public :: compliance_rise, loss_profile, loss_of
+   public :: compliance_rise, loss_profile, loss_of, orthogonalise, orthogonalise_over_ranks
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
