@@ -915,7 +915,7 @@ contains
    type(loss_profile) function loss_of(op) result(profile)
       type(compliance_operator), intent(in) :: op
       type(held_modes) :: modes
-      real(wp), allocatable :: before(:), rows(:)
+      real(wp), allocatable :: before(:), rows(:), losses(:)
       real(wp) :: loss, summary(4), running
       integer :: i, nkx, kx, ky, last, position
       nkx = op%grid%nx/2 + 1
@@ -934,12 +934,16 @@ contains
       modes = modes_of(op)
       last = modes%x_start + modes%columns - 1
       ! (each row's largest on this rank's columns; then before(ky): the largest before this
-      ! rank's first mode of row ky, in the whole spectrum's order)
-      allocate (rows(0:op%grid%ny - 1), before(0:op%grid%ny - 1))
+      ! rank's first mode of row ky, in the whole spectrum's order. Each mode's loss kept for
+      ! the second walk, -1 where it has none: one division a mode, as serially)
+      allocate (rows(0:op%grid%ny - 1), before(0:op%grid%ny - 1), losses(op%nk))
       rows = 0.0_wp
       do kx = modes%x_start, last
          do ky = 0, op%grid%ny - 1
-            if (loss_at(kx, ky, loss)) rows(ky) = max(rows(ky), loss)
+            losses(held_index(modes, kx, ky)) = -1.0_wp
+            if (.not. loss_at(kx, ky, loss)) cycle
+            losses(held_index(modes, kx, ky)) = loss
+            rows(ky) = max(rows(ky), loss)
          end do
       end do
       before = rows
@@ -954,7 +958,8 @@ contains
       position = -1
       do kx = modes%x_start, last
          do ky = 0, op%grid%ny - 1
-            if (.not. loss_at(kx, ky, loss)) cycle
+            loss = losses(held_index(modes, kx, ky))
+            if (loss < 0.0_wp) cycle
             if (loss > before(ky)*(1.0_wp + 1.0e-9_wp)) position = max(position, ky*nkx + kx)
             before(ky) = max(before(ky), loss)
             call summarise(kx, ky, loss)
