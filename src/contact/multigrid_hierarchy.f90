@@ -482,11 +482,15 @@ contains
          ! (the modes in the order they are stored: the columns in turn on a slab, the rows
          ! on a whole grid; a column's sum runs over ky in order either way)
          if (modes%distributed) then
+            ! (ky in order, its rows 0..my/2 and then the negative ones, -(my - 1)/2..-1,
+            ! which lie at the column's end: no division a mode)
             do kx = modes%x_start, last
                base = (kx - modes%x_start)*modes%ny + 1
-               do ky = 0, my - 1
-                  sy = merge(ky, ky - my, 2*ky <= my)
-                  call take(kx, sy, base + modulo(sy, modes%ny))
+               do ky = 0, my/2
+                  call take(kx, ky, base + ky)
+               end do
+               do ky = my/2 + 1, my - 1
+                  call take(kx, ky - my, base + modes%ny + ky - my)
                end do
             end do
          else
