@@ -66,8 +66,9 @@ import time
 # GCR on the slabs, not modelled here, orthogonalises in one message too: it took one a
 # stored column, up to 9, before.)
 ALLREDUCES_PER_ITERATION = 10
-#: The share of the serial set-up that does not fall with P (model_setup), from the 2048²
-#: set-ups measured serially and on two ranks (bench/mpi.py, docs/performance.md)
+#: The share of the serial set-up that does not fall with P (model_setup): 0, the set-up's
+#: work divided among the ranks; the shares fitted to this machine's serial and two-rank
+#: set-ups (bench/mpi.py) are quoted in docs/performance.md, 'Beyond one node: a model'
 SETUP_FIXED = 0.0
 
 MIB = 2.0**20
