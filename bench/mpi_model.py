@@ -20,7 +20,11 @@ The model (model_* functions, which take every measured part as an argument):
   fine iterations are their transform pairs (the solve's pairs shared between the coarse
   start and the fine iterations as their time is) times the fitted pair, plus the passes
   between the transforms, which scale as N;
-- on P ranks: set-up, local transforms and passes divided by P; each pair's two global
+- the set-up on P ranks: the share `--setup-fixed` of the serial set-up does not fall with
+  P (an Amdahl term: what every rank does alike, its waits at the set-up's reductions and
+  FFTW-MPI's planning), the rest falls as 1/P; the share is fitted to the measured serial
+  and two-rank set-ups, fixed = 2 S_2/S_1 - 1;
+- on P ranks: local transforms and passes divided by P; each pair's two global
   transposes (FFTW_MPI_TRANSPOSED_OUT/IN) move the half spectrum twice, in total
   2 x 16 B x nx/2 x ny x (P-1)/P, a rank's share 1/P of it, over the link's bandwidth,
   plus P-1 messages a transpose per rank at the latency; every iteration's MPI_Allreduce
@@ -57,8 +61,15 @@ import time
 # two (the centre's sums, then the norm and the step's product); update; scale_to_load's
 # field_points; one fewer where the compiler skips merge's unused field_points). An
 # iteration that lets points in adds reorthonormalise's 3, one after a change of the set
-# history_products, clip_negative, total_pressure and another evaluate (8).
+# history_products, clip_negative, total_pressure and another evaluate (8). The history's
+# products (history_products) are one message for all the stored columns. (The multigrid's
+# GCR on the slabs, not modelled here, orthogonalises in one message too: it took one a
+# stored column, up to 9, before.)
 ALLREDUCES_PER_ITERATION = 10
+#: The share of the serial set-up that does not fall with P (model_setup): 0, the set-up's
+#: work divided among the ranks; the shares fitted to this machine's serial and two-rank
+#: set-ups (bench/mpi.py) are quoted in docs/performance.md, 'Beyond one node: a model'
+SETUP_FIXED = 0.0
 
 MIB = 2.0**20
 #: src/contact/solve.f90: a coarse level is solved on the slabs from this many rows a rank,
@@ -152,13 +163,19 @@ def model_serial(n: int, coefficient: float, ref: dict) -> dict:
             "iterations": ref["iterations"]}
 
 
+def model_setup(serial: float, ranks: int, fixed: float) -> float:
+    """The set-up on P ranks (s): its share `fixed` whatever P, the rest over P."""
+    return serial if ranks == 1 else serial * (fixed + (1.0 - fixed) / ranks)
+
+
 def model_time(n: int, ranks: int, coefficient: float, ref: dict, bandwidth: float, latency: float,
                allreduces: int = ALLREDUCES_PER_ITERATION) -> dict:
-    """Solve time on P ranks (s) and its parts: set-up, coarse start (model_coarse), fine
-    iterations (local transforms, transposes, passes, reductions)."""
+    """Solve time on P ranks (s) and its parts: set-up (model_setup, ref["setup_fixed"]),
+    coarse start (model_coarse), fine iterations (local transforms, transposes, passes,
+    reductions)."""
     s = model_serial(n, coefficient, ref)
     parts = {
-        "setup": s["setup"] / ranks,
+        "setup": model_setup(s["setup"], ranks, ref.get("setup_fixed", 0.0)),
         "coarse": model_coarse(n, ranks, s, bandwidth, latency, allreduces),
         "fft": s["fine_pairs"] * s["pair"] / ranks,
         "transpose": s["fine_pairs"] * transpose_seconds(n, n, ranks, bandwidth, latency),
@@ -187,6 +204,17 @@ def coarse_dominates_from(n: int, coefficient: float, ref: dict, bandwidth: floa
     while ranks <= 2**20:
         parts = model_time(n, ranks, coefficient, ref, bandwidth, latency)
         if parts["coarse"] > 0.5 * parts["total"]:
+            return ranks
+        ranks *= 2
+    return 0
+
+
+def setup_dominates_from(n: int, coefficient: float, ref: dict, bandwidth: float, latency: float) -> int:
+    """The smallest power-of-two P at which the set-up takes more than half the solve."""
+    ranks = 1
+    while ranks <= 2**20:
+        parts = model_time(n, ranks, coefficient, ref, bandwidth, latency)
+        if parts["setup"] > 0.5 * parts["total"]:
             return ranks
         ranks *= 2
     return 0
@@ -250,13 +278,15 @@ def main() -> None:
                         metavar=("N", "SOLVE_S", "ITERATIONS", "PAIRS"))
     parser.add_argument("--split", type=float, nargs=3, default=[0.05, 0.13, 0.82],
                         metavar=("SETUP", "COARSE", "FINE"))
+    parser.add_argument("--setup-fixed", type=float, default=SETUP_FIXED,
+                        help="share of the serial set-up that does not fall with P (2 S_2/S_1 - 1)")
     parser.add_argument("--serial-mib", type=float, default=535.0, help="serial peak RSS of the reference")
     parser.add_argument("--two-ranks", type=float, nargs=3, default=[10.55, 431.0, 295.0],
                         metavar=("SOLVE_S", "RANK0_MIB", "RANK1_MIB"))
     args = parser.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.1f}")
     ref = {"n": int(args.reference[0]), "solve": args.reference[1], "iterations": args.reference[2],
-           "pairs": args.reference[3], "split": args.split}
+           "pairs": args.reference[3], "split": args.split, "setup_fixed": args.setup_fixed}
     coefficient = args.fft_coefficient or measure_fft_coefficient()
     memcpy = args.memcpy_bandwidth or measure_memcpy_bandwidth()
     doubles = args.serial_mib * MIB / 8.0 / ref["n"] ** 2
@@ -303,6 +333,9 @@ def main() -> None:
         fit = ("rank 0 alone does not fit" if room < 0
                else f"{1 + int(room // m['other'])} ranks fit on rank 0's node")
         best, speed_up = best_speed_up(n, coefficient, ref, args.bandwidth, args.latency)
+        q = setup_dominates_from(n, coefficient, ref, args.bandwidth, args.latency)
+        print(f"{n}²: the set-up ({100 * args.setup_fixed:.0f} % of it fixed) takes over half the solve from "
+              f"P = {q or 'none up to 2^20'}")
         print(f"{n}²: the coarse start takes over half the solve from P = {p or 'none up to 2^20'}; "
               f"the largest speed-up {speed_up:.0f}x at P = {best}; at P = {max(args.ranks)} "
               f"{fit} ({m['rank0'] / 2**30:.0f} GiB rank 0, {m['other'] / 2**30:.0f} GiB each other rank)")

@@ -226,7 +226,8 @@ def slabs_program() -> Path:
 def test_the_slabs_precondition_as_the_whole_grid(ranks, slabs_program):
     """The hierarchy on the slabs against the whole grid's on every rank
     (tests/fortran/test_multigrid_slabs.f90): B r, K x and x.K x, the interpolation onto the
-    slab, for a real symbol, a complex one, and one smoothed by rows, to 1e-12."""
+    slab, for a real symbol, a complex one, and one smoothed by rows, and the GCR's
+    orthogonalisation in one message against the whole grid's Gram-Schmidt, to 1e-12."""
     done = subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(slabs_program)], capture_output=True,
                           text=True, env=launcher_env(), timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr

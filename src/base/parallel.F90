@@ -18,7 +18,7 @@ module lc_base_parallel
 #ifdef LC_MPI
    use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_Comm_rank, MPI_Comm_size, MPI_Allreduce, MPI_Allgatherv, &
       & MPI_Gatherv, MPI_Scatterv, MPI_Bcast, MPI_Abort, MPI_Initialized, MPI_IN_PLACE, MPI_SUM, MPI_MAX, MPI_MIN, &
-      & MPI_LOR, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_Barrier, MPI_Allgather, MPI_Alltoallv, MPI_Exscan
+      & MPI_LOR, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_Barrier, MPI_Allgather, MPI_Alltoallv, MPI_Exscan, MPI_Op
 #endif
    implicit none (type, external)
    private
@@ -234,34 +234,41 @@ contains
    subroutine min_over_lower_ranks(x)
       real(wp), contiguous, intent(inout) :: x(:)
 #ifdef LC_MPI
-      real(wp), allocatable :: below(:)
-      if (ranks > 1) then
-         allocate (below(size(x)))
-         call MPI_Exscan(x, below, size(x), MPI_DOUBLE_PRECISION, MPI_MIN, communicator)
-         ! (MPI leaves the first rank's result undefined)
-         if (rank == 0) below = huge(1.0_wp)
-         x = below
-         return
-      end if
-#endif
+      call over_lower_ranks(x, MPI_MIN, huge(1.0_wp))
+#else
       x = huge(1.0_wp)
+#endif
    end subroutine min_over_lower_ranks
 
    !> x <- the largest of the lower ranks' x, element by element (-huge on the first rank).
    subroutine max_over_lower_ranks(x)
       real(wp), contiguous, intent(inout) :: x(:)
 #ifdef LC_MPI
+      call over_lower_ranks(x, MPI_MAX, -huge(1.0_wp))
+#else
+      x = -huge(1.0_wp)
+#endif
+   end subroutine max_over_lower_ranks
+#ifdef LC_MPI
+
+   !> x <- the lower ranks' x combined by `operation`, element by element (one MPI_Exscan);
+   !> `first` on the first rank, which has none below it (and on one rank).
+   subroutine over_lower_ranks(x, operation, first)
+      real(wp), contiguous, intent(inout) :: x(:)
+      type(MPI_Op), intent(in) :: operation
+      real(wp), intent(in) :: first
       real(wp), allocatable :: below(:)
-      if (ranks > 1) then
-         allocate (below(size(x)))
-         call MPI_Exscan(x, below, size(x), MPI_DOUBLE_PRECISION, MPI_MAX, communicator)
-         if (rank == 0) below = -huge(1.0_wp)
-         x = below
+      if (ranks == 1) then
+         x = first
          return
       end if
+      allocate (below(size(x)))
+      call MPI_Exscan(x, below, size(x), MPI_DOUBLE_PRECISION, operation, communicator)
+      ! (MPI leaves the first rank's result undefined)
+      if (rank == 0) below = first
+      x = below
+   end subroutine over_lower_ranks
 #endif
-      x = -huge(1.0_wp)
-   end subroutine max_over_lower_ranks
 
    logical function global_any(x) result(any_rank)
       logical, intent(in) :: x

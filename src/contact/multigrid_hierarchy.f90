@@ -469,7 +469,7 @@ contains
       real(wp), intent(in), optional :: odd(:)
       real(wp), intent(out) :: mu_x, mu_y, mu_both
       real(wp) :: mean, bound, factors(3)
-      real(wp) :: column(0:mx/2)
+      real(wp) :: column(0:mx/2), shared(0:mx/2 + 1)
       integer :: kx, ky, sy, pass, last, base
       last = min(mx/2, modes%x_start + modes%columns - 1)
       column = 0.0_wp
@@ -482,11 +482,15 @@ contains
          ! (the modes in the order they are stored: the columns in turn on a slab, the rows
          ! on a whole grid; a column's sum runs over ky in order either way)
          if (modes%distributed) then
+            ! (ky in order, its rows 0..my/2 and then the negative ones, -(my - 1)/2..-1,
+            ! which lie at the column's end: no division a mode)
             do kx = modes%x_start, last
                base = (kx - modes%x_start)*modes%ny + 1
-               do ky = 0, my - 1
-                  sy = merge(ky, ky - my, 2*ky <= my)
-                  call take(kx, sy, base + modulo(sy, modes%ny))
+               do ky = 0, my/2
+                  call take(kx, ky, base + ky)
+               end do
+               do ky = my/2 + 1, my - 1
+                  call take(kx, ky - my, base + modes%ny + ky - my)
                end do
             end do
          else
@@ -501,8 +505,13 @@ contains
          ! (the second pass takes the Jacobi diagonal for `mean`)
          if (pass == 1) then
             if (modes%distributed) then
-               call sum_over_ranks(column)
-               bound = global_max(bound)
+               ! (a column's sum is its rank's, at least 0, and 0 on the others: its largest
+               ! over the ranks, exactly; one message with the bound)
+               shared(0:mx/2) = column
+               shared(mx/2 + 1) = bound
+               call max_over_ranks(shared)
+               column = shared(0:mx/2)
+               bound = shared(mx/2 + 1)
             end if
             do kx = 0, mx/2
                mean = mean + column(kx)

@@ -172,7 +172,11 @@ contains
       end do
       q_min = minval(q_ranges(1, :))
       q_max = maxval(q_ranges(2, :))
-      if (.not. op%distributed) call mirror_rows(op, nkx)
+      if (op%distributed) then
+         call mirror_columns(op)
+      else
+         call mirror_rows(op, nkx)
+      end if
       allocate (op%preconditioner(op%nk))
       call advise_huge_pages(op%preconditioner)
       ! (an elastic law has one compliance: no factor)
@@ -212,9 +216,10 @@ contains
       do i = first, last
          call op%fft%mode_indices(i, mx, my)
          if (mx == 0 .and. my == 0) cycle
-         ! (a whole surface's row my > ny/2 has the q_y of row ny - my negated, and the
-         ! multipliers depend on |q| and q_x alone: mirror_rows copies it, the same bits)
-         if (.not. op%distributed .and. 2*my > op%grid%ny) cycle
+         ! (a row my > ny/2 has the q_y of row ny - my negated, and the multipliers depend
+         ! on |q| and q_x alone: mirror_rows, or on a slab mirror_columns, copies it, the
+         ! same bits)
+         if (2*my > op%grid%ny) cycle
          call op%grid%wavevector(my*nkx + mx + 1, qx, qy)
          q = hypot(qx, qy)
          q_range(1) = min(q_range(1), q)
@@ -273,6 +278,29 @@ contains
       op%metric(row + 1:row + nkx) = op%metric(mirror + 1:mirror + nkx)
       if (op%coupled) op%full(row + 1:row + nkx) = op%full(mirror + 1:mirror + nkx)
    end subroutine mirror_row
+
+   !> mirror_rows on a slab: in each of this rank's columns of the transposed half spectrum
+   !> (all ny rows, my fastest) the rows my > ny/2 from the rows ny - my of the same column.
+   subroutine mirror_columns(op)
+      type(compliance_operator), intent(inout) :: op
+      integer :: column
+      !$omp parallel do schedule(static) if(op%nk >= parallel_points)
+      do column = 0, op%fft%nkx_local - 1
+         call mirror_column(op, column*op%grid%ny)
+      end do
+   end subroutine mirror_columns
+
+   !> mirror_columns on the column whose row my is the mode base + my + 1.
+   subroutine mirror_column(op, base)
+      type(compliance_operator), intent(inout) :: op
+      integer, intent(in) :: base
+      integer :: my, ny
+      ny = op%grid%ny
+      do my = ny/2 + 1, ny - 1
+         op%metric(base + my + 1) = op%metric(base + ny - my + 1)
+         if (op%coupled) op%full(base + my + 1) = op%full(base + ny - my + 1)
+      end do
+   end subroutine mirror_column
 
    !> The quantities derived from the multipliers: diagonal, largest (the real-space column
    !> is made when a CG solve asks for it: prepare_cg).

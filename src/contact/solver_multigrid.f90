@@ -62,7 +62,7 @@ module lc_contact_solver_multigrid
    private
    public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
    public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, whole_operator, solves_on_slabs
-   public :: compliance_rise, loss_profile, loss_of
+   public :: compliance_rise, loss_profile, loss_of, orthogonalise, orthogonalise_over_ranks
 
    !> Jacobi smooths K_II where the stiffness rises with |q|; a compliance that falls with |q|
    !> (op%metric_falls) is more than needed: it may rise over the grid by up to this factor
@@ -915,7 +915,7 @@ contains
    type(loss_profile) function loss_of(op) result(profile)
       type(compliance_operator), intent(in) :: op
       type(held_modes) :: modes
-      real(wp), allocatable :: before(:), rows(:)
+      real(wp), allocatable :: before(:), rows(:), losses(:)
       real(wp) :: loss, summary(4), running
       integer :: i, nkx, kx, ky, last, position
       nkx = op%grid%nx/2 + 1
@@ -934,12 +934,16 @@ contains
       modes = modes_of(op)
       last = modes%x_start + modes%columns - 1
       ! (each row's largest on this rank's columns; then before(ky): the largest before this
-      ! rank's first mode of row ky, in the whole spectrum's order)
-      allocate (rows(0:op%grid%ny - 1), before(0:op%grid%ny - 1))
+      ! rank's first mode of row ky, in the whole spectrum's order. Each mode's loss kept for
+      ! the second walk, -1 where it has none: one division a mode, as serially)
+      allocate (rows(0:op%grid%ny - 1), before(0:op%grid%ny - 1), losses(op%nk))
       rows = 0.0_wp
       do kx = modes%x_start, last
          do ky = 0, op%grid%ny - 1
-            if (loss_at(kx, ky, loss)) rows(ky) = max(rows(ky), loss)
+            losses(held_index(modes, kx, ky)) = -1.0_wp
+            if (.not. loss_at(kx, ky, loss)) cycle
+            losses(held_index(modes, kx, ky)) = loss
+            rows(ky) = max(rows(ky), loss)
          end do
       end do
       before = rows
@@ -954,7 +958,8 @@ contains
       position = -1
       do kx = modes%x_start, last
          do ky = 0, op%grid%ny - 1
-            if (.not. loss_at(kx, ky, loss)) cycle
+            loss = losses(held_index(modes, kx, ky))
+            if (loss < 0.0_wp) cycle
             if (loss > before(ky)*(1.0_wp + 1.0e-9_wp)) position = max(position, ky*nkx + kx)
             before(ky) = max(before(ky), loss)
             call summarise(kx, ky, loss)
@@ -1324,24 +1329,33 @@ contains
       tension = totals(3) > 0.0_wp
    end subroutine examine_over_ranks
 
-   !> orthogonalise on a slab: each beta_k summed over the ranks before the column is
-   !> subtracted (one message a column: Gram-Schmidt's columns in turn).
+   !> orthogonalise on a slab, by classical Gram-Schmidt: every beta_k = (I kz, kdirs_k) of
+   !> the kz given, their sums over the ranks in one message, then the columns subtracted.
+   !> The stored images are orthonormal on the free points (each orthogonalised and scaled
+   !> to a unit image when it was stored, on the same free points), so these are modified
+   !> Gram-Schmidt's betas in exact arithmetic; one message an iteration instead of one a
+   !> column (up to gcr_memory - 1). The step that follows is exact whatever is left of the
+   !> images' orthogonality: it minimises the residual along kz and updates it by kz.
    subroutine orthogonalise_over_ranks(z, kz, dirs, kdirs, free)
       real(wp), contiguous, intent(inout) :: z(:), kz(:)
       real(wp), contiguous, intent(in) :: dirs(:, :), kdirs(:, :), free(:)
-      real(wp) :: beta
+      real(wp) :: beta(size(dirs, 2)), total
       integer :: k, j
-      do k = 1, size(dirs, 2)
-         beta = 0.0_wp
-         !$omp simd reduction(+:beta)
+      if (size(beta) == 0) return
+      do k = 1, size(beta)
+         total = 0.0_wp
+         !$omp simd reduction(+:total)
          do j = 1, size(z)
-            beta = beta + free(j)*kz(j)*kdirs(j, k)
+            total = total + free(j)*kz(j)*kdirs(j, k)
          end do
-         beta = global_sum(beta)
+         beta(k) = total
+      end do
+      call sum_over_ranks(beta)
+      do k = 1, size(beta)
          !$omp simd
          do j = 1, size(z)
-            z(j) = z(j) - beta*dirs(j, k)
-            kz(j) = kz(j) - beta*kdirs(j, k)
+            z(j) = z(j) - beta(k)*dirs(j, k)
+            kz(j) = kz(j) - beta(k)*kdirs(j, k)
          end do
       end do
    end subroutine orthogonalise_over_ranks

@@ -16,8 +16,16 @@
 !> A share added into the wrong coarse row, a halo row missed or a mode of the transposed
 !> spectrum read at the wrong index changes B r by a fraction of its size.
 !>
+!> The GCR's orthogonalisation of a direction and its image against the stored unit images
+!> on the free points (orthogonalise_over_ranks: classical Gram-Schmidt, every product summed
+!> over the ranks in one message) is checked against the whole grid's modified Gram-Schmidt
+!> (orthogonalise) on the same fields; a product left unsummed misses the other slabs'
+!> share of it, half of it on two ranks.
+!>
 !> Tolerance: 1e-12 of the largest entry: the same sums in another order (the distributed
-!> transforms, the ranks' shares added after their rows).
+!> transforms, the ranks' shares added after their rows; Gram-Schmidt's products taken
+!> before, not between, the subtractions, the same in exact arithmetic for orthonormal
+!> images, apart by a few roundings of the products here).
 program test_multigrid_slabs
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
@@ -26,6 +34,7 @@ program test_multigrid_slabs
    use lc_contact_operator, only: compliance_operator
    use lc_contact_multigrid_hierarchy, only: hierarchy, build_hierarchy, set_grid, set_contact, precondition, &
       & apply_stiffness, interpolate, interpolate_onto_slab
+   use lc_contact_solver_multigrid, only: orthogonalise, orthogonalise_over_ranks
    use lc_test_checks, only: check, finish
    implicit none (type, external)
 
@@ -39,6 +48,7 @@ program test_multigrid_slabs
    call check_slabs('real symbol, Jacobi steps', .false., .false.)
    call check_slabs('complex symbol, Jacobi steps', .true., .false.)
    call check_slabs('complex symbol, smoothed by rows', .true., .true.)
+   call check_orthogonalisation()
    call finish('multigrid on slabs (rank ' // achar(iachar('0') + this_rank()) // ')')
    call parallel_end()
 
@@ -106,6 +116,46 @@ contains
       call check(maxval(abs(us - uw(first:last))) <= tol_identity*maxval(abs(uw)), &
          & what // ': the interpolation onto the slab is the whole grid''s')
    end subroutine check_slabs
+
+   !> The GCR's orthogonalisation on the slabs against the whole grid's (see the header): four
+   !> stored images made orthonormal on the free points (about 70 % of them) by the whole
+   !> grid's Gram-Schmidt, then a direction z and its image kz orthogonalised against them.
+   subroutine check_orthogonalisation()
+      integer, parameter :: stored = 4
+      type(compliance_operator) :: slab
+      real(wp), allocatable :: free(:), dirs(:, :), kdirs(:, :), zw(:), kzw(:), zs(:), kzs(:)
+      real(wp) :: norm, leftover
+      integer :: i, k, first, last
+      if (.not. planned('orthogonalisation', slab, .true.)) return
+      first = nx*slab%fft%y_start + 1
+      last = nx*(slab%fft%y_start + slab%fft%ny_local)
+      free = [(merge(0.0_wp, 1.0_wp, mod(i*7919, 10) < 3), i = 1, nx*ny)]
+      allocate (dirs(nx*ny, stored), kdirs(nx*ny, stored))
+      do k = 1, stored
+         dirs(:, k) = [(sin(0.37_wp*k*i) + 0.2_wp*k, i = 1, nx*ny)]
+         kdirs(:, k) = [(cos(0.53_wp*k*i + 0.1_wp*i*i) + 0.1_wp*k, i = 1, nx*ny)]
+         call orthogonalise(dirs(:, k), kdirs(:, k), dirs(:, :k - 1), kdirs(:, :k - 1), free)
+         norm = sqrt(sum(free*kdirs(:, k)**2))
+         dirs(:, k) = dirs(:, k)/norm
+         kdirs(:, k) = kdirs(:, k)/norm
+      end do
+      zw = [(sin(1.7_wp*i) + 0.3_wp, i = 1, nx*ny)]
+      kzw = [(cos(0.29_wp*i*i) + 0.5_wp*sin(0.11_wp*i) + 0.4_wp, i = 1, nx*ny)]
+      zs = zw(first:last)
+      kzs = kzw(first:last)
+      call orthogonalise(zw, kzw, dirs, kdirs, free)
+      call orthogonalise_over_ranks(zs, kzs, dirs(first:last, :), kdirs(first:last, :), free(first:last))
+      call check(maxval(abs(kzs - kzw(first:last))) <= tol_identity*maxval(abs(kzw)) .and. &
+         & maxval(abs(zs - zw(first:last))) <= tol_identity*maxval(abs(zw)), &
+         & 'the GCR''s orthogonalisation on the slab (one message) is the whole grid''s Gram-Schmidt')
+      ! (and what is left is orthogonal to the stored images on the free points)
+      leftover = 0.0_wp
+      do k = 1, stored
+         leftover = max(leftover, abs(sum(free*kzw*kdirs(:, k))))
+      end do
+      call check(leftover <= tol_identity*sqrt(sum(free*kzw**2)), &
+         & 'the image orthogonalised on the whole grid is orthogonal to the stored ones', leftover)
+   end subroutine check_orthogonalisation
 
    !> h for op with the symbol (+ i odd where complex_symbol), smoothed by rows if `rows`.
    subroutine build(h, op, symbol, odd, complex_symbol, rows)
