@@ -15,6 +15,7 @@ transform whose column blocks are shared out among the threads.
 from __future__ import annotations
 
 import os
+import resource
 
 import h5py
 import numpy as np
@@ -156,6 +157,24 @@ def test_a_large_surface_is_the_same_on_two_threads():
                                threads=threads) for threads in (1, 2))
     assert one.converged and (one.omp_threads, two.omp_threads) == (1, 2)
     assert_same(one, two, FIELDS + ["mean_pressure", "penetration", "delta_mu", "iterations", "solver", "residual"])
+
+
+@needs_openmp
+def test_two_thread_transforms_take_no_fresh_memory():
+    """Once planned, a 2048 x 2048 transform pair on two threads touches no new page: the
+    two-pass column blocks go through buffers of the plan's own (lc_fft_plans), where
+    FFTW's plans for a strided block allocate buffers at every execution, which on the
+    second thread's malloc arena came as fresh pages (5000-8300 page faults a pair). 20
+    pairs more than a first pair may fault fewer times than there are pairs."""
+    from layercontact.native import core
+
+    def faults(repeats):
+        before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        core.py_grid_fft_pair_seconds(2048, 2048, 2, repeats, 1)
+        return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+
+    faults(1)  # the second thread's arena and FFTW's twiddle tables exist from here on
+    assert faults(21) - faults(1) < 20
 
 
 @needs_openmp

@@ -8,14 +8,14 @@
 module lc_base_threads
    use, intrinsic :: iso_c_binding, only: c_int
 #ifdef LC_OPENMP
-   use omp_lib, only: omp_set_num_threads, omp_get_max_threads
+   use omp_lib, only: omp_set_num_threads, omp_get_max_threads, omp_get_thread_num
 #endif
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_base_strings, only: to_string
    implicit none (type, external)
    private
-   public :: openmp_available, job_threads, solve_threads, use_threads, active_threads, most_threads
+   public :: openmp_available, job_threads, solve_threads, use_threads, active_threads, thread_number, most_threads
    public :: parallel_points, reduction_block, reduction_blocks, block_range
    public :: copy_field, fill_field, largest_magnitude
 
@@ -172,6 +172,16 @@ contains
       active_threads = 1
 #endif
    end function active_threads
+
+   !> This thread's number in the team that runs it, 0 .. threads-1 (0 outside a parallel
+   !> region and without OpenMP).
+   integer function thread_number()
+#ifdef LC_OPENMP
+      thread_number = omp_get_thread_num()
+#else
+      thread_number = 0
+#endif
+   end function thread_number
 
    !> A positive integer environment variable's value, or 0 (unset, empty, or not one).
    integer function positive_variable(name) result(value)

@@ -22,12 +22,12 @@ module lc_fft_plans
       & fftw_plan_dft_c2r_1d, fftw_plan_dft_r2c_2d, fftw_plan_dft_c2r_2d, fftw_execute_dft_r2c, &
       & fftw_execute_dft_c2r, fftw_destroy_plan, fftw_init_threads, fftw_plan_with_nthreads, FFTW_ESTIMATE, &
       & FFTW_DESTROY_INPUT, fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft, &
-      & FFTW_FORWARD, FFTW_BACKWARD, FFTW_UNALIGNED
+      & FFTW_FORWARD, FFTW_BACKWARD
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_base_strings, only: to_string
    use lc_base_pages, only: advise_huge_pages
-   use lc_base_threads, only: fill_field
+   use lc_base_threads, only: fill_field, thread_number
    use lc_base_parallel, only: is_distributed, slab
 #ifdef LC_MPI
    use lc_base_parallel, only: communicator
@@ -45,7 +45,11 @@ module lc_fft_plans
    !> FFTW_ESTIMATE's plan for the 2D transform walks the columns one at a time with a
    !> stride of nx/2 + 1 complex numbers, a cache line per element; blocks of 8 share the
    !> lines. The gain is steady from about 1000^2 on (docs/performance.md, 'Cost': 'Large surfaces:
-   !> a two-pass transform'; bench/fft_plans.c).
+   !> a two-pass transform'; bench/fft_plans.c). Each block is copied, row by row, into a
+   !> buffer of its thread and transformed there: FFTW's plans for the block in place (stride
+   !> nx/2 + 1) copy it into buffers they allocate at every execution, which on a second
+   !> thread's malloc arena came as fresh pages each time, a page fault every 4 KiB
+   !> (docs/decisions/022-threads.md, 'The column pass's buffers').
    integer, parameter :: split_points = 800000
    integer, parameter :: column_block = 8
    !> FFTW-MPI's own set-up is done (once per process)
@@ -77,8 +81,10 @@ module lc_fft_plans
       !> columns, `column_block` at a time (the last block: `last_block` columns)
       logical, private :: split = .false.
       integer, private :: last_block = 0
-      !> the spectrum's memory once more: the out argument of the in-place column pass
-      complex(c_double_complex), pointer, contiguous, private :: in_place(:) => null()
+      !> one buffer of column_block columns of ny modes a thread (two-pass surfaces): the
+      !> block a thread transforms, row by row (a row's columns adjacent)
+      complex(c_double_complex), pointer, contiguous, private :: column_buffer(:, :) => null()
+      type(c_ptr), private :: column_memory = c_null_ptr
       type(c_ptr), private :: columns_forward = c_null_ptr, columns_backward = c_null_ptr
       type(c_ptr), private :: last_forward = c_null_ptr, last_backward = c_null_ptr
       !> the rows alone (plan_rows): r2c and c2r along x of each of the ny rows
@@ -267,37 +273,41 @@ contains
       end do
    end subroutine unpad_rows
 
-   !> The plans of a two-pass surface: rows r2c/c2r (contiguous), and the columns of the
-   !> half spectrum in blocks of column_block (stride nkx, in place; unaligned, since a block
-   !> may start at any column). A null plan is caught by init.
+   !> The plans of a two-pass surface: rows r2c/c2r (contiguous), and a block of
+   !> column_block columns of the half spectrum in a thread's column_buffer (row by row, in
+   !> place: with this stride FFTW's plans need no buffer of their own). A null plan or
+   !> buffer is caught by init.
    subroutine plan_split(self)
       class(fft_plan), intent(inout) :: self
       integer(c_int) :: nx, ny, nkx, block
-      integer(c_int), parameter :: in_place_column = ior(FFTW_ESTIMATE, FFTW_UNALIGNED)
       nx = int(self%nx, c_int)
       ny = int(self%ny, c_int)
       nkx = nx/2 + 1
       self%split = .true.
-      call c_f_pointer(self%complex_memory, self%in_place, [self%nk])
       self%r2c = fftw_plan_many_dft_r2c(1_c_int, [nx], ny, self%real_buffer, [nx], 1_c_int, nx, self%spectrum, &
          & [nkx], 1_c_int, nkx, FFTW_ESTIMATE)
       self%c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], ny, self%spectrum, [nkx], 1_c_int, nkx, self%real_buffer, &
          & [nx], 1_c_int, nx, ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
       block = int(min(column_block, nkx), c_int)
+      ! (a buffer per thread, each a multiple of 8*ny*16 bytes from FFTW's aligned start, so
+      ! every thread's buffer has the alignment the plans were made for)
+      self%column_memory = fftw_alloc_complex(int(block, c_size_t)*int(ny, c_size_t)*int(self%threads, c_size_t))
+      if (.not. c_associated(self%column_memory)) then
+         call fftw_destroy_plan(self%r2c)
+         self%r2c = c_null_ptr
+         return
+      end if
+      call c_f_pointer(self%column_memory, self%column_buffer, [int(block)*self%ny, self%threads])
       ! (each block's plan runs on one thread: the blocks are shared out among the threads)
 #ifdef LC_OPENMP
       call fftw_plan_with_nthreads(1_c_int)
 #endif
-      self%columns_forward = fftw_plan_many_dft(1_c_int, [ny], block, self%spectrum, [ny], nkx, 1_c_int, &
-         & self%in_place, [ny], nkx, 1_c_int, FFTW_FORWARD, in_place_column)
-      self%columns_backward = fftw_plan_many_dft(1_c_int, [ny], block, self%spectrum, [ny], nkx, 1_c_int, &
-         & self%in_place, [ny], nkx, 1_c_int, FFTW_BACKWARD, in_place_column)
+      self%columns_forward = column_plan(block, FFTW_FORWARD)
+      self%columns_backward = column_plan(block, FFTW_BACKWARD)
       self%last_block = int(mod(nkx, block))
       if (self%last_block > 0) then
-         self%last_forward = fftw_plan_many_dft(1_c_int, [ny], int(self%last_block, c_int), self%spectrum, [ny], &
-            & nkx, 1_c_int, self%in_place, [ny], nkx, 1_c_int, FFTW_FORWARD, in_place_column)
-         self%last_backward = fftw_plan_many_dft(1_c_int, [ny], int(self%last_block, c_int), self%spectrum, [ny], &
-            & nkx, 1_c_int, self%in_place, [ny], nkx, 1_c_int, FFTW_BACKWARD, in_place_column)
+         self%last_forward = column_plan(int(self%last_block, c_int), FFTW_FORWARD)
+         self%last_backward = column_plan(int(self%last_block, c_int), FFTW_BACKWARD)
       end if
       if (.not. (c_associated(self%columns_forward) .and. c_associated(self%columns_backward) .and. &
          & (self%last_block == 0 .or. (c_associated(self%last_forward) .and. c_associated(self%last_backward))))) then
@@ -305,6 +315,13 @@ contains
          call fftw_destroy_plan(self%r2c)
          self%r2c = c_null_ptr
       end if
+   contains
+      !> `columns` transforms of ny modes, row by row, in place in the first thread's buffer.
+      type(c_ptr) function column_plan(columns, sign)
+         integer(c_int), intent(in) :: columns, sign
+         column_plan = fftw_plan_many_dft(1_c_int, [ny], columns, self%column_buffer(:, 1), [ny], columns, 1_c_int, &
+            & self%column_buffer(:, 1), [ny], columns, 1_c_int, sign, FFTW_ESTIMATE)
+      end function column_plan
    end subroutine plan_split
 
    !> Plans for transforming the rows alone (rows_forward_unscaled, rows_backward), on the
@@ -400,7 +417,8 @@ contains
       transform_seconds = real(transform_ticks, wp)/real(rate, wp)
    end function transform_seconds
 
-   !> The column pass of a two-pass surface: each block of adjacent columns in place.
+   !> The column pass of a two-pass surface: each block of adjacent columns through its
+   !> thread's buffer.
    subroutine transform_columns(self, block_plan, last_plan)
       class(fft_plan), intent(inout) :: self
       type(c_ptr), intent(in) :: block_plan, last_plan
@@ -410,14 +428,30 @@ contains
       ! plan whatever the thread count, so the bits do not depend on it)
       !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
       do first = 1, nkx - self%last_block, column_block
-         call fftw_execute_dft(block_plan, self%spectrum(first:), self%in_place(first:))
+         call transform_block(self, block_plan, first, column_block, self%column_buffer(:, thread_number() + 1))
       end do
       !$omp end parallel do
-      if (self%last_block > 0) then
-         first = nkx - self%last_block + 1
-         call fftw_execute_dft(last_plan, self%spectrum(first:), self%in_place(first:))
-      end if
+      if (self%last_block > 0) call transform_block(self, last_plan, nkx - self%last_block + 1, self%last_block, &
+         & self%column_buffer(:, 1))
    end subroutine transform_columns
+
+   !> The columns first .. first+columns-1 of the spectrum, transformed by `plan` in `buffer`
+   !> (row my's modes at buffer(my*columns + 1 : (my + 1)*columns)).
+   subroutine transform_block(self, plan, first, columns, buffer)
+      class(fft_plan), intent(inout) :: self
+      type(c_ptr), intent(in) :: plan
+      integer, intent(in) :: first, columns
+      complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
+      integer :: row, nkx
+      nkx = self%nx/2 + 1
+      do row = 0, self%ny - 1
+         buffer(row*columns + 1:(row + 1)*columns) = self%spectrum(row*nkx + first:row*nkx + first + columns - 1)
+      end do
+      call fftw_execute_dft(plan, buffer, buffer)
+      do row = 0, self%ny - 1
+         self%spectrum(row*nkx + first:row*nkx + first + columns - 1) = buffer(row*columns + 1:(row + 1)*columns)
+      end do
+   end subroutine transform_block
 
    subroutine destroy(self)
       class(fft_plan), intent(inout) :: self
@@ -454,7 +488,9 @@ contains
       self%complex_memory = c_null_ptr
       self%real_buffer => null()
       self%spectrum => null()
-      self%in_place => null()
+      if (c_associated(self%column_memory)) call fftw_free(self%column_memory)
+      self%column_memory = c_null_ptr
+      self%column_buffer => null()
       self%n = 0
       self%nk = 0
       self%nx = 0
