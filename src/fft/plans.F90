@@ -226,7 +226,7 @@ contains
       self%real_buffer = 0.0_wp
       self%padded = 0.0_wp
       self%r2c = fftw_mpi_plan_dft_r2c_2d(int(ny, c_intptr_t), int(nx, c_intptr_t), self%padded, self%spectrum, &
-         & communicator%MPI_VAL, ior(FFTW_ESTIMATE, FFTW_MPI_TRANSPOSED_OUT))
+         & communicator%MPI_VAL, ior(ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT), FFTW_MPI_TRANSPOSED_OUT))
       self%c2r = fftw_mpi_plan_dft_c2r_2d(int(ny, c_intptr_t), int(nx, c_intptr_t), self%spectrum, self%padded, &
          & communicator%MPI_VAL, ior(ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT), FFTW_MPI_TRANSPOSED_IN))
       if (.not. (c_associated(self%r2c) .and. c_associated(self%c2r))) &
