@@ -14,6 +14,16 @@
  * the two alternately, --rounds rounds (5), the best of each:
  *
  *     /tmp/fft_plans --blocks [--rounds 5] 1024 2048
+ *
+ * With --buffers: the column pass alone (forward, every block of 8 columns), after a pass
+ * over 64 MiB, the blocks shared out among --threads OpenMP threads (1): FFTW's plan for a
+ * block in place at the stride n/2 + 1 (a buffered plan that allocates its buffers at
+ * every execution), against each block copied row by row into a buffer of its thread and
+ * transformed there (the library's, src/fft/plans.F90); wall-clock ms, the best of
+ * --rounds (6), the two alternately, and the minor page faults of each:
+ *
+ *     cc -O2 -fopenmp bench/fft_plans.c -lfftw3 -o /tmp/fft_plans
+ *     /tmp/fft_plans --buffers [--threads 2] [--rounds 6] 1024 2048
  */
 #include <fftw3.h>
 #include <stdio.h>
@@ -21,8 +31,12 @@
 #include <string.h>
 #include <time.h>
 #include <stdint.h>
+#include <sys/resource.h>
 #if defined(__linux__)
 #include <sys/mman.h>
+#endif
+#if defined(_OPENMP)
+#include <omp.h>
 #endif
 
 enum { repeats = 20 };
@@ -147,8 +161,104 @@ static int compare_blocks(int argc, char **argv) {
     return 0;
 }
 
+static double wall_seconds(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+static long minor_faults(void) {
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return u.ru_minflt;
+}
+
+static int thread_number(void) {
+#if defined(_OPENMP)
+    return omp_get_thread_num();
+#else
+    return 0;
+#endif
+}
+
+/* ms of one forward column pass of an n x n half spectrum on `threads` threads: in place
+ * (own_buffers 0) or through each thread's buffer (1); *faults gets its page faults */
+static double column_pass(int n, int threads, int own_buffers, fftw_complex *c, fftw_complex *buffers,
+                          double *flush, long *faults) {
+    enum { block = 8 };
+    int nk = n / 2 + 1, blocks = nk / block;
+    fftw_plan plan = own_buffers
+        ? fftw_plan_many_dft(1, &n, block, buffers, NULL, block, 1, buffers, NULL, block, 1, FFTW_FORWARD,
+                             FFTW_ESTIMATE)
+        : fftw_plan_many_dft(1, &n, block, c, NULL, nk, 1, c, NULL, nk, 1, FFTW_FORWARD,
+                             FFTW_ESTIMATE | FFTW_UNALIGNED);
+    for (size_t i = 0; i < ((size_t)64 << 20) / sizeof(double); i++) flush[i] += 1.0;
+    long before = minor_faults();
+    double start = wall_seconds();
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (int b = 0; b < blocks; b++) {
+        fftw_complex *first = c + (size_t)b * block;
+        if (!own_buffers) {
+            fftw_execute_dft(plan, first, first);
+            continue;
+        }
+        fftw_complex *mine = buffers + (size_t)thread_number() * block * n;
+        for (int row = 0; row < n; row++) memcpy(mine + (size_t)row * block, first + (size_t)row * nk, sizeof(fftw_complex) * block);
+        fftw_execute_dft(plan, mine, mine);
+        for (int row = 0; row < n; row++) memcpy(first + (size_t)row * nk, mine + (size_t)row * block, sizeof(fftw_complex) * block);
+    }
+    double t = wall_seconds() - start;
+    *faults = minor_faults() - before;
+    for (size_t i = 0; i < (size_t)n * nk; i++) {   /* back to the scale it started at */
+        c[i][0] /= n;
+        c[i][1] /= n;
+    }
+    fftw_destroy_plan(plan);
+    return 1e3 * t;
+}
+
+/* --buffers: FFTW's buffered block in place against the library's buffers, alternately */
+static int compare_buffers(int argc, char **argv) {
+    int rounds = 6, threads = 1, a = 2;
+    for (; a + 1 < argc && strncmp(argv[a], "--", 2) == 0; a += 2) {
+        if (strcmp(argv[a], "--rounds") == 0) rounds = atoi(argv[a + 1]);
+        else if (strcmp(argv[a], "--threads") == 0) threads = atoi(argv[a + 1]);
+    }
+    double *flush = calloc(((size_t)64 << 20) / sizeof(double), sizeof(double));
+    if (!flush) return 1;
+    printf("| n | threads | FFTW's block in place (ms) | page faults | own buffers (ms) | page faults | own / FFTW's |\n");
+    printf("|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (; a < argc; a++) {
+        int n = atoi(argv[a]), nk = n / 2 + 1;
+        fftw_complex *c = fftw_alloc_complex((size_t)n * nk);
+        fftw_complex *buffers = fftw_alloc_complex((size_t)8 * n * threads);
+        advise_huge_pages(c, sizeof(fftw_complex) * n * nk);
+        for (size_t i = 0; i < (size_t)n * nk; i++) {
+            c[i][0] = rand() / (double)RAND_MAX;
+            c[i][1] = rand() / (double)RAND_MAX;
+        }
+        memset(buffers, 0, sizeof(fftw_complex) * 8 * n * threads);
+        double best[2] = {1e300, 1e300};
+        long faults[2] = {0, 0}, f;
+        for (int k = 0; k < rounds; k++)
+            for (int v = 0; v < 2; v++) {
+                double t = column_pass(n, threads, v, c, buffers, flush, &f);
+                if (t < best[v]) best[v] = t;
+                if (k == rounds - 1) faults[v] = f;
+            }
+        printf("| %d^2 | %d | %.2f | %ld | %.2f | %ld | %.3f |\n", n, threads, best[0], faults[0], best[1], faults[1],
+               best[1] / best[0]);
+        fflush(stdout);
+        fftw_free(c);
+        fftw_free(buffers);
+    }
+    free(flush);
+    return 0;
+}
+
 int main(int argc, char **argv) {
     if (argc > 1 && strcmp(argv[1], "--blocks") == 0) return compare_blocks(argc, argv);
+    if (argc > 1 && strcmp(argv[1], "--buffers") == 0) return compare_buffers(argc, argv);
     printf("| n | 2D, ESTIMATE (ms) | 2D, MEASURE (ms) | MEASURE's planning (s) | two-pass, ESTIMATE (ms) |\n");
     printf("|---:|---:|---:|---:|---:|\n");
     for (int a = 1; a < argc; a++) {

@@ -2,7 +2,10 @@
  * FFTW-MPI's plans on the ranks of the job, in the natural layout (the spectrum by rows,
  * as lc_fft_plans keeps it; with and without the row copies into FFTW-MPI's padded real
  * array that the library makes around each transform) and with FFTW_MPI_TRANSPOSED_OUT/IN
- * (the spectrum by columns kx: two transposes a pair fewer). FFTW_ESTIMATE, as the library.
+ * (the spectrum by columns kx: two transposes a pair fewer), the latter also with the copies
+ * and with the copies and an r2c that may destroy its input (FFTW_DESTROY_INPUT, as the
+ * library plans it: FFTW-MPI then transposes out of place, with no buffer allocated at each
+ * execution). FFTW_ESTIMATE, as the library.
  *
  *     mpicc -O2 bench/mpi_fft_pair.c -lfftw3_mpi -lfftw3 -o fft_pair && mpirun -n 2 ./fft_pair 2048 2048 10
  *
@@ -54,8 +57,10 @@ int main(int argc, char **argv) {
         fftw_free(spectrum);
     }
 
-    for (int variant = 0; variant < 3; ++variant) {
-        int transposed = variant == 2, copies = variant == 1;
+    static const char *names[] = {"mpi rows", "mpi rows + copies", "mpi transposed", "transposed + copies",
+                                  "+ input destroyed"};
+    for (int variant = 0; variant < 5; ++variant) {
+        int transposed = variant >= 2, copies = variant == 1 || variant >= 3, destroy = variant == 4;
         if (transposed)
             local_complex = fftw_mpi_local_size_2d_transposed(ny, nkx, MPI_COMM_WORLD, &local_rows, &local_start,
                                                               &local_cols, &local_col_start);
@@ -67,7 +72,8 @@ int main(int argc, char **argv) {
         memset(padded, 0, sizeof(double) * 2 * local_complex);
         memset(rows, 0, sizeof(double) * (nx * local_rows + 1));
         unsigned out = transposed ? FFTW_MPI_TRANSPOSED_OUT : 0, in = transposed ? FFTW_MPI_TRANSPOSED_IN : 0;
-        fftw_plan r2c = fftw_mpi_plan_dft_r2c_2d(ny, nx, padded, spectrum, MPI_COMM_WORLD, FFTW_ESTIMATE | out);
+        fftw_plan r2c = fftw_mpi_plan_dft_r2c_2d(ny, nx, padded, spectrum, MPI_COMM_WORLD,
+                                                 FFTW_ESTIMATE | (destroy ? FFTW_DESTROY_INPUT : 0) | out);
         fftw_plan c2r = fftw_mpi_plan_dft_c2r_2d(ny, nx, spectrum, padded, MPI_COMM_WORLD,
                                                  FFTW_ESTIMATE | FFTW_DESTROY_INPUT | in);
         for (int k = -1; k < repeats; ++k) {
@@ -85,9 +91,8 @@ int main(int argc, char **argv) {
             if (k >= 0) times[k] = slowest;
         }
         if (rank == 0)
-            printf("%-18s %ld x %ld  %d rank%s %9.2f ms\n",
-                   transposed ? "mpi transposed" : copies ? "mpi rows + copies" : "mpi rows",
-                   (long)nx, (long)ny, size, size == 1 ? " " : "s", 1e3 * median(times, repeats));
+            printf("%-19s %ld x %ld  %d rank%s %9.2f ms\n", names[variant], (long)nx, (long)ny, size,
+                   size == 1 ? " " : "s", 1e3 * median(times, repeats));
         fftw_destroy_plan(r2c);
         fftw_destroy_plan(c2r);
         fftw_free(padded);
