@@ -442,16 +442,28 @@ contains
       type(c_ptr), intent(in) :: plan
       integer, intent(in) :: first, columns
       complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
-      integer :: row, nkx
-      nkx = self%nx/2 + 1
-      do row = 0, self%ny - 1
-         buffer(row*columns + 1:(row + 1)*columns) = self%spectrum(row*nkx + first:row*nkx + first + columns - 1)
-      end do
+      call copy_columns(self%spectrum, self%nx/2 + 1, self%ny, first, columns, buffer, .true.)
       call fftw_execute_dft(plan, buffer, buffer)
-      do row = 0, self%ny - 1
-         self%spectrum(row*nkx + first:row*nkx + first + columns - 1) = buffer(row*columns + 1:(row + 1)*columns)
-      end do
+      call copy_columns(self%spectrum, self%nx/2 + 1, self%ny, first, columns, buffer, .false.)
    end subroutine transform_block
+
+   !> block <- the columns first .. first+columns-1 of the spectrum (`into_block`), or back.
+   !> (Explicit shapes: the copies compile to plain strided loads and stores.)
+   pure subroutine copy_columns(spectrum, nkx, ny, first, columns, block, into_block)
+      integer, intent(in) :: nkx, ny, first, columns
+      complex(c_double_complex), intent(inout) :: spectrum(nkx, ny), block(columns, ny)
+      logical, intent(in) :: into_block
+      integer :: row
+      if (into_block) then
+         do row = 1, ny
+            block(:, row) = spectrum(first:first + columns - 1, row)
+         end do
+      else
+         do row = 1, ny
+            spectrum(first:first + columns - 1, row) = block(:, row)
+         end do
+      end if
+   end subroutine copy_columns
 
    subroutine destroy(self)
       class(fft_plan), intent(inout) :: self
