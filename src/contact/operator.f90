@@ -754,6 +754,10 @@ contains
    subroutine multiply_complex_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
       complex(wp), contiguous, intent(in) :: multiplier(:)
+      if (self%fft%fuses_products()) then
+         call self%fft%convolve(self%inv_n, complex_multiplier=multiplier)
+         return
+      end if
       call self%fft%forward_unscaled()
       call multiply_complex(self%fft%spectrum, multiplier, self%inv_n)
       call self%fft%backward()
@@ -774,6 +778,10 @@ contains
    subroutine multiply_in_buffer(self, multiplier)
       class(compliance_operator), intent(inout) :: self
       real(wp), contiguous, intent(in) :: multiplier(:)
+      if (self%fft%fuses_products()) then
+         call self%fft%convolve(self%inv_n, real_multiplier=multiplier)
+         return
+      end if
       call self%fft%forward_unscaled()
       call multiply_spectrum(self%fft%spectrum, multiplier, self%inv_n)
       call self%fft%backward()

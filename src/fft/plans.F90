@@ -97,6 +97,8 @@ module lc_fft_plans
       procedure :: forward
       procedure :: forward_unscaled
       procedure :: backward
+      procedure :: fuses_products
+      procedure :: convolve
       procedure :: plan_rows
       procedure :: rows_forward_unscaled
       procedure :: rows_backward
@@ -408,6 +410,84 @@ contains
       !$omp atomic
       transform_ticks = transform_ticks + (finish - start)
    end subroutine backward
+
+   !> Whether `convolve` applies a product between the column transforms of each block
+   !> (a two-pass surface on one process), so saving the pass over the spectrum and a copy
+   !> of each block out and back in.
+   pure logical function fuses_products(self)
+      class(fft_plan), intent(in) :: self
+      fuses_products = self%split .and. .not. self%distributed
+   end function fuses_products
+
+   !> real_buffer <- the c2r of (multiplier * scale) times the bare r2c of real_buffer, for a
+   !> plan that fuses_products: forward_unscaled, the product and backward in one, each
+   !> block of columns multiplied in its thread's buffer between its two column transforms.
+   !> One multiplier on the half spectrum (spectrum's layout), real or complex. The same
+   !> bits as the three steps apart; the product's time counts as the transforms'.
+   subroutine convolve(self, scale, real_multiplier, complex_multiplier)
+      class(fft_plan), intent(inout) :: self
+      real(wp), intent(in) :: scale
+      real(wp), contiguous, intent(in), optional :: real_multiplier(:)
+      complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
+      integer(i8) :: start, finish
+      integer :: first, nkx
+      call system_clock(start)
+      nkx = self%nx/2 + 1
+      call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+      do first = 1, nkx - self%last_block, column_block
+         call convolve_block(self, self%columns_forward, self%columns_backward, first, column_block, &
+            & self%column_buffer(:, thread_number() + 1))
+      end do
+      !$omp end parallel do
+      if (self%last_block > 0) call convolve_block(self, self%last_forward, self%last_backward, &
+         & nkx - self%last_block + 1, self%last_block, self%column_buffer(:, 1))
+      call fftw_execute_dft_c2r(self%c2r, self%spectrum, self%real_buffer)
+      call system_clock(finish)
+      !$omp atomic
+      transform_ticks = transform_ticks + (finish - start)
+   contains
+      !> The columns first .. first+columns-1: forward, the product, backward, in `buffer`.
+      subroutine convolve_block(self, forward_plan, backward_plan, first, columns, buffer)
+         class(fft_plan), intent(inout) :: self
+         type(c_ptr), intent(in) :: forward_plan, backward_plan
+         integer, intent(in) :: first, columns
+         complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
+         call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .true.)
+         call fftw_execute_dft(forward_plan, buffer, buffer)
+         if (present(real_multiplier)) then
+            call multiply_real_columns(buffer, columns, self%ny, real_multiplier, nkx, first, scale)
+         else
+            call multiply_complex_columns(buffer, columns, self%ny, complex_multiplier, nkx, first, scale)
+         end if
+         call fftw_execute_dft(backward_plan, buffer, buffer)
+         call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .false.)
+      end subroutine convolve_block
+   end subroutine convolve
+
+   !> block(:, row) <- block(:, row) * (the multiplier's columns first.. of that row * scale)
+   !> (the operators' product, multiply_spectrum, on a block in a thread's buffer).
+   pure subroutine multiply_real_columns(block, columns, ny, multiplier, nkx, first, scale)
+      integer, intent(in) :: columns, ny, nkx, first
+      complex(c_double_complex), intent(inout) :: block(columns, ny)
+      real(wp), intent(in) :: multiplier(nkx, ny), scale
+      integer :: row
+      do row = 1, ny
+         block(:, row) = block(:, row)*(multiplier(first:first + columns - 1, row)*scale)
+      end do
+   end subroutine multiply_real_columns
+
+   !> The same with a complex multiplier.
+   pure subroutine multiply_complex_columns(block, columns, ny, multiplier, nkx, first, scale)
+      integer, intent(in) :: columns, ny, nkx, first
+      complex(c_double_complex), intent(inout) :: block(columns, ny)
+      complex(wp), intent(in) :: multiplier(nkx, ny)
+      real(wp), intent(in) :: scale
+      integer :: row
+      do row = 1, ny
+         block(:, row) = block(:, row)*(multiplier(first:first + columns - 1, row)*scale)
+      end do
+   end subroutine multiply_complex_columns
 
    !> Seconds this process has spent in the grid transforms so far (a solve takes the
    !> difference over its run: contact_result%transform_time).

@@ -1,0 +1,74 @@
+!> lc_fft_plans' convolve, the product fused between the column transforms of a two-pass
+!> surface, against the three steps apart (forward_unscaled, the product on the whole
+!> spectrum, backward), on 1024 x 1000 points (two-pass; 513 columns, so the last block
+!> has one) with a real and a complex multiplier, on one thread and on two. The fused path
+!> makes the same products in the same order on the same transforms, so the two agree to
+!> rounding (1e-14 of the largest value). A 64 x 64 surface (the 2D plan) does not fuse.
+program test_fft_convolve
+   use lc_base_kinds, only: wp
+   use lc_base_errors, only: error_type
+   use lc_fft_plans, only: fft_plan
+   use lc_test_checks, only: check, finish
+   implicit none (type, external)
+
+   integer, parameter :: nx = 1024, ny = 1000
+   real(wp), parameter :: scale = 1.0_wp/(real(nx, wp)*ny)
+   real(wp), allocatable :: field(:), real_multiplier(:), reference(:)
+   complex(wp), allocatable :: complex_multiplier(:)
+   type(fft_plan) :: small
+   type(error_type), allocatable :: error
+   integer :: i, threads
+
+   allocate (field(nx*ny), real_multiplier((nx/2 + 1)*ny), complex_multiplier((nx/2 + 1)*ny))
+   ! (a field with every mode present, and multipliers that differ from mode to mode)
+   do i = 1, nx*ny
+      field(i) = sin(0.37_wp*i) + 0.5_wp*cos(1.0e-3_wp*real(i, wp)**1.1_wp)
+   end do
+   do i = 1, size(real_multiplier)
+      real_multiplier(i) = 1.0_wp/(1.0_wp + mod(i, 37))
+      complex_multiplier(i) = cmplx(real_multiplier(i), 0.1_wp*sin(0.01_wp*i), kind=wp)
+   end do
+
+   do threads = 1, 2
+      call check_convolution(threads)
+   end do
+
+   call small%init(64, 64, 1, error)
+   if (allocated(error)) error stop 2
+   call check(.not. small%fuses_products(), '64 x 64 (the 2D plan) does not fuse the product')
+   call finish('fft convolve')
+
+contains
+
+   subroutine check_convolution(threads)
+      integer, intent(in) :: threads
+      type(fft_plan) :: plan
+      character(len=32) :: label
+      real(wp) :: worst
+      call plan%init(nx, ny, threads, error)
+      if (allocated(error)) error stop 2
+      write (label, '(a, i0, a)') ' (', threads, ' threads)'
+      call check(plan%fuses_products(), '1024 x 1000 fuses the product' // trim(label))
+
+      plan%real_buffer = field
+      call plan%forward_unscaled()
+      plan%spectrum = plan%spectrum*(real_multiplier*scale)
+      call plan%backward()
+      reference = plan%real_buffer
+      plan%real_buffer = field
+      call plan%convolve(scale, real_multiplier=real_multiplier)
+      worst = maxval(abs(plan%real_buffer - reference))/maxval(abs(reference))
+      call check(worst <= 1.0e-14_wp, 'a real multiplier, fused = apart' // trim(label), worst)
+
+      plan%real_buffer = field
+      call plan%forward_unscaled()
+      plan%spectrum = plan%spectrum*(complex_multiplier*scale)
+      call plan%backward()
+      reference = plan%real_buffer
+      plan%real_buffer = field
+      call plan%convolve(scale, complex_multiplier=complex_multiplier)
+      worst = maxval(abs(plan%real_buffer - reference))/maxval(abs(reference))
+      call check(worst <= 1.0e-14_wp, 'a complex multiplier, fused = apart' // trim(label), worst)
+   end subroutine check_convolution
+
+end program test_fft_convolve
