@@ -44,31 +44,36 @@ contains
       integer, intent(in) :: threads
       type(fft_plan) :: plan
       character(len=32) :: label
-      real(wp) :: worst
       call plan%init(nx, ny, threads, error)
       if (allocated(error)) error stop 2
       write (label, '(a, i0, a)') ' (', threads, ' threads)'
       call check(plan%fuses_products(), '1024 x 1000 fuses the product' // trim(label))
-
-      plan%real_buffer = field
-      call plan%forward_unscaled()
-      plan%spectrum = plan%spectrum*(real_multiplier*scale)
-      call plan%backward()
-      reference = plan%real_buffer
-      plan%real_buffer = field
-      call plan%convolve(scale, real_multiplier=real_multiplier)
-      worst = maxval(abs(plan%real_buffer - reference))/maxval(abs(reference))
-      call check(worst <= 1.0e-14_wp, 'a real multiplier, fused = apart' // trim(label), worst)
-
-      plan%real_buffer = field
-      call plan%forward_unscaled()
-      plan%spectrum = plan%spectrum*(complex_multiplier*scale)
-      call plan%backward()
-      reference = plan%real_buffer
-      plan%real_buffer = field
-      call plan%convolve(scale, complex_multiplier=complex_multiplier)
-      worst = maxval(abs(plan%real_buffer - reference))/maxval(abs(reference))
-      call check(worst <= 1.0e-14_wp, 'a complex multiplier, fused = apart' // trim(label), worst)
+      call check_against_steps(plan, 'a real multiplier, fused = apart' // trim(label), &
+         & real_multiplier=real_multiplier)
+      call check_against_steps(plan, 'a complex multiplier, fused = apart' // trim(label), &
+         & complex_multiplier=complex_multiplier)
    end subroutine check_convolution
+
+   !> convolve against forward_unscaled, the product on the whole spectrum and backward.
+   subroutine check_against_steps(plan, what, real_multiplier, complex_multiplier)
+      type(fft_plan), intent(inout) :: plan
+      character(len=*), intent(in) :: what
+      real(wp), intent(in), optional :: real_multiplier(:)
+      complex(wp), intent(in), optional :: complex_multiplier(:)
+      real(wp) :: worst
+      plan%real_buffer = field
+      call plan%forward_unscaled()
+      if (present(real_multiplier)) then
+         plan%spectrum = plan%spectrum*(real_multiplier*scale)
+      else
+         plan%spectrum = plan%spectrum*(complex_multiplier*scale)
+      end if
+      call plan%backward()
+      reference = plan%real_buffer
+      plan%real_buffer = field
+      call plan%convolve(scale, real_multiplier, complex_multiplier)
+      worst = maxval(abs(plan%real_buffer - reference))/maxval(abs(reference))
+      call check(worst <= 1.0e-14_wp, what, worst)
+   end subroutine check_against_steps
 
 end program test_fft_convolve
