@@ -801,19 +801,13 @@ contains
       type(hierarchy), intent(inout) :: h
       integer, intent(in) :: t
       associate (lv => h%level(t))
-      if (lv%fft%fuses_products() .and. h%complex) then
-         call lv%fft%convolve(1.0_wp, complex_multiplier=lv%cmultiplier)
-      else if (lv%fft%fuses_products()) then
-         call lv%fft%convolve(1.0_wp, real_multiplier=lv%multiplier)
+      call lv%fft%forward_unscaled()
+      if (h%complex) then
+         call multiply_complex(lv%fft%spectrum, lv%cmultiplier)
       else
-         call lv%fft%forward_unscaled()
-         if (h%complex) then
-            call multiply_complex(lv%fft%spectrum, lv%cmultiplier)
-         else
-            call multiply_spectrum(lv%fft%spectrum, lv%multiplier)
-         end if
-         call lv%fft%backward()
+         call multiply_spectrum(lv%fft%spectrum, lv%multiplier)
       end if
+      call lv%fft%backward()
       h%pairs = h%pairs + real(lv%n, wp)/h%n_fine
       end associate
    end subroutine transform
