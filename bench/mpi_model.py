@@ -198,26 +198,26 @@ def model_memory(n: int, ranks: int, doubles_per_point: float) -> dict:
     return {"rank0": solve, "other": solve}
 
 
-def coarse_dominates_from(n: int, coefficient: float, ref: dict, bandwidth: float, latency: float) -> int:
-    """The smallest power-of-two P at which the coarse start takes more than half the solve."""
+def part_dominates_from(part: str, n: int, coefficient: float, ref: dict, bandwidth: float, latency: float) -> int:
+    """The smallest power-of-two P at which `part` of model_time ("coarse", "setup") takes
+    more than half the solve; 0 if none up to 2^20."""
     ranks = 1
     while ranks <= 2**20:
         parts = model_time(n, ranks, coefficient, ref, bandwidth, latency)
-        if parts["coarse"] > 0.5 * parts["total"]:
+        if parts[part] > 0.5 * parts["total"]:
             return ranks
         ranks *= 2
     return 0
+
+
+def coarse_dominates_from(n: int, coefficient: float, ref: dict, bandwidth: float, latency: float) -> int:
+    """The smallest power-of-two P at which the coarse start takes more than half the solve."""
+    return part_dominates_from("coarse", n, coefficient, ref, bandwidth, latency)
 
 
 def setup_dominates_from(n: int, coefficient: float, ref: dict, bandwidth: float, latency: float) -> int:
     """The smallest power-of-two P at which the set-up takes more than half the solve."""
-    ranks = 1
-    while ranks <= 2**20:
-        parts = model_time(n, ranks, coefficient, ref, bandwidth, latency)
-        if parts["setup"] > 0.5 * parts["total"]:
-            return ranks
-        ranks *= 2
-    return 0
+    return part_dominates_from("setup", n, coefficient, ref, bandwidth, latency)
 
 
 def best_speed_up(n: int, coefficient: float, ref: dict, bandwidth: float,
