@@ -7,14 +7,16 @@
 !> scaling).
 !>
 !> Distributed (`init` with `distributed`, under several MPI ranks: lc_base_parallel): the
-!> surface's rows are split into slabs, FFTW-MPI's r2c/c2r transform the whole surface, and
-!> `real_buffer` holds this rank's slab: rows y_start+1 .. y_start+ny_local of the field.
-!> The spectrum is transposed (FFTW_MPI_TRANSPOSED_OUT/IN, two global transposes a pair
-!> fewer: docs/decisions/023-mpi-slabs.md): this rank holds the columns mx = x_start ..
-!> x_start+nkx_local-1 of the half spectrum, each with all ny rows, my fastest
-!> (`mode_indices`). FFTW-MPI pads the rows of its real arrays to 2(nx/2 + 1) values even
-!> out of place; the rows are copied between `real_buffer` (nx values a row, the layout of
-!> every field) and the padded array around each transform.
+!> surface's rows are split into slabs and `real_buffer` holds this rank's slab: rows
+!> y_start+1 .. y_start+ny_local of the field. The spectrum is transposed (two global
+!> transposes a pair fewer: docs/decisions/023-mpi-slabs.md): this rank holds the columns
+!> mx = x_start .. x_start+nkx_local-1 of the half spectrum, each with all ny rows, my
+!> fastest (`mode_indices`). A pair is three stages of the plan's own around FFTW-MPI's
+!> transposes (decision 023, 'The distributed pair in stages of its own'): the rows' r2c
+!> in blocks of `column_block` rows through a thread's buffer, written by column mx
+!> (`row_spectra`), so that FFTW-MPI's transpose needs no local transpose before its
+!> exchange; the columns' DFTs in place, contiguous, in blocks, with an operator's product
+!> between them (`convolve`); the transpose back to rows, and their c2r.
 module lc_fft_plans
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_double_complex, c_size_t, &
       & c_f_pointer, c_associated, c_null_ptr
@@ -22,7 +24,7 @@ module lc_fft_plans
       & fftw_plan_dft_c2r_1d, fftw_plan_dft_r2c_2d, fftw_plan_dft_c2r_2d, fftw_execute_dft_r2c, &
       & fftw_execute_dft_c2r, fftw_destroy_plan, fftw_init_threads, fftw_plan_with_nthreads, FFTW_ESTIMATE, &
       & FFTW_DESTROY_INPUT, fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft, &
-      & FFTW_FORWARD, FFTW_BACKWARD
+      & FFTW_FORWARD, FFTW_BACKWARD, FFTW_NO_BUFFERING
    use lc_base_kinds, only: wp, i8
    use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_base_strings, only: to_string
@@ -31,9 +33,8 @@ module lc_fft_plans
    use lc_base_parallel, only: is_distributed, slab
 #ifdef LC_MPI
    use lc_base_parallel, only: communicator
-   use lc_fft_fftw3_mpi, only: fftw_mpi_init, fftw_mpi_local_size_2d_transposed, fftw_mpi_plan_dft_r2c_2d, &
-      & fftw_mpi_plan_dft_c2r_2d, fftw_mpi_execute_dft_r2c, fftw_mpi_execute_dft_c2r, FFTW_MPI_TRANSPOSED_OUT, &
-      & FFTW_MPI_TRANSPOSED_IN
+   use lc_fft_fftw3_mpi, only: fftw_mpi_init, fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, &
+      & fftw_mpi_execute_r2r, FFTW_MPI_TRANSPOSED_IN, FFTW_MPI_DEFAULT_BLOCK
    use, intrinsic :: iso_c_binding, only: c_intptr_t
 #endif
    implicit none (type, external)
@@ -89,9 +90,20 @@ module lc_fft_plans
       type(c_ptr), private :: last_forward = c_null_ptr, last_backward = c_null_ptr
       !> the rows alone (plan_rows): r2c and c2r along x of each of the ny rows
       type(c_ptr), private :: rows_r2c = c_null_ptr, rows_c2r = c_null_ptr
-      !> distributed: FFTW-MPI's real array, rows padded to 2(nx/2 + 1) values
-      real(c_double), pointer, contiguous, private :: padded(:) => null()
-      type(c_ptr), private :: padded_memory = c_null_ptr
+      !> distributed: the rows' half spectra by column (row_spectra(my, mx), this rank's rows
+      !> my), FFTW-MPI's transpose's input; after the transpose back, by row (the c2r's input)
+      complex(c_double_complex), pointer, contiguous, private :: row_spectra(:) => null()
+      type(c_ptr), private :: row_spectra_memory = c_null_ptr
+      !> distributed: one buffer of column_block rows' half spectra a thread (a column's
+      !> modes adjacent), and the plans of the last block of rows, of the transposes, and of
+      !> the c2r of every row
+      complex(c_double_complex), pointer, contiguous, private :: row_buffer(:, :) => null()
+      type(c_ptr), private :: row_memory = c_null_ptr
+      integer, private :: last_rows = 0
+      type(c_ptr), private :: last_rows_r2c = c_null_ptr
+      type(c_ptr), private :: to_columns = c_null_ptr, to_rows = c_null_ptr
+      !> the spectrum's and row_spectra's memory as pairs of doubles (the transposes' view)
+      real(c_double), pointer, contiguous, private :: spectrum_values(:) => null(), row_values(:) => null()
    contains
       procedure :: init
       procedure :: forward
@@ -179,7 +191,7 @@ contains
       integer, intent(in) :: nx, ny, threads
       type(error_type), allocatable, intent(out) :: error
 #ifdef LC_MPI
-      integer(c_intptr_t) :: local_complex, local_rows, local_start, local_columns, column_start
+      integer(c_intptr_t) :: local_values, local_complex, local_rows, local_start, local_columns, column_start
       integer(c_int) :: status
       integer :: nkx
       if (.not. fftw_mpi_ready) then
@@ -200,9 +212,11 @@ contains
       self%nx = nx
       self%ny = ny
       call slab(ny, self%y_start, self%ny_local)
-      ! (the r2c's sizes: n0 = ny rows of nkx complex values, as FFTW-MPI's manual asks)
-      local_complex = fftw_mpi_local_size_2d_transposed(int(ny, c_intptr_t), int(nkx, c_intptr_t), &
-         & communicator%MPI_VAL, local_rows, local_start, local_columns, column_start)
+      ! (the transposes' sizes: ny rows of nkx complex values, pairs of doubles to FFTW-MPI)
+      local_values = fftw_mpi_local_size_many_transposed(2_c_int, [int(ny, c_intptr_t), int(nkx, c_intptr_t)], &
+         & 2_c_intptr_t, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, communicator%MPI_VAL, local_rows, &
+         & local_start, local_columns, column_start)
+      local_complex = (local_values + 1)/2
       if (local_rows /= self%ny_local .or. local_start /= self%y_start) then
          call fatal_error(error, 'fft: FFTW-MPI gives this rank rows ' // to_string(int(local_start)) // ' + ' // &
             & to_string(int(local_rows)) // ', the slab contract ' // to_string(self%y_start) // ' + ' // &
@@ -213,32 +227,197 @@ contains
       self%nkx_local = int(local_columns)
       self%n = nx*self%ny_local
       self%nk = self%nkx_local*ny
+      ! (row_spectra is the transposes' other array, of FFTW-MPI's local size as the spectrum)
       self%real_memory = fftw_alloc_real(int(max(self%n, 1), c_size_t))
-      self%padded_memory = fftw_alloc_real(int(2*max(local_complex, 1_c_intptr_t), c_size_t))
       self%complex_memory = fftw_alloc_complex(int(max(local_complex, 1_c_intptr_t), c_size_t))
+      self%row_spectra_memory = fftw_alloc_complex(int(max(local_complex, 1_c_intptr_t), c_size_t))
+      self%row_memory = fftw_alloc_complex(int(column_block, c_size_t)*int(nkx, c_size_t)*int(self%threads, c_size_t))
       if (.not. (c_associated(self%real_memory) .and. c_associated(self%complex_memory) .and. &
-         & c_associated(self%padded_memory))) then
+         & c_associated(self%row_spectra_memory) .and. c_associated(self%row_memory))) then
          call fatal_error(error, 'fft: cannot allocate FFTW buffers for ' // to_string(nx) // ' x ' // &
             & to_string(self%ny_local) // ' points (a slab of ' // to_string(ny) // ' rows)', code_internal)
          return
       end if
       call c_f_pointer(self%real_memory, self%real_buffer, [self%n])
-      call c_f_pointer(self%padded_memory, self%padded, [2*local_complex])
       call c_f_pointer(self%complex_memory, self%spectrum, [self%nk])
-      self%real_buffer = 0.0_wp
-      self%padded = 0.0_wp
-      self%r2c = fftw_mpi_plan_dft_r2c_2d(int(ny, c_intptr_t), int(nx, c_intptr_t), self%padded, self%spectrum, &
-         & communicator%MPI_VAL, ior(ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT), FFTW_MPI_TRANSPOSED_OUT))
-      self%c2r = fftw_mpi_plan_dft_c2r_2d(int(ny, c_intptr_t), int(nx, c_intptr_t), self%spectrum, self%padded, &
-         & communicator%MPI_VAL, ior(ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT), FFTW_MPI_TRANSPOSED_IN))
-      if (.not. (c_associated(self%r2c) .and. c_associated(self%c2r))) &
-         & call fatal_error(error, 'fft: FFTW-MPI could not plan a transform of ' // to_string(nx) // ' x ' // &
-         & to_string(ny) // ' points', code_internal)
+      call c_f_pointer(self%row_spectra_memory, self%row_spectra, [local_complex])
+      call c_f_pointer(self%row_memory, self%row_buffer, [column_block*nkx, self%threads])
+      call advise_huge_pages(self%real_buffer)
+      call advise_huge_pages(self%spectrum)
+      call advise_huge_pages(self%row_spectra)
+      call fill_field(self%real_buffer, 0.0_wp)
+      call plan_distributed(self, int(local_complex), error)
 #else
       call fatal_error(error, 'fft: this build has no FFTW-MPI (' // to_string(nx) // ' x ' // to_string(ny) // &
          & ' points on ' // to_string(threads) // ' threads)', code_internal)
 #endif
    end subroutine init_distributed
+
+#ifdef LC_MPI
+   !> The plans of a distributed pair (see the module): a block of column_block rows' r2c
+   !> into a thread's buffer (a column's modes adjacent) and the same for the last, shorter
+   !> block; FFTW-MPI's transposes between row_spectra and the spectrum (the first's input
+   !> by column, FFTW_MPI_TRANSPOSED_IN, so that it sends its blocks as they lie; the way
+   !> back leaves the rows' spectra by row); the columns' DFTs in blocks in place; the c2r
+   !> of every row. `local_complex`: FFTW-MPI's local size of both arrays.
+   subroutine plan_distributed(self, local_complex, error)
+      class(fft_plan), intent(inout) :: self
+      integer, intent(in) :: local_complex
+      type(error_type), allocatable, intent(out) :: error
+      integer(c_int) :: nx, ny, nkx, rows, columns
+      nx = int(self%nx, c_int)
+      ny = int(self%ny, c_int)
+      nkx = nx/2 + 1
+      ! (the transposes see both arrays as pairs of doubles, and are zeroed through them)
+      call c_f_pointer(self%complex_memory, self%spectrum_values, [2*local_complex])
+      call c_f_pointer(self%row_spectra_memory, self%row_values, [2*local_complex])
+      self%spectrum_values = 0.0_wp
+      self%row_values = 0.0_wp
+      self%to_columns = fftw_mpi_plan_many_transpose(int(ny, c_intptr_t), int(nkx, c_intptr_t), 2_c_intptr_t, &
+         & FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, self%row_values, self%spectrum_values, communicator%MPI_VAL, &
+         & ior(FFTW_ESTIMATE, FFTW_MPI_TRANSPOSED_IN))
+      self%to_rows = fftw_mpi_plan_many_transpose(int(nkx, c_intptr_t), int(ny, c_intptr_t), 2_c_intptr_t, &
+         & FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, self%spectrum_values, self%row_values, communicator%MPI_VAL, &
+         & ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
+      self%c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], int(self%ny_local, c_int), self%row_spectra, [nkx], 1_c_int, &
+         & nkx, self%real_buffer, [nx], 1_c_int, nx, ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
+      ! (each block's plan runs on one thread: the blocks are shared out among the threads)
+#ifdef LC_OPENMP
+      call fftw_plan_with_nthreads(1_c_int)
+#endif
+      rows = int(min(column_block, self%ny_local), c_int)
+      self%r2c = row_plan(rows)
+      self%last_rows = mod(self%ny_local, column_block)
+      if (self%last_rows > 0) self%last_rows_r2c = row_plan(int(self%last_rows, c_int))
+      columns = int(min(column_block, self%nkx_local), c_int)
+      if (columns > 0) then
+         self%columns_forward = column_plan(columns, FFTW_FORWARD)
+         self%columns_backward = column_plan(columns, FFTW_BACKWARD)
+      end if
+      self%last_block = mod(self%nkx_local, column_block)
+      if (self%last_block > 0) then
+         self%last_forward = column_plan(int(self%last_block, c_int), FFTW_FORWARD)
+         self%last_backward = column_plan(int(self%last_block, c_int), FFTW_BACKWARD)
+      end if
+      if (.not. (c_associated(self%to_columns) .and. c_associated(self%to_rows) .and. c_associated(self%c2r) .and. &
+         & c_associated(self%r2c) .and. (self%last_rows == 0 .or. c_associated(self%last_rows_r2c)) .and. &
+         & (columns == 0 .or. (c_associated(self%columns_forward) .and. c_associated(self%columns_backward))) .and. &
+         & (self%last_block == 0 .or. (c_associated(self%last_forward) .and. c_associated(self%last_backward))))) &
+         & call fatal_error(error, 'fft: FFTW-MPI could not plan a transform of ' // to_string(self%nx) // ' x ' // &
+         & to_string(self%ny) // ' points', code_internal)
+   contains
+      !> The r2c of `count` rows of the slab into the first thread's buffer, row r's
+      !> coefficient mx at buffer(mx*count + r + 1).
+      type(c_ptr) function row_plan(count)
+         integer(c_int), intent(in) :: count
+         row_plan = fftw_plan_many_dft_r2c(1_c_int, [nx], count, self%real_buffer, [nx], 1_c_int, nx, &
+            & self%row_buffer(:, 1), [nkx], count, 1_c_int, FFTW_ESTIMATE)
+      end function row_plan
+
+      !> `count` adjacent columns of ny modes, each contiguous, in place in the spectrum.
+      type(c_ptr) function column_plan(count, sign)
+         integer(c_int), intent(in) :: count, sign
+         column_plan = fftw_plan_many_dft(1_c_int, [ny], count, self%spectrum(1:), [ny], 1_c_int, ny, &
+            & self%spectrum(1:), [ny], 1_c_int, ny, sign, ior(FFTW_ESTIMATE, FFTW_NO_BUFFERING))
+      end function column_plan
+   end subroutine plan_distributed
+
+   !> row_spectra(my, mx) <- the r2c of the slab's rows my (unscaled), each block of
+   !> column_block rows through its thread's buffer.
+   subroutine rows_to_columns(self)
+      class(fft_plan), intent(inout) :: self
+      integer :: first, nkx
+      nkx = self%nx/2 + 1
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+      do first = 1, self%ny_local - self%last_rows, column_block
+         call row_block(self%r2c, first, column_block, self%row_buffer(:, thread_number() + 1))
+      end do
+      !$omp end parallel do
+      if (self%last_rows > 0) call row_block(self%last_rows_r2c, self%ny_local - self%last_rows + 1, self%last_rows, &
+         & self%row_buffer(:, 1))
+   contains
+      subroutine row_block(plan, first, rows, buffer)
+         type(c_ptr), intent(in) :: plan
+         integer, intent(in) :: first, rows
+         complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
+         call fftw_execute_dft_r2c(plan, self%real_buffer((first - 1)*self%nx + 1:), buffer)
+         call copy_columns(self%row_spectra, self%ny_local, nkx, first, rows, buffer, .false.)
+      end subroutine row_block
+   end subroutine rows_to_columns
+#endif
+
+   !> The DFTs of this rank's columns of a distributed spectrum, in place, by blocks of
+   !> column_block adjacent columns (each contiguous) on the solve's threads. With
+   !> `then_plan` and `then_last` (convolve), each block is then multiplied by the
+   !> multiplier's same modes times `scale` and transformed by these.
+   subroutine transform_local_columns(self, block_plan, last_plan, then_plan, then_last, scale, &
+         & real_multiplier, complex_multiplier)
+      class(fft_plan), intent(inout) :: self
+      type(c_ptr), intent(in) :: block_plan, last_plan
+      type(c_ptr), intent(in), optional :: then_plan, then_last
+      real(wp), intent(in), optional :: scale
+      real(wp), contiguous, intent(in), optional :: real_multiplier(:)
+      complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
+      integer :: first
+      ! (the same plan for a block whatever the thread count: the bits do not depend on it)
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+      do first = 1, self%nkx_local - self%last_block, column_block
+         call local_block(block_plan, first, column_block)
+         if (present(then_plan)) then
+            call multiply_block(first, column_block)
+            call local_block(then_plan, first, column_block)
+         end if
+      end do
+      !$omp end parallel do
+      if (self%last_block > 0) then
+         first = self%nkx_local - self%last_block + 1
+         call local_block(last_plan, first, self%last_block)
+         if (present(then_last)) then
+            call multiply_block(first, self%last_block)
+            call local_block(then_last, first, self%last_block)
+         end if
+      end if
+   contains
+      !> The plan on the columns first .. first+columns-1: modes (first-1) ny + 1 ..
+      subroutine local_block(plan, first, columns)
+         type(c_ptr), intent(in) :: plan
+         integer, intent(in) :: first, columns
+         integer :: start
+         start = (first - 1)*self%ny + 1
+         call fftw_execute_dft(plan, self%spectrum(start:start + columns*self%ny - 1), &
+            & self%spectrum(start:start + columns*self%ny - 1))
+      end subroutine local_block
+
+      !> Those modes times the multiplier's (times scale), as the operators' product.
+      subroutine multiply_block(first, columns)
+         integer, intent(in) :: first, columns
+         integer :: start, count
+         start = (first - 1)*self%ny + 1
+         count = columns*self%ny
+         if (present(real_multiplier)) then
+            call multiply_real_values(count, self%spectrum(start:), real_multiplier(start:), scale)
+         else
+            call multiply_complex_values(count, self%spectrum(start:), complex_multiplier(start:), scale)
+         end if
+      end subroutine multiply_block
+   end subroutine transform_local_columns
+
+   !> values <- values * (multiplier * scale), n of each (explicit shapes: a plain loop).
+   pure subroutine multiply_real_values(n, values, multiplier, scale)
+      integer, intent(in) :: n
+      complex(c_double_complex), intent(inout) :: values(n)
+      real(wp), intent(in) :: multiplier(n), scale
+      values = values*(multiplier*scale)
+   end subroutine multiply_real_values
+
+   !> The same with a complex multiplier.
+   pure subroutine multiply_complex_values(n, values, multiplier, scale)
+      integer, intent(in) :: n
+      complex(c_double_complex), intent(inout) :: values(n)
+      complex(wp), intent(in) :: multiplier(n)
+      real(wp), intent(in) :: scale
+      values = values*(multiplier*scale)
+   end subroutine multiply_complex_values
 
    !> The column mx (0..nx/2) and row my (0..ny-1) of this plan's spectrum entry i (1-based):
    !> mx fastest (serial), or my fastest in this rank's columns (distributed, transposed).
@@ -254,26 +433,6 @@ contains
          my = (i - 1)/(self%nx/2 + 1)
       end if
    end subroutine mode_indices
-
-   !> padded <- real_buffer (distributed: nx values a row into rows of 2(nx/2 + 1)).
-   subroutine pad_rows(self)
-      class(fft_plan), intent(inout) :: self
-      integer :: row, stride
-      stride = 2*(self%nx/2 + 1)
-      do row = 0, self%ny_local - 1
-         self%padded(row*stride + 1:row*stride + self%nx) = self%real_buffer(row*self%nx + 1:(row + 1)*self%nx)
-      end do
-   end subroutine pad_rows
-
-   !> real_buffer <- padded (the inverse of pad_rows).
-   subroutine unpad_rows(self)
-      class(fft_plan), intent(inout) :: self
-      integer :: row, stride
-      stride = 2*(self%nx/2 + 1)
-      do row = 0, self%ny_local - 1
-         self%real_buffer(row*self%nx + 1:(row + 1)*self%nx) = self%padded(row*stride + 1:row*stride + self%nx)
-      end do
-   end subroutine unpad_rows
 
    !> The plans of a two-pass surface: rows r2c/c2r (contiguous), and a block of
    !> column_block columns of the half spectrum in a thread's column_buffer (row by row, in
@@ -380,8 +539,9 @@ contains
       call system_clock(start)
       if (self%distributed) then
 #ifdef LC_MPI
-         call pad_rows(self)
-         call fftw_mpi_execute_dft_r2c(self%r2c, self%padded, self%spectrum)
+         call rows_to_columns(self)
+         call fftw_mpi_execute_r2r(self%to_columns, self%row_values, self%spectrum_values)
+         call transform_local_columns(self, self%columns_forward, self%last_forward)
 #endif
       else
          call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
@@ -399,8 +559,9 @@ contains
       call system_clock(start)
       if (self%distributed) then
 #ifdef LC_MPI
-         call fftw_mpi_execute_dft_c2r(self%c2r, self%spectrum, self%padded)
-         call unpad_rows(self)
+         call transform_local_columns(self, self%columns_backward, self%last_backward)
+         call fftw_mpi_execute_r2r(self%to_rows, self%spectrum_values, self%row_values)
+         call fftw_execute_dft_c2r(self%c2r, self%row_spectra, self%real_buffer)
 #endif
       else
          if (self%split) call transform_columns(self, self%columns_backward, self%last_backward)
@@ -412,18 +573,19 @@ contains
    end subroutine backward
 
    !> Whether `convolve` applies a product between the column transforms of each block
-   !> (a two-pass surface on one process), so saving the pass over the spectrum and a copy
-   !> of each block out and back in.
+   !> (a two-pass surface on one process, or a distributed surface), so saving the pass
+   !> over the spectrum (and on one process a copy of each block out and back in).
    pure logical function fuses_products(self)
       class(fft_plan), intent(in) :: self
-      fuses_products = self%split .and. .not. self%distributed
+      fuses_products = self%split .or. self%distributed
    end function fuses_products
 
    !> real_buffer <- the c2r of (multiplier * scale) times the bare r2c of real_buffer, for a
    !> plan that fuses_products: forward_unscaled, the product and backward in one, each
-   !> block of columns multiplied in its thread's buffer between its two column transforms.
-   !> One multiplier on the half spectrum (spectrum's layout), real or complex. The same
-   !> bits as the three steps apart; the product's time counts as the transforms'.
+   !> block of columns multiplied between its two column transforms (in its thread's
+   !> buffer on one process, in place on a distributed surface). One multiplier on the half
+   !> spectrum (spectrum's layout), real or complex. The same bits as the three steps apart;
+   !> the product's time counts as the transforms'.
    subroutine convolve(self, scale, real_multiplier, complex_multiplier)
       class(fft_plan), intent(inout) :: self
       real(wp), intent(in) :: scale
@@ -432,17 +594,28 @@ contains
       integer(i8) :: start, finish
       integer :: first, nkx
       call system_clock(start)
-      nkx = self%nx/2 + 1
-      call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
-      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
-      do first = 1, nkx - self%last_block, column_block
-         call convolve_block(self, self%columns_forward, self%columns_backward, first, column_block, &
-            & self%column_buffer(:, thread_number() + 1))
-      end do
-      !$omp end parallel do
-      if (self%last_block > 0) call convolve_block(self, self%last_forward, self%last_backward, &
-         & nkx - self%last_block + 1, self%last_block, self%column_buffer(:, 1))
-      call fftw_execute_dft_c2r(self%c2r, self%spectrum, self%real_buffer)
+      if (self%distributed) then
+#ifdef LC_MPI
+         call rows_to_columns(self)
+         call fftw_mpi_execute_r2r(self%to_columns, self%row_values, self%spectrum_values)
+         call transform_local_columns(self, self%columns_forward, self%last_forward, self%columns_backward, &
+            & self%last_backward, scale, real_multiplier, complex_multiplier)
+         call fftw_mpi_execute_r2r(self%to_rows, self%spectrum_values, self%row_values)
+         call fftw_execute_dft_c2r(self%c2r, self%row_spectra, self%real_buffer)
+#endif
+      else
+         nkx = self%nx/2 + 1
+         call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
+         !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+         do first = 1, nkx - self%last_block, column_block
+            call convolve_block(self, self%columns_forward, self%columns_backward, first, column_block, &
+               & self%column_buffer(:, thread_number() + 1))
+         end do
+         !$omp end parallel do
+         if (self%last_block > 0) call convolve_block(self, self%last_forward, self%last_backward, &
+            & nkx - self%last_block + 1, self%last_block, self%column_buffer(:, 1))
+         call fftw_execute_dft_c2r(self%c2r, self%spectrum, self%real_buffer)
+      end if
       call system_clock(finish)
       !$omp atomic
       transform_ticks = transform_ticks + (finish - start)
@@ -566,9 +739,21 @@ contains
       self%last_block = 0
       if (c_associated(self%real_memory)) call fftw_free(self%real_memory)
       if (c_associated(self%complex_memory)) call fftw_free(self%complex_memory)
-      if (c_associated(self%padded_memory)) call fftw_free(self%padded_memory)
-      self%padded_memory = c_null_ptr
-      self%padded => null()
+      if (c_associated(self%last_rows_r2c)) call fftw_destroy_plan(self%last_rows_r2c)
+      if (c_associated(self%to_columns)) call fftw_destroy_plan(self%to_columns)
+      if (c_associated(self%to_rows)) call fftw_destroy_plan(self%to_rows)
+      self%last_rows_r2c = c_null_ptr
+      self%to_columns = c_null_ptr
+      self%to_rows = c_null_ptr
+      self%last_rows = 0
+      if (c_associated(self%row_spectra_memory)) call fftw_free(self%row_spectra_memory)
+      if (c_associated(self%row_memory)) call fftw_free(self%row_memory)
+      self%row_spectra_memory = c_null_ptr
+      self%row_memory = c_null_ptr
+      self%row_spectra => null()
+      self%row_buffer => null()
+      self%spectrum_values => null()
+      self%row_values => null()
       self%distributed = .false.
       self%y_start = 0
       self%ny_local = 1
