@@ -323,6 +323,30 @@ def test_anderson_on_the_slabs_gives_the_serial_answer(tmp_path):
             assert f["results"].attrs["outer_iterations"] > 1
 
 
+@needs_mpi
+@pytest.mark.parametrize("scene", ["coupled", "frictionless"])
+def test_threads_within_the_ranks_give_the_serial_answer(scene, tmp_path):
+    """Two ranks of two threads each (&solver threads = 2): the rows' blocks and the column
+    blocks of each rank's transform are shared out among its threads, each through its
+    own buffer (src/fft/plans.F90), and the coupled scene's products are fused into the
+    column blocks; the serial run's answer to SAME, and the run records 2 ranks, 2 threads.
+    64 rows: 32 a rank, 4 blocks of 8 rows; 33 columns of the half spectrum: 17 and 16 a
+    rank, two blocks of 8 and one shorter block on the first."""
+    nml = write_scene(tmp_path, "serial", 64, SCENES[scene], "serial.h5")
+    done = run_serial(nml)
+    assert done.returncode == 0, done.stderr
+    threaded = tmp_path / "threaded.nml"
+    threaded.write_text(nml.read_text().replace("&solver tol = 1e-13 /", "&solver tol = 1e-13, threads = 2 /")
+                        .replace("'serial.h5'", "'threaded.h5'"))
+    assert "threads = 2" in threaded.read_text()
+    done = run_mpi(2, [executable(), str(threaded)], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert_same(tmp_path / "serial.h5", tmp_path / "threaded.h5")
+    with h5py.File(tmp_path / "threaded.h5", "r") as f:
+        assert int(f.attrs["mpi_ranks"]) == 2
+        assert int(f["results"].attrs["omp_threads"]) == 2
+
+
 @pytest.fixture(scope="module")
 def redistribute_program() -> Path:
     """tests/fortran/test_redistribute, built in build/unit when needed."""
