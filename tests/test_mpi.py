@@ -328,8 +328,8 @@ def test_anderson_on_the_slabs_gives_the_serial_answer(tmp_path):
 def test_threads_within_the_ranks_give_the_serial_answer(scene, tmp_path):
     """Two ranks of two threads each (&solver threads = 2): the rows' blocks and the column
     blocks of each rank's transform are shared out among its threads, each through its
-    own buffer (src/fft/plans.F90), and the coupled scene's products are fused into the
-    column blocks; the serial run's answer to SAME, and the run records 2 ranks, 2 threads.
+    own buffer (src/fft/plans.F90), and the operator's products are fused into the column
+    blocks; the serial run's answer to SAME, and the run records 2 ranks, 2 threads.
     64 rows: 32 a rank, 4 blocks of 8 rows; 33 columns of the half spectrum: 17 and 16 a
     rank, two blocks of 8 and one shorter block on the first."""
     nml = write_scene(tmp_path, "serial", 64, SCENES[scene], "serial.h5")
