@@ -529,13 +529,15 @@ contains
       class(compliance_operator), intent(inout) :: self
       real(wp), intent(out), optional :: energy
       if (present(energy)) then
-         call self%fft%forward_unscaled()
-         if (self%distributed) then
-            call multiply_with_energy_of_columns(self%fft%spectrum, self%metric, self%inv_n, self%once, energy)
-         else
-            call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, self%grid%nkx(), &
-               & mod(self%grid%nx, 2) == 0, energy)
+         if (self%fft%fuses_products()) then
+            ! (the energy summed in the product's pass, between each block's column transforms)
+            call self%fft%convolve(self%inv_n, real_multiplier=self%metric, energy=energy)
+            if (self%distributed) energy = global_sum(energy)
+            return
          end if
+         call self%fft%forward_unscaled()
+         call multiply_with_energy(self%fft%spectrum, self%metric, self%inv_n, self%grid%nkx(), &
+            & mod(self%grid%nx, 2) == 0, energy)
          call self%fft%backward()
       else
          call multiply_in_buffer(self, self%metric)
@@ -569,26 +571,6 @@ contains
       end do
       energy = 2.0_wp*sum(block_sums) - once
    end subroutine multiply_with_energy
-
-   !> multiply_with_energy on this rank's columns of a distributed spectrum (the modes
-   !> `once` stand for themselves only), the energy summed over the ranks.
-   subroutine multiply_with_energy_of_columns(spectrum, multiplier, inv_n, once, energy)
-      complex(wp), contiguous, intent(inout) :: spectrum(:)
-      real(wp), contiguous, intent(in) :: multiplier(:)
-      real(wp), intent(in) :: inv_n
-      integer, intent(in) :: once(:)
-      real(wp), intent(out) :: energy
-      real(wp) :: single
-      real(wp) :: block_sums(reduction_blocks(size(spectrum)))
-      integer :: first, last, block
-      single = sum(multiplier(once)*inv_n*abs(spectrum(once))**2)
-      !$omp parallel do schedule(static) private(first, last) if(size(spectrum) >= parallel_points)
-      do block = 1, size(block_sums)
-         call block_range(block, size(spectrum), first, last)
-         block_sums(block) = multiplied_energy(spectrum(first:last), multiplier(first:last), inv_n)
-      end do
-      energy = global_sum(2.0_wp*sum(block_sums) - single)
-   end subroutine multiply_with_energy_of_columns
 
    !> True if mode i of the operator's spectrum stands for itself only (its column is mx = 0
    !> or, for even nx, nx/2).

@@ -59,6 +59,35 @@ module lc_fft_plans
    !> the distributed ones' transposes included): a solve's own FFT time (transform_seconds)
    integer(i8) :: transform_ticks = 0
 
+   !> The block passes of a two-pass surface, rows fetched ahead (columns.c).
+   interface
+      subroutine lc_copy_columns(spectrum, nkx, ny, first, columns, block, into_block) bind(c, name='lc_copy_columns')
+         import :: c_int
+         type(*), dimension(*), intent(inout) :: spectrum, block
+         integer(c_int), value, intent(in) :: nkx, ny, first, columns, into_block
+      end subroutine lc_copy_columns
+
+      subroutine lc_multiply_columns_real(block, columns, ny, multiplier, nkx, first, scale, weights, energy) &
+            & bind(c, name='lc_multiply_columns_real')
+         import :: c_int, c_double
+         type(*), dimension(*), intent(inout) :: block
+         integer(c_int), value, intent(in) :: columns, ny, nkx, first
+         real(c_double), intent(in) :: multiplier(*)
+         real(c_double), value, intent(in) :: scale
+         real(c_double), intent(in), optional :: weights(*)
+         real(c_double), intent(out), optional :: energy
+      end subroutine lc_multiply_columns_real
+
+      subroutine lc_multiply_columns_complex(block, columns, ny, multiplier, nkx, first, scale) &
+            & bind(c, name='lc_multiply_columns_complex')
+         import :: c_int, c_double, c_double_complex
+         type(*), dimension(*), intent(inout) :: block
+         integer(c_int), value, intent(in) :: columns, ny, nkx, first
+         complex(c_double_complex), intent(in) :: multiplier(*)
+         real(c_double), value, intent(in) :: scale
+      end subroutine lc_multiply_columns_complex
+   end interface
+
    !> An r2c/c2r plan pair with its buffers: copy data into `real_buffer`, call
    !> `forward`, work on `spectrum`, call `backward`, read `real_buffer`. Planning with
    !> FFTW_ESTIMATE costs a few transforms' time and gives the same plan, so the same bits,
@@ -351,13 +380,15 @@ contains
    !> `then_plan` and `then_last` (convolve), each block is then multiplied by the
    !> multiplier's same modes times `scale` and transformed by these.
    subroutine transform_local_columns(self, block_plan, last_plan, then_plan, then_last, scale, &
-         & real_multiplier, complex_multiplier)
+         & real_multiplier, complex_multiplier, block_energy)
       class(fft_plan), intent(inout) :: self
       type(c_ptr), intent(in) :: block_plan, last_plan
       type(c_ptr), intent(in), optional :: then_plan, then_last
       real(wp), intent(in), optional :: scale
       real(wp), contiguous, intent(in), optional :: real_multiplier(:)
       complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
+      !> allocated: each block's share of convolve's energy (a real multiplier)
+      real(wp), allocatable, intent(inout), optional :: block_energy(:)
       integer :: first
       ! (the same plan for a block whatever the thread count: the bits do not depend on it)
       !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
@@ -394,6 +425,14 @@ contains
          integer :: start, count
          start = (first - 1)*self%ny + 1
          count = columns*self%ny
+         if (present(block_energy)) then
+            if (allocated(block_energy)) then
+               call multiply_real_values_energy(columns, self%ny, self%spectrum(start:), real_multiplier(start:), &
+                  & scale, column_weights(self%x_start + first - 1, columns, self%nx), &
+                  & block_energy((first - 1)/column_block + 1))
+               return
+            end if
+         end if
          if (present(real_multiplier)) then
             call multiply_real_values(count, self%spectrum(start:), real_multiplier(start:), scale)
          else
@@ -409,6 +448,27 @@ contains
       real(wp), intent(in) :: multiplier(n), scale
       values = values*(multiplier*scale)
    end subroutine multiply_real_values
+
+   !> multiply_real_values on `columns` columns of ny modes each, and energy = the sum of
+   !> weights(column) scale multiplier |values|^2 before the product (see convolve).
+   pure subroutine multiply_real_values_energy(columns, ny, values, multiplier, scale, weights, energy)
+      integer, intent(in) :: columns, ny
+      complex(c_double_complex), intent(inout) :: values(ny, columns)
+      real(wp), intent(in) :: multiplier(ny, columns), scale, weights(columns)
+      real(wp), intent(out) :: energy
+      real(wp) :: f, column_energy
+      integer :: column, my
+      energy = 0.0_wp
+      do column = 1, columns
+         column_energy = 0.0_wp
+         do my = 1, ny
+            f = multiplier(my, column)*scale
+            column_energy = column_energy + f*(real(values(my, column), wp)**2 + aimag(values(my, column))**2)
+            values(my, column) = values(my, column)*f
+         end do
+         energy = energy + weights(column)*column_energy
+      end do
+   end subroutine multiply_real_values_energy
 
    !> The same with a complex multiplier.
    pure subroutine multiply_complex_values(n, values, multiplier, scale)
@@ -585,26 +645,37 @@ contains
    !> block of columns multiplied between its two column transforms (in its thread's
    !> buffer on one process, in place on a distributed surface). One multiplier on the half
    !> spectrum (spectrum's layout), real or complex. The same bits as the three steps apart;
-   !> the product's time counts as the transforms'.
-   subroutine convolve(self, scale, real_multiplier, complex_multiplier)
+   !> the product's time counts as the transforms'. `energy` (a real multiplier): the sum
+   !> over the whole spectrum (this rank's columns, on a distributed surface) of
+   !> scale * multiplier |c|^2 for the bare r2c's coefficients c, taken in the same pass as
+   !> the product (a mode of the half spectrum stands for q and -q, those of the columns
+   !> mx = 0 and, for even nx, nx/2 for themselves only). Its blocks' sums are added in
+   !> order: the same bits on any number of threads.
+   subroutine convolve(self, scale, real_multiplier, complex_multiplier, energy)
       class(fft_plan), intent(inout) :: self
       real(wp), intent(in) :: scale
       real(wp), contiguous, intent(in), optional :: real_multiplier(:)
       complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
+      real(wp), intent(out), optional :: energy
+      real(wp), allocatable :: block_energy(:)
       integer(i8) :: start, finish
       integer :: first, nkx
       call system_clock(start)
+      nkx = self%nx/2 + 1
+      if (present(energy)) then
+         allocate (block_energy((merge(self%nkx_local, nkx, self%distributed) + column_block - 1)/column_block))
+         block_energy = 0.0_wp
+      end if
       if (self%distributed) then
 #ifdef LC_MPI
          call rows_to_columns(self)
          call fftw_mpi_execute_r2r(self%to_columns, self%row_values, self%spectrum_values)
          call transform_local_columns(self, self%columns_forward, self%last_forward, self%columns_backward, &
-            & self%last_backward, scale, real_multiplier, complex_multiplier)
+            & self%last_backward, scale, real_multiplier, complex_multiplier, block_energy)
          call fftw_mpi_execute_r2r(self%to_rows, self%spectrum_values, self%row_values)
          call fftw_execute_dft_c2r(self%c2r, self%row_spectra, self%real_buffer)
 #endif
       else
-         nkx = self%nx/2 + 1
          call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
          !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
          do first = 1, nkx - self%last_block, column_block
@@ -616,6 +687,7 @@ contains
             & nkx - self%last_block + 1, self%last_block, self%column_buffer(:, 1))
          call fftw_execute_dft_c2r(self%c2r, self%spectrum, self%real_buffer)
       end if
+      if (present(energy)) energy = sum(block_energy)
       call system_clock(finish)
       !$omp atomic
       transform_ticks = transform_ticks + (finish - start)
@@ -628,39 +700,30 @@ contains
          complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
          call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .true.)
          call fftw_execute_dft(forward_plan, buffer, buffer)
-         if (present(real_multiplier)) then
-            call multiply_real_columns(buffer, columns, self%ny, real_multiplier, nkx, first, scale)
+         if (present(energy)) then
+            call lc_multiply_columns_real(buffer, columns, self%ny, real_multiplier, nkx, first, scale, &
+               & column_weights(first - 1, columns, self%nx), block_energy((first - 1)/column_block + 1))
+         else if (present(real_multiplier)) then
+            call lc_multiply_columns_real(buffer, columns, self%ny, real_multiplier, nkx, first, scale)
          else
-            call multiply_complex_columns(buffer, columns, self%ny, complex_multiplier, nkx, first, scale)
+            call lc_multiply_columns_complex(buffer, columns, self%ny, complex_multiplier, nkx, first, scale)
          end if
          call fftw_execute_dft(backward_plan, buffer, buffer)
          call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .false.)
       end subroutine convolve_block
    end subroutine convolve
 
-   !> block(:, row) <- block(:, row) * (the multiplier's columns first.. of that row * scale)
-   !> (the operators' product, multiply_spectrum, on a block in a thread's buffer).
-   pure subroutine multiply_real_columns(block, columns, ny, multiplier, nkx, first, scale)
-      integer, intent(in) :: columns, ny, nkx, first
-      complex(c_double_complex), intent(inout) :: block(columns, ny)
-      real(wp), intent(in) :: multiplier(nkx, ny), scale
-      integer :: row
-      do row = 1, ny
-         block(:, row) = block(:, row)*(multiplier(first:first + columns - 1, row)*scale)
+   !> The weight of each of the half spectrum's columns mx = first_mx .. first_mx+columns-1
+   !> in a sum over the whole spectrum: 2 (q and -q), 1 for mx = 0 and, for even nx, nx/2.
+   pure function column_weights(first_mx, columns, nx) result(weights)
+      integer, intent(in) :: first_mx, columns, nx
+      real(wp) :: weights(columns)
+      integer :: c, mx
+      do c = 1, columns
+         mx = first_mx + c - 1
+         weights(c) = merge(1.0_wp, 2.0_wp, mx == 0 .or. 2*mx == nx)
       end do
-   end subroutine multiply_real_columns
-
-   !> The same with a complex multiplier.
-   pure subroutine multiply_complex_columns(block, columns, ny, multiplier, nkx, first, scale)
-      integer, intent(in) :: columns, ny, nkx, first
-      complex(c_double_complex), intent(inout) :: block(columns, ny)
-      complex(wp), intent(in) :: multiplier(nkx, ny)
-      real(wp), intent(in) :: scale
-      integer :: row
-      do row = 1, ny
-         block(:, row) = block(:, row)*(multiplier(first:first + columns - 1, row)*scale)
-      end do
-   end subroutine multiply_complex_columns
+   end function column_weights
 
    !> Seconds this process has spent in the grid transforms so far (a solve takes the
    !> difference over its run: contact_result%transform_time).
@@ -700,22 +763,14 @@ contains
       call copy_columns(self%spectrum, self%nx/2 + 1, self%ny, first, columns, buffer, .false.)
    end subroutine transform_block
 
-   !> block <- the columns first .. first+columns-1 of the spectrum (`into_block`), or back.
-   !> (Explicit shapes: the copies compile to plain strided loads and stores.)
-   pure subroutine copy_columns(spectrum, nkx, ny, first, columns, block, into_block)
+   !> block <- the columns first .. first+columns-1 of the spectrum (nkx x ny), or back
+   !> (`into_block` false): lc_copy_columns, each row fetched ahead.
+   subroutine copy_columns(spectrum, nkx, ny, first, columns, block, into_block)
       integer, intent(in) :: nkx, ny, first, columns
-      complex(c_double_complex), intent(inout) :: spectrum(nkx, ny), block(columns, ny)
+      complex(c_double_complex), contiguous, intent(inout) :: spectrum(:), block(:)
       logical, intent(in) :: into_block
-      integer :: row
-      if (into_block) then
-         do row = 1, ny
-            block(:, row) = spectrum(first:first + columns - 1, row)
-         end do
-      else
-         do row = 1, ny
-            spectrum(first:first + columns - 1, row) = block(:, row)
-         end do
-      end if
+      call lc_copy_columns(spectrum, int(nkx, c_int), int(ny, c_int), int(first, c_int), int(columns, c_int), block, &
+         & merge(1_c_int, 0_c_int, into_block))
    end subroutine copy_columns
 
    subroutine destroy(self)
