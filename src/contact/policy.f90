@@ -27,8 +27,8 @@ module lc_contact_policy
    use lc_contact_operator, only: compliance_operator
    use lc_contact_solver_newton, only: dense_points
    use lc_contact_solver_gfmd, only: gfmd_refusal
-   use lc_contact_solver_multigrid, only: multigrid_refusal, metric_refusal, coupled_refusal, rows_ahead_of_gcr, &
-      & loss_among_short_waves, short_loss_limit, solves_on_slabs
+   use lc_contact_solver_multigrid, only: multigrid_refusal, metric_refusal, coupled_refusal, size_refusal, &
+      & rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, solves_on_slabs
    implicit none (type, external)
    private
    public :: problem_indicators, solve_plan, measure_problem, measure_start, plan_solve, max_stages
@@ -94,7 +94,9 @@ module lc_contact_policy
       logical :: multigrid_on_slabs = .false.
       !> the multigrid method's measures (refusal, metric_admitted) are left to measure_start:
       !> under 'auto' a coupled operator reads them only where its start is hard or it may be
-      !> lossy among its short waves (rules 3a, 3b)
+      !> lossy among its short waves (rules 3a, 3b), a symmetric one that the symmetric
+      !> method refuses whether the coupled form admits it (`rising`) only where its start
+      !> is hard (refusal then holds the symmetric method's)
       logical :: multigrid_deferred = .false.
    end type problem_indicators
 
@@ -133,9 +135,19 @@ contains
          if (all(trim(method) /= [character(len=9) :: 'auto', 'multigrid'])) return
       end if
       ! (a coupled operator under 'auto' takes the constrained GCR unless its start says
-      ! otherwise: the measures wait for the start, which most grids never need)
-      ind%multigrid_deferred = trim(method) == 'auto' .and. op%coupled
-      if (ind%multigrid_deferred) return
+      ! otherwise: the measures wait for the start, which most grids never need. A symmetric
+      ! one needs before its start only whether the symmetric method takes it; where that
+      ! refuses a rising compliance, whether the coupled form admits it waits as well: it
+      ! matters only after a hard start, rule 3b)
+      if (trim(method) == 'auto') then
+         ind%multigrid_deferred = op%coupled
+         if (ind%multigrid_deferred) return
+         ind%refusal = multigrid_refusal(op)
+         ! (deferred: the compliance's rise alone refused, which the coupled form may admit)
+         ind%multigrid_deferred = len(ind%refusal) > 0 .and. .not. op%kernel%viscoelastic .and. &
+            & len(size_refusal(op)) == 0
+         return
+      end if
       ! (on a slab each measure takes the rank's modes, reduced over the ranks: the whole
       ! grid's values, docs/decisions/028-distributed-multigrid.md)
       call measure_multigrid(ind, op, load_control)
@@ -290,7 +302,7 @@ contains
          else
             first = 'cg'
             why = 'a symmetric operator: the constrained CG'
-            if (ind%rising) then
+            if (ind%rising .or. ind%multigrid_deferred) then
                why = why // ' (its compliance rises too steeply for the symmetric multigrid method)'
             else if (len(ind%refusal) > 0) then
                why = why // ' (no multigrid method: ' // ind%refusal // ')'

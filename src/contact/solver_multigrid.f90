@@ -61,6 +61,7 @@ module lc_contact_solver_multigrid
    implicit none (type, external)
    private
    public :: multigrid_solver, multigrid, multigrid_outcome, multigrid_refusal, metric_refusal, coupled_refusal, coupled_tnnmg
+   public :: size_refusal
    public :: allowed_rise, rows_ahead_of_gcr, loss_among_short_waves, short_loss_limit, whole_operator, solves_on_slabs
    public :: compliance_rise, loss_profile, loss_of, orthogonalise, orthogonalise_over_ranks
 

@@ -123,6 +123,12 @@ contains
       ind%refusal = 'the Jacobi step would not smooth'
       ind%points = 262144
       call expect('rising compliance refused by the coupled form: CG', ind, .true., 'cg', 'constrained CG')
+      ! before its start (or after an easy one) the coupled form's admission is not measured
+      ind = problem(1024**2, .false., .false.)
+      ind%refusal = 'the compliance rises with |q| over the grid by a factor 12.0'
+      ind%multigrid_deferred = .true.
+      call expect('rising compliance, its coupled form not measured: CG with the start', ind, .true., 'cg', &
+         & 'rises too steeply for the symmetric multigrid method')
    end subroutine check_after_a_hard_start
 
    subroutine check_lossy()

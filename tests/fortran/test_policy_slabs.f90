@@ -143,8 +143,9 @@ contains
          & what // control // ': the refusals are the whole grid''s ("' // coupled_refusal(whole, load_control) // '")')
       if (whole%coupled) call check(rows_ahead_of_gcr(slab, load_control) .eqv. rows_ahead_of_gcr(whole, load_control), &
          & what // control // ': the rows'' rule is the whole grid''s')
-      ind_whole = measure_problem(whole, 'auto', load_control)
-      ind_slab = measure_problem(slab, 'auto', load_control)
+      ! (method 'multigrid' takes every measure before the start; 'auto' leaves some to it)
+      ind_whole = measure_problem(whole, 'multigrid', load_control)
+      ind_slab = measure_problem(slab, 'multigrid', load_control)
       call check(ind_slab%refusal == ind_whole%refusal .and. (ind_slab%rising .eqv. ind_whole%rising) .and. &
          & (ind_slab%metric_admitted .eqv. ind_whole%metric_admitted), &
          & what // control // ': the policy''s indicators are the whole grid''s')
