@@ -366,10 +366,7 @@ contains
       if (allocated(self%column) .or. self%distributed) return
       allocate (self%column(self%n))
       call advise_huge_pages(self%column)
-      ! (the unit load at the first point, written straight into the transform's buffer)
-      call fill_field(self%fft%real_buffer, 0.0_wp)
-      self%fft%real_buffer(1) = 1.0_wp
-      call multiply_in_buffer(self, self%metric)
+      call column_in_buffer(self, real_multiplier=self%metric)
       call copy_field(self%fft%real_buffer, self%column)
    end subroutine prepare_cg
 
@@ -678,23 +675,60 @@ contains
          call block_range(block, self%nk, first, last)
          call invert_block(g(first:last), self%inverse_full(first:last))
       end do
-      ! (the unit load at the first point, on the rank holding it, written straight into
-      ! the transform's buffer)
       if (.not. self%distributed) then
          if (.not. allocated(self%full_column)) then
             allocate (self%full_column(n))
             call advise_huge_pages(self%full_column)
          end if
-         call unit_load_in_buffer(self)
-         call multiply_complex_in_buffer(self, g)
+         call column_in_buffer(self, complex_multiplier=g)
          call copy_field(self%fft%real_buffer, self%full_column)
       end if
-      call unit_load_in_buffer(self)
-      call multiply_complex_in_buffer(self, self%inverse_full)
-      self%inverse_diagonal = 0.0_wp
-      if (self%fft%y_start == 0) self%inverse_diagonal = self%fft%real_buffer(1)
-      if (self%distributed) call broadcast(self%inverse_diagonal)
+      ! (the inverse's real-space diagonal, its column's value at the load: (1/n) times the
+      ! sum of the inverse over the whole spectrum, whose imaginary parts cancel between q
+      ! and -q; summed as derive sums the metric's diagonal)
+      self%inverse_diagonal = spectrum_sum(self, real(self%inverse_full, wp))
    end subroutine prepare_gcr_with
+
+   !> fft%real_buffer <- the real-space column of a multiplier on the half spectrum: its
+   !> response to a unit load at the first point. The bare r2c of that load is 1 on every
+   !> mode, so the product is the multiplier times 1/n, and only the backward transform is
+   !> needed.
+   subroutine column_in_buffer(self, real_multiplier, complex_multiplier)
+      class(compliance_operator), intent(inout) :: self
+      real(wp), contiguous, intent(in), optional :: real_multiplier(:)
+      complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
+      integer :: block, first, last
+      !$omp parallel do schedule(static) private(first, last) if(self%nk >= parallel_points)
+      do block = 1, reduction_blocks(self%nk)
+         call block_range(block, self%nk, first, last)
+         if (present(real_multiplier)) then
+            self%fft%spectrum(first:last) = real_multiplier(first:last)*self%inv_n
+         else
+            self%fft%spectrum(first:last) = complex_multiplier(first:last)*self%inv_n
+         end if
+      end do
+      call self%fft%backward()
+   end subroutine column_in_buffer
+
+   !> (1/n) times the sum over the whole spectrum of `values` on the half spectrum (each
+   !> mode standing for q and -q, those of the columns mx = 0 and, for even nx, nx/2 for
+   !> themselves only): on a distributed surface over every rank's columns.
+   real(wp) function spectrum_sum(self, values) result(total)
+      class(compliance_operator), intent(in) :: self
+      real(wp), contiguous, intent(in) :: values(:)
+      real(wp), allocatable :: row_sums(:)
+      integer :: row, nkx
+      if (self%distributed) then
+         total = global_sum(2*sum(values) - sum(values(self%once)))*self%inv_n
+         return
+      end if
+      nkx = self%grid%nkx()
+      allocate (row_sums(self%grid%ny))
+      do row = 1, self%grid%ny
+         row_sums(row) = row_weighted_sum(values((row - 1)*nkx + 1:row*nkx), mod(self%grid%nx, 2) == 0)
+      end do
+      total = sum(row_sums)*self%inv_n
+   end function spectrum_sum
 
    !> inverse = 1/g (0 where g = 0) on a block of modes.
    pure subroutine invert_block(g, inverse)
@@ -706,13 +740,6 @@ contains
          inverse = (0.0_wp, 0.0_wp)
       end where
    end subroutine invert_block
-
-   !> fft%real_buffer <- a unit load at the first point of the grid (on the rank holding it).
-   subroutine unit_load_in_buffer(self)
-      class(compliance_operator), intent(inout) :: self
-      call fill_field(self%fft%real_buffer, 0.0_wp)
-      if (self%fft%y_start == 0 .and. self%n > 0) self%fft%real_buffer(1) = 1.0_wp
-   end subroutine unit_load_in_buffer
 
    !> fft%real_buffer <- G_eff fft%real_buffer (see metric_in_buffer).
    subroutine full_in_buffer(self)
