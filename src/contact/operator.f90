@@ -23,7 +23,7 @@ module lc_contact_operator
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type, fatal_error, code_input
    use lc_base_strings, only: to_string
-   use lc_fft_plans, only: fft_plan
+   use lc_fft_plans, only: fft_plan, row_work
    use lc_base_grid, only: grid_type
    use lc_greens_kernel, only: layer_kernel
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range, copy_field, fill_field
@@ -99,6 +99,8 @@ module lc_contact_operator
       procedure :: buffer
       procedure :: column_mode
       procedure :: metric_in_buffer
+      procedure :: metric_with_work
+      procedure :: add_metric_columns_at
       procedure :: inverse_metric_in_buffer
       procedure :: prepare_cg
       procedure :: prepare_gcr
@@ -465,6 +467,20 @@ contains
       call add_columns(self%grid, self%column, r, d, d_contact, p)
    end subroutine add_metric_columns
 
+   !> add_metric_columns for the loads r_k at the points points(k) alone.
+   subroutine add_metric_columns_at(self, points, r, p, d, d_contact)
+      class(compliance_operator), intent(in) :: self
+      integer, intent(in) :: points(:)
+      real(wp), intent(in) :: r(:)
+      real(wp), contiguous, intent(in) :: p(:)
+      real(wp), contiguous, intent(inout) :: d(:)
+      real(wp), intent(inout) :: d_contact
+      integer :: k
+      do k = 1, size(points)
+         call add_column(self%grid, self%column, points(k), r(k), d, d_contact, p)
+      end do
+   end subroutine add_metric_columns_at
+
    !> d <- d + sum_j r_j column(. - j), the circulant column shifted to each point j with
    !> r_j /= 0 (periodically along x and y), and, with p, total <- total + the sum of the
    !> change where p > 0.
@@ -474,24 +490,36 @@ contains
       real(wp), contiguous, intent(inout) :: d(:)
       real(wp), intent(inout) :: total
       real(wp), contiguous, intent(in), optional :: p(:)
-      integer :: j, jx, jy, iy, nx, target, source
-      nx = grid%nx
+      integer :: j
       do j = 1, size(r)
-         if (r(j) == 0.0_wp) cycle
-         jx = mod(j - 1, nx) + 1
-         jy = (j - 1)/nx
-         do iy = 0, grid%ny - 1
-            ! row iy of the response holds row iy - jy of the column, shifted by jx - 1:
-            ! column(1..nx-jx+1) for ix = jx..nx, wrapped round for ix < jx
-            target = iy*nx
-            source = modulo(iy - jy, grid%ny)*nx
-            call add_segment(r(j), column(source + 1:source + nx - jx + 1), d(target + jx:target + nx), total, &
-               & p, target + jx)
-            call add_segment(r(j), column(source + nx - jx + 2:source + nx), d(target + 1:target + jx - 1), total, &
-               & p, target + 1)
-         end do
+         if (r(j) /= 0.0_wp) call add_column(grid, column, j, r(j), d, total, p)
       end do
    end subroutine add_columns
+
+   !> add_columns for the one point j.
+   subroutine add_column(grid, column, j, value, d, total, p)
+      type(grid_type), intent(in) :: grid
+      real(wp), contiguous, intent(in) :: column(:)
+      integer, intent(in) :: j
+      real(wp), intent(in) :: value
+      real(wp), contiguous, intent(inout) :: d(:)
+      real(wp), intent(inout) :: total
+      real(wp), contiguous, intent(in), optional :: p(:)
+      integer :: jx, jy, iy, nx, target, source
+      nx = grid%nx
+      jx = mod(j - 1, nx) + 1
+      jy = (j - 1)/nx
+      do iy = 0, grid%ny - 1
+         ! row iy of the response holds row iy - jy of the column, shifted by jx - 1:
+         ! column(1..nx-jx+1) for ix = jx..nx, wrapped round for ix < jx
+         target = iy*nx
+         source = modulo(iy - jy, grid%ny)*nx
+         call add_segment(value, column(source + 1:source + nx - jx + 1), d(target + jx:target + nx), total, &
+            & p, target + jx)
+         call add_segment(value, column(source + nx - jx + 2:source + nx), d(target + 1:target + jx - 1), total, &
+            & p, target + 1)
+      end do
+   end subroutine add_column
 
    !> d <- d + value column, and (with p) total <- total + the sum of the change where
    !> p(offset:) > 0.
@@ -540,6 +568,16 @@ contains
          call multiply_in_buffer(self, self%metric)
       end if
    end subroutine metric_in_buffer
+
+   !> The product with the metric, r = M t, with a solver's passes fused into its row
+   !> stages (lc_fft_plans' convolve_passes: `work` writes t by blocks of rows, gets
+   !> sum t M t, reads r by blocks of rows), for an operator whose plan fuses_products.
+   subroutine metric_with_work(self, work, error)
+      class(compliance_operator), intent(inout) :: self
+      class(row_work), intent(inout) :: work
+      type(error_type), allocatable, intent(out) :: error
+      call self%fft%convolve_passes(self%inv_n, self%metric, work, error)
+   end subroutine metric_with_work
 
    !> spectrum <- spectrum * multiplier/n, and energy = (1/n) sum over the whole spectrum of
    !> multiplier |spectrum|^2 (the modes of the half spectrum stand for two, q and -q, but

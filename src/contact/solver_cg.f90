@@ -18,6 +18,7 @@ module lc_contact_solver_cg
    use lc_contact_operator, only: compliance_operator
    use lc_contact_progress, only: progress_log
    use lc_base_errors, only: error_type
+   use lc_fft_plans, only: row_work
    use lc_contact_problem, only: contact_problem, contact_state, solve_outcome
    use lc_contact_solver, only: contact_solver
    use lc_base_threads, only: parallel_points, reduction_blocks, block_range, copy_field, fill_field, largest_magnitude
@@ -62,6 +63,34 @@ module lc_contact_solver_cg
    end type grid_sums
 
 
+   !> An iteration's direction pass (new_direction_range) and update pass (update_range)
+   !> fused into the row stages of the product r = M t on a surface whose transforms fuse
+   !> products (the operator's metric_with_work): each block's t goes from the pass into
+   !> the transform's rows in the cache, and its r from them into the update, so that
+   !> neither crosses the memory as a field. The update keeps r only at the points it
+   !> changed (column updates), block by block.
+   type, extends(row_work) :: direction_and_update
+      integer :: nx = 0
+      real(wp), pointer, contiguous :: p(:) => null(), d(:) => null(), b(:) => null(), t(:) => null(), z(:) => null()
+      real(wp) :: s = 0.0_wp, z_mean = 0.0_wp, beta = 0.0_wp, t_shift = 0.0_wp
+      logical :: preconditioned = .false., reenter = .false.
+      !> each block's sums: the direction's (sum g t, sum t), the update's
+      real(wp), allocatable :: gt_parts(:), t_parts(:), lefts(:)
+      type(grid_sums), allocatable :: parts(:)
+      integer, allocatable :: changed(:)
+      logical, allocatable :: entries(:)
+      !> each block's first column_updates + 1 points changed and their change of p
+      integer, allocatable :: points(:, :)
+      real(wp), allocatable :: changes(:, :)
+      !> after the product: sum g t, sum t, sum t M t and the step (taken where it is > 0)
+      real(wp) :: gt_sum = 0.0_wp, t_sum = 0.0_wp, energy = 0.0_wp, tau = 0.0_wp
+      logical :: step = .false.
+   contains
+      procedure :: before => direction_rows
+      procedure :: between => step_length
+      procedure :: after => update_rows
+   end type direction_and_update
+
    !> Method 'cg': the constrained CG on the metric M (a symmetric operator: M = G_eff).
    type, extends(contact_solver) :: cg_solver
    contains
@@ -77,7 +106,7 @@ contains
    subroutine constrained_cg(op, b, load_control, mean_pressure, s, g_ref, tol, max_iter, precondition, p, w, &
          & gap, outcome, history, progress)
       type(compliance_operator), intent(inout) :: op
-      real(wp), contiguous, intent(in) :: b(:)
+      real(wp), contiguous, intent(in), target :: b(:)
       logical, intent(in) :: load_control
       real(wp), intent(in) :: mean_pressure   !< p_m (load control; ignored otherwise)
       real(wp), intent(inout) :: s            !< in: given (displacement control); out: the multiplier
@@ -85,19 +114,22 @@ contains
       integer, intent(in) :: max_iter
       !> precondition the residual with the stiffness 1/M on the contact set
       logical, intent(in) :: precondition
-      real(wp), contiguous, intent(inout) :: p(:)
-      real(wp), contiguous, intent(out) :: w(:), gap(:)
+      real(wp), contiguous, intent(inout), target :: p(:)
+      real(wp), contiguous, intent(out) :: w(:)
+      real(wp), contiguous, intent(out), target :: gap(:)
       type(cg_outcome), intent(out) :: outcome
       real(wp), intent(inout), optional :: history(:)
       type(progress_log), intent(inout), optional :: progress
-      real(wp), allocatable :: t(:)
+      real(wp), allocatable, target :: t(:)
       !> the operator's FFT buffer: transform input and output, written and read in place
       real(wp), pointer, contiguous :: buffer(:)
       type(grid_sums) :: sums
+      type(direction_and_update) :: fused
+      type(error_type), allocatable :: error
       real(wp) :: gnorm, gnorm_old, tau, best, beta, b_max, m_max, load_scale, p_ref, g_floor
       real(wp) :: gt_sum, gz_sum, z_mean, t_sum, t_left, t_shift, denominator
       integer :: it, n, n_contact, last_progress, since_fresh, n_changed, block, first, last
-      logical :: restart, preconditioned, stale, entered, safeguarded
+      logical :: restart, preconditioned, stale, entered, safeguarded, fuses
 
       ! The iteration works on the raw gap d = w - b (kept in `gap`) instead of w: the
       ! update moves it with w (d <- d - tau M t), and the gap on the contact set is d - s.
@@ -113,6 +145,12 @@ contains
       call advise_huge_pages(t)
       call op%prepare_cg()
       buffer => op%buffer()
+      ! (the passes fused into the product's rows where the plan fuses products; where FFTW
+      ! cannot plan the blocks of rows, the passes apart)
+      fuses = op%fft%fuses_products()
+      if (fuses) call op%fft%plan_passes(error)
+      fuses = fuses .and. .not. allocated(error)
+      if (fuses) call prepare_fused(fused, op, p, d, b, t, buffer)
       call fill_field(t, 0.0_wp)
       t_sum = 0.0_wp
       t_left = 0.0_wp
@@ -224,8 +262,23 @@ contains
          end if
          beta = merge(0.0_wp, gnorm/gnorm_old, restart)
          gnorm_old = gnorm
-         call new_direction(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
-         call op%metric_in_buffer(denominator)   ! buffer <- r = M t; denominator = sum t M t
+         if (fuses) then
+            ! the direction, r = M t and, where sum t M t > 0, the update in one product
+            fused%s = s
+            fused%z_mean = z_mean
+            fused%beta = beta
+            fused%t_shift = t_shift
+            fused%preconditioned = preconditioned
+            fused%reenter = safeguarded
+            fused%parts = sums
+            call op%metric_with_work(fused, error)   ! (planned above: no error)
+            gt_sum = fused%gt_sum
+            t_sum = fused%t_sum
+            denominator = fused%energy
+         else
+            call new_direction(p, d, s, preconditioned, z_mean, beta, t_shift, t, buffer, gt_sum, t_sum)
+            call op%metric_in_buffer(denominator)   ! buffer <- r = M t; denominator = sum t M t
+         end if
          outcome%fft_pairs = outcome%fft_pairs + 1
          if (.not. denominator > 0.0_wp) then
             ! t is (numerically) in the null space of the projected operator (e.g. a single
@@ -242,11 +295,18 @@ contains
          tau = gt_sum/denominator
          ! update, clip at zero, let overlapping points in; d follows p along t, and the
          ! points clipped or let in are added column by column (M is circulant) below
-         call update(p, d, b, s, tau, t, buffer, safeguarded, sums, t_left, n_changed, entered)
+         if (fuses) then
+            call combine_update(fused%parts, fused%lefts, fused%changed, fused%entries, sums, t_left, n_changed, entered)
+         else
+            call update(p, d, b, s, tau, t, buffer, safeguarded, sums, t_left, n_changed, entered)
+         end if
          restart = entered .and. safeguarded
          if (n_changed > column_updates .or. (n_changed > 0 .and. op%distributed)) then
             ! (a distributed operator has no real-space column: the state is made afresh)
             stale = .true.
+         else if (n_changed > 0 .and. fuses) then
+            call op%add_metric_columns_at(pack(fused%points, fused%points > 0), pack(fused%changes, fused%points > 0), &
+               & p, d, sums%d_contact)
          else if (n_changed > 0) then
             call op%add_metric_columns(buffer, p, d, sums%d_contact)
          end if
@@ -551,7 +611,6 @@ contains
       real(wp) :: lefts(size(parts))
       integer :: changed(size(parts))
       logical :: entries(size(parts))
-      real(wp) :: totals(7)
       integer :: block, first, last
       parts = sums
       !$omp parallel do schedule(static) private(first, last) if(size(p) >= parallel_points)
@@ -560,6 +619,20 @@ contains
          call update_range(p(first:last), d(first:last), b(first:last), s, tau, t(first:last), r(first:last), &
             & reenter, parts(block), lefts(block), changed(block), entries(block))
       end do
+      call combine_update(parts, lefts, changed, entries, sums, t_left, n_changed, entered)
+   end subroutine update
+
+   !> The state's sums after the update from its blocks' (added in order) and over the ranks.
+   subroutine combine_update(parts, lefts, changed, entries, sums, t_left, n_changed, entered)
+      type(grid_sums), intent(in) :: parts(:)
+      real(wp), intent(in) :: lefts(:)
+      integer, intent(in) :: changed(:)
+      logical, intent(in) :: entries(:)
+      type(grid_sums), intent(out) :: sums
+      real(wp), intent(out) :: t_left
+      integer, intent(out) :: n_changed
+      logical, intent(out) :: entered
+      real(wp) :: totals(7)
       sums = added(parts)
       t_left = sum(lefts)
       n_changed = sum(changed)
@@ -577,7 +650,7 @@ contains
          n_changed = nint(totals(6))
          entered = totals(7) > 0.0_wp
       end if
-   end subroutine update
+   end subroutine combine_update
 
    !> One pass: p <- p - tau t clipped at zero, overlapping points (p = 0, g < 0) let in,
    !> d <- d - tau r (r = M t, in the buffer); r then keeps the change of p that was not
@@ -663,6 +736,79 @@ contains
       end do
       if (across_ranks) n_changed = global_sum(n_changed)
    end subroutine let_in_overlaps
+
+   !> The fused passes' fields and their sums by block of rows (direction_and_update).
+   subroutine prepare_fused(fused, op, p, d, b, t, z)
+      type(direction_and_update), intent(out) :: fused
+      type(compliance_operator), intent(in) :: op
+      real(wp), contiguous, target, intent(in) :: p(:), d(:), b(:), t(:), z(:)
+      integer :: blocks
+      fused%nx = op%grid%nx
+      fused%p => p
+      fused%d => d
+      fused%b => b
+      fused%t => t
+      fused%z => z
+      blocks = op%fft%row_blocks()
+      allocate (fused%gt_parts(blocks), fused%t_parts(blocks), fused%lefts(blocks), fused%parts(blocks), &
+         & fused%changed(blocks), fused%entries(blocks), fused%points(column_updates + 1, blocks), &
+         & fused%changes(column_updates + 1, blocks))
+   end subroutine prepare_fused
+
+   !> The direction on a block of rows (new_direction_range): the preconditioned residual z
+   !> (or the masked gap) copied into the transform's rows, t written over it there and into t.
+   subroutine direction_rows(self, first, rows, values, block)
+      class(direction_and_update), intent(inout) :: self
+      integer, intent(in) :: first, rows, block
+      real(wp), contiguous, intent(inout) :: values(:)
+      integer :: j0, j1
+      j0 = (first - 1)*self%nx + 1
+      j1 = (first - 1 + rows)*self%nx
+      values = self%z(j0:j1)
+      call new_direction_range(self%p(j0:j1), self%d(j0:j1), self%s, self%preconditioned, self%z_mean, self%beta, &
+         & self%t_shift, self%t(j0:j1), values, self%gt_parts(block), self%t_parts(block))
+   end subroutine direction_rows
+
+   !> The direction's sums (over the ranks too) and the step tau = sum g t / sum t M t.
+   subroutine step_length(self, energy)
+      class(direction_and_update), intent(inout) :: self
+      real(wp), intent(in) :: energy
+      real(wp) :: totals(2)
+      totals = [sum(self%gt_parts), sum(self%t_parts)]
+      if (across_ranks) call sum_over_ranks(totals)
+      self%gt_sum = totals(1)
+      self%t_sum = totals(2)
+      self%energy = energy
+      self%step = energy > 0.0_wp
+      self%tau = 0.0_wp
+      if (self%step) self%tau = self%gt_sum/energy
+   end subroutine step_length
+
+   !> The update on a block of rows (update_range) with r = M t from the transform's rows,
+   !> and the points whose pressure changed other than along t with their change.
+   subroutine update_rows(self, first, rows, values, block)
+      class(direction_and_update), intent(inout) :: self
+      integer, intent(in) :: first, rows, block
+      real(wp), contiguous, intent(inout) :: values(:)
+      integer :: j0, j1, j, k
+      self%points(:, block) = 0
+      self%changed(block) = 0
+      if (.not. self%step) return
+      j0 = (first - 1)*self%nx + 1
+      j1 = (first - 1 + rows)*self%nx
+      call update_range(self%p(j0:j1), self%d(j0:j1), self%b(j0:j1), self%s, self%tau, self%t(j0:j1), values, &
+         & self%reenter, self%parts(block), self%lefts(block), self%changed(block), self%entries(block))
+      if (self%changed(block) == 0) return
+      ! (values now holds the change of p not along t: nonzero at the changed points only)
+      k = 0
+      do j = 1, size(values)
+         if (values(j) == 0.0_wp) cycle
+         k = k + 1
+         if (k > size(self%points, 1)) exit
+         self%points(k, block) = j0 + j - 1
+         self%changes(k, block) = values(j)
+      end do
+   end subroutine update_rows
 
    !> The fields returned from the raw gap d (= w - b): w = d + b, gap = d - s (in place).
    pure subroutine final_fields(d, b, s, w, gap)

@@ -30,7 +30,7 @@ module lc_fft_plans
    use lc_base_strings, only: to_string
    use lc_base_pages, only: advise_huge_pages
    use lc_base_threads, only: fill_field, thread_number
-   use lc_base_parallel, only: is_distributed, slab
+   use lc_base_parallel, only: is_distributed, slab, global_sum
 #ifdef LC_MPI
    use lc_base_parallel, only: communicator
    use lc_fft_fftw3_mpi, only: fftw_mpi_init, fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, &
@@ -39,7 +39,7 @@ module lc_fft_plans
 #endif
    implicit none (type, external)
    private
-   public :: fft_plan, transform_seconds
+   public :: fft_plan, transform_seconds, row_work
 
    !> Surfaces of at least this many points are transformed in two passes: the rows (r2c),
    !> then the columns of the half spectrum in blocks of `column_block` adjacent columns.
@@ -88,6 +88,34 @@ module lc_fft_plans
       end subroutine lc_multiply_columns_complex
    end interface
 
+   !> A solver's passes over the grid fused into a product's row stages (convolve_passes):
+   !> `before` writes the product's input on a block of rows (rows first .. first+rows-1,
+   !> `values` their nx*rows values, `block` the block's number from 1, for sums kept by
+   !> block), `between` gets the product's energy (as convolve's, summed over the ranks)
+   !> once every block's input is in and before any output, and `after` reads the
+   !> product's output on a block of rows. The blocks are shared among the solve's threads.
+   type, abstract :: row_work
+   contains
+      procedure(rows_action), deferred :: before
+      procedure(energy_action), deferred :: between
+      procedure(rows_action), deferred :: after
+   end type row_work
+
+   abstract interface
+      subroutine rows_action(self, first, rows, values, block)
+         import :: row_work, wp
+         class(row_work), intent(inout) :: self
+         integer, intent(in) :: first, rows, block
+         real(wp), contiguous, intent(inout) :: values(:)
+      end subroutine rows_action
+
+      subroutine energy_action(self, energy)
+         import :: row_work, wp
+         class(row_work), intent(inout) :: self
+         real(wp), intent(in) :: energy
+      end subroutine energy_action
+   end interface
+
    !> An r2c/c2r plan pair with its buffers: copy data into `real_buffer`, call
    !> `forward`, work on `spectrum`, call `backward`, read `real_buffer`. Planning with
    !> FFTW_ESTIMATE costs a few transforms' time and gives the same plan, so the same bits,
@@ -131,6 +159,14 @@ module lc_fft_plans
       integer, private :: last_rows = 0
       type(c_ptr), private :: last_rows_r2c = c_null_ptr
       type(c_ptr), private :: to_columns = c_null_ptr, to_rows = c_null_ptr
+      !> two-pass and distributed surfaces, made on convolve_passes' first call: a buffer of
+      !> column_block rows of the field a thread (a block's input and output), and the r2c
+      !> and c2r of a block of rows between it and the spectrum (on a distributed surface
+      !> the c2r from row_spectra; its r2c is the rows' stage's own), the last block apart
+      real(c_double), pointer, contiguous, private :: rows_real(:, :) => null()
+      type(c_ptr), private :: rows_real_memory = c_null_ptr
+      type(c_ptr), private :: block_r2c = c_null_ptr, last_block_r2c = c_null_ptr
+      type(c_ptr), private :: block_c2r = c_null_ptr, last_block_c2r = c_null_ptr
       !> the spectrum's and row_spectra's memory as pairs of doubles (the transposes' view)
       real(c_double), pointer, contiguous, private :: spectrum_values(:) => null(), row_values(:) => null()
    contains
@@ -140,6 +176,9 @@ module lc_fft_plans
       procedure :: backward
       procedure :: fuses_products
       procedure :: convolve
+      procedure :: convolve_passes
+      procedure :: plan_passes
+      procedure :: row_blocks
       procedure :: plan_rows
       procedure :: rows_forward_unscaled
       procedure :: rows_backward
@@ -713,6 +752,199 @@ contains
       end subroutine convolve_block
    end subroutine convolve
 
+   !> The number of blocks of column_block rows of this plan's field (this rank's slab):
+   !> convolve_passes' `block` runs from 1 to it.
+   pure integer function row_blocks(self)
+      class(fft_plan), intent(in) :: self
+      row_blocks = (self%ny_local + column_block - 1)/column_block
+   end function row_blocks
+
+   !> convolve with a real multiplier and its energy, the solver's passes `work` fused into
+   !> its row stages, for a plan that fuses_products: each block of column_block rows is
+   !> written by work%before into a thread's buffer and transformed from there while in
+   !> the cache, and after the columns' stage each block's c2r lands in that buffer for
+   !> work%after. So the product's input and output never cross the memory as fields of
+   !> their own: a pass writing the input and one reading the output save two of their
+   !> fields' streams each, and the rows' transforms read and write the cache. real_buffer
+   !> is not used. The passes' time is not counted as the transforms' (on several threads,
+   !> their mean over the threads).
+   subroutine convolve_passes(self, scale, multiplier, work, error)
+      class(fft_plan), intent(inout) :: self
+      real(wp), intent(in) :: scale
+      real(wp), contiguous, intent(in) :: multiplier(:)
+      class(row_work), intent(inout) :: work
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: block_energy(:)
+      real(wp) :: energy
+      integer(i8) :: start, finish, passes(0:max(self%threads, 1) - 1)
+      integer :: first, nkx, last_first
+      call self%plan_passes(error)
+      if (allocated(error)) return
+      call system_clock(start)
+      passes = 0
+      nkx = self%nx/2 + 1
+      allocate (block_energy((merge(self%nkx_local, nkx, self%distributed) + column_block - 1)/column_block))
+      block_energy = 0.0_wp
+      last_first = self%ny_local - self%last_rows + 1
+      ! the rows' stage: each block's input from the work, then its r2c
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+      do first = 1, self%ny_local - self%last_rows, column_block
+         call rows_in(first, column_block, self%rows_real(:, thread_number() + 1))
+      end do
+      !$omp end parallel do
+      if (self%last_rows > 0) call rows_in(last_first, self%last_rows, self%rows_real(:, 1))
+      ! the columns' stage, the product and its energy (as convolve)
+      if (self%distributed) then
+#ifdef LC_MPI
+         call fftw_mpi_execute_r2r(self%to_columns, self%row_values, self%spectrum_values)
+         call transform_local_columns(self, self%columns_forward, self%last_forward, self%columns_backward, &
+            & self%last_backward, scale, multiplier, block_energy=block_energy)
+         call fftw_mpi_execute_r2r(self%to_rows, self%spectrum_values, self%row_values)
+#endif
+      else
+         !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+         do first = 1, nkx - self%last_block, column_block
+            call product_block(first, column_block, self%column_buffer(:, thread_number() + 1), self%columns_forward, &
+               & self%columns_backward)
+         end do
+         !$omp end parallel do
+         if (self%last_block > 0) call product_block(nkx - self%last_block + 1, self%last_block, &
+            & self%column_buffer(:, 1), self%last_forward, self%last_backward)
+      end if
+      energy = sum(block_energy)
+      if (self%distributed) energy = global_sum(energy)
+      call timed_work_between(energy)
+      ! the rows' way back: each block's c2r, then its output to the work
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+      do first = 1, self%ny_local - self%last_rows, column_block
+         call rows_out(self%block_c2r, first, column_block, self%rows_real(:, thread_number() + 1))
+      end do
+      !$omp end parallel do
+      if (self%last_rows > 0) call rows_out(self%last_block_c2r, last_first, self%last_rows, self%rows_real(:, 1))
+      call system_clock(finish)
+      !$omp atomic
+      transform_ticks = transform_ticks + (finish - start) - sum(passes)/size(passes)
+   contains
+      !> Block `first`'s input written by the work, then its r2c: into the spectrum's rows
+      !> (one process) or through the thread's row buffer into row_spectra (distributed).
+      subroutine rows_in(first, rows, values)
+         integer, intent(in) :: first, rows
+         real(c_double), contiguous, intent(inout) :: values(:)
+         integer(i8) :: began, ended
+         call system_clock(began)
+         call work%before(first, rows, values(1:self%nx*rows), (first - 1)/column_block + 1)
+         call system_clock(ended)
+         passes(thread_number()) = passes(thread_number()) + (ended - began)
+         if (self%distributed) then
+#ifdef LC_MPI
+            call fftw_execute_dft_r2c(merge(self%r2c, self%last_rows_r2c, rows == column_block), values, &
+               & self%row_buffer(:, thread_number() + 1))
+            call copy_columns(self%row_spectra, self%ny_local, nkx, first, rows, self%row_buffer(:, thread_number() + 1), &
+               & .false.)
+#endif
+         else
+            call fftw_execute_dft_r2c(merge(self%block_r2c, self%last_block_r2c, rows == column_block), values, &
+               & self%spectrum((first - 1)*nkx + 1:))
+         end if
+      end subroutine rows_in
+
+      !> Block `first`'s c2r into the thread's buffer, then its output read by the work.
+      subroutine rows_out(plan, first, rows, values)
+         type(c_ptr), intent(in) :: plan
+         integer, intent(in) :: first, rows
+         real(c_double), contiguous, intent(inout) :: values(:)
+         integer(i8) :: began, ended
+         if (self%distributed) then
+            call fftw_execute_dft_c2r(plan, self%row_spectra((first - 1)*nkx + 1:), values)
+         else
+            call fftw_execute_dft_c2r(plan, self%spectrum((first - 1)*nkx + 1:), values)
+         end if
+         call system_clock(began)
+         call work%after(first, rows, values(1:self%nx*rows), (first - 1)/column_block + 1)
+         call system_clock(ended)
+         passes(thread_number()) = passes(thread_number()) + (ended - began)
+      end subroutine rows_out
+
+      subroutine timed_work_between(energy)
+         real(wp), intent(in) :: energy
+         integer(i8) :: began, ended
+         call system_clock(began)
+         call work%between(energy)
+         call system_clock(ended)
+         passes = passes + (ended - began)
+      end subroutine timed_work_between
+
+      !> The columns first .. first+columns-1 through `buffer`: forward, the product with
+      !> its energy, backward.
+      subroutine product_block(first, columns, buffer, forward_plan, backward_plan)
+         integer, intent(in) :: first, columns
+         complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
+         type(c_ptr), intent(in) :: forward_plan, backward_plan
+         call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .true.)
+         call fftw_execute_dft(forward_plan, buffer, buffer)
+         call lc_multiply_columns_real(buffer, columns, self%ny, multiplier, nkx, first, scale, &
+            & column_weights(first - 1, columns, self%nx), block_energy((first - 1)/column_block + 1))
+         call fftw_execute_dft(backward_plan, buffer, buffer)
+         call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .false.)
+      end subroutine product_block
+   end subroutine convolve_passes
+
+   !> Make convolve_passes' buffers and plans, if not made yet (an error where FFTW cannot).
+   subroutine plan_passes(self, error)
+      class(fft_plan), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      if (c_associated(self%block_c2r)) return
+      call plan_row_blocks(self)
+      if (.not. c_associated(self%block_c2r)) call fatal_error(error, 'fft: FFTW could not plan the blocks of rows of ' &
+         & // to_string(self%nx) // ' x ' // to_string(self%ny_local) // ' points', code_internal)
+   end subroutine plan_passes
+
+   !> convolve_passes' buffers and plans (see the type): one buffer of column_block rows a
+   !> thread, the r2c of a block into the spectrum's rows (one process) and the c2r of a
+   !> block from the spectrum's rows or row_spectra's (distributed), the last, shorter
+   !> block apart. Left null where FFTW could not plan (convolve_passes reports it).
+   subroutine plan_row_blocks(self)
+      class(fft_plan), intent(inout) :: self
+      integer(c_int) :: nx, nkx, rows
+      complex(c_double_complex), pointer, contiguous :: rows_spectrum(:)
+      nx = int(self%nx, c_int)
+      nkx = nx/2 + 1
+      rows = int(min(column_block, self%ny_local), c_int)
+      self%last_rows = mod(self%ny_local, column_block)
+      self%rows_real_memory = fftw_alloc_real(int(column_block, c_size_t)*int(nx, c_size_t)*int(self%threads, c_size_t))
+      if (.not. c_associated(self%rows_real_memory)) return
+      call c_f_pointer(self%rows_real_memory, self%rows_real, [column_block*self%nx, self%threads])
+      rows_spectrum => self%spectrum
+      if (self%distributed) rows_spectrum => self%row_spectra
+      ! (each block's plan runs on one thread: the blocks are shared out among the threads)
+#ifdef LC_OPENMP
+      call fftw_plan_with_nthreads(1_c_int)
+#endif
+      if (.not. self%distributed) then
+         self%block_r2c = block_plan_r2c(rows)
+         if (self%last_rows > 0) self%last_block_r2c = block_plan_r2c(int(self%last_rows, c_int))
+      end if
+      self%block_c2r = block_plan_c2r(rows)
+      if (self%last_rows > 0) self%last_block_c2r = block_plan_c2r(int(self%last_rows, c_int))
+      if (.not. ((self%distributed .or. (c_associated(self%block_r2c) .and. (self%last_rows == 0 .or. &
+         & c_associated(self%last_block_r2c)))) .and. (self%last_rows == 0 .or. c_associated(self%last_block_c2r)))) then
+         if (c_associated(self%block_c2r)) call fftw_destroy_plan(self%block_c2r)
+         self%block_c2r = c_null_ptr
+      end if
+   contains
+      type(c_ptr) function block_plan_r2c(count)
+         integer(c_int), intent(in) :: count
+         block_plan_r2c = fftw_plan_many_dft_r2c(1_c_int, [nx], count, self%rows_real(:, 1), [nx], 1_c_int, nx, &
+            & rows_spectrum, [nkx], 1_c_int, nkx, FFTW_ESTIMATE)
+      end function block_plan_r2c
+
+      type(c_ptr) function block_plan_c2r(count)
+         integer(c_int), intent(in) :: count
+         block_plan_c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], count, rows_spectrum, [nkx], 1_c_int, nkx, &
+            & self%rows_real(:, 1), [nx], 1_c_int, nx, ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
+      end function block_plan_c2r
+   end subroutine plan_row_blocks
+
    !> The weight of each of the half spectrum's columns mx = first_mx .. first_mx+columns-1
    !> in a sum over the whole spectrum: 2 (q and -q), 1 for mx = 0 and, for even nx, nx/2.
    pure function column_weights(first_mx, columns, nx) result(weights)
@@ -823,6 +1055,17 @@ contains
       if (c_associated(self%column_memory)) call fftw_free(self%column_memory)
       self%column_memory = c_null_ptr
       self%column_buffer => null()
+      if (c_associated(self%block_r2c)) call fftw_destroy_plan(self%block_r2c)
+      if (c_associated(self%last_block_r2c)) call fftw_destroy_plan(self%last_block_r2c)
+      if (c_associated(self%block_c2r)) call fftw_destroy_plan(self%block_c2r)
+      if (c_associated(self%last_block_c2r)) call fftw_destroy_plan(self%last_block_c2r)
+      self%block_r2c = c_null_ptr
+      self%last_block_r2c = c_null_ptr
+      self%block_c2r = c_null_ptr
+      self%last_block_c2r = c_null_ptr
+      if (c_associated(self%rows_real_memory)) call fftw_free(self%rows_real_memory)
+      self%rows_real_memory = c_null_ptr
+      self%rows_real => null()
       self%n = 0
       self%nk = 0
       self%nx = 0

@@ -1,23 +1,71 @@
 !> lc_fft_plans' convolve, the product fused between the column transforms of a two-pass
 !> surface, against the three steps apart (forward_unscaled, the product on the whole
-!> spectrum, backward), on 1024 x 1000 points (two-pass; 513 columns, so the last block
-!> has one) with a real and a complex multiplier, on one thread and on two. The fused path
+!> spectrum, backward), on 1024 x 1003 points (two-pass; 513 columns, so the last block
+!> has one; 1003 rows, so the last block of rows has three) with a real and a complex
+!> multiplier, on one thread and on two. The fused path
 !> makes the same products in the same order on the same transforms, so the two agree to
 !> rounding (1e-14 of the largest value). The energy convolve sums in the same pass,
 !> sum over the whole spectrum of scale * multiplier |c|^2, is checked against Parseval's
 !> identity in real space, sum_j f_j (M f)_j for the field f and its product M f, to
-!> 1e-12 (two sums of a million terms in different orders). A 64 x 64 surface (the 2D
-!> plan) does not fuse.
+!> 1e-12 (two sums of a million terms in different orders). convolve_passes, a solver's
+!> work on blocks of rows fused into the row stages, here copying the field in and the
+!> product out, gives convolve's product and energy to rounding (its rows are transformed
+!> by plans of a block of rows each: 1e-14). A 64 x 64 surface (the 2D plan) does not fuse.
+module fft_convolve_copy_work
+   use lc_base_kinds, only: wp
+   use lc_fft_plans, only: row_work
+   implicit none (type, external)
+   private
+   public :: copy_work
+
+   !> Copies `input` into each block's rows and each block's output into `output`.
+   type, extends(row_work) :: copy_work
+      integer :: nx = 0
+      real(wp), pointer, contiguous :: input(:) => null(), output(:) => null()
+      real(wp) :: energy = 0.0_wp
+   contains
+      procedure :: before => copy_in
+      procedure :: between => keep_energy
+      procedure :: after => copy_out
+   end type copy_work
+
+contains
+
+   subroutine copy_in(self, first, rows, values, block)
+      class(copy_work), intent(inout) :: self
+      integer, intent(in) :: first, rows, block
+      real(wp), contiguous, intent(inout) :: values(:)
+      values = self%input((first - 1)*self%nx + 1:(first - 1 + rows)*self%nx)
+      if (block < 1) error stop 'block numbers start at 1'
+   end subroutine copy_in
+
+   subroutine keep_energy(self, energy)
+      class(copy_work), intent(inout) :: self
+      real(wp), intent(in) :: energy
+      self%energy = energy
+   end subroutine keep_energy
+
+   subroutine copy_out(self, first, rows, values, block)
+      class(copy_work), intent(inout) :: self
+      integer, intent(in) :: first, rows, block
+      real(wp), contiguous, intent(inout) :: values(:)
+      self%output((first - 1)*self%nx + 1:(first - 1 + rows)*self%nx) = values
+      if (block < 1) error stop 'block numbers start at 1'
+   end subroutine copy_out
+end module fft_convolve_copy_work
+
 program test_fft_convolve
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
    use lc_fft_plans, only: fft_plan
    use lc_test_checks, only: check, finish
+   use fft_convolve_copy_work, only: copy_work
    implicit none (type, external)
 
-   integer, parameter :: nx = 1024, ny = 1000
+   integer, parameter :: nx = 1024, ny = 1003
    real(wp), parameter :: scale = 1.0_wp/(real(nx, wp)*ny)
-   real(wp), allocatable :: field(:), real_multiplier(:), reference(:)
+   real(wp), allocatable, target :: field(:)
+   real(wp), allocatable :: real_multiplier(:), reference(:)
    complex(wp), allocatable :: complex_multiplier(:)
    type(fft_plan) :: small
    type(error_type), allocatable :: error
@@ -51,13 +99,36 @@ contains
       call plan%init(nx, ny, threads, error)
       if (allocated(error)) error stop 2
       write (label, '(a, i0, a)') ' (', threads, ' threads)'
-      call check(plan%fuses_products(), '1024 x 1000 fuses the product' // trim(label))
+      call check(plan%fuses_products(), '1024 x 1003 fuses the product' // trim(label))
       call check_against_steps(plan, 'a real multiplier, fused = apart' // trim(label), &
          & real_multiplier=real_multiplier)
       call check_against_steps(plan, 'a complex multiplier, fused = apart' // trim(label), &
          & complex_multiplier=complex_multiplier)
       call check_energy(plan, 'the energy of a real multiplier = sum f (M f)' // trim(label))
+      call check_passes(plan, 'the passes fused into the rows = convolve' // trim(label))
    end subroutine check_convolution
+
+   !> convolve_passes with a work that copies the field in and the product out, against
+   !> convolve's product and energy.
+   subroutine check_passes(plan, what)
+      type(fft_plan), intent(inout) :: plan
+      character(len=*), intent(in) :: what
+      type(copy_work) :: work
+      type(error_type), allocatable :: error
+      real(wp), allocatable, target :: output(:)
+      real(wp) :: energy, worst
+      plan%real_buffer = field
+      call plan%convolve(scale, real_multiplier, energy=energy)
+      reference = plan%real_buffer
+      allocate (output(nx*ny))
+      work%nx = nx
+      work%input => field
+      work%output => output
+      call plan%convolve_passes(scale, real_multiplier, work, error)
+      if (allocated(error)) error stop 2
+      worst = max(maxval(abs(output - reference))/maxval(abs(reference)), abs(work%energy - energy)/abs(energy))
+      call check(worst <= 1.0e-14_wp, what, worst)
+   end subroutine check_passes
 
    !> convolve's energy against sum_j f_j (M f)_j (Parseval: the same sum, in real space),
    !> for an even multiplier M(q) = M(-q), as the operators' metrics are (on the columns
