@@ -156,6 +156,8 @@ def test_gfmd_steps_with_a_mass_per_mode_do_not_grow_with_the_grid():
             dyn = lc.solve_areal(h, thickness=0.05, poisson=0.5, normalised_pressure=0.02154, stress=False,
                                  tol=1e-8, method="gfmd", gfmd_mass=mass, max_iter=20000)
             assert dyn.converged
+            assert {"one": "GFMD with unit masses, as the scene asks",
+                    "mode": "GFMD with a mass per mode, as the scene asks"}[mass] in dyn.solver_reason
             steps[mass, n] = dyn.iterations
     assert steps["mode", 256] <= 1.15 * steps["mode", 64]
     assert steps["one", 256] > 1.3 * steps["one", 64]
@@ -171,12 +173,14 @@ def test_gfmd_auto_takes_the_mass_per_mode_at_sparse_contact_from_512(n, load, p
     mass (a pair a step and one per check) on 256² (494 against 367 pairs) and at 6.6 %
     contact (359 against 331 at 512²); h/lambda = 0.05, frictionless. The pairs per step
     tell which ran: 1.1-1.3 with one mass (a pair a step, one a check of ten steps, and the
-    coarse start's), 2 or more with the mass per mode."""
+    coarse start's), 2 or more with the mass per mode. The result's reason says which."""
     h = fig3_surface(n)
     dyn = lc.solve_areal(h, thickness=0.05, poisson=0.5, normalised_pressure=load, stress=False, tol=1e-8,
                          method="gfmd", max_iter=20000)
     assert dyn.converged
     assert (dyn.fft_pairs >= 2 * dyn.iterations) == per_mode
+    said = "GFMD with a mass per mode (gfmd_mass 'auto'" if per_mode else "GFMD with unit masses (gfmd_mass 'auto'"
+    assert said in dyn.solver_reason, dyn.solver_reason
 
 
 def test_gfmd_refuses_an_unknown_mass():

@@ -47,6 +47,8 @@ module lc_contact_problem
       integer :: fft_pairs = 0          !< transform pairs on this grid's points
       real(wp) :: residual = huge(1.0_wp)
       real(wp), allocatable :: history(:)   !< the residual after each iteration (or check) recorded
+      !> what a method chose for itself, for the result's reason (e.g. GFMD's masses; '' if nothing)
+      character(len=:), allocatable :: note
    end type solve_outcome
 
 end module lc_contact_problem

@@ -317,6 +317,9 @@ contains
       if (allocated(error)) return
       result%solver = outcome%path
       result%solver_reason = plan%reason
+      if (allocated(outcome%note)) then
+         if (len(outcome%note) > 0) result%solver_reason = result%solver_reason // '; ' // outcome%note
+      end if
       result%converged = outcome%converged
       result%iterations = outcome%iterations
       result%outer_iterations = outcome%outer_iterations

@@ -61,7 +61,7 @@ module lc_contact_solver_gfmd
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    use lc_base_kinds, only: wp
    use lc_base_errors, only: error_type
-   use lc_base_strings, only: formatted
+   use lc_base_strings, only: formatted, to_string
    use lc_base_parallel, only: global_sum, global_max, global_any, sum_over_ranks, max_over_ranks
    use lc_contact_operator, only: compliance_operator
    use lc_contact_residual, only: complementarity_residual, rounding_floor
@@ -658,14 +658,26 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(gfmd_outcome) :: dynamics
       real(wp), allocatable :: history(:)
+      character(len=:), allocatable :: masses
       logical :: per_mode
       select case (trim(problem%gfmd_mass))
       case ('mode')
          per_mode = .true.
+         masses = 'GFMD with a mass per mode, as the scene asks'
       case ('one')
          per_mode = .false.
+         masses = 'GFMD with unit masses, as the scene asks'
       case default   ! 'auto'
          per_mode = takes_mode_mass(problem%op, state%p)
+         if (per_mode) then
+            masses = "GFMD with a mass per mode (gfmd_mass 'auto': a surface of at least " // &
+               & to_string(nint(mode_mass_points)) // ' points whose start touches on at most ' // &
+               & to_string(nint(100*mode_mass_contact)) // ' % of it)'
+         else
+            masses = "GFMD with unit masses (gfmd_mass 'auto': a line, a surface of fewer than " // &
+               & to_string(nint(mode_mass_points)) // ' points, or a start touching nowhere or on more than ' // &
+               & to_string(nint(100*mode_mass_contact)) // ' % of it)'
+         end if
       end select
       allocate (history(budget))
       call gfmd(problem%op, problem%b, problem%load_control, problem%mean_pressure, state%s, problem%g_ref, &
@@ -673,7 +685,7 @@ contains
       if (allocated(error)) return
       outcome = solve_outcome(converged=dynamics%converged, iterations=dynamics%iterations, &
          & outer_iterations=dynamics%updates, fft_pairs=dynamics%fft_pairs, residual=dynamics%residual, &
-         & history=history(1:min(dynamics%checks, size(history))))
+         & history=history(1:min(dynamics%checks, size(history))), note=masses)
    end subroutine solve_by_gfmd
 
    !> Whether &solver gfmd_mass = 'auto' takes the mass per mode: on a surface of at least

@@ -62,6 +62,11 @@ contains
             cycle
          end if
          outcome%path = outcome%path // '+' // solver%name()
+         if (allocated(stage%note)) then
+            if (.not. allocated(outcome%note)) outcome%note = ''
+            if (len(outcome%note) > 0 .and. len(stage%note) > 0) outcome%note = outcome%note // '; '
+            outcome%note = outcome%note // stage%note
+         end if
          outcome%iterations = outcome%iterations + stage%iterations
          outcome%outer_iterations = outcome%outer_iterations + stage%outer_iterations
          outcome%fft_pairs = outcome%fft_pairs + stage%fft_pairs
