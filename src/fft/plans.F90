@@ -17,6 +17,13 @@
 !> (`row_spectra`), so that FFTW-MPI's transpose needs no local transpose before its
 !> exchange; the columns' DFTs in place, contiguous, in blocks, with an operator's product
 !> between them (`convolve`); the transpose back to rows, and their c2r.
+!>
+!> `convolve_passes` (two-pass and distributed surfaces) takes a solver's passes over the
+!> grid into a product's row stages (`row_work`): each block of rows is written by the
+!> solver into a thread's buffer and transformed from there, and read back by it from
+!> there after the c2r, so that the product's input and output never cross the memory as
+!> fields (docs/decisions/024-fft-floor.md, 'Rows fetched ahead, and the CG's passes
+!> inside its product's rows').
 module lc_fft_plans
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_double_complex, c_size_t, &
       & c_f_pointer, c_associated, c_null_ptr
