@@ -705,7 +705,7 @@ contains
       real(wp), intent(out), optional :: energy
       real(wp), allocatable :: block_energy(:)
       integer(i8) :: start, finish
-      integer :: first, nkx
+      integer :: nkx
       call system_clock(start)
       nkx = self%nx/2 + 1
       if (present(energy)) then
@@ -723,30 +723,44 @@ contains
 #endif
       else
          call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
-         !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
-         do first = 1, nkx - self%last_block, column_block
-            call convolve_block(self, self%columns_forward, self%columns_backward, first, column_block, &
-               & self%column_buffer(:, thread_number() + 1))
-         end do
-         !$omp end parallel do
-         if (self%last_block > 0) call convolve_block(self, self%last_forward, self%last_backward, &
-            & nkx - self%last_block + 1, self%last_block, self%column_buffer(:, 1))
+         call product_in_columns(self, scale, block_energy, real_multiplier, complex_multiplier)
          call fftw_execute_dft_c2r(self%c2r, self%spectrum, self%real_buffer)
       end if
       if (present(energy)) energy = sum(block_energy)
       call system_clock(finish)
       !$omp atomic
       transform_ticks = transform_ticks + (finish - start)
+   end subroutine convolve
+
+   !> The columns' stage of a product on one process (convolve, convolve_passes): each block
+   !> of column_block columns copied into its thread's buffer, forward, the product (with
+   !> the block's energy where `block_energy` is allocated: a real multiplier), backward,
+   !> and copied back.
+   subroutine product_in_columns(self, scale, block_energy, real_multiplier, complex_multiplier)
+      class(fft_plan), intent(inout) :: self
+      real(wp), intent(in) :: scale
+      real(wp), allocatable, intent(inout) :: block_energy(:)
+      real(wp), contiguous, intent(in), optional :: real_multiplier(:)
+      complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
+      integer :: first, nkx
+      nkx = self%nx/2 + 1
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+      do first = 1, nkx - self%last_block, column_block
+         call product_block(self%columns_forward, self%columns_backward, first, column_block, &
+            & self%column_buffer(:, thread_number() + 1))
+      end do
+      !$omp end parallel do
+      if (self%last_block > 0) call product_block(self%last_forward, self%last_backward, nkx - self%last_block + 1, &
+         & self%last_block, self%column_buffer(:, 1))
    contains
       !> The columns first .. first+columns-1: forward, the product, backward, in `buffer`.
-      subroutine convolve_block(self, forward_plan, backward_plan, first, columns, buffer)
-         class(fft_plan), intent(inout) :: self
+      subroutine product_block(forward_plan, backward_plan, first, columns, buffer)
          type(c_ptr), intent(in) :: forward_plan, backward_plan
          integer, intent(in) :: first, columns
          complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
          call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .true.)
          call fftw_execute_dft(forward_plan, buffer, buffer)
-         if (present(energy)) then
+         if (allocated(block_energy)) then
             call lc_multiply_columns_real(buffer, columns, self%ny, real_multiplier, nkx, first, scale, &
                & column_weights(first - 1, columns, self%nx), block_energy((first - 1)/column_block + 1))
          else if (present(real_multiplier)) then
@@ -756,8 +770,8 @@ contains
          end if
          call fftw_execute_dft(backward_plan, buffer, buffer)
          call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .false.)
-      end subroutine convolve_block
-   end subroutine convolve
+      end subroutine product_block
+   end subroutine product_in_columns
 
    !> The number of blocks of column_block rows of this plan's field (this rank's slab):
    !> convolve_passes' `block` runs from 1 to it.
@@ -809,14 +823,7 @@ contains
          call fftw_mpi_execute_r2r(self%to_rows, self%spectrum_values, self%row_values)
 #endif
       else
-         !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
-         do first = 1, nkx - self%last_block, column_block
-            call product_block(first, column_block, self%column_buffer(:, thread_number() + 1), self%columns_forward, &
-               & self%columns_backward)
-         end do
-         !$omp end parallel do
-         if (self%last_block > 0) call product_block(nkx - self%last_block + 1, self%last_block, &
-            & self%column_buffer(:, 1), self%last_forward, self%last_backward)
+         call product_in_columns(self, scale, block_energy, multiplier)
       end if
       energy = sum(block_energy)
       if (self%distributed) energy = global_sum(energy)
@@ -881,19 +888,6 @@ contains
          passes = passes + (ended - began)
       end subroutine timed_work_between
 
-      !> The columns first .. first+columns-1 through `buffer`: forward, the product with
-      !> its energy, backward.
-      subroutine product_block(first, columns, buffer, forward_plan, backward_plan)
-         integer, intent(in) :: first, columns
-         complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
-         type(c_ptr), intent(in) :: forward_plan, backward_plan
-         call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .true.)
-         call fftw_execute_dft(forward_plan, buffer, buffer)
-         call lc_multiply_columns_real(buffer, columns, self%ny, multiplier, nkx, first, scale, &
-            & column_weights(first - 1, columns, self%nx), block_energy((first - 1)/column_block + 1))
-         call fftw_execute_dft(backward_plan, buffer, buffer)
-         call copy_columns(self%spectrum, nkx, self%ny, first, columns, buffer, .false.)
-      end subroutine product_block
    end subroutine convolve_passes
 
    !> Make convolve_passes' buffers and plans, if not made yet (an error where FFTW cannot).
