@@ -368,6 +368,28 @@ def test_rows_move_between_slab_layouts(ranks, redistribute_program):
     assert "FAIL" not in done.stdout
 
 
+@pytest.fixture(scope="module")
+def fft_slabs_program() -> Path:
+    """tests/fortran/test_fft_slabs, built in build/unit when needed."""
+    built, program = build_unit_program("test_fft_slabs")
+    assert built.returncode == 0 and program.exists(), built.stdout[-2000:]
+    return program
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [2, 3, 4])
+def test_products_on_the_slabs_match_the_whole_surface(ranks, fft_slabs_program):
+    """lc_fft_plans' products on the slabs (their blocks exchanged between the ranks) against
+    the whole surface's on one process, to 1e-13 of the largest value
+    (tests/fortran/test_fft_slabs.f90: real and complex multipliers, the energy, the
+    solver's passes in the rows' stages; 96 x 70 and 95 x 67 points)."""
+    done = subprocess.run(["mpirun", "--oversubscribe", "-n", str(ranks), str(fft_slabs_program)],
+                          capture_output=True, text=True, env=launcher_env(), timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("all fft on slabs checks passed") == ranks
+    assert "FAIL" not in done.stdout
+
+
 @needs_mpi
 def test_companion_patches_and_leakage(tmp_path):
     """The frictionless companion, the contact patches and the leakage (both on the slabs:

@@ -15,8 +15,12 @@
 !> transposes (decision 023, 'The distributed pair in stages of its own'): the rows' r2c
 !> in blocks of `column_block` rows through a thread's buffer, written by column mx
 !> (`row_spectra`), so that FFTW-MPI's transpose needs no local transpose before its
-!> exchange; the columns' DFTs in place, contiguous, in blocks, with an operator's product
-!> between them (`convolve`); the transpose back to rows, and their c2r.
+!> exchange; the columns' DFTs in place, contiguous, in blocks; the transpose back to
+!> rows, and their c2r. An operator's product (`convolve`, `convolve_passes`) exchanges
+!> whole blocks by MPI_Alltoallv instead, and no local transpose is left (decision 023,
+!> 'The products' exchanges'): the spectrum lies by row slabs between the exchanges, each
+!> block of columns gathered into a thread's buffer for its DFTs and the product, each
+!> block of rows gathered from row_spectra for its c2r.
 !>
 !> `convolve_passes` (two-pass and distributed surfaces) takes a solver's passes over the
 !> grid into a product's row stages (`row_work`): each block of rows is written by the
@@ -33,13 +37,14 @@ module lc_fft_plans
       & FFTW_DESTROY_INPUT, fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft, &
       & FFTW_FORWARD, FFTW_BACKWARD, FFTW_NO_BUFFERING
    use lc_base_kinds, only: wp, i8
-   use lc_base_errors, only: error_type, fatal_error, code_internal
+   use lc_base_errors, only: error_type, fatal_error, code_internal, code_input
    use lc_base_strings, only: to_string
    use lc_base_pages, only: advise_huge_pages
    use lc_base_threads, only: fill_field, thread_number
    use lc_base_parallel, only: is_distributed, slab, global_sum
 #ifdef LC_MPI
-   use lc_base_parallel, only: communicator
+   use lc_base_parallel, only: communicator, rank_count, this_rank, slab_rows, global_any
+   use mpi_f08, only: MPI_Alltoallv, MPI_DOUBLE_COMPLEX
    use lc_fft_fftw3_mpi, only: fftw_mpi_init, fftw_mpi_local_size_many_transposed, fftw_mpi_plan_many_transpose, &
       & fftw_mpi_execute_r2r, FFTW_MPI_TRANSPOSED_IN, FFTW_MPI_DEFAULT_BLOCK
    use, intrinsic :: iso_c_binding, only: c_intptr_t
@@ -166,6 +171,21 @@ module lc_fft_plans
       integer, private :: last_rows = 0
       type(c_ptr), private :: last_rows_r2c = c_null_ptr
       type(c_ptr), private :: to_columns = c_null_ptr, to_rows = c_null_ptr
+      !> distributed: the products (convolve, convolve_passes) exchange whole blocks with
+      !> MPI_Alltoallv, not by FFTW-MPI's transposes (`plan_exchanges`). Rank q's columns
+      !> of row_spectra go to it as they lie (`column_counts`, `column_offsets`, complex
+      !> numbers, by rank); the spectrum then holds this rank's columns by row slabs, rank s's
+      !> rows of every column together (`slab_counts`, `slab_offsets`; its rows
+      !> `slab_first` + 1 .. + `slab_row_counts`), each block of columns gathered into a thread's
+      !> column_buffer for its DFTs and put back; the way back lands in row_spectra by column
+      !> again, and each block of rows is gathered into its thread's row_buffer for its c2r
+      !> (`rows_c2r_block`, the last, shorter block apart). This rank's own block, its rows of
+      !> its columns, lies in row_spectra as the spectrum would hold it: it is not sent (its
+      !> counts are 0), and the columns' stage reads and writes it there (rank `own_rank`).
+      integer, private :: own_rank = 0
+      integer, allocatable, private :: column_counts(:), column_offsets(:), slab_counts(:), slab_offsets(:)
+      integer, allocatable, private :: slab_first(:), slab_row_counts(:)
+      type(c_ptr), private :: rows_c2r_block = c_null_ptr, last_rows_c2r_block = c_null_ptr
       !> two-pass and distributed surfaces, made on convolve_passes' first call: a buffer of
       !> column_block rows of the field a thread (a block's input and output), and the r2c
       !> and c2r of a block of rows between it and the spectrum (on a distributed surface
@@ -322,6 +342,7 @@ contains
       call advise_huge_pages(self%row_spectra)
       call fill_field(self%real_buffer, 0.0_wp)
       call plan_distributed(self, int(local_complex), error)
+      if (.not. allocated(error)) call plan_exchanges(self, error)
 #else
       call fatal_error(error, 'fft: this build has no FFTW-MPI (' // to_string(nx) // ' x ' // to_string(ny) // &
          & ' points on ' // to_string(threads) // ' threads)', code_internal)
@@ -397,6 +418,180 @@ contains
       end function column_plan
    end subroutine plan_distributed
 
+   !> The products' exchanges (see `column_counts`): what each rank sends to each and where it
+   !> lands, a column buffer a thread, and the c2r of a block of rows from a thread's
+   !> row_buffer. The same error on every rank where they cannot be made.
+   subroutine plan_exchanges(self, error)
+      class(fft_plan), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      integer :: p, q, x_first, x_count, nkx
+      integer(c_int) :: rows
+      logical :: made
+      nkx = self%nx/2 + 1
+      p = rank_count()
+      ! (the largest count and offset: a block of ceiling(nkx/P) columns of every row, or of
+      ! every column of ceiling(ny/P) rows; the same bound on every rank)
+      if (max(int(nkx, i8)*((self%ny + p - 1)/p), int((nkx + p - 1)/p, i8)*self%ny) > huge(1)) then
+         call fatal_error(error, 'fft: a slab of a ' // to_string(self%nx) // ' x ' // to_string(self%ny) // &
+            & ' surface on ' // to_string(p) // ' ranks holds more spectral modes than an MPI count reaches (' // &
+            & to_string(huge(1)) // '); run it on more ranks', code_input)
+         return
+      end if
+      allocate (self%column_counts(0:p - 1), self%column_offsets(0:p - 1), self%slab_counts(0:p - 1), &
+         & self%slab_offsets(0:p - 1), self%slab_first(0:p - 1), self%slab_row_counts(0:p - 1))
+      do q = 0, p - 1
+         call slab_rows(nkx, p, q, x_first, x_count)
+         ! (a rank without columns: FFTW-MPI's start is then 0)
+         if (q == this_rank() .and. (x_count /= self%nkx_local .or. (x_count > 0 .and. x_first /= self%x_start))) then
+            call fatal_error(error, 'fft: FFTW-MPI gives this rank columns ' // to_string(self%x_start) // ' + ' // &
+               & to_string(self%nkx_local) // ', the slab contract ' // to_string(x_first) // ' + ' // &
+               & to_string(x_count), code_internal)
+            return
+         end if
+         call slab_rows(self%ny, p, q, self%slab_first(q), self%slab_row_counts(q))
+         self%column_counts(q) = x_count*self%ny_local
+         self%column_offsets(q) = x_first*self%ny_local
+         self%slab_counts(q) = self%nkx_local*self%slab_row_counts(q)
+         self%slab_offsets(q) = self%nkx_local*self%slab_first(q)
+      end do
+      self%own_rank = this_rank()
+      self%column_counts(self%own_rank) = 0
+      self%slab_counts(self%own_rank) = 0
+      ! (a column buffer a thread, each a multiple of 8*ny*16 bytes from FFTW's aligned start)
+      made = .true.
+      if (self%nkx_local > 0) then
+         self%column_memory = fftw_alloc_complex(int(column_block, c_size_t)*int(self%ny, c_size_t)* &
+            & int(self%threads, c_size_t))
+         made = c_associated(self%column_memory)
+         if (made) call c_f_pointer(self%column_memory, self%column_buffer, [column_block*self%ny, self%threads])
+      end if
+      if (made) then
+#ifdef LC_OPENMP
+         call fftw_plan_with_nthreads(1_c_int)
+#endif
+         rows = int(min(column_block, self%ny_local), c_int)
+         self%rows_c2r_block = rows_plan(rows)
+         if (self%last_rows > 0) self%last_rows_c2r_block = rows_plan(int(self%last_rows, c_int))
+         made = c_associated(self%rows_c2r_block) .and. (self%last_rows == 0 .or. c_associated(self%last_rows_c2r_block))
+      end if
+      if (global_any(.not. made)) call fatal_error(error, 'fft: cannot allocate or plan the blocks of a ' // &
+         & to_string(self%nx) // ' x ' // to_string(self%ny) // ' surface''s slabs on ' // to_string(p) // ' ranks', &
+         & code_internal)
+   contains
+      !> The c2r of `count` rows from the first thread's row_buffer (row r's coefficient mx
+      !> at buffer(mx*count + r + 1), as the rows' r2c leaves them) into rows of the field.
+      type(c_ptr) function rows_plan(count)
+         integer(c_int), intent(in) :: count
+         rows_plan = fftw_plan_many_dft_c2r(1_c_int, [int(self%nx, c_int)], count, self%row_buffer(:, 1), &
+            & [int(nkx, c_int)], count, 1_c_int, self%real_buffer, [int(self%nx, c_int)], 1_c_int, &
+            & int(self%nx, c_int), ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
+      end function rows_plan
+   end subroutine plan_exchanges
+
+   !> row_spectra's blocks of columns to their ranks, into the spectrum by row slabs
+   !> (`to_columns`), or back (see `column_counts`).
+   subroutine exchange_blocks(self, to_columns)
+      class(fft_plan), intent(inout) :: self
+      logical, intent(in) :: to_columns
+      if (to_columns) then
+         call MPI_Alltoallv(self%row_spectra, self%column_counts, self%column_offsets, MPI_DOUBLE_COMPLEX, &
+            & self%spectrum, self%slab_counts, self%slab_offsets, MPI_DOUBLE_COMPLEX, communicator)
+      else
+         call MPI_Alltoallv(self%spectrum, self%slab_counts, self%slab_offsets, MPI_DOUBLE_COMPLEX, &
+            & self%row_spectra, self%column_counts, self%column_offsets, MPI_DOUBLE_COMPLEX, communicator)
+      end if
+   end subroutine exchange_blocks
+
+   !> The columns' stage of a product on the exchanged spectrum (convolve, convolve_passes):
+   !> each block of column_block of this rank's columns gathered from the row slabs into its
+   !> thread's buffer, column by column, forward, the product (with the block's energy
+   !> where `block_energy` is allocated), backward, and put back.
+   subroutine product_in_slab_columns(self, scale, block_energy, real_multiplier, complex_multiplier)
+      class(fft_plan), intent(inout) :: self
+      real(wp), intent(in) :: scale
+      real(wp), allocatable, intent(inout) :: block_energy(:)
+      real(wp), contiguous, intent(in), optional :: real_multiplier(:)
+      complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
+      integer :: first
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+      do first = 1, self%nkx_local - self%last_block, column_block
+         call product_block(self%columns_forward, self%columns_backward, first, column_block, &
+            & self%column_buffer(:, thread_number() + 1))
+      end do
+      !$omp end parallel do
+      if (self%last_block > 0) call product_block(self%last_forward, self%last_backward, &
+         & self%nkx_local - self%last_block + 1, self%last_block, self%column_buffer(:, 1))
+   contains
+      subroutine product_block(forward_plan, backward_plan, first, columns, buffer)
+         type(c_ptr), intent(in) :: forward_plan, backward_plan
+         integer, intent(in) :: first, columns
+         complex(c_double_complex), contiguous, intent(inout) :: buffer(:)
+         call slab_columns(self, first, columns, buffer, .true.)
+         call fftw_execute_dft(forward_plan, buffer, buffer)
+         call multiply_local_columns(self, first, columns, buffer, scale, real_multiplier, complex_multiplier, &
+            & block_energy)
+         call fftw_execute_dft(backward_plan, buffer, buffer)
+         call slab_columns(self, first, columns, buffer, .false.)
+      end subroutine product_block
+   end subroutine product_in_slab_columns
+
+   !> block <- this rank's columns first .. first+columns-1 of the exchanged spectrum (row
+   !> slabs, see `column_counts`), each column's ny modes adjacent; or back (`into_block` false).
+   subroutine slab_columns(self, first, columns, block, into_block)
+      class(fft_plan), intent(inout) :: self
+      integer, intent(in) :: first, columns
+      complex(c_double_complex), contiguous, intent(inout) :: block(:)
+      logical, intent(in) :: into_block
+      complex(c_double_complex), pointer, contiguous :: slabs(:)
+      integer :: s, c, rows, start, from, to
+      do s = 0, size(self%slab_counts) - 1
+         rows = self%slab_row_counts(s)
+         if (s == self%own_rank) then
+            slabs => self%row_spectra
+            start = self%x_start*self%ny_local
+         else
+            slabs => self%spectrum
+            start = self%slab_offsets(s)
+         end if
+         do c = 0, columns - 1
+            from = start + (first - 1 + c)*rows
+            to = c*self%ny + self%slab_first(s)
+            if (into_block) then
+               block(to + 1:to + rows) = slabs(from + 1:from + rows)
+            else
+               slabs(from + 1:from + rows) = block(to + 1:to + rows)
+            end if
+         end do
+      end do
+   end subroutine slab_columns
+
+   !> real_buffer <- the c2r of row_spectra held by column (after the way back's exchange),
+   !> each block of column_block rows gathered into its thread's row_buffer first.
+   subroutine rows_from_columns(self)
+      class(fft_plan), intent(inout) :: self
+      integer :: first
+      !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
+      do first = 1, self%ny_local - self%last_rows, column_block
+         call rows_c2r(self, first, column_block, self%real_buffer((first - 1)*self%nx + 1:))
+      end do
+      !$omp end parallel do
+      if (self%last_rows > 0) call rows_c2r(self, self%ny_local - self%last_rows + 1, self%last_rows, &
+         & self%real_buffer((self%ny_local - self%last_rows)*self%nx + 1:))
+   end subroutine rows_from_columns
+
+   !> values <- the c2r of the rows first .. first+rows-1 of row_spectra held by column,
+   !> through the calling thread's row_buffer.
+   subroutine rows_c2r(self, first, rows, values)
+      class(fft_plan), intent(inout) :: self
+      integer, intent(in) :: first, rows
+      real(c_double), contiguous, intent(inout) :: values(:)
+      integer :: thread
+      thread = thread_number() + 1
+      call copy_columns(self%row_spectra, self%ny_local, self%nx/2 + 1, first, rows, self%row_buffer(:, thread), .true.)
+      call fftw_execute_dft_c2r(merge(self%rows_c2r_block, self%last_rows_c2r_block, rows == column_block), &
+         & self%row_buffer(:, thread), values)
+   end subroutine rows_c2r
+
    !> row_spectra(my, mx) <- the r2c of the slab's rows my (unscaled), each block of
    !> column_block rows through its thread's buffer.
    subroutine rows_to_columns(self)
@@ -422,38 +617,18 @@ contains
 #endif
 
    !> The DFTs of this rank's columns of a distributed spectrum, in place, by blocks of
-   !> column_block adjacent columns (each contiguous) on the solve's threads. With
-   !> `then_plan` and `then_last` (convolve), each block is then multiplied by the
-   !> multiplier's same modes times `scale` and transformed by these.
-   subroutine transform_local_columns(self, block_plan, last_plan, then_plan, then_last, scale, &
-         & real_multiplier, complex_multiplier, block_energy)
+   !> column_block adjacent columns (each contiguous) on the solve's threads.
+   subroutine transform_local_columns(self, block_plan, last_plan)
       class(fft_plan), intent(inout) :: self
       type(c_ptr), intent(in) :: block_plan, last_plan
-      type(c_ptr), intent(in), optional :: then_plan, then_last
-      real(wp), intent(in), optional :: scale
-      real(wp), contiguous, intent(in), optional :: real_multiplier(:)
-      complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
-      !> allocated: each block's share of convolve's energy (a real multiplier)
-      real(wp), allocatable, intent(inout), optional :: block_energy(:)
       integer :: first
       ! (the same plan for a block whatever the thread count: the bits do not depend on it)
       !$omp parallel do schedule(static) num_threads(self%threads) if(self%threads > 1)
       do first = 1, self%nkx_local - self%last_block, column_block
          call local_block(block_plan, first, column_block)
-         if (present(then_plan)) then
-            call multiply_block(first, column_block)
-            call local_block(then_plan, first, column_block)
-         end if
       end do
       !$omp end parallel do
-      if (self%last_block > 0) then
-         first = self%nkx_local - self%last_block + 1
-         call local_block(last_plan, first, self%last_block)
-         if (present(then_last)) then
-            call multiply_block(first, self%last_block)
-            call local_block(then_last, first, self%last_block)
-         end if
-      end if
+      if (self%last_block > 0) call local_block(last_plan, self%nkx_local - self%last_block + 1, self%last_block)
    contains
       !> The plan on the columns first .. first+columns-1: modes (first-1) ny + 1 ..
       subroutine local_block(plan, first, columns)
@@ -464,28 +639,37 @@ contains
          call fftw_execute_dft(plan, self%spectrum(start:start + columns*self%ny - 1), &
             & self%spectrum(start:start + columns*self%ny - 1))
       end subroutine local_block
-
-      !> Those modes times the multiplier's (times scale), as the operators' product.
-      subroutine multiply_block(first, columns)
-         integer, intent(in) :: first, columns
-         integer :: start, count
-         start = (first - 1)*self%ny + 1
-         count = columns*self%ny
-         if (present(block_energy)) then
-            if (allocated(block_energy)) then
-               call multiply_real_values_energy(columns, self%ny, self%spectrum(start:), real_multiplier(start:), &
-                  & scale, column_weights(self%x_start + first - 1, columns, self%nx), &
-                  & block_energy((first - 1)/column_block + 1))
-               return
-            end if
-         end if
-         if (present(real_multiplier)) then
-            call multiply_real_values(count, self%spectrum(start:), real_multiplier(start:), scale)
-         else
-            call multiply_complex_values(count, self%spectrum(start:), complex_multiplier(start:), scale)
-         end if
-      end subroutine multiply_block
    end subroutine transform_local_columns
+
+   !> values <- values * (the multiplier's modes of this rank's columns first ..
+   !> first+columns-1) * scale, the columns' ny modes each adjacent in values, a real or
+   !> complex multiplier (the spectrum's layout), as the operators' product; with a real
+   !> multiplier and `block_energy` allocated, also the block's share of convolve's energy.
+   subroutine multiply_local_columns(self, first, columns, values, scale, real_multiplier, complex_multiplier, &
+         & block_energy)
+      class(fft_plan), intent(in) :: self
+      integer, intent(in) :: first, columns
+      complex(c_double_complex), contiguous, intent(inout) :: values(:)
+      real(wp), intent(in) :: scale
+      real(wp), contiguous, intent(in), optional :: real_multiplier(:)
+      complex(wp), contiguous, intent(in), optional :: complex_multiplier(:)
+      real(wp), allocatable, intent(inout), optional :: block_energy(:)
+      integer :: start, count
+      start = (first - 1)*self%ny + 1
+      count = columns*self%ny
+      if (present(block_energy)) then
+         if (allocated(block_energy)) then
+            call multiply_real_values_energy(columns, self%ny, values, real_multiplier(start:), scale, &
+               & column_weights(self%x_start + first - 1, columns, self%nx), block_energy((first - 1)/column_block + 1))
+            return
+         end if
+      end if
+      if (present(real_multiplier)) then
+         call multiply_real_values(count, values, real_multiplier(start:), scale)
+      else
+         call multiply_complex_values(count, values, complex_multiplier(start:), scale)
+      end if
+   end subroutine multiply_local_columns
 
    !> values <- values * (multiplier * scale), n of each (explicit shapes: a plain loop).
    pure subroutine multiply_real_values(n, values, multiplier, scale)
@@ -715,11 +899,10 @@ contains
       if (self%distributed) then
 #ifdef LC_MPI
          call rows_to_columns(self)
-         call fftw_mpi_execute_r2r(self%to_columns, self%row_values, self%spectrum_values)
-         call transform_local_columns(self, self%columns_forward, self%last_forward, self%columns_backward, &
-            & self%last_backward, scale, real_multiplier, complex_multiplier, block_energy)
-         call fftw_mpi_execute_r2r(self%to_rows, self%spectrum_values, self%row_values)
-         call fftw_execute_dft_c2r(self%c2r, self%row_spectra, self%real_buffer)
+         call exchange_blocks(self, .true.)
+         call product_in_slab_columns(self, scale, block_energy, real_multiplier, complex_multiplier)
+         call exchange_blocks(self, .false.)
+         call rows_from_columns(self)
 #endif
       else
          call fftw_execute_dft_r2c(self%r2c, self%real_buffer, self%spectrum)
@@ -817,10 +1000,9 @@ contains
       ! the columns' stage, the product and its energy (as convolve)
       if (self%distributed) then
 #ifdef LC_MPI
-         call fftw_mpi_execute_r2r(self%to_columns, self%row_values, self%spectrum_values)
-         call transform_local_columns(self, self%columns_forward, self%last_forward, self%columns_backward, &
-            & self%last_backward, scale, multiplier, block_energy=block_energy)
-         call fftw_mpi_execute_r2r(self%to_rows, self%spectrum_values, self%row_values)
+         call exchange_blocks(self, .true.)
+         call product_in_slab_columns(self, scale, block_energy, multiplier)
+         call exchange_blocks(self, .false.)
 #endif
       else
          call product_in_columns(self, scale, block_energy, multiplier)
@@ -869,7 +1051,9 @@ contains
          real(c_double), contiguous, intent(inout) :: values(:)
          integer(i8) :: began, ended
          if (self%distributed) then
-            call fftw_execute_dft_c2r(plan, self%row_spectra((first - 1)*nkx + 1:), values)
+#ifdef LC_MPI
+            call rows_c2r(self, first, rows, values)
+#endif
          else
             call fftw_execute_dft_c2r(plan, self%spectrum((first - 1)*nkx + 1:), values)
          end if
@@ -894,41 +1078,44 @@ contains
    subroutine plan_passes(self, error)
       class(fft_plan), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
-      if (c_associated(self%block_c2r)) return
+      if (passes_planned()) return
       call plan_row_blocks(self)
-      if (.not. c_associated(self%block_c2r)) call fatal_error(error, 'fft: FFTW could not plan the blocks of rows of ' &
+      if (.not. passes_planned()) call fatal_error(error, 'fft: FFTW could not plan the blocks of rows of ' &
          & // to_string(self%nx) // ' x ' // to_string(self%ny_local) // ' points', code_internal)
+   contains
+      !> (a distributed surface's c2r of a block is the exchanges' own, from its row buffer)
+      logical function passes_planned()
+         passes_planned = c_associated(self%rows_real_memory) .and. (self%distributed .or. c_associated(self%block_c2r))
+      end function passes_planned
    end subroutine plan_passes
 
    !> convolve_passes' buffers and plans (see the type): one buffer of column_block rows a
-   !> thread, the r2c of a block into the spectrum's rows (one process) and the c2r of a
-   !> block from the spectrum's rows or row_spectra's (distributed), the last, shorter
-   !> block apart. Left null where FFTW could not plan (convolve_passes reports it).
+   !> thread and, on one process, the r2c and c2r of a block of rows between it and the
+   !> spectrum's rows, the last, shorter block apart (a distributed surface's are the rows'
+   !> stage's and the exchanges' own). Left null where FFTW could not plan (convolve_passes
+   !> reports it).
    subroutine plan_row_blocks(self)
       class(fft_plan), intent(inout) :: self
       integer(c_int) :: nx, nkx, rows
-      complex(c_double_complex), pointer, contiguous :: rows_spectrum(:)
       nx = int(self%nx, c_int)
       nkx = nx/2 + 1
       rows = int(min(column_block, self%ny_local), c_int)
       self%last_rows = mod(self%ny_local, column_block)
-      self%rows_real_memory = fftw_alloc_real(int(column_block, c_size_t)*int(nx, c_size_t)*int(self%threads, c_size_t))
+      if (.not. c_associated(self%rows_real_memory)) self%rows_real_memory = &
+         & fftw_alloc_real(int(column_block, c_size_t)*int(nx, c_size_t)*int(self%threads, c_size_t))
       if (.not. c_associated(self%rows_real_memory)) return
       call c_f_pointer(self%rows_real_memory, self%rows_real, [column_block*self%nx, self%threads])
-      rows_spectrum => self%spectrum
-      if (self%distributed) rows_spectrum => self%row_spectra
+      if (self%distributed) return
       ! (each block's plan runs on one thread: the blocks are shared out among the threads)
 #ifdef LC_OPENMP
       call fftw_plan_with_nthreads(1_c_int)
 #endif
-      if (.not. self%distributed) then
-         self%block_r2c = block_plan_r2c(rows)
-         if (self%last_rows > 0) self%last_block_r2c = block_plan_r2c(int(self%last_rows, c_int))
-      end if
+      self%block_r2c = block_plan_r2c(rows)
+      if (self%last_rows > 0) self%last_block_r2c = block_plan_r2c(int(self%last_rows, c_int))
       self%block_c2r = block_plan_c2r(rows)
       if (self%last_rows > 0) self%last_block_c2r = block_plan_c2r(int(self%last_rows, c_int))
-      if (.not. ((self%distributed .or. (c_associated(self%block_r2c) .and. (self%last_rows == 0 .or. &
-         & c_associated(self%last_block_r2c)))) .and. (self%last_rows == 0 .or. c_associated(self%last_block_c2r)))) then
+      if (.not. (c_associated(self%block_r2c) .and. (self%last_rows == 0 .or. c_associated(self%last_block_r2c)) .and. &
+         & (self%last_rows == 0 .or. c_associated(self%last_block_c2r)))) then
          if (c_associated(self%block_c2r)) call fftw_destroy_plan(self%block_c2r)
          self%block_c2r = c_null_ptr
       end if
@@ -936,12 +1123,12 @@ contains
       type(c_ptr) function block_plan_r2c(count)
          integer(c_int), intent(in) :: count
          block_plan_r2c = fftw_plan_many_dft_r2c(1_c_int, [nx], count, self%rows_real(:, 1), [nx], 1_c_int, nx, &
-            & rows_spectrum, [nkx], 1_c_int, nkx, FFTW_ESTIMATE)
+            & self%spectrum, [nkx], 1_c_int, nkx, FFTW_ESTIMATE)
       end function block_plan_r2c
 
       type(c_ptr) function block_plan_c2r(count)
          integer(c_int), intent(in) :: count
-         block_plan_c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], count, rows_spectrum, [nkx], 1_c_int, nkx, &
+         block_plan_c2r = fftw_plan_many_dft_c2r(1_c_int, [nx], count, self%spectrum, [nkx], 1_c_int, nkx, &
             & self%rows_real(:, 1), [nx], 1_c_int, nx, ior(FFTW_ESTIMATE, FFTW_DESTROY_INPUT))
       end function block_plan_c2r
    end subroutine plan_row_blocks
@@ -1033,6 +1220,12 @@ contains
       self%last_rows_r2c = c_null_ptr
       self%to_columns = c_null_ptr
       self%to_rows = c_null_ptr
+      if (c_associated(self%rows_c2r_block)) call fftw_destroy_plan(self%rows_c2r_block)
+      if (c_associated(self%last_rows_c2r_block)) call fftw_destroy_plan(self%last_rows_c2r_block)
+      self%rows_c2r_block = c_null_ptr
+      self%last_rows_c2r_block = c_null_ptr
+      if (allocated(self%column_counts)) deallocate (self%column_counts, self%column_offsets, self%slab_counts, &
+         & self%slab_offsets, self%slab_first, self%slab_row_counts)
       self%last_rows = 0
       if (c_associated(self%row_spectra_memory)) call fftw_free(self%row_spectra_memory)
       if (c_associated(self%row_memory)) call fftw_free(self%row_memory)
