@@ -5,7 +5,10 @@
  * (the spectrum by columns kx: two transposes a pair fewer), the latter also with the copies
  * and with the copies and an r2c that may destroy its input (FFTW_DESTROY_INPUT, as the
  * library plans it: FFTW-MPI then transposes out of place, with no buffer allocated at each
- * execution). FFTW_ESTIMATE, as the library.
+ * execution). FFTW_ESTIMATE, as the library. Then the library's own pairs: "own stages", its
+ * stages around FFTW-MPI's transposes (forward and backward), and, on several ranks, "own
+ * exchanges", a product's stages around MPI_Alltoallv of whole blocks (convolve), with the
+ * time of each stage on rank 0.
  *
  *     mpicc -O2 bench/mpi_fft_pair.c -lfftw3_mpi -lfftw3 -o fft_pair && mpirun -n 2 ./fft_pair 2048 2048 10
  *
