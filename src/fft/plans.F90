@@ -151,8 +151,9 @@ module lc_fft_plans
       !> columns, `column_block` at a time (the last block: `last_block` columns)
       logical, private :: split = .false.
       integer, private :: last_block = 0
-      !> one buffer of column_block columns of ny modes a thread (two-pass surfaces): the
-      !> block a thread transforms, row by row (a row's columns adjacent)
+      !> one buffer of column_block columns of ny modes a thread: the block a thread
+      !> transforms, row by row (a row's columns adjacent) on a two-pass surface, column by
+      !> column (a column's modes adjacent) in a distributed product
       complex(c_double_complex), pointer, contiguous, private :: column_buffer(:, :) => null()
       type(c_ptr), private :: column_memory = c_null_ptr
       type(c_ptr), private :: columns_forward = c_null_ptr, columns_backward = c_null_ptr
@@ -188,8 +189,8 @@ module lc_fft_plans
       type(c_ptr), private :: rows_c2r_block = c_null_ptr, last_rows_c2r_block = c_null_ptr
       !> two-pass and distributed surfaces, made on convolve_passes' first call: a buffer of
       !> column_block rows of the field a thread (a block's input and output), and the r2c
-      !> and c2r of a block of rows between it and the spectrum (on a distributed surface
-      !> the c2r from row_spectra; its r2c is the rows' stage's own), the last block apart
+      !> and c2r of a block of rows between it and the spectrum (one process; a distributed
+      !> surface's are the rows' stage's and the exchanges' own), the last block apart
       real(c_double), pointer, contiguous, private :: rows_real(:, :) => null()
       type(c_ptr), private :: rows_real_memory = c_null_ptr
       type(c_ptr), private :: block_r2c = c_null_ptr, last_block_r2c = c_null_ptr
@@ -616,6 +617,7 @@ contains
    end subroutine rows_to_columns
 #endif
 
+#ifdef LC_MPI
    !> The DFTs of this rank's columns of a distributed spectrum, in place, by blocks of
    !> column_block adjacent columns (each contiguous) on the solve's threads.
    subroutine transform_local_columns(self, block_plan, last_plan)
@@ -708,6 +710,7 @@ contains
       real(wp), intent(in) :: scale
       values = values*(multiplier*scale)
    end subroutine multiply_complex_values
+#endif
 
    !> The column mx (0..nx/2) and row my (0..ny-1) of this plan's spectrum entry i (1-based):
    !> mx fastest (serial), or my fastest in this rank's columns (distributed, transposed).
@@ -872,8 +875,8 @@ contains
 
    !> real_buffer <- the c2r of (multiplier * scale) times the bare r2c of real_buffer, for a
    !> plan that fuses_products: forward_unscaled, the product and backward in one, each
-   !> block of columns multiplied between its two column transforms (in its thread's
-   !> buffer on one process, in place on a distributed surface). One multiplier on the half
+   !> block of columns multiplied between its two column transforms in its thread's buffer
+   !> (on a distributed surface between the exchanges: see `column_counts`). One multiplier on the half
    !> spectrum (spectrum's layout), real or complex. The same bits as the three steps apart;
    !> the product's time counts as the transforms'. `energy` (a real multiplier): the sum
    !> over the whole spectrum (this rank's columns, on a distributed surface) of
