@@ -37,7 +37,7 @@ module lc_fft_plans
       & FFTW_DESTROY_INPUT, fftw_plan_many_dft_r2c, fftw_plan_many_dft_c2r, fftw_plan_many_dft, fftw_execute_dft, &
       & FFTW_FORWARD, FFTW_BACKWARD, FFTW_NO_BUFFERING
    use lc_base_kinds, only: wp, i8
-   use lc_base_errors, only: error_type, fatal_error, code_internal, code_input
+   use lc_base_errors, only: error_type, fatal_error, code_internal
    use lc_base_strings, only: to_string
    use lc_base_pages, only: advise_huge_pages
    use lc_base_threads, only: fill_field, thread_number
@@ -430,12 +430,12 @@ contains
       logical :: made
       nkx = self%nx/2 + 1
       p = rank_count()
-      ! (the largest count and offset: a block of ceiling(nkx/P) columns of every row, or of
-      ! every column of ceiling(ny/P) rows; the same bound on every rank)
+      ! (MPI's counts are default integers: the largest block, ceiling(nkx/P) columns of
+      ! every row or every column of ceiling(ny/P) rows, must fit; the input's limit of
+      ! 2^28 points keeps it below 2^27)
       if (max(int(nkx, i8)*((self%ny + p - 1)/p), int((nkx + p - 1)/p, i8)*self%ny) > huge(1)) then
-         call fatal_error(error, 'fft: a slab of a ' // to_string(self%nx) // ' x ' // to_string(self%ny) // &
-            & ' surface on ' // to_string(p) // ' ranks holds more spectral modes than an MPI count reaches (' // &
-            & to_string(huge(1)) // '); run it on more ranks', code_input)
+         call fatal_error(error, 'fft: a block of the spectrum of ' // to_string(self%nx) // ' x ' // &
+            & to_string(self%ny) // ' points on ' // to_string(p) // ' ranks exceeds an MPI count', code_internal)
          return
       end if
       allocate (self%column_counts(0:p - 1), self%column_offsets(0:p - 1), self%slab_counts(0:p - 1), &
