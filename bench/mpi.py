@@ -7,6 +7,7 @@ and 4 ranks (4 oversubscribed on a 2-core machine) in FFTW-MPI's two layouts.
                                   [--runs serial,1,2] [--fields] [--before PATH] [--method auto]
     .venv/bin/python bench/mpi.py --scene sliding --n 1024 --no-pairs
 
+With --scene frictionless: the same scene without friction (the constrained CG).
 With --scene sliding (docs/decisions/028-distributed-multigrid.md): a standard linear solid
 (E_inf/E0 = 10, V tau/lambda = 0.1) sliding on a layer h/lambda = 0.16, nu = 0.5, with
 mu_c = 0.5 and p_m = 0.02 E0, which 'auto' sends to the multigrid method serially (from
@@ -71,8 +72,9 @@ def environment(launched: bool) -> dict[str, str]:
 
 def scene(directory: Path, n: int, kind: str = "coupled", method: str = "auto", fields: bool = False) -> Path:
     nml = directory / f"{kind}_{method}.nml"
-    if kind == "coupled":
-        body = ("&layer thickness = 0.05, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
+    if kind in ("coupled", "frictionless"):
+        body = ("&layer thickness = 0.05, poisson = 0.5 /\n" +
+                ("&friction coefficient = 0.5 /\n" if kind == "coupled" else "") +
                 "&loading control = 'load', normalised_pressure = 0.15 /\n")
     else:
         body = ("&layer thickness = 0.16, poisson = 0.5 /\n&friction coefficient = 0.5 /\n"
@@ -133,7 +135,7 @@ def main() -> None:
     parser.add_argument("--executable", help="the layercontact program (default: the installed one)")
     parser.add_argument("--runs", default="serial,1,2", help="runs: serial (no launcher) and rank counts")
     parser.add_argument("--fields", action="store_true", help="write the maps (the result file by slabs)")
-    parser.add_argument("--scene", choices=("coupled", "sliding"), default="coupled")
+    parser.add_argument("--scene", choices=("coupled", "frictionless", "sliding"), default="coupled")
     parser.add_argument("--before", help="another build's layercontact program, run alternately with this one")
     parser.add_argument("--method", default="auto", choices=("auto", "gcr", "multigrid"),
                         help="&solver method of the coupled scene")
@@ -149,9 +151,10 @@ def main() -> None:
         pairs(args.n)
     if args.pairs_only:
         return
-    if args.scene == "coupled":
+    if args.scene in ("coupled", "frictionless"):
         cases = [(0 if name == "serial" else int(name), args.method) for name in args.runs.split(",")]
-        title = f"{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5)"
+        title = (f"{args.n}² coupled (mu_c 0.5, h/lambda 0.05, nu 0.5)" if args.scene == "coupled" else
+                 f"{args.n}² frictionless (h/lambda 0.05, nu 0.5)")
     else:
         cases = [(0, "auto"), (2, "multigrid"), (2, "gcr")]
         title = f"{args.n}² sliding SLS (E_inf/E0 10, V tau/lambda 0.1, h/lambda 0.16, mu_c 0.5)"
