@@ -8,6 +8,8 @@ and 4 ranks (4 oversubscribed on a 2-core machine) in FFTW-MPI's two layouts.
     .venv/bin/python bench/mpi.py --scene sliding --n 1024 --no-pairs
 
 With --scene frictionless: the same scene without friction (the constrained CG).
+--family physical: the shortest wavelength period/32 at every n (bench/scaling.py's family
+(a)) instead of 8 grid points.
 With --scene sliding (docs/decisions/028-distributed-multigrid.md): a standard linear solid
 (E_inf/E0 = 10, V tau/lambda = 0.1) sliding on a layer h/lambda = 0.16, nu = 0.5, with
 mu_c = 0.5 and p_m = 0.02 E0, which 'auto' sends to the multigrid method serially (from
@@ -70,7 +72,8 @@ def environment(launched: bool) -> dict[str, str]:
     return env
 
 
-def scene(directory: Path, n: int, kind: str = "coupled", method: str = "auto", fields: bool = False) -> Path:
+def scene(directory: Path, n: int, kind: str = "coupled", method: str = "auto", fields: bool = False,
+          family: str = "points") -> Path:
     nml = directory / f"{kind}_{method}.nml"
     if kind in ("coupled", "frictionless"):
         body = ("&layer thickness = 0.05, poisson = 0.5 /\n" +
@@ -82,7 +85,7 @@ def scene(directory: Path, n: int, kind: str = "coupled", method: str = "auto", 
                 "&loading control = 'load', mean_pressure = 0.02 /\n")
     nml.write_text(
         f"&scene geometry = 'areal', n = {n}, ny = {n} /\n" + body +
-        f"&profile kind = 'self_affine', hurst = 0.8, seed = 1, short_wavelength = {8 / n}, rms_gradient = 0.1 /\n"
+        f"&profile kind = 'self_affine', hurst = 0.8, seed = 1, short_wavelength = {8 / n if family == 'points' else 1 / 32}, rms_gradient = 0.1 /\n"
         f"&solver tol = 1e-8, method = '{method}' /\n"
         f"&output file = '{kind}.h5', overwrite = .true., stress = .false., "
         f"fields = {'.true.' if fields else '.false.'} /\n")
@@ -137,6 +140,8 @@ def main() -> None:
     parser.add_argument("--fields", action="store_true", help="write the maps (the result file by slabs)")
     parser.add_argument("--scene", choices=("coupled", "frictionless", "sliding"), default="coupled")
     parser.add_argument("--before", help="another build's layercontact program, run alternately with this one")
+    parser.add_argument("--family", choices=("points", "physical"), default="points",
+                        help="shortest wavelength 8 grid points, or period/32 at every n")
     parser.add_argument("--method", default="auto", choices=("auto", "gcr", "multigrid"),
                         help="&solver method of the coupled scene")
     args = parser.parse_args()
@@ -162,7 +167,7 @@ def main() -> None:
         rows = {}
         for _ in range(args.repeats):
             for ranks, method in cases:
-                nml = scene(Path(tmp), args.n, args.scene, method, args.fields)
+                nml = scene(Path(tmp), args.n, args.scene, method, args.fields, args.family)
                 for label, program in programs.items():
                     measured = run(ranks, nml, program)
                     best = rows.get((label, ranks, method))
